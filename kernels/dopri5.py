@@ -1,0 +1,203 @@
+"""Dormand-Prince 5(4) for the modal oscillator, step for step as SciPy's RK45.
+
+The tableau, the error estimate, the RMS error norm, the initial-step selection and the
+step-size controller are those of `scipy.integrate._ivp.rk.RK45` (SciPy 1.17), so that on the
+same problem the kernel accepts and rejects the same steps as
+``solve_ivp(method="RK45")`` up to round-off. The state is y = (q, q') in (m, m/s).
+
+Solver (the tableau and `rk_step`), controller (`step_factor`) and dense output
+(`dense_coefficients`, `dense_value`) are separate pieces.
+"""
+
+import math
+
+import numba as nb
+import numpy as np
+
+from .oscillator import acceleration
+
+# --- the tableau (Dormand & Prince 1980; dense output with Shampine's optimal c6) -------------
+N_STAGES = 6
+ERROR_ESTIMATOR_ORDER = 4
+C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
+A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
+])
+B = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
+E = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
+P = np.array([
+    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
+    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
+    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408,
+     701980252875 / 199316789632],
+    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
+    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
+])
+
+# --- the controller (SciPy's constants) -------------------------------------------------------
+SAFETY = 0.9          # multiply asymptotic step estimates by this
+MIN_FACTOR = 0.2      # smallest allowed step decrease
+MAX_FACTOR = 10.0     # largest allowed step increase
+ERROR_EXPONENT = -1.0 / (ERROR_ESTIMATOR_ORDER + 1)
+MIN_RTOL = 100 * np.finfo(float).eps   # SciPy raises smaller rtol to this
+
+
+@nb.njit(cache=True, nogil=True)
+def rk_step(t, y, h, p, K, y_new):
+    """One Dormand-Prince step of size h (s) from (t, y); K[0] must hold f(t, y).
+
+    Fills K[1..6] with the stage derivatives (K[6] = f(t + h, y_new)) and y_new with the
+    fifth-order solution. Six right-hand-side evaluations.
+    """
+    for s in range(1, N_STAGES):
+        dq = 0.0
+        dv = 0.0
+        for j in range(s):
+            dq += K[j, 0] * A[s, j]
+            dv += K[j, 1] * A[s, j]
+        q = y[0] + dq * h
+        v = y[1] + dv * h
+        K[s, 0] = v
+        K[s, 1] = acceleration(t + C[s] * h, q, v, p)
+    sq = 0.0
+    sv = 0.0
+    for j in range(N_STAGES):
+        sq += K[j, 0] * B[j]
+        sv += K[j, 1] * B[j]
+    y_new[0] = y[0] + h * sq
+    y_new[1] = y[1] + h * sv
+    K[N_STAGES, 0] = y_new[1]
+    K[N_STAGES, 1] = acceleration(t + h, y_new[0], y_new[1], p)
+
+
+@nb.njit(cache=True, nogil=True)
+def error_norm(K, h, y, y_new, rtol, atol):
+    """SciPy's RMS norm of the embedded error estimate, scaled by atol + rtol max(|y|, |y_new|)."""
+    eq = 0.0
+    ev = 0.0
+    for j in range(N_STAGES + 1):
+        eq += K[j, 0] * E[j]
+        ev += K[j, 1] * E[j]
+    eq *= h
+    ev *= h
+    sq = atol + max(abs(y[0]), abs(y_new[0])) * rtol
+    sv = atol + max(abs(y[1]), abs(y_new[1])) * rtol
+    rq = eq / sq
+    rv = ev / sv
+    return math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
+
+
+@nb.njit(cache=True, nogil=True)
+def step_factor(err, rejected_before):
+    """SciPy RK45's step-size factor for an error norm `err`.
+
+    Accepted (err < 1): min(MAX_FACTOR, SAFETY err^(-1/5)), capped at 1 after a rejection.
+    Rejected: max(MIN_FACTOR, SAFETY err^(-1/5)); a non-finite error gives MIN_FACTOR.
+    """
+    if err < 1.0:
+        if err == 0.0:
+            factor = MAX_FACTOR
+        else:
+            factor = min(MAX_FACTOR, SAFETY * err ** ERROR_EXPONENT)
+        if rejected_before:
+            factor = min(1.0, factor)
+        return factor
+    factor = SAFETY * err ** ERROR_EXPONENT
+    if not factor > MIN_FACTOR:          # also catches NaN
+        factor = MIN_FACTOR
+    return factor
+
+
+@nb.njit(cache=True, nogil=True)
+def _rms2(a, b):
+    return math.sqrt(a * a + b * b) / math.sqrt(2.0)
+
+
+@nb.njit(cache=True, nogil=True)
+def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p):
+    """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4). One evaluation."""
+    interval = abs(t_bound - t0)
+    if interval == 0.0:
+        return 0.0
+    sq = atol + abs(y[0]) * rtol
+    sv = atol + abs(y[1]) * rtol
+    d0 = _rms2(y[0] / sq, y[1] / sv)
+    d1 = _rms2(f[0] / sq, f[1] / sv)
+    if d0 < 1e-5 or d1 < 1e-5:
+        h0 = 1e-6
+    else:
+        h0 = 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    q1 = y[0] + h0 * f[0]
+    v1 = y[1] + h0 * f[1]
+    fq1 = v1
+    fv1 = acceleration(t0 + h0, q1, v1, p)
+    d2 = _rms2((fq1 - f[0]) / sq, (fv1 - f[1]) / sv) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (ERROR_ESTIMATOR_ORDER + 1))
+    return min(100.0 * h0, h1, interval, max_step)
+
+
+@nb.njit(cache=True, nogil=True)
+def dense_coefficients(K, Q):
+    """Q = K^T P: the quartic interpolant of the last step, shape (2, 4)."""
+    for i in range(2):
+        for k in range(4):
+            s = 0.0
+            for j in range(N_STAGES + 1):
+                s += K[j, i] * P[j, k]
+            Q[i, k] = s
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def dense_value(y_old_i, h, Q, i, x):
+    """Component i of the interpolant at x = (t - t_old)/h in [0, 1]."""
+    return y_old_i + h * (x * (Q[i, 0] + x * (Q[i, 1] + x * (Q[i, 2] + x * Q[i, 3]))))
+
+
+@nb.njit(cache=True, nogil=True)
+def dense_root(y_old_i, h, Q, i, target, xa, xb):
+    """x in [xa, xb] where component i of the interpolant equals `target`.
+
+    Requires a bracket: the values at xa and xb lie on opposite sides of `target` (or the one
+    at xb equals it). Illinois false position with bisection as a guard; converges to a few
+    ulps of x.
+    """
+    fa = dense_value(y_old_i, h, Q, i, xa) - target
+    fb = dense_value(y_old_i, h, Q, i, xb) - target
+    if fb == 0.0:
+        return xb
+    if fa == 0.0:
+        return xa
+    side = 0
+    for _ in range(100):
+        if xb - xa <= 4e-16 * max(1.0, abs(xb)):
+            break
+        x = xb - fb * (xb - xa) / (fb - fa)
+        if not (xa < x < xb):
+            x = 0.5 * (xa + xb)
+        fx = dense_value(y_old_i, h, Q, i, x) - target
+        if fx == 0.0:
+            return x
+        if (fx > 0.0) == (fb > 0.0):
+            xb = x
+            fb = fx
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            xa = x
+            fa = fx
+            if side == 1:
+                fb *= 0.5
+            side = 1
+    return 0.5 * (xa + xb)

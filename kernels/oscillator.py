@@ -1,0 +1,37 @@
+"""The modal oscillator of MODEL.md in general form (SI units).
+
+    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = 0
+
+q is the midspan deflection (m), t the time (s). A point's coefficients live in one row of a
+float64 parameter array; the column of each is named below.
+"""
+
+import math
+
+import numba as nb
+
+# Columns of a parameter row.
+MASS = 0        # m   (kg-like: any consistent scaling of the equation; must be > 0)
+DAMPING = 1     # c   (m's units / s)
+K0 = 2          # k0  linear stiffness, mean part           (m's units / s^2)
+K1 = 3          # k1  linear stiffness, cos(W t) part       (m's units / s^2)
+G0 = 4          # g0  cubic stiffness, mean part            (m's units / (s^2 m^2))
+G1 = 5          # g1  cubic stiffness, cos(W t) part        (m's units / (s^2 m^2))
+H = 6           # h   quintic stiffness                     (m's units / (s^2 m^4))
+OMEGA = 7       # W   load angular frequency                (rad/s)
+Q0 = 8          # q(0)                                      (m)
+V0 = 9          # q'(0)                                     (m/s)
+BOUND = 10      # |q| beyond which the point is diverged    (m)
+N_PARAMS = 11
+
+PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound")
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def acceleration(t, q, v, p):
+    """q'' (m/s^2) at time t (s) for deflection q (m), velocity v (m/s), parameter row p."""
+    cw = math.cos(p[OMEGA] * t)
+    q2 = q * q
+    force = (p[DAMPING] * v + (p[K0] + p[K1] * cw) * q
+             + (p[G0] + p[G1] * cw) * q * q2 + p[H] * q * q2 * q2)
+    return -force / p[MASS]

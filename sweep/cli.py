@@ -1,0 +1,98 @@
+"""The `sweep` command: run a scene, list the built-in scenes.
+
+    sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
+    sweep scenes
+
+Exit status: 0 on success, 2 on a user error (one line on stderr), 1 on an internal error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from typing import Sequence
+
+from .errors import UserError
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"sweep: error: {message} (see 'sweep --help')\n")
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="sweep", description="Parameter sweeps of nonlinear cable vibration.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    run = sub.add_parser("run", help="run a scene and write the result as netCDF")
+    run.add_argument("scene", help="a built-in scene name (see 'sweep scenes') or a .toml file")
+    run.add_argument("-o", "--output", help="netCDF file to write (atomically)")
+    run.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                     help="override a dotted scene key, e.g. --set solver.rtol=1e-9 "
+                          "or --set axes.length=[0.5,1.0]")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    run.add_argument("--threads", type=int, default=None, help="worker threads (default: all)")
+    run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    sub.add_parser("scenes", help="list the built-in scenes")
+    return parser
+
+
+def _summary(ds, seconds: float) -> str:
+    import numpy as np
+    from kernels.metrics import STATE_MEANINGS
+    counts = np.bincount(ds["state"].values.ravel(), minlength=len(STATE_MEANINGS))
+    states = ", ".join(f"{c} {m}" for c, m in zip(counts, STATE_MEANINGS) if c)
+    n = int(ds.attrs["n_points"])
+    return f"{ds.attrs['title']}: {n} points in {seconds:.2f} s ({states})"
+
+
+def _run(args: argparse.Namespace) -> int:
+    from .scene import load_scene, parse_override
+    from .run import run
+    from .io import check_output_path
+
+    if args.threads is not None and args.threads < 1:
+        raise UserError(f"--threads {args.threads}: must be a positive number of threads")
+    overrides = dict(parse_override(item) for item in args.overrides)
+    scene = load_scene(args.scene, overrides=overrides)
+    if args.output:
+        check_output_path(args.output, args.overwrite)
+    started = time.perf_counter()
+    ds = run(scene, output=args.output, overwrite=args.overwrite, threads=args.threads,
+             progress=False if args.quiet else None)
+    if not args.quiet:
+        line = _summary(ds, time.perf_counter() - started)
+        print(line + (f" -> {args.output}" if args.output else ""))
+        if not args.output:
+            print(ds)
+    return 0
+
+
+def _scenes() -> int:
+    from .scene import builtin_scenes
+    scenes = builtin_scenes()
+    width = max(len(name) for name in scenes)
+    for name, description in scenes.items():
+        print(f"{name:<{width}}  {description}")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the `sweep` console script."""
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "run":
+            return _run(args)
+        return _scenes()
+    except UserError as exc:
+        print(f"sweep: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("sweep: interrupted; no output written", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

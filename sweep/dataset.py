@@ -1,0 +1,119 @@
+"""Result Dataset assembly: labelled dims in scene order, CF attributes, units everywhere."""
+
+from __future__ import annotations
+
+import datetime as _dt
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import xarray as xr
+
+from kernels import metrics as km
+from kernels import transverse as tk
+
+from .scene import Scene
+
+if TYPE_CHECKING:
+    from .run import KernelResult
+
+CONVENTIONS = "CF-1.10"
+
+# name -> (kernel column, units, long_name, scene output switch)
+_REALS = {
+    "amplitude": (tk.AMPLITUDE, "m", "max |q| over the tail window (midspan deflection)",
+                  "outputs.amplitude"),
+    "peak_amplitude": (tk.PEAK, "m", "max |q| over the whole run (overshoot)",
+                       "outputs.peak_amplitude"),
+    "settling_time": (tk.SETTLING, "s", "time after which every envelope peak stays within "
+                      "+-tolerance of its final level (decayed: last time |q| > tolerance * peak)",
+                      "outputs.settling_time"),
+    "response_period": (tk.PERIOD, "s", "mean time between maxima of q in the tail window",
+                        "outputs.response_period"),
+    "failure_time": (tk.FAILURE_TIME, "s", "time at which a diverged or failed point stopped",
+                     None),
+}
+_COUNTS = {
+    "n_steps": (tk.STEPS, "accepted RK45 steps"),
+    "n_rejected": (tk.REJECTED, "rejected RK45 step attempts"),
+    "n_rhs": (tk.RHS_EVALS, "right-hand-side evaluations"),
+}
+_DERIVED = {
+    "natural_frequency": ("Hz", "first linear natural frequency of the unloaded span"),
+    "buckling_load": ("N", "Euler buckling load of the span (paper: implied by Eq.32)"),
+    "load_ratio": ("1", "load amplitude over buckling load, P0/Pcr"),
+    "load_frequency": ("Hz", "load frequency W/(2 pi)"),
+}
+
+
+def package_version() -> str:
+    """The installed cable-sweep version, or '0+unknown' when run from a bare checkout."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("cable-sweep")
+    except PackageNotFoundError:
+        return "0+unknown"
+
+
+def _derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
+    """A derived quantity as a DataArray over exactly the axes it depends on."""
+    if isinstance(values, xr.DataArray):
+        dims = [d for d in coords if d in values.dims]
+        return values.transpose(*dims).drop_vars(list(values.coords), errors="ignore")
+    return xr.DataArray(float(values))
+
+
+def state_attrs() -> dict[str, Any]:
+    """CF flag attributes of the `state` variable."""
+    return {
+        "long_name": "response state of the point",
+        "units": "1",
+        "flag_values": np.arange(len(km.STATE_MEANINGS), dtype=np.int8),
+        "flag_meanings": " ".join(km.STATE_MEANINGS),
+        "comment": "decayed/steady have a settling time; modulated (beating, quasi-periodic), "
+                   "unsettled (still drifting at t_end: lengthen solver.t_end) and the failure "
+                   "states have NaN",
+    }
+
+
+def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ...],
+             coeffs: dict[str, Any], result: "KernelResult", elapsed: float) -> xr.Dataset:
+    """Build the result Dataset of the contract from the flat kernel result."""
+    dims = tuple(coords)
+    data: dict[str, xr.DataArray] = {}
+    data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims, attrs=state_attrs())
+    for name, (col, units, long_name, switch) in _REALS.items():
+        if switch is None or scene.get(switch):
+            data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
+                                      attrs={"units": units, "long_name": long_name})
+    if scene.get("outputs.solver_stats"):
+        for name, (col, long_name) in _COUNTS.items():
+            data[name] = xr.DataArray(result.counts[:, col].reshape(shape), dims=dims,
+                                      attrs={"units": "1", "long_name": long_name})
+    for name, (units, long_name) in _DERIVED.items():
+        if name in coeffs:
+            data[name] = _derived(coeffs[name], coords)
+            data[name].attrs = {"units": units, "long_name": long_name}
+    all_coords: dict[str, Any] = dict(coords)
+    if result.series.shape[1] > 0:
+        all_coords["time"] = xr.DataArray(result.sample_times, dims="time",
+                                          attrs={"units": "s", "long_name": "time",
+                                                 "standard_name": "time"})
+        data["displacement"] = xr.DataArray(
+            result.series.reshape(shape + (result.series.shape[1],)), dims=dims + ("time",),
+            attrs={"units": "m", "long_name": "midspan deflection q(t)"})
+    version = package_version()
+    now = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    attrs = {
+        "title": scene.name,
+        "description": scene.description,
+        "Conventions": CONVENTIONS,
+        "source": f"cable-sweep {version}: transverse modal oscillator, Dormand-Prince RK45",
+        "history": f"{now} created by cable-sweep {version} from scene '{scene.source}'",
+        "cable_sweep_version": version,
+        "scene": scene.to_toml(),
+        "model_kind": scene.get("model.kind"),
+        "coefficients": scene.get("model.coefficients"),
+        "run_seconds": float(elapsed),
+        "n_points": int(np.prod(shape, dtype=np.int64)),
+    }
+    return xr.Dataset(data, coords=all_coords, attrs=attrs)

@@ -1,0 +1,57 @@
+"""The sweep grid: axes as labelled coordinates, parameters as scalars or axis DataArrays."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from .errors import SceneError
+from .schema import BY_AXIS
+from .scene import Scene
+
+
+def coordinates(scene: Scene) -> dict[str, xr.DataArray]:
+    """One 1-D coordinate per axis, in scene order, with units and long_name."""
+    coords = {}
+    for name, values in scene.axes.items():
+        key = BY_AXIS[name]
+        coords[name] = xr.DataArray(np.asarray(values, dtype=float), dims=name,
+                                    attrs={"units": key.units, "long_name": key.long_name})
+    return coords
+
+
+def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
+    """Every model parameter by axis name: the axis coordinate if swept, else the scalar."""
+    params: dict[str, Any] = {}
+    for name, key in BY_AXIS.items():
+        params[name] = coords[name] if name in coords else scene.get(key.dotted)
+    params["coefficients"] = scene.get("model.coefficients")
+    params["paper_parametric"] = scene.get("model.paper_parametric")
+    params["load_type"] = scene.get("load.type")
+    params["divergence_bound"] = scene.get("metrics.divergence_bound")
+    if params["load_type"] == "constant":
+        for name in ("frequency", "frequency_ratio"):
+            if name in coords:
+                raise SceneError(f"axis '{name}': load.type = 'constant' has no frequency "
+                                 "(remove the axis or use load.type = 'harmonic')")
+        params["frequency"] = None
+    return params
+
+
+def flatten(values: dict[str, Any], names: tuple[str, ...], dims: tuple[str, ...],
+            shape: tuple[int, ...]) -> np.ndarray:
+    """Stack the named values, broadcast to the full grid (dims in order), as rows (n, len(names))."""
+    n = int(np.prod(shape, dtype=np.int64))
+    table = np.empty((n, len(names)))
+    for j, name in enumerate(names):
+        value = values[name]
+        if isinstance(value, xr.DataArray):
+            value = value.transpose(*[d for d in dims if d in value.dims])
+            expanded = value.values.reshape([shape[i] if d in value.dims else 1
+                                             for i, d in enumerate(dims)])
+            table[:, j] = np.broadcast_to(expanded, shape).reshape(n)
+        else:
+            table[:, j] = float(value)
+    return table

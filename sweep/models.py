@@ -1,0 +1,114 @@
+"""Physical models: cable data and load -> coefficients of the kernel's modal oscillator.
+
+    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = 0
+
+Every function here works element-wise on floats, NumPy arrays or xarray DataArrays, so the
+derived quantities keep exactly the dimensions of the axes they depend on.
+
+Two coefficient sets (MODEL.md sec. 2):
+- "consistent": the Galerkin projection of the paper's Eq.17 on sin(pi x / l), re-derived;
+  divided by rho A l / 2, so m = 1 and q is the midspan deflection in metres.
+- "paper": Eq.32 exactly as printed (Table 1 cable baked in), including its errors: the
+  parametric (cos) terms 10x too small, the frequency 1.86 n pi rad/s with the 1/l^4 of w0
+  dropped, and a quintic of the wrong sign. `paper_parametric = "corrected"` multiplies the two
+  cos terms back to their consistent size (37.5/1.86^2 and 18.7/1.86^2 from Eq.31). The printed
+  terms are for P0 = 4 N; they are scaled by P0 / 4 N for other load amplitudes.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+# Eq.32 as printed (SI, P0 = 4 N).
+PAPER_LOAD = 4.0                      # N, the load Eq.32 was printed for
+PAPER_OMEGA0 = 1.86 * np.pi           # rad/s, "w0 = 1.86 pi / l^4" with the l^4 dropped
+PAPER_COS_LINEAR = {"printed": 1.08, "corrected": 37.5 / 1.86 ** 2}   # x l^5
+PAPER_COS_CUBIC = {"printed": 0.54, "corrected": 18.7 / 1.86 ** 2}    # x pi^2 l^3
+
+
+def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
+    """Coefficients of the re-derived modal equation (MODEL.md sec. 2), m = 1.
+
+    p: youngs_modulus (Pa), density (kg/m^3), area (m^2), inertia (m^4), length (m),
+    membrane (alpha, 1), load_amplitude (N, compression > 0).
+    Returns the load-independent part (k, g, h), the load-proportional parts (k_load,
+    g_load), the unloaded natural angular frequency w1 (rad/s) and the buckling load (N).
+    """
+    k = np.pi / p["length"]
+    ei = p["youngs_modulus"] * p["inertia"]
+    rho_a = p["density"] * p["area"]
+    w1_sq = ei / rho_a * k ** 4
+    load = p["load_amplitude"]
+    return {
+        "mass": 1.0,
+        "k": w1_sq,
+        "g": p["membrane"] * p["youngs_modulus"] / p["density"] * k ** 4
+        - 1.25 * ei / rho_a * k ** 6,
+        "h": -21.0 / 16.0 * ei / rho_a * k ** 8,
+        "k_load": -load * k ** 2 / rho_a,
+        "g_load": load * k ** 4 / (2.0 * rho_a),
+        "omega_1": np.sqrt(w1_sq),
+        "buckling_load": ei * k ** 2,
+        "omega_ref": np.sqrt(w1_sq),
+    }
+
+
+def paper(p: Mapping[str, Any]) -> dict[str, Any]:
+    """Coefficients of the paper's Eq.32 as printed (or with corrected cos terms).
+
+    p: length (m), load_amplitude (N), paper_parametric ("printed" | "corrected").
+    The buckling load is the one Eq.32's own coefficients imply: the load at which the
+    parametric stiffness would cancel the linear stiffness.
+    """
+    l = p["length"]
+    scale = p["load_amplitude"] / PAPER_LOAD
+    k_static = 1.73 * np.pi ** 2 * l
+    k_cos = PAPER_COS_LINEAR[p["paper_parametric"]] * l ** 5
+    mass = 0.5 * l
+    return {
+        "mass": mass,
+        "k": k_static,
+        "g": 6.6e5 * np.pi ** 2 * l ** 3 - 2.1 * np.pi ** 4 / l,
+        "h": 76.0 * np.pi ** 6 / l ** 3,
+        "k_load": -k_cos * scale,
+        "g_load": PAPER_COS_CUBIC[p["paper_parametric"]] * np.pi ** 2 * l ** 3 * scale,
+        "omega_1": np.sqrt(k_static / mass),
+        "buckling_load": PAPER_LOAD * k_static / k_cos,
+        "omega_ref": PAPER_OMEGA0,
+    }
+
+
+def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
+    """Kernel coefficients and derived quantities for one model configuration.
+
+    p holds the scene's parameters by axis name (scalars or arrays) plus "coefficients",
+    "load_type" and "paper_parametric". Returns the oscillator coefficients under the names of
+    `kernels.oscillator.PARAM_NAMES` and the derived quantities natural_frequency (Hz),
+    buckling_load (N), load_ratio (1) and load_frequency (Hz, harmonic load only).
+    """
+    c = consistent(p) if p["coefficients"] == "consistent" else paper(p)
+    out = {
+        "mass": c["mass"],
+        "damping": 2.0 * p["damping_ratio"] * c["mass"] * c["omega_1"],
+        "h": c["h"],
+        "q0": p["initial_displacement"],
+        "v0": p["initial_velocity"],
+        "bound": p["divergence_bound"] if p.get("divergence_bound") is not None
+        else p["length"],
+        "natural_frequency": c["omega_1"] / (2.0 * np.pi),
+        "buckling_load": c["buckling_load"],
+        "load_ratio": p["load_amplitude"] / c["buckling_load"],
+    }
+    if p["load_type"] == "harmonic":
+        if p.get("frequency") is not None:
+            omega = 2.0 * np.pi * p["frequency"]
+        else:
+            omega = p["frequency_ratio"] * c["omega_ref"]
+        out.update(k0=c["k"], k1=c["k_load"], g0=c["g"], g1=c["g_load"], omega=omega,
+                   load_frequency=omega / (2.0 * np.pi))
+    else:
+        out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
+                   omega=0.0)
+    return out

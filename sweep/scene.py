@@ -1,0 +1,850 @@
+"""Scene files: load a sweep description from TOML, validate it, and write it back.
+
+A scene is a TOML document (see DESIGN.md) checked against the table in `sweep.schema`.
+`load_scene` takes a built-in name (a file in ``sweep/scenes/``) or a path, applies
+``KEY=VALUE`` overrides to the parsed document, validates everything, and returns a
+`Scene`: every scalar key resolved (defaults applied) plus one float64 array per axis.
+
+Every mistake a user can make raises `SceneError` with a one-line message of the form
+``WHERE: what is wrong (how to fix it)``, where WHERE names the dotted key, axis or file.
+
+Resolution rules worth knowing:
+- A key swept under ``[axes]`` has ``values[key] = None``; its values live in ``axes``.
+  If the key is also given as a scalar, the axis wins.
+- ``load.frequency`` and ``load.frequency_ratio`` are alternatives; if neither is given,
+  ``load.frequency_ratio = 1.0``.
+- With ``model.coefficients = "paper"`` the cable data is baked into Eq.32, so its
+  parameters cannot be swept, and ``initial.velocity`` defaults to 0.0321 m/s when no
+  initial condition is given (MODEL.md: that reproduces the paper's Fig 5 amplitudes).
+- An override that sets a sweepable key as a scalar removes that key's axis, and an
+  override of one load frequency key removes the other, so ``--set`` can always replace
+  what the scene file says.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import re
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, NoReturn
+
+import numpy as np
+
+from . import schema
+from .errors import SceneError
+
+PAPER_VELOCITY = 0.0321
+"""initial.velocity (m/s) used by the paper preset when no initial condition is given."""
+
+PAPER_FIXED_AXES: tuple[str, ...] = ("youngs_modulus", "density", "area", "inertia", "membrane")
+"""Axes the paper preset cannot sweep: Eq.32 has these numbers baked in."""
+
+FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
+DEFAULT_FREQUENCY_RATIO = 1.0
+RANGE_KEYS: tuple[str, ...] = ("start", "stop", "num", "spacing")
+MAX_AXIS_POINTS = 10_000_000
+
+_VALUE_SECTIONS: tuple[str, ...] = tuple(s for s in schema.SECTIONS if s != "axes")
+_COMMON_AXES = ("length", "load_amplitude", "frequency_ratio", "frequency", "damping_ratio")
+_SWEEPABLE_TEXT = ", ".join(dict.fromkeys([*(a for a in _COMMON_AXES if a in schema.BY_AXIS),
+                                          *schema.BY_AXIS]))
+_BUILTIN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_TOML_POSITION = re.compile(r"\s*\(at line (\d+), column (\d+)\)\s*$")
+_TOML_AT_END = re.compile(r"\s*\(at end of document\)\s*$")
+
+# How to fix an out-of-range value, for the keys users most often get wrong.
+_HINTS: dict[str, str] = {
+    "cable.length": "give the span length in metres",
+    "cable.density": "give the density in kg/m^3, e.g. 8900 for copper",
+    "cable.area": "give the cross-sectional area in m^2, e.g. 6e-6 for 6 mm^2",
+    "cable.inertia": "give the bending second moment of area in m^4, e.g. 5.73e-12",
+    "cable.youngs_modulus": "give Young's modulus in Pa, e.g. 1.1e11 for copper",
+    "cable.damping_ratio": "give the damping ratio as a fraction of critical, e.g. 0.02 for 2 %",
+    "model.membrane": "use 0.375 (the paper), 0.25 (classical stretching) or 0 (none)",
+    "load.frequency_ratio": "give the load frequency as a multiple of w1, e.g. 2.0",
+    "load.frequency": "give the load frequency in Hz",
+    "solver.t_end": "give the simulated time in seconds, e.g. 5.0",
+    "solver.rtol": "typical values are 1e-6 to 1e-10",
+    "solver.atol": "give a small positive absolute tolerance, e.g. 1e-12 (m for q)",
+    "solver.max_steps": "give a positive step budget, e.g. 1000000",
+    "metrics.tail": "give the tail window as a fraction of t_end, e.g. 0.5",
+    "metrics.tolerance": "give a relative tolerance, e.g. 0.02",
+    "run.threads": "give a thread count, or 0 for all cores",
+}
+
+
+# --------------------------------------------------------------------------- the Scene
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A validated, fully resolved scene.
+
+    values: every dotted key of `schema.KEYS` -> its value (defaults applied); None for an
+        optional key that is absent and for a key that is swept (see ``axes``).
+    axes: axis name -> 1-D read-only float64 array, in scene order ([axes] table order,
+        then axes added by overrides).
+    text: the TOML text as read; source: the built-in name or the path given;
+    overrides: the overrides applied, with parsed values.
+
+    Two scenes are equal when their name, description, values and axes are equal
+    (text, source and overrides are not compared).
+    """
+
+    name: str
+    description: str
+    values: dict[str, Any]
+    axes: dict[str, np.ndarray]
+    text: str = field(repr=False)
+    source: str
+    overrides: dict[str, Any] = field(default_factory=dict)
+
+    def get(self, dotted: str) -> Any:
+        """The resolved value of a dotted key, e.g. ``scene.get("solver.rtol")``."""
+        return self.values[dotted]
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Scene):
+            return NotImplemented
+        return (self.name == other.name
+                and self.description == other.description
+                and self.values == other.values
+                and list(self.axes) == list(other.axes)
+                and all(np.array_equal(self.axes[a], other.axes[a]) for a in self.axes))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def to_toml(self) -> str:
+        """The resolved scene as TOML: every section, defaults included, axes as lists.
+
+        None-valued keys are left out. `load_scene_text` of the result gives an equal Scene.
+        """
+        lines = [f"# Resolved scene from {_comment_text(self.source)}: "
+                 "defaults written out, axes as explicit lists."]
+        if self.overrides:
+            lines.append(f"# Overrides applied: {_comment_text(', '.join(self.overrides))}.")
+        lines.append(f"name = {_toml_value(self.name)}")
+        lines.append(f"description = {_toml_value(self.description)}")
+        for section in _VALUE_SECTIONS:
+            lines.extend(self._section_lines(section))
+        if self.axes:
+            lines.extend(["", "[axes]"])
+            lines.extend(f"{_toml_key(a)} = {_toml_array(v)}" for a, v in self.axes.items())
+        return "\n".join(lines) + "\n"
+
+    def _section_lines(self, section: str) -> list[str]:
+        """``[section]`` and its non-None keys, in schema order; empty if none."""
+        body = [f"{key.name} = {_toml_value(self.values[key.dotted])}"
+                for key in schema.KEYS
+                if key.section == section and self.values[key.dotted] is not None]
+        return ["", f"[{section}]", *body] if body else []
+
+
+# --------------------------------------------------------------------------- public API
+
+
+def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = None) -> Scene:
+    """Load a built-in scene by name, or a scene file by path, and validate it.
+
+    overrides: dotted key -> value, applied to the document before validation. Values may be
+    Python values or strings; strings are parsed as TOML values (see `parse_override`).
+    """
+    source, text, default_name = _read_scene(scene)
+    return _build(text, source, default_name, overrides)
+
+
+def load_scene_text(text: str, source: str = "<string>",
+                    overrides: Mapping[str, Any] | None = None) -> Scene:
+    """Like `load_scene`, from TOML text; ``source`` is used in error messages."""
+    return _build(text, source, "unnamed", overrides)
+
+
+def builtin_scenes() -> dict[str, str]:
+    """Built-in scene name -> the first line of its description, sorted by name."""
+    found: dict[str, str] = {}
+    try:
+        entries = list(_scenes_dir().iterdir())
+    except OSError:
+        return {}
+    for entry in entries:
+        if entry.name.endswith(".toml") and entry.is_file():
+            found[entry.name[:-len(".toml")]] = _first_description_line(entry.read_text("utf-8"))
+    return dict(sorted(found.items()))
+
+
+def parse_override(item: str) -> tuple[str, Any]:
+    """Split ``"KEY=VALUE"`` into the dotted key and the value parsed as a TOML value.
+
+    A VALUE that is not valid TOML is kept as the raw string, so ``model.coefficients=paper``
+    works as well as ``model.coefficients="paper"``.
+    """
+    key, sep, value = item.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        _fail(f"override '{item}'", "must have the form KEY=VALUE",
+              "KEY is a dotted scene key, e.g. solver.rtol=1e-9 or axes.length=[0.5, 1.0]")
+    return key, _parse_value_text(value)
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def _scenes_dir() -> Any:
+    """The package-data folder of built-in scenes (works from an installed wheel too)."""
+    return resources.files(__package__ or "sweep") / "scenes"
+
+
+def _builtin_file(name: str) -> Any | None:
+    """The built-in scene file called ``name``, or None."""
+    if not _BUILTIN_NAME.fullmatch(name):
+        return None
+    try:
+        candidate = _scenes_dir() / f"{name}.toml"
+        return candidate if candidate.is_file() else None
+    except OSError:
+        return None
+
+
+def _read_scene(scene: str | os.PathLike) -> tuple[str, str, str]:
+    """(source, text, default name) of a built-in name or a scene file path."""
+    if isinstance(scene, str):
+        builtin = _builtin_file(scene)
+        if builtin is not None:
+            return scene, builtin.read_text("utf-8"), scene
+    source = os.fspath(scene)
+    path = Path(source)
+    if not source or not path.exists():
+        _fail(f"scene '{source}'", "no built-in scene of that name and no such file",
+              "run 'sweep scenes' for the built-in names")
+    if path.is_dir():
+        _fail(f"scene file '{source}'", "is a directory, not a TOML file",
+              "give the path of a .toml scene file")
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        _fail(f"scene file '{source}'", f"cannot be read: {exc.strerror or exc}",
+              "check the path and its permissions")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        _fail(f"scene file '{source}'", f"is not UTF-8 text (bad byte at offset {exc.start})",
+              "save the file as UTF-8")
+    return source, text, path.stem or "unnamed"
+
+
+def _first_description_line(text: str) -> str:
+    """The first line of a scene's ``description``, or "" if it has none."""
+    try:
+        description = tomllib.loads(text).get("description", "")
+    except tomllib.TOMLDecodeError:
+        return ""
+    lines = description.strip().splitlines() if isinstance(description, str) else []
+    return lines[0] if lines else ""
+
+
+def _parse_toml(text: str, source: str) -> dict[str, Any]:
+    """Parse scene text; a syntax error names the file, line and column."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        message = str(exc)
+        position = _TOML_POSITION.search(message)
+        if position:
+            where = f"at line {position.group(1)}, column {position.group(2)}"
+            message = message[:position.start()]
+        elif _TOML_AT_END.search(message):
+            where = "at the end of the file"
+            message = _TOML_AT_END.sub("", message)
+        else:
+            where = "somewhere"
+        _fail(f"scene file '{source}'", f"TOML syntax error {where}: {message}",
+              "fix the line and run again")
+
+
+# --------------------------------------------------------------------------- overrides
+
+
+def _parse_value_text(text: str) -> Any:
+    """A TOML value from text, or the stripped text itself if it is not one."""
+    try:
+        parsed = tomllib.loads("v = " + text)
+    except tomllib.TOMLDecodeError:
+        return text.strip()
+    return parsed["v"] if list(parsed) == ["v"] else text.strip()
+
+
+def _expects_string(dotted: str) -> bool:
+    """Whether a dotted key holds a string (so a raw string override is taken as is)."""
+    if dotted in schema.TOP_LEVEL:
+        return True
+    key = schema.BY_DOTTED.get(dotted)
+    return key is not None and key.kind == "str"
+
+
+def _override_value(dotted: str, value: Any) -> Any:
+    """An override's value as a plain Python value; strings are parsed as TOML values."""
+    if not isinstance(value, str):
+        return _plain(value)
+    parsed = _parse_value_text(value)
+    if _expects_string(dotted) and not isinstance(parsed, str):
+        return value
+    return parsed
+
+
+def _plain(value: Any) -> Any:
+    """Numpy scalars/arrays and tuples -> Python scalars and lists, recursively."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (np.ndarray, tuple, list)):
+        return [_plain(v) for v in (value.tolist() if isinstance(value, np.ndarray) else value)]
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
+    """Check override keys and parse their values; refuse both load frequency keys at once."""
+    parsed: dict[str, Any] = {}
+    for key, value in (overrides or {}).items():
+        if not isinstance(key, str) or not key.strip():
+            _fail(f"override {key!r}", "has no key",
+                  "the form is KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
+        key = key.strip()
+        parsed[key] = _override_value(key, value)
+    frequencies = {_frequency_target(k) for k in parsed} - {None}
+    if len(frequencies) == 2:
+        _fail("overrides 'load.frequency' and 'load.frequency_ratio'", "give one, not both",
+              "remove one of the two overrides")
+    return parsed
+
+
+def _frequency_target(dotted: str) -> str | None:
+    """The load frequency key an override sets (as scalar or axis), or None."""
+    if dotted in FREQUENCY_KEYS:
+        return dotted
+    if dotted.startswith("axes."):
+        axis = _axis_or_none(dotted[len("axes."):])
+        if axis is not None and schema.BY_AXIS[axis].dotted in FREQUENCY_KEYS:
+            return schema.BY_AXIS[axis].dotted
+    return None
+
+
+def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
+    """Write overrides into the parsed document (in place), before validation."""
+    for dotted, value in overrides.items():
+        section, _, name = dotted.partition(".")
+        if not name:
+            doc[dotted] = value
+        elif section == "axes":
+            _override_axis(doc, name, value)
+        else:
+            _override_scalar(doc, section, name, value)
+
+
+def _override_table(doc: dict[str, Any], section: str) -> dict[str, Any]:
+    """The document's ``[section]`` table, created if absent."""
+    table = doc.setdefault(section, {})
+    if not isinstance(table, dict):
+        _section_not_table(section, table)
+    return table
+
+
+def _override_axis(doc: dict[str, Any], name: str, value: Any) -> None:
+    """Set or replace an axis (keeping its place); drop the other load frequency key."""
+    axes = _override_table(doc, "axes")
+    axis = _axis_or_none(name)
+    if axis is None:
+        axes[name] = value
+        return
+    _drop_frequency_partner(doc, schema.BY_AXIS[axis].dotted)
+    replaced = {(axis if _axis_or_none(k) == axis else k): v for k, v in axes.items()}
+    replaced[axis] = value
+    axes.clear()
+    axes.update(replaced)
+
+
+def _override_scalar(doc: dict[str, Any], section: str, name: str, value: Any) -> None:
+    """Set a scalar key; it replaces an axis on the same key."""
+    _override_table(doc, section)[name] = value
+    key = schema.BY_DOTTED.get(f"{section}.{name}")
+    if key is not None and key.axis is not None:
+        _drop_axis(doc, key.axis)
+        _drop_frequency_partner(doc, key.dotted)
+
+
+def _drop_axis(doc: dict[str, Any], axis: str) -> None:
+    """Remove every ``[axes]`` entry that names ``axis``."""
+    axes = doc.get("axes")
+    if isinstance(axes, dict):
+        for entry in [k for k in axes if _axis_or_none(k) == axis]:
+            del axes[entry]
+
+
+def _drop_frequency_partner(doc: dict[str, Any], dotted: str) -> None:
+    """When one load frequency key is set, remove the other (scalar and axis)."""
+    if dotted not in FREQUENCY_KEYS:
+        return
+    partner = schema.BY_DOTTED[FREQUENCY_KEYS[1 - FREQUENCY_KEYS.index(dotted)]]
+    load = doc.get("load")
+    if isinstance(load, dict):
+        load.pop(partner.name, None)
+    _drop_axis(doc, partner.axis or "")
+
+
+# --------------------------------------------------------------------------- validation
+
+
+def _build(text: str, source: str, default_name: str,
+           overrides: Mapping[str, Any] | None) -> Scene:
+    """Parse, override, validate and resolve a scene."""
+    doc = _parse_toml(text, source)
+    if isinstance(doc.get("axes"), dict):
+        doc["axes"] = _flatten_axes(doc["axes"])
+    applied = _parse_overrides(overrides)
+    _apply_overrides(doc, applied)
+    _check_top_level(doc)
+    name = _check_name(doc.get("name", default_name))
+    description = _check_description(doc.get("description", ""))
+    given = _check_sections(doc)
+    axes = _check_axes(doc.get("axes", {}))
+    _check_model(given, axes)
+    _check_frequency_pair(given, axes)
+    values = _resolve(given, axes)
+    _check_times(values)
+    return Scene(name=name, description=description, values=values, axes=axes,
+                 text=text, source=source, overrides=applied)
+
+
+def _flatten_axes(table: dict[str, Any]) -> dict[str, Any]:
+    """``[axes] cable.length = ...`` parses as a nested table: make it ``"cable.length"``."""
+    flat: dict[str, Any] = {}
+    for entry, value in table.items():
+        if entry in _VALUE_SECTIONS and isinstance(value, dict):
+            flat.update({f"{entry}.{name}": v for name, v in value.items()})
+        else:
+            flat[entry] = value
+    return flat
+
+
+def _check_top_level(doc: dict[str, Any]) -> None:
+    """Only ``name``, ``description`` and the schema's sections may appear at the top."""
+    for key, value in doc.items():
+        if key in schema.TOP_LEVEL:
+            continue
+        if key in schema.SECTIONS:
+            if not isinstance(value, dict):
+                _section_not_table(key, value)
+            continue
+        _unknown_top_level(key, value)
+
+
+def _section_not_table(section: str, value: Any) -> NoReturn:
+    _fail(f"scene key '{section}'", f"must be a table ([{section}] section), got {_show(value)}",
+          f"write [{section}] on a line of its own, with its keys below it")
+
+
+def _unknown_top_level(key: str, value: Any) -> NoReturn:
+    """Report an unknown top-level key or section, with a suggestion."""
+    if isinstance(value, dict) and value:
+        first = next(iter(value))
+        section = _close(key, _VALUE_SECTIONS)
+        guess = _guess_key(first, section) if section else _guess_key(first)
+        _fail(f"scene key '{key}.{first}'", f"unknown section '{key}'",
+              _suggestion(guess or section, _SECTIONS_TEXT))
+    guess = _close(key, [*schema.TOP_LEVEL, *schema.SECTIONS]) or _guess_key(key)
+    _fail(f"scene key '{key}'", "unknown top-level key", _suggestion(guess, _SECTIONS_TEXT))
+
+
+_SECTIONS_TEXT = ("the top level holds name, description and the sections "
+                  + ", ".join(f"[{s}]" for s in schema.SECTIONS))
+
+
+def _guess_key(name: str, section: str | None = None) -> str | None:
+    """The dotted key a misspelt ``name`` most likely means: first in ``section``, then anywhere.
+
+    E.g. ('lenght', 'cable') -> 'cable.length'; ('amplitude', 'cable') -> 'load.amplitude'.
+    """
+    if section is not None:
+        in_section = _close(name, [k.name for k in schema.KEYS if k.section == section])
+        if in_section:
+            return f"{section}.{in_section}"
+    anywhere = _close(name, [k.name for k in schema.KEYS])
+    return next((k.dotted for k in schema.KEYS if k.name == anywhere), None)
+
+
+def _check_name(value: Any) -> str:
+    if not isinstance(value, str) or not value.strip():
+        _fail("scene key 'name'", f"must be a non-empty string, got {_show(value)}",
+              'write e.g. name = "my-sweep"')
+    return value
+
+
+def _check_description(value: Any) -> str:
+    if not isinstance(value, str):
+        _fail("scene key 'description'", f"must be a string, got {_show(value)}",
+              'write e.g. description = "what the sweep is for"')
+    return value
+
+
+def _check_sections(doc: dict[str, Any]) -> dict[str, Any]:
+    """Validate every scalar key present in the sections; dotted key -> value."""
+    given: dict[str, Any] = {}
+    for section in _VALUE_SECTIONS:
+        for name, raw in doc.get(section, {}).items():
+            dotted = f"{section}.{name}"
+            key = schema.BY_DOTTED.get(dotted)
+            if key is None:
+                _unknown_section_key(section, dotted)
+            given[dotted] = _check_value(f"scene key '{dotted}'", key, raw)
+    return given
+
+
+def _unknown_section_key(section: str, dotted: str) -> NoReturn:
+    valid = [k.name for k in schema.KEYS if k.section == section]
+    fallback = f"valid keys in [{section}]: {', '.join(valid)}"
+    _fail(f"scene key '{dotted}'", "unknown key",
+          _suggestion(_guess_key(dotted.partition(".")[2], section), fallback))
+
+
+def _check_value(where: str, key: schema.Key, raw: Any) -> Any:
+    """A value of the key's kind, within its bounds and choices."""
+    if isinstance(raw, (dict, list)):
+        _fail(where, f"must be a single value, got {_show(raw)}", _container_fix(key, raw))
+    if key.kind == "float":
+        value: Any = _as_float(where, raw, _example(key))
+    elif key.kind == "int":
+        value = _as_int(where, raw, _example(key))
+    elif key.kind == "bool":
+        value = _as_bool(where, key, raw)
+    else:
+        value = _as_choice(where, key, raw)
+    if key.kind in ("float", "int"):
+        _check_bounds(where, key, value)
+    return value
+
+
+def _container_fix(key: schema.Key, raw: Any) -> str:
+    """How to fix a list or table given where a single value is expected."""
+    if isinstance(raw, list) and key.axis is not None:
+        return f"to sweep it, put it under [axes] as {key.axis} = [...]"
+    if isinstance(raw, list):
+        return f"{key.dotted} cannot be swept; {_example(key)}"
+    return _example(key)
+
+
+def _example(key: schema.Key) -> str:
+    """'write e.g. rtol = 1e-08', or a generic hint for keys without a default."""
+    if key.default is None:
+        return f"write e.g. {key.name} = 1.0" if key.kind == "float" else "give a single value"
+    return f"write e.g. {key.name} = {_toml_value(key.default)}"
+
+
+def _as_float(where: str, raw: Any, fix: str) -> float:
+    """A finite float from an int or float (never a bool)."""
+    if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+        _fail(where, f"must be a number, got {_show(raw)}", fix)
+    try:
+        value = float(raw)
+    except OverflowError:
+        value = math.inf
+    if not math.isfinite(value):
+        _fail(where, f"must be a finite number, got {_show(raw)}", fix)
+    return value
+
+
+def _as_int(where: str, raw: Any, fix: str) -> int:
+    """An int from an int or an integral float such as 1e6 (never a bool)."""
+    value = _as_float(where, raw, fix) if isinstance(raw, float) else raw
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        _fail(where, f"must be a whole number, got {_show(raw)}", fix)
+    if isinstance(value, float) and not value.is_integer():
+        _fail(where, f"must be a whole number, got {_show(raw)}", fix)
+    return int(value)
+
+
+def _as_bool(where: str, key: schema.Key, raw: Any) -> bool:
+    if not isinstance(raw, bool):
+        _fail(where, f"must be true or false, got {_show(raw)}",
+              f"write {key.name} = true or {key.name} = false, without quotes")
+    return raw
+
+
+def _as_choice(where: str, key: schema.Key, raw: Any) -> str:
+    """A string, one of the key's choices if it has any."""
+    if not isinstance(raw, str):
+        _fail(where, f"must be a string, got {_show(raw)}", f'write {key.name} = "..." with quotes')
+    if key.choices and raw not in key.choices:
+        listed = ", ".join(f"'{c}'" for c in key.choices)
+        _fail(where, f"must be one of {listed}, got {_show(raw)}",
+              _suggestion(_close(raw, key.choices), "use one of those"))
+    return raw
+
+
+def _check_bounds(where: str, key: schema.Key, values: Any) -> None:
+    """Refuse a scalar, or the first element of an axis, outside the key's bounds."""
+    array = np.atleast_1d(np.asarray(values, dtype=float))
+    bad = ~_within(key, array)
+    if not bad.any():
+        return
+    fix = _HINTS.get(key.dotted) or _generic_hint(key)
+    if np.ndim(values) == 0:
+        _fail(where, f"must be {_bounds_text(key)}, got {_show(values)}", fix)
+    value = float(array[np.argmax(bad)])
+    _fail(where, f"value {_show(value)} is out of range: must be {_bounds_text(key)}", fix)
+
+
+def _within(key: schema.Key, array: np.ndarray) -> np.ndarray:
+    """Elementwise: does each value satisfy the key's minimum and maximum?"""
+    ok = np.ones(array.shape, dtype=bool)
+    if key.minimum is not None:
+        ok &= array > key.minimum if key.exclusive_min else array >= key.minimum
+    if key.maximum is not None:
+        ok &= array < key.maximum if key.exclusive_max else array <= key.maximum
+    return ok
+
+
+def _bounds_text(key: schema.Key) -> str:
+    """E.g. '> 0 m' or '>= 1e-14 and <= 0.1'."""
+    units = f" {key.units}" if key.units not in ("", "1") else ""
+    parts = []
+    if key.minimum is not None:
+        parts.append(f"{'>' if key.exclusive_min else '>='} {key.minimum:g}{units}")
+    if key.maximum is not None:
+        parts.append(f"{'<' if key.exclusive_max else '<='} {key.maximum:g}{units}")
+    return " and ".join(parts)
+
+
+def _generic_hint(key: schema.Key) -> str:
+    units = f" in {key.units}" if key.units not in ("", "1") else ""
+    return f"give the {key.long_name or key.name}{units} within that range"
+
+
+# --------------------------------------------------------------------------- axes
+
+
+def _check_axes(table: dict[str, Any]) -> dict[str, np.ndarray]:
+    """Validate ``[axes]``: axis name -> read-only float64 array, in table order."""
+    axes: dict[str, np.ndarray] = {}
+    for entry, raw in table.items():
+        axis = _axis_name(entry)
+        if axis in axes:
+            _fail(f"axis '{entry}'", f"axis '{axis}' is given twice", "keep one of the entries")
+        axes[axis] = _axis_values(axis, raw)
+    return axes
+
+
+def _axis_or_none(entry: str) -> str | None:
+    """The axis an ``[axes]`` entry name means (axis name or sweepable dotted key), or None."""
+    if entry in schema.BY_AXIS:
+        return entry
+    key = schema.BY_DOTTED.get(entry)
+    return key.axis if key is not None else None
+
+
+def _axis_name(entry: str) -> str:
+    """The axis an ``[axes]`` entry names; refuse unknown and non-sweepable names."""
+    axis = _axis_or_none(entry)
+    if axis is not None:
+        return axis
+    sweepable = _SWEEPABLE_TEXT
+    key = schema.BY_DOTTED.get(entry)
+    same_name = [k for k in schema.KEYS if k.name == entry]
+    if key is None and same_name and all(k.axis is None for k in same_name):
+        key = same_name[0]
+    if key is not None:
+        _fail(f"axis '{entry}'", f"'{key.dotted}' cannot be swept",
+              f"sweepable: {sweepable}; set {key.dotted} as a single value in [{key.section}]")
+    candidates = [*schema.BY_AXIS, *(k.dotted for k in schema.BY_AXIS.values())]
+    guess = _close(entry, candidates) or next((k.axis for k in same_name if k.axis), None)
+    _fail(f"axis '{entry}'", "unknown axis", _suggestion(guess, f"sweepable: {sweepable}"))
+
+
+def _axis_values(axis: str, raw: Any) -> np.ndarray:
+    """An axis's values from a list or a range table, checked against the key's bounds."""
+    where = f"axis '{axis}'"
+    if isinstance(raw, list):
+        values = _axis_list(where, raw)
+    elif isinstance(raw, dict):
+        values = _axis_range(where, raw)
+    else:
+        _fail(where, f"must be a list of values or a range table, got {_show(raw)}",
+              f"write e.g. {axis} = [0.5, 1.0] or {axis} = {{start = 0.5, stop = 1.0, num = 11}}")
+    _check_monotonic(where, values)
+    _check_bounds(where, schema.BY_AXIS[axis], values)
+    values.flags.writeable = False
+    return values
+
+
+def _axis_list(where: str, raw: list) -> np.ndarray:
+    if not raw:
+        _fail(where, "empty list", "give at least one value")
+    fix = "give a list of numbers, e.g. [0.5, 0.7, 1.0]"
+    return np.array([_as_float(where, v, fix) for v in raw], dtype=np.float64)
+
+
+def _axis_range(where: str, raw: dict) -> np.ndarray:
+    """Values of a ``{start, stop, num, spacing}`` table (linear or log)."""
+    fix = "write e.g. {start = 0.5, stop = 3.0, num = 26, spacing = \"linear\"}"
+    unknown = [k for k in raw if k not in RANGE_KEYS]
+    if unknown:
+        _fail(where, f"unknown key '{unknown[0]}' in range table",
+              f"allowed: {', '.join(RANGE_KEYS)}")
+    missing = [k for k in ("start", "stop", "num") if k not in raw]
+    if missing:
+        _fail(where, f"range table needs '{missing[0]}'", fix)
+    start = _as_float(where, raw["start"], fix)
+    stop = _as_float(where, raw["stop"], fix)
+    num = _as_int(where, raw["num"], fix)
+    if not 1 <= num <= MAX_AXIS_POINTS:
+        _fail(where, f"num must be between 1 and {MAX_AXIS_POINTS}, got {_show(raw['num'])}", fix)
+    spacing = raw.get("spacing", "linear")
+    if spacing not in schema.AXIS_SPACINGS:
+        _fail(where, f"spacing must be one of {', '.join(schema.AXIS_SPACINGS)}, "
+                     f"got {_show(spacing)}", 'write spacing = "linear" or spacing = "log"')
+    if spacing == "log":
+        if start <= 0 or stop <= 0:
+            _fail(where, f"log spacing needs start and stop > 0, got start = {start!r}, "
+                         f"stop = {stop!r}", 'use positive limits or spacing = "linear"')
+        return np.geomspace(start, stop, num, dtype=np.float64)
+    return np.linspace(start, stop, num, dtype=np.float64)
+
+
+def _check_monotonic(where: str, values: np.ndarray) -> None:
+    steps = np.diff(values)
+    if not (np.all(steps > 0) or np.all(steps < 0)):
+        _fail(where, "values must be strictly increasing or strictly decreasing",
+              "sort them and remove duplicates")
+
+
+# --------------------------------------------------------------------------- cross-key rules
+
+
+def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules tied to model.kind and model.coefficients."""
+    if given.get("model.kind") == "longitudinal":
+        raise SceneError("scene key 'model.kind': 'longitudinal' (central-difference) is not "
+                         "available in this version; use 'transverse'")
+    if given.get("model.coefficients") == "paper":
+        for axis in axes:
+            if axis in PAPER_FIXED_AXES:
+                _fail(f"axis '{axis}'", "model.coefficients = 'paper' has no such parameter",
+                      "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
+                      "to sweep it")
+
+
+def _check_frequency_pair(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    present = [d for d in FREQUENCY_KEYS
+               if d in given or schema.BY_DOTTED[d].axis in axes]
+    if len(present) == 2:
+        raise SceneError("scene keys 'load.frequency' and 'load.frequency_ratio': "
+                         "give one, not both (remove one of them)")
+
+
+def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray]) -> dict[str, Any]:
+    """Every dotted key -> value: given, else default; None for swept keys."""
+    swept = {schema.BY_AXIS[a].dotted for a in axes}
+    values = {k.dotted: None if k.dotted in swept else given.get(k.dotted, k.default)
+              for k in schema.KEYS}
+
+    def mentioned(dotted: str) -> bool:
+        return dotted in given or dotted in swept
+
+    if not any(mentioned(d) for d in FREQUENCY_KEYS):
+        values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    paper = values["model.coefficients"] == "paper"
+    if paper and not (mentioned("initial.displacement") or mentioned("initial.velocity")):
+        values["initial.velocity"] = PAPER_VELOCITY
+    return values
+
+
+def _check_times(values: dict[str, Any]) -> None:
+    """Intervals and steps must fit inside the simulated time."""
+    t_end = values["solver.t_end"]
+    for dotted in ("outputs.sample_interval", "solver.max_step", "solver.first_step"):
+        value = values[dotted]
+        if value is not None and value > t_end:
+            _fail(f"scene key '{dotted}'", f"must be <= solver.t_end ({t_end!r} s), got {value!r}",
+                  "use a smaller value or a longer solver.t_end")
+
+
+# --------------------------------------------------------------------------- messages
+
+
+def _fail(where: str, problem: str, fix: str) -> NoReturn:
+    """Raise a one-line SceneError: ``WHERE: PROBLEM (FIX)``."""
+    message = f"{where}: {problem} ({fix})"
+    raise SceneError(message.replace("\r", "\\r").replace("\n", "\\n"))
+
+
+def _close(word: str, candidates: Any) -> str | None:
+    """The closest candidate to a misspelt word, or None."""
+    matches = difflib.get_close_matches(word, list(candidates), n=1)
+    return matches[0] if matches else None
+
+
+def _suggestion(guess: str | None, fallback: str) -> str:
+    return f"did you mean '{guess}'?" if guess else fallback
+
+
+def _show(value: Any) -> str:
+    """A short repr of a user's value for a message."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _comment_text(text: str) -> str:
+    """Text safe inside a TOML comment (no control characters)."""
+    return "".join(c if c.isprintable() else "?" for c in repr(text))
+
+
+# --------------------------------------------------------------------------- TOML writer
+
+
+def _toml_value(value: Any) -> str:
+    """TOML for a str, bool, int, float, or list of numbers."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    if isinstance(value, str):
+        return _toml_string(value)
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return _toml_array(value)
+    raise TypeError(f"cannot write {type(value).__name__} as a TOML value")
+
+
+def _toml_array(values: Any, per_line: int = 8) -> str:
+    """A TOML array of numbers, wrapped every ``per_line`` items."""
+    items = [_toml_value(v) for v in (values.tolist() if isinstance(values, np.ndarray) else values)]
+    if len(items) <= per_line:
+        return "[" + ", ".join(items) + "]"
+    rows = [", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line)]
+    return "[\n    " + ",\n    ".join(rows) + ",\n]"
+
+
+def _toml_string(text: str) -> str:
+    """A TOML basic string with the escapes TOML requires."""
+    escapes = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n",
+               "\f": "\\f", "\r": "\\r"}
+    out = []
+    for char in text:
+        if char in escapes:
+            out.append(escapes[char])
+        elif ord(char) < 0x20 or ord(char) == 0x7F:
+            out.append(f"\\u{ord(char):04X}")
+        else:
+            out.append(char)
+    return '"' + "".join(out) + '"'
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.fullmatch(key) else _toml_string(key)

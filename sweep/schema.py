@@ -1,0 +1,132 @@
+"""The scene-file schema: every key a scene may hold, its type, default, bounds and units.
+
+This table is data. `sweep.scene` validates a parsed TOML document against it; the
+dataset builder takes units and long names from it. Add a key here first.
+
+Kinds of value:
+    "float"   a finite real number (a TOML integer is accepted and converted)
+    "int"     an integer
+    "bool"    true or false
+    "str"     a string; `choices` lists the allowed values
+A float key with ``sweepable=True`` may also appear under ``[axes]``, by its axis name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene key.
+
+    section, name: where it lives (``[section] name = ...``).
+    kind: "float" | "int" | "bool" | "str".
+    default: value used when the key is absent; None means "no default" (optional key).
+    units: SI units of the value ("1" for dimensionless, "" for non-numeric).
+    long_name: a human description, used as the netCDF ``long_name``.
+    minimum, maximum: inclusive bounds unless ``exclusive_min`` / ``exclusive_max``.
+    choices: allowed strings for kind "str".
+    axis: the axis (and coordinate) name when the key is sweepable, else None.
+    """
+
+    section: str
+    name: str
+    kind: str
+    default: Any
+    units: str = ""
+    long_name: str = ""
+    minimum: float | None = None
+    maximum: float | None = None
+    exclusive_min: bool = False
+    exclusive_max: bool = False
+    choices: tuple[str, ...] = field(default_factory=tuple)
+    axis: str | None = None
+
+    @property
+    def dotted(self) -> str:
+        return f"{self.section}.{self.name}"
+
+
+KEYS: tuple[Key, ...] = (
+    # [model]
+    Key("model", "kind", "str", "transverse", choices=("transverse", "longitudinal"),
+        long_name="which vibration problem is solved"),
+    Key("model", "coefficients", "str", "consistent", choices=("consistent", "paper"),
+        long_name="transverse modal coefficients: re-derived (consistent) or Eq.32 as printed (paper)"),
+    Key("model", "membrane", "float", 0.375, units="1", minimum=0.0,
+        long_name="membrane stretching coefficient alpha", axis="membrane"),
+    Key("model", "paper_parametric", "str", "printed", choices=("printed", "corrected"),
+        long_name="paper preset: Eq.32's parametric (cos) terms as printed or 10x-corrected"),
+    # [cable]
+    Key("cable", "youngs_modulus", "float", 1.1e11, units="Pa", minimum=0.0, exclusive_min=True,
+        long_name="Young's modulus", axis="youngs_modulus"),
+    Key("cable", "density", "float", 8900.0, units="kg m-3", minimum=0.0, exclusive_min=True,
+        long_name="density", axis="density"),
+    Key("cable", "area", "float", 6e-6, units="m2", minimum=0.0, exclusive_min=True,
+        long_name="cross-sectional area", axis="area"),
+    Key("cable", "inertia", "float", 5.73e-12, units="m4", minimum=0.0, exclusive_min=True,
+        long_name="second moment of area used for bending", axis="inertia"),
+    Key("cable", "damping_ratio", "float", 0.0, units="1", minimum=0.0,
+        long_name="modal viscous damping ratio", axis="damping_ratio"),
+    Key("cable", "length", "float", 1.0, units="m", minimum=0.0, exclusive_min=True,
+        long_name="span length between constraints", axis="length"),
+    # [load]
+    Key("load", "type", "str", "harmonic", choices=("harmonic", "constant"),
+        long_name="end load: harmonic P0 cos(W t) or constant P0 from t = 0"),
+    Key("load", "amplitude", "float", 4.0, units="N",
+        long_name="end load amplitude P0 (positive = compression)", axis="load_amplitude"),
+    Key("load", "frequency_ratio", "float", None, units="1", minimum=0.0,
+        long_name="load frequency over the span's first natural frequency, W/w1",
+        axis="frequency_ratio"),
+    Key("load", "frequency", "float", None, units="Hz", minimum=0.0,
+        long_name="load frequency W/(2 pi)", axis="frequency"),
+    # [initial]
+    Key("initial", "displacement", "float", 0.0, units="m",
+        long_name="initial midspan deflection q(0)", axis="initial_displacement"),
+    Key("initial", "velocity", "float", 0.0, units="m s-1",
+        long_name="initial midspan velocity q'(0)", axis="initial_velocity"),
+    # [solver]
+    Key("solver", "rtol", "float", 1e-8, units="1", minimum=1e-14, maximum=0.1,
+        long_name="relative tolerance"),
+    Key("solver", "atol", "float", 1e-12, units="", minimum=0.0, exclusive_min=True,
+        maximum=1.0, long_name="absolute tolerance (m for q, m/s for q')"),
+    Key("solver", "t_end", "float", 5.0, units="s", minimum=0.0, exclusive_min=True,
+        long_name="end of the simulated time"),
+    Key("solver", "max_steps", "int", 1_000_000, units="1", minimum=1,
+        long_name="bound on accepted steps per point"),
+    Key("solver", "max_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="largest step allowed (default: unbounded)"),
+    Key("solver", "first_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="first step (default: SciPy's initial-step selection)"),
+    # [metrics]
+    Key("metrics", "tail", "float", 0.5, units="1", minimum=0.0, exclusive_min=True,
+        maximum=1.0, long_name="tail window as a fraction of t_end"),
+    Key("metrics", "tolerance", "float", 0.02, units="1", minimum=0.0, exclusive_min=True,
+        maximum=0.5, long_name="settling band and decay threshold, relative"),
+    Key("metrics", "divergence_bound", "float", None, units="m", minimum=0.0,
+        exclusive_min=True, long_name="|q| beyond which a point is diverged (default: the span length)"),
+    # [outputs]
+    Key("outputs", "amplitude", "bool", True, long_name="store the tail amplitude"),
+    Key("outputs", "peak_amplitude", "bool", True, long_name="store the global max |q|"),
+    Key("outputs", "settling_time", "bool", True, long_name="compute and store the settling time"),
+    Key("outputs", "response_period", "bool", True, long_name="store the response period"),
+    Key("outputs", "solver_stats", "bool", True, long_name="store step and evaluation counts"),
+    Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
+    Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="time-series sample interval (default t_end/1000)"),
+    # [run]
+    Key("run", "threads", "int", 0, units="1", minimum=0,
+        long_name="worker threads (0 = all cores)"),
+)
+
+TOP_LEVEL: dict[str, str] = {"name": "a short name for the sweep",
+                             "description": "one line saying what the sweep is for"}
+
+SECTIONS: tuple[str, ...] = tuple(dict.fromkeys(k.section for k in KEYS)) + ("axes",)
+
+BY_DOTTED: dict[str, Key] = {k.dotted: k for k in KEYS}
+BY_AXIS: dict[str, Key] = {k.axis: k for k in KEYS if k.axis is not None}
+
+AXIS_SPACINGS: tuple[str, ...] = ("linear", "log")
