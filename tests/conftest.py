@@ -1,0 +1,64 @@
+"""Shared helpers: build kernel parameter rows, run the kernel, the same ODE for SciPy."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from kernels import oscillator as osc
+from kernels import transverse as tk
+
+
+def param_row(m=1.0, c=0.0, k0=1.0, k1=0.0, g0=0.0, g1=0.0, h=0.0, omega=0.0,
+              q0=0.0, v0=0.0, bound=1e9) -> np.ndarray:
+    """One kernel parameter row (columns of kernels.oscillator)."""
+    row = np.zeros(osc.N_PARAMS)
+    for name, value in zip(osc.PARAM_NAMES, (m, c, k0, k1, g0, g1, h, omega, q0, v0, bound)):
+        row[osc.PARAM_NAMES.index(name)] = value
+    return row
+
+
+def settings(rtol=1e-8, atol=1e-12, t_end=5.0, max_steps=10**6, max_step=math.inf,
+             first_step=0.0, tail=0.5, tol=0.02, sample_dt=0.01, settling=True) -> np.ndarray:
+    """A kernel settings vector (kernels.transverse)."""
+    s = np.zeros(tk.N_SETTINGS)
+    s[tk.RTOL], s[tk.ATOL], s[tk.T_END] = rtol, atol, t_end
+    s[tk.MAX_STEPS], s[tk.MAX_STEP], s[tk.FIRST_STEP] = max_steps, max_step, first_step
+    s[tk.TAIL], s[tk.TOL], s[tk.SAMPLE_DT] = tail, tol, sample_dt
+    s[tk.WANT_SETTLING] = 1.0 if settling else 0.0
+    return s
+
+
+def solve(rows, s, n_samples=0):
+    """Run the batched kernel; returns (states, reals, counts, series)."""
+    rows = np.atleast_2d(np.asarray(rows, dtype=float))
+    n = rows.shape[0]
+    states = np.empty(n, np.int8)
+    reals = np.empty((n, tk.N_REALS))
+    counts = np.empty((n, tk.N_COUNTS), np.int64)
+    series = np.empty((n, n_samples))
+    tk.solve_batch(rows, s, states, reals, counts, series)
+    return states, reals, counts, series
+
+
+def rhs(row):
+    """The oscillator as a SciPy right-hand side, written independently of the kernel."""
+    m, c, k0, k1, g0, g1, h, w = row[:8]
+
+    def f(t, y):
+        q, v = y
+        cw = np.cos(w * t)
+        return [v, -(c * v + (k0 + k1 * cw) * q + (g0 + g1 * cw) * q ** 3 + h * q ** 5) / m]
+    return f
+
+
+@pytest.fixture
+def paper_row():
+    """Eq.32 as printed at l = 1 m, n = 1, released with q'(0) = 0.0321 m/s."""
+    l = 1.0
+    return param_row(m=0.5 * l, k0=1.73 * np.pi ** 2 * l, k1=-1.08 * l ** 5,
+                     g0=6.6e5 * np.pi ** 2 * l ** 3 - 2.1 * np.pi ** 4 / l,
+                     g1=0.54 * np.pi ** 2 * l ** 3, h=76 * np.pi ** 6 / l ** 3,
+                     omega=1.86 * np.pi, v0=0.0321, bound=l)
