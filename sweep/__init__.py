@@ -9,6 +9,6 @@ SI units throughout; see the README and MODEL.md for the equations.
 
 from .errors import SceneError, UserError
 from .run import run
-from .scene import Scene, builtin_scenes, load_scene
+from .scene import Scene, builtin_scenes, load_scene, load_scene_text
 
-__all__ = ["Scene", "SceneError", "UserError", "builtin_scenes", "load_scene", "run"]
+__all__ = ["Scene", "SceneError", "UserError", "builtin_scenes", "load_scene", "load_scene_text", "run"]

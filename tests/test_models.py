@@ -1,0 +1,120 @@
+"""Model coefficients against independent references: quadrature of the paper's Galerkin
+integrals (Eq.17 projected on sin(pi x / l), as Eq.22 defines them) and Eq.32 as printed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from sweep import models
+
+
+def galerkin_by_quadrature(E, rho, A, I, l, P):
+    """Project Eq.17 (divided by rho A) on phi = sin(pi x/l) numerically; divide by int phi^2.
+
+    Eq.17: rho A w_tt + P w_xx + EI w_xxxx - 3 EI w_xx^3 - 11 EI w_xx w_xxx w_x
+           - (2P + 3/2 EA) w_xx w_x^2 - 3 EI w_xxxx w_x^2 + 21/2 EI w_xx^3 w_x^2 = 0.
+    Returns the coefficients of q, q^3 and q^5 of q'' + ... = 0.
+    """
+    k = np.pi / l
+    d = [lambda x, n=n: (k ** n) * [np.sin, np.cos, lambda s: -np.sin(s), lambda s: -np.cos(s)]
+         [n % 4](k * x) for n in range(5)]                      # phi and its derivatives
+    lam2, lam1, beta = E * I / (rho * A), E / rho, P / (rho * A)
+
+    def proj(f):
+        return quad(lambda x: f(x) * d[0](x), 0, l, epsabs=0, epsrel=1e-13, limit=200)[0]
+
+    c1 = proj(d[0])
+    lin = proj(lambda x: beta * d[2](x) + lam2 * d[4](x))
+    cub = proj(lambda x: -3 * lam2 * d[2](x) ** 3 - 11 * lam2 * d[2](x) * d[3](x) * d[1](x)
+               - (2 * beta + 1.5 * lam1) * d[2](x) * d[1](x) ** 2
+               - 3 * lam2 * d[4](x) * d[1](x) ** 2)
+    quint = proj(lambda x: 10.5 * lam2 * d[2](x) ** 3 * d[1](x) ** 2)
+    return lin / c1, cub / c1, quint / c1
+
+
+CABLES = [
+    dict(E=1.1e11, rho=8900.0, A=6e-6, I=5.73e-12, l=1.0, P=4.0),
+    dict(E=1.1e11, rho=8900.0, A=6e-6, I=2.865e-12, l=0.35, P=-12.0),
+    dict(E=7.0e10, rho=2700.0, A=2e-5, I=3.2e-11, l=2.3, P=150.0),
+]
+
+
+@pytest.mark.parametrize("cable", CABLES)
+def test_consistent_coefficients_equal_the_projection_of_eq17(cable):
+    lin, cub, quint = galerkin_by_quadrature(**cable)
+    c = models.consistent(dict(youngs_modulus=cable["E"], density=cable["rho"],
+                               area=cable["A"], inertia=cable["I"], length=cable["l"],
+                               membrane=0.375, load_amplitude=cable["P"]))
+    assert c["mass"] == 1.0
+    assert c["k"] + c["k_load"] == pytest.approx(lin, rel=1e-10)
+    assert c["g"] + c["g_load"] == pytest.approx(cub, rel=1e-10)
+    assert c["h"] == pytest.approx(quint, rel=1e-10)
+
+
+def test_paper_c4_is_wrong_and_ours_is_the_projection():
+    """Eq.30 prints c4 = +357/16 lam2 k^8 l; the projection gives -21/32 lam2 k^8 l."""
+    cable = CABLES[0]
+    _, _, quint = galerkin_by_quadrature(**cable)
+    lam2 = cable["E"] * cable["I"] / (cable["rho"] * cable["A"])
+    k, l = np.pi / cable["l"], cable["l"]
+    assert quint * l / 2 == pytest.approx(-21 / 32 * lam2 * k ** 8 * l, rel=1e-10)
+    assert quint * l / 2 != pytest.approx(357 / 16 * lam2 * k ** 8 * l, rel=0.5)
+
+
+def test_closed_forms_of_table1_cable():
+    p = dict(youngs_modulus=1.1e11, density=8900.0, area=6e-6, inertia=5.73e-12, length=1.0,
+             membrane=0.375, load_amplitude=4.0)
+    c = models.consistent(p)
+    EI, rhoA = 1.1e11 * 5.73e-12, 8900.0 * 6e-6
+    assert EI == pytest.approx(0.630, rel=1e-3) and rhoA == pytest.approx(0.0534, rel=1e-3)
+    assert c["buckling_load"] == pytest.approx(EI * np.pi ** 2, rel=1e-14)
+    assert c["omega_1"] == pytest.approx(np.pi ** 2 * np.sqrt(EI / rhoA), rel=1e-14)
+
+
+def _paper(l, corrected=False, load=4.0):
+    return models.paper(dict(length=l, load_amplitude=load,
+                             paper_parametric="corrected" if corrected else "printed"))
+
+
+@pytest.mark.parametrize("l", [0.5, 0.7, 0.85, 1.0])
+def test_paper_preset_is_eq32_as_printed(l):
+    c = _paper(l)
+    pi = np.pi
+    assert c["mass"] == 0.5 * l
+    assert c["k"] == pytest.approx(1.73 * pi ** 2 * l)
+    assert c["k_load"] == pytest.approx(-1.08 * l ** 5)
+    assert c["g"] == pytest.approx(6.6e5 * pi ** 2 * l ** 3 - 2.1 * pi ** 4 / l)
+    assert c["g_load"] == pytest.approx(0.54 * pi ** 2 * l ** 3)
+    assert c["h"] == pytest.approx(76 * pi ** 6 / l ** 3)
+    assert c["omega_ref"] == pytest.approx(1.86 * pi)
+
+
+def test_paper_corrected_parametric_terms_come_from_eq31():
+    """Eq.31's 37.5 and 18.7 over w0^2 = (1.86 pi)^2 l^-8: 10.84 l^5 and 5.41 pi^2 l^3."""
+    c = _paper(1.0, corrected=True)
+    assert -c["k_load"] == pytest.approx(10.84, abs=0.005)
+    assert c["g_load"] / np.pi ** 2 == pytest.approx(5.41, abs=0.005)
+    # Corrected, the load ratio is close to the consistent model's P0/Pcr = 4 / (0.63 pi^2).
+    ratio = 4.0 / c["buckling_load"]
+    assert ratio == pytest.approx(4.0 / (1.1e11 * 5.73e-12 * np.pi ** 2), rel=0.02)
+
+
+def test_oscillator_frequency_and_constant_load():
+    base = dict(youngs_modulus=1.1e11, density=8900.0, area=6e-6, inertia=5.73e-12,
+                length=0.5, membrane=0.375, load_amplitude=4.0, damping_ratio=0.02,
+                frequency_ratio=2.0, frequency=None, initial_displacement=0.0,
+                initial_velocity=0.0, coefficients="consistent", load_type="harmonic",
+                paper_parametric="printed", divergence_bound=None)
+    h = models.oscillator(base)
+    w1 = 2 * np.pi * h["natural_frequency"]
+    assert h["omega"] == pytest.approx(2.0 * w1)
+    assert h["damping"] == pytest.approx(2 * 0.02 * w1)
+    assert h["bound"] == 0.5
+    f = models.oscillator({**base, "frequency": 50.0, "frequency_ratio": None})
+    assert f["omega"] == pytest.approx(2 * np.pi * 50.0)
+    c = models.oscillator({**base, "load_type": "constant"})
+    assert c["k1"] == 0.0 and c["g1"] == 0.0 and c["omega"] == 0.0
+    assert c["k0"] == pytest.approx(h["k0"] + h["k1"])
+    assert c["g0"] == pytest.approx(h["g0"] + h["g1"])

@@ -1,0 +1,157 @@
+"""End to end: scenes -> Dataset -> netCDF, and the `sweep` command as a user runs it."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import sweep
+from kernels import metrics as km
+
+PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]   # installed or checkout, as imported
+
+SMALL = """
+name = "small"
+[model]
+coefficients = "consistent"
+[cable]
+damping_ratio = 0.02
+[initial]
+displacement = 1e-3
+[axes]
+length = [0.4, 0.6]
+frequency_ratio = [1.0, 2.0, 2.5]
+[solver]
+t_end = 2.0
+"""
+
+
+def cli(*args, cwd=None):
+    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    return subprocess.run([sys.executable, "-m", "sweep.cli", *args], capture_output=True,
+                          text=True, cwd=cwd, env=env, timeout=600)
+
+
+def test_paper_fig5_amplitudes():
+    """Within 10 % of the paper's 4.1, 3.8, 3.4, 3.0 mm; and MODEL.md's re-run of Eq.32."""
+    ds = sweep.run(sweep.load_scene("paper-fig5"), progress=False)
+    amp_mm = ds["amplitude"].values * 1e3
+    np.testing.assert_allclose(amp_mm, [4.1, 3.8, 3.4, 3.0], rtol=0.10)
+    np.testing.assert_allclose(amp_mm, [4.10, 3.67, 3.42, 3.22], atol=0.006)
+    assert ds["displacement"].dims == ("length", "time")
+    assert ds["time"].values[-1] == pytest.approx(5.0)
+
+
+def test_dataset_layout_units_and_netcdf_round_trip(tmp_path):
+    scene = sweep.load_scene_text(SMALL)
+    out = tmp_path / "small.nc"
+    ds = sweep.run(scene, output=out, progress=False)
+    assert ds["state"].dims == ("length", "frequency_ratio")
+    assert ds["natural_frequency"].dims == ("length",)          # depends on length only
+    for name in list(ds.data_vars) + list(ds.coords):
+        assert ds[name].attrs.get("units") is not None, name
+        assert ds[name].attrs.get("long_name"), name
+    back = xr.open_dataset(out)
+    try:
+        assert back.attrs["Conventions"].startswith("CF-")
+        assert back.attrs["cable_sweep_version"]
+        again = sweep.load_scene_text(back.attrs["scene"])
+        assert again == scene
+        flags = back["state"].attrs
+        assert list(flags["flag_values"]) == list(range(len(km.STATE_MEANINGS)))
+        assert flags["flag_meanings"].split() == list(km.STATE_MEANINGS)
+        for name in ds.variables:
+            np.testing.assert_array_equal(back[name].values, ds[name].values)
+            assert back[name].attrs["units"] == ds[name].attrs["units"]
+    finally:
+        back.close()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.nc"]
+
+
+def test_only_what_is_asked_is_stored():
+    scene = sweep.load_scene_text(SMALL, overrides={"outputs.settling_time": False,
+                                                    "outputs.solver_stats": False,
+                                                    "outputs.amplitude": False})
+    ds = sweep.run(scene, progress=False)
+    assert "settling_time" not in ds and "n_steps" not in ds and "amplitude" not in ds
+    assert "displacement" not in ds and "time" not in ds.coords
+    assert "state" in ds and "peak_amplitude" in ds
+
+
+def test_axis_order_follows_the_scene_and_results_do_not_depend_on_it():
+    a = sweep.run(sweep.load_scene_text(SMALL), progress=False)
+    swapped = SMALL.replace("length = [0.4, 0.6]\nfrequency_ratio = [1.0, 2.0, 2.5]",
+                            "frequency_ratio = [1.0, 2.0, 2.5]\nlength = [0.4, 0.6]")
+    b = sweep.run(sweep.load_scene_text(swapped), progress=False)
+    assert b["state"].dims == ("frequency_ratio", "length")
+    for name in ("state", "amplitude", "settling_time", "n_steps"):
+        np.testing.assert_array_equal(a[name].values, b[name].transpose(*a[name].dims).values)
+
+
+def test_existing_output_is_refused_before_any_work(tmp_path):
+    out = tmp_path / "x.nc"
+    out.write_text("keep me")
+    with pytest.raises(sweep.UserError, match="exists"):
+        sweep.run(sweep.load_scene_text(SMALL), output=out)
+    assert out.read_text() == "keep me"
+    sweep.run(sweep.load_scene_text(SMALL), output=out, overwrite=True, progress=False)
+    xr.open_dataset(out).close()
+
+
+def test_failed_write_leaves_nothing_behind(tmp_path, monkeypatch):
+    def boom(self, *args, **kwargs):
+        raise RuntimeError("disk on fire")
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", boom)
+    with pytest.raises(RuntimeError):
+        sweep.run(sweep.load_scene_text(SMALL), output=tmp_path / "y.nc", progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_run_writes_netcdf_and_summarises(tmp_path):
+    r = cli("run", "paper-fig5", "-o", "fig5.nc", "--set", "axes.length=[0.5, 1.0]",
+            cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "2 points" in r.stdout and "fig5.nc" in r.stdout
+    with xr.open_dataset(tmp_path / "fig5.nc") as ds:
+        assert list(ds["length"].values) == [0.5, 1.0]
+
+
+def test_cli_lists_scenes():
+    r = cli("scenes")
+    assert r.returncode == 0
+    names = [line.split()[0] for line in r.stdout.splitlines()]
+    assert "paper-fig5" in names and "harness-parametric" in names
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["run", "paper-fig6"], "paper-fig6"),
+    (["run", "paper-fig5", "--set", "cable.lenght=1"], "did you mean"),
+    (["run", "paper-fig5", "--set", "solver.t_end=-1"], "solver.t_end"),
+    (["run", "paper-fig5", "--set", "solver.rtol"], "KEY=VALUE"),
+    (["run", "paper-fig5", "-o", "no/such/dir/x.nc"], "does not exist"),
+    (["run", "paper-fig5", "-o", "out.txt"], ".nc"),
+    (["run", "paper-fig5", "--threads", "0"], "--threads"),
+    (["run"], "SCENE".lower()),
+    (["fly"], "fly"),
+])
+def test_cli_user_errors_exit_2_with_one_line(args, needle, tmp_path):
+    r = cli(*args, cwd=tmp_path)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    assert needle.lower() in lines[0].lower()
+    assert "Traceback" not in r.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_refuses_existing_output(tmp_path):
+    (tmp_path / "o.nc").write_text("x")
+    r = cli("run", "paper-fig5", "-o", "o.nc", cwd=tmp_path)
+    assert r.returncode == 2 and "--overwrite" in r.stderr
+    assert (tmp_path / "o.nc").read_text() == "x"
