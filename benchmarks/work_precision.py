@@ -116,7 +116,7 @@ class Measurement:
     rtol: float
     atol: float
     wall_s: float
-    mean_steps: float
+    steps: np.ndarray          # accepted steps per point
     amplitude: np.ndarray
     q_end: np.ndarray
 
@@ -184,7 +184,7 @@ def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float) -
 
     wall = best_time(once)
     last = result[-1]
-    return Measurement("cable-sweep", rtol, atol, wall, float(last.counts[:, tk.STEPS].mean()),
+    return Measurement("cable-sweep", rtol, atol, wall, last.counts[:, tk.STEPS].copy(),
                        last.reals[:, tk.AMPLITUDE].copy(), last.series[:, -1].copy())
 
 
@@ -199,7 +199,7 @@ def run_scipy(table: np.ndarray, method: str, rtol: float, atol: float) -> Measu
         steps[i] = len(sol.t) - 1
         amp[i] = tail_amplitude(sol, TAIL_START, T_END)
         q_end[i] = sol.y[0, -1]
-    return Measurement(f"SciPy {method}", rtol, atol, wall, float(steps.mean()), amp, q_end)
+    return Measurement(f"SciPy {method}", rtol, atol, wall, steps, amp, q_end)
 
 
 def amplitude_errors(amplitude: np.ndarray, ref: Reference) -> np.ndarray:
@@ -225,6 +225,19 @@ def recommend(runs: list[Measurement], ref: Reference, judged: np.ndarray,
         else:
             break
     return best
+
+
+def step_agreement(runs: list[Measurement], n: int) -> str:
+    """A line: on how many points cable-sweep and SciPy RK45 took the same accepted steps."""
+    parts = []
+    for m in runs:
+        if m.method != "cable-sweep":
+            continue
+        rk = next(r for r in runs if r.method == "SciPy RK45" and r.rtol == m.rtol)
+        diff = np.abs(m.steps - rk.steps)
+        parts.append(f"rtol {m.rtol:.0e}: {int(np.sum(diff == 0))}/{n}"
+                     + (f" (max diff {int(diff.max())})" if diff.max() > 0 else ""))
+    return "Accepted steps equal, cable-sweep vs SciPy RK45: " + "; ".join(parts) + "."
 
 
 def warm_up(table: np.ndarray, scene: Scene) -> float:
@@ -302,7 +315,7 @@ def main() -> None:
     for m in runs:
         amp_err = amplitude_errors(m.amplitude, ref)
         rows.append([m.method, f"{m.rtol:.0e}", f"{m.atol:.0e}", f"{m.wall_s:.4f}",
-                     f"{m.mean_steps:,.0f}", f"{np.max(amp_err[~decayed], initial=0):.1e}",
+                     f"{m.steps.mean():,.1f}", f"{np.max(amp_err[~decayed], initial=0):.1e}",
                      f"{np.max(amp_err):.1e}",
                      f"{np.max(final_state_errors(m.q_end, ref)):.1e}"])
     print(markdown_table(["method", "rtol", "atol", "wall (s)", "mean steps", "amp err",
@@ -310,6 +323,7 @@ def main() -> None:
     print("\namp err: max |A - A_ref| / A_ref over non-decayed points; amp err (all): over all "
           "points; q(5) err: max |q(5) - q_ref(5)| / max|q_ref|.\n")
 
+    print(step_agreement(runs, len(table)) + "\n")
     chosen = recommend(runs, ref, judged, args.threshold)
     which = "all" if args.include_decayed else "non-decayed"
     if chosen is None:
@@ -335,7 +349,7 @@ def main() -> None:
             "recommended_rtol": chosen,
             "recommended_atol": None if chosen is None else atol_for(chosen, args),
             "runs": [{"method": m.method, "rtol": m.rtol, "atol": m.atol, "wall_s": m.wall_s,
-                      "mean_steps": m.mean_steps,
+                      "mean_steps": float(m.steps.mean()),
                       "max_rel_amplitude_error": float(np.max(
                           amplitude_errors(m.amplitude, ref)[~decayed], initial=0)),
                       "max_rel_amplitude_error_all": float(np.max(

@@ -49,7 +49,7 @@ ERROR_EXPONENT = -1.0 / (ERROR_ESTIMATOR_ORDER + 1)
 MIN_RTOL = 100 * np.finfo(float).eps   # SciPy raises smaller rtol to this
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def rk_step(t, y, h, p, K, y_new):
     """One Dormand-Prince step of size h (s) from (t, y); K[0] must hold f(t, y).
 
@@ -77,7 +77,7 @@ def rk_step(t, y, h, p, K, y_new):
     K[N_STAGES, 1] = acceleration(t + h, y_new[0], y_new[1], p)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def error_norm(K, h, y, y_new, rtol, atol):
     """SciPy's RMS norm of the embedded error estimate, scaled by atol + rtol max(|y|, |y_new|)."""
     eq = 0.0
@@ -94,7 +94,7 @@ def error_norm(K, h, y, y_new, rtol, atol):
     return math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def step_factor(err, rejected_before):
     """SciPy RK45's step-size factor for an error norm `err`.
 
@@ -115,12 +115,12 @@ def step_factor(err, rejected_before):
     return factor
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _rms2(a, b):
     return math.sqrt(a * a + b * b) / math.sqrt(2.0)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p):
     """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4). One evaluation."""
     interval = abs(t_bound - t0)
@@ -147,7 +147,7 @@ def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p):
     return min(100.0 * h0, h1, interval, max_step)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def dense_coefficients(K, Q):
     """Q = K^T P: the quartic interpolant of the last step, shape (2, 4)."""
     for i in range(2):
@@ -158,13 +158,13 @@ def dense_coefficients(K, Q):
             Q[i, k] = s
 
 
-@nb.njit(cache=True, nogil=True, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def dense_value(y_old_i, h, Q, i, x):
     """Component i of the interpolant at x = (t - t_old)/h in [0, 1]."""
     return y_old_i + h * (x * (Q[i, 0] + x * (Q[i, 1] + x * (Q[i, 2] + x * Q[i, 3]))))
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def dense_root(y_old_i, h, Q, i, target, xa, xb):
     """x in [xa, xb] where component i of the interpolant equals `target`.
 

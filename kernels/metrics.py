@@ -45,7 +45,7 @@ EXT_Q = 1      # q at the extremum (m)
 EXT_KIND = 2   # MAXIMUM or MINIMUM
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def push_extremum(buf, n, t, q, kind):
     """Append (t, q, kind) to the extrema buffer, doubling it when full. Returns the buffer."""
     if n >= buf.shape[0]:
@@ -58,7 +58,7 @@ def push_extremum(buf, n, t, q, kind):
     return buf
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def tail_counts(buf, n, t_tail):
     """Number of maxima and minima at t >= t_tail, and the response period from the maxima."""
     n_max = 0
@@ -79,7 +79,7 @@ def tail_counts(buf, n, t_tail):
     return n_max, n_min, period
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def last_envelope_violation(buf, n, band):
     """Time of the last extremum farther than `band` (m) from the final level of its kind.
 
@@ -100,7 +100,7 @@ def last_envelope_violation(buf, n, band):
     return 0.0
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def tail_trend(buf, n, t_tail, t_end):
     """True when the envelope drifts one way across the tail: the max |q| of the extrema in each
     quarter of the tail window strictly falls (or strictly rises) from quarter to quarter.

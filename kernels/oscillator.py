@@ -27,7 +27,7 @@ N_PARAMS = 11
 PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound")
 
 
-@nb.njit(cache=True, nogil=True, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def acceleration(t, q, v, p):
     """q'' (m/s^2) at time t (s) for deflection q (m), velocity v (m/s), parameter row p."""
     cw = math.cos(p[OMEGA] * t)

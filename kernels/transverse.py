@@ -45,7 +45,7 @@ RHS_EVALS = 2       # right-hand-side evaluations
 N_COUNTS = 3
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _last_time_above(t, h, Q, q_old, q_new, has_ext, xe, qe, centre, thr, last):
     """Update the last time |q - centre| > thr with the step [t, t + h] (see `integrate`)."""
     if abs(q_new - centre) > thr:
@@ -68,7 +68,7 @@ def _last_time_above(t, h, Q, q_old, q_new, has_ext, xe, qe, centre, thr, last):
     return t + x * h
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
     """Integrate one point from t = 0 to t_end, reducing metrics on the fly.
 
@@ -165,17 +165,24 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
         v_old = y[1]
         q_new = y_new[0]
         v_new = y_new[1]
-        dense_coefficients(K, Q)
-
         if not (abs(q_new) <= bound and math.isfinite(v_new)):
             status = mt.DIVERGED
             t_stop = t_new
             if math.isfinite(q_new) and abs(q_new) > bound and abs(q_old) <= bound:
+                dense_coefficients(K, Q)
                 side = 1.0 if q_new > 0.0 else -1.0
                 t_stop = t + dense_root(q_old, h, Q, 0, side * bound, 0.0, 1.0) * h
             break
 
+        # The interpolant is built only for steps that need it (an extremum, the tail's start,
+        # a sample or a crossing of the tracked threshold).
         has_ext = (v_old > 0.0 and v_new <= 0.0) or (v_old < 0.0 and v_new >= 0.0)
+        straddles_tail = t < t_tail <= t_new
+        has_sample = k < n_samples and k * dt_sample <= t_new
+        thr_now = thr_fixed + thr_rel * max(peak, abs(q_new))
+        may_cross = track and abs(q_new - centre) <= thr_now < abs(q_old - centre)
+        if has_ext or straddles_tail or has_sample or may_cross:
+            dense_coefficients(K, Q)
         xe = 0.0
         qe = 0.0
         if has_ext:
@@ -193,7 +200,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
         peak = max(peak, abs(q_new))
 
         if t_new >= t_tail:
-            if t < t_tail:
+            if straddles_tail:
                 qt = dense_value(q_old, h, Q, 0, (t_tail - t) / h)
                 tail_amp = max(tail_amp, abs(qt))
                 tail_qmin = min(tail_qmin, qt)
@@ -223,7 +230,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
             last_above, y[0], buf, n_ext)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _valid(p):
     for j in range(N_PARAMS):
         if not math.isfinite(p[j]):
@@ -231,7 +238,7 @@ def _valid(p):
     return p[MASS] > 0.0 and p[BOUND] > 0.0
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_point(p, settings, reals, counts, series):
     """Integrate one point and classify it (metrics module). Fills `reals` and `counts`; returns
     the state flag. Never raises for bad parameters: they give INVALID_INPUT."""
@@ -284,7 +291,7 @@ def solve_point(p, settings, reals, counts, series):
     return mt.UNSETTLED
 
 
-@nb.njit(cache=True, nogil=True, parallel=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def solve_batch(params, settings, states, reals, counts, series):
     """Solve every row of `params` (n, N_PARAMS) in parallel, one trajectory per iteration.
 
