@@ -7,8 +7,8 @@
 SI units throughout; see the README and MODEL.md for the equations.
 """
 
-from .errors import SceneError, UserError
+from .errors import CableSweepWarning, SceneError, UserError
 from .run import run
 from .scene import Scene, builtin_scenes, load_scene, load_scene_text
 
-__all__ = ["Scene", "SceneError", "UserError", "builtin_scenes", "load_scene", "load_scene_text", "run"]
+__all__ = ["CableSweepWarning", "Scene", "SceneError", "UserError", "builtin_scenes", "load_scene", "load_scene_text", "run"]

@@ -54,7 +54,7 @@ def package_version() -> str:
         return "0+unknown"
 
 
-def _derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
+def derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
     """A derived quantity as a DataArray over exactly the axes it depends on."""
     if isinstance(values, xr.DataArray):
         dims = [d for d in coords if d in values.dims]
@@ -62,13 +62,41 @@ def _derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
     return xr.DataArray(float(values))
 
 
-def state_attrs() -> dict[str, Any]:
-    """CF flag attributes of the `state` variable."""
+def global_attrs(scene: Scene, shape: tuple[int, ...], elapsed: float,
+                 method: str) -> dict[str, Any]:
+    """The dataset's global attributes: CF conventions, provenance and the resolved scene."""
+    version = package_version()
+    now = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     return {
-        "long_name": "response state of the point",
+        "title": scene.name,
+        "description": scene.description,
+        "Conventions": CONVENTIONS,
+        "source": f"cable-sweep {version}: {method}",
+        "history": f"{now} created by cable-sweep {version} from scene '{scene.source}'",
+        "cable_sweep_version": version,
+        "scene": scene.to_toml(),
+        "model_kind": scene.get("model.kind"),
+        "coefficients": scene.get("model.coefficients"),
+        "run_seconds": float(elapsed),
+        "n_points": int(np.prod(shape, dtype=np.int64)),
+    }
+
+
+def flag_attrs(meanings: tuple[str, ...]) -> dict[str, Any]:
+    """CF flag attributes of an int8 `state` variable with the given meanings."""
+    return {
+        "long_name": "state of the point",
         "units": "1",
-        "flag_values": np.arange(len(km.STATE_MEANINGS), dtype=np.int8),
-        "flag_meanings": " ".join(km.STATE_MEANINGS),
+        "flag_values": np.arange(len(meanings), dtype=np.int8),
+        "flag_meanings": " ".join(meanings),
+    }
+
+
+def state_attrs() -> dict[str, Any]:
+    """CF flag attributes of the transverse `state` variable."""
+    return {
+        **flag_attrs(km.STATE_MEANINGS),
+        "long_name": "response state of the point",
         "comment": "decayed/steady have a settling time; modulated (beating, quasi-periodic), "
                    "unsettled (still drifting at t_end: lengthen solver.t_end) and the failure "
                    "states have NaN",
@@ -91,7 +119,7 @@ def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ..
                                       attrs={"units": "1", "long_name": long_name})
     for name, (units, long_name) in _DERIVED.items():
         if name in coeffs:
-            data[name] = _derived(coeffs[name], coords)
+            data[name] = derived(coeffs[name], coords)
             data[name].attrs = {"units": units, "long_name": long_name}
     all_coords: dict[str, Any] = dict(coords)
     if result.series.shape[1] > 0:
@@ -101,19 +129,6 @@ def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ..
         data["displacement"] = xr.DataArray(
             result.series.reshape(shape + (result.series.shape[1],)), dims=dims + ("time",),
             attrs={"units": "m", "long_name": "midspan deflection q(t)"})
-    version = package_version()
-    now = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-    attrs = {
-        "title": scene.name,
-        "description": scene.description,
-        "Conventions": CONVENTIONS,
-        "source": f"cable-sweep {version}: transverse modal oscillator, Dormand-Prince RK45",
-        "history": f"{now} created by cable-sweep {version} from scene '{scene.source}'",
-        "cable_sweep_version": version,
-        "scene": scene.to_toml(),
-        "model_kind": scene.get("model.kind"),
-        "coefficients": scene.get("model.coefficients"),
-        "run_seconds": float(elapsed),
-        "n_points": int(np.prod(shape, dtype=np.int64)),
-    }
+    attrs = global_attrs(scene, shape, elapsed,
+                         "transverse modal oscillator, Dormand-Prince RK45")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)

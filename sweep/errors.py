@@ -10,3 +10,7 @@ class UserError(ValueError):
 
 class SceneError(UserError):
     """A scene file, a built-in scene name or an override is invalid."""
+
+
+class CableSweepWarning(UserWarning):
+    """Something the user should know about a run that still goes ahead (one line)."""

@@ -77,34 +77,55 @@ def _progress_printer(total: int, enabled: bool) -> Callable[[int], None]:
     return report
 
 
+def point_order(n: int) -> np.ndarray:
+    """The fixed pseudo-random order points are solved in: spreads costly points over threads.
+
+    The order never changes a result: each point depends only on its own parameters.
+    """
+    return np.random.default_rng(_PERMUTATION_SEED).permutation(n)
+
+
+def grid_order(order: np.ndarray) -> np.ndarray:
+    """Indices that put results solved in `order` back in grid order."""
+    back = np.empty(order.size, np.int64)
+    back[order] = np.arange(order.size)
+    return back
+
+
+def in_chunks(n: int, solve_chunk: Callable[[int, int], None], threads: int = 0,
+              progress: bool = False) -> None:
+    """Call solve_chunk(lo, hi) over [0, n) in chunks, on `threads` Numba threads (0 = all),
+    with a progress bar on stderr when `progress` and the run has more than one chunk."""
+    import numba
+    if threads:
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    chunk = max(512 * numba.get_num_threads(), -(-n // 100))
+    report = _progress_printer(n, progress and n > chunk)
+    for lo in range(0, n, chunk):
+        hi = min(n, lo + chunk)
+        solve_chunk(lo, hi)
+        report(hi)
+
+
 def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
                  threads: int = 0, progress: bool = False) -> KernelResult:
-    """Run the transverse kernel over the rows of `params`, in chunks, with optional progress.
-
-    Points are solved in a fixed pseudo-random order (cost balance across threads) and put back
-    in grid order; a point's result depends only on its own row.
-    """
-    import numba
+    """Run the transverse kernel over the rows of `params` (grid order in, grid order out)."""
     from kernels import transverse as tk
 
     n = params.shape[0]
-    if threads:
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    order = np.random.default_rng(_PERMUTATION_SEED).permutation(n)
+    order = point_order(n)
     shuffled = np.ascontiguousarray(params[order])
     states = np.empty(n, np.int8)
     reals = np.empty((n, tk.N_REALS))
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     series = np.empty((n, n_samples))
-    chunk = max(512 * numba.get_num_threads(), -(-n // 100))
-    report = _progress_printer(n, progress and n > chunk)
-    for lo in range(0, n, chunk):
-        hi = min(n, lo + chunk)
+
+    def solve_chunk(lo: int, hi: int) -> None:
         tk.solve_batch(shuffled[lo:hi], settings, states[lo:hi], reals[lo:hi],
                        counts[lo:hi], series[lo:hi])
-        report(hi)
-    back = np.empty(n, np.int64)
-    back[order] = np.arange(n)
+
+    in_chunks(n, solve_chunk, threads, progress)
+    back = grid_order(order)
     return KernelResult(states[back], reals[back], counts[back], series[back], np.empty(0))
 
 
@@ -122,6 +143,20 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         check_output_path(output, overwrite)
     if progress is None:
         progress = sys.stderr.isatty()
+    if threads is None:
+        threads = scene.get("run.threads")
+    if scene.get("model.kind") == "longitudinal":
+        from .longitudinal import run_longitudinal
+        ds = run_longitudinal(scene, threads=threads, progress=progress)
+    else:
+        ds = run_transverse(scene, threads=threads, progress=progress)
+    if output is not None:
+        write_netcdf(ds, output, overwrite)
+    return ds
+
+
+def run_transverse(scene: Scene, threads: int = 0, progress: bool = False) -> xr.Dataset:
+    """The transverse (RK45) sweep of `scene` as a Dataset."""
     coords = grid.coordinates(scene)
     params = grid.parameters(scene, coords)
     coeffs = models.oscillator(params)
@@ -135,12 +170,6 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if scene.get("outputs.time_series") else np.empty(0))
     started = time.perf_counter()
-    result = solve_points(table, settings, times.size,
-                          threads=scene.get("run.threads") if threads is None else threads,
-                          progress=progress)
+    result = solve_points(table, settings, times.size, threads=threads, progress=progress)
     result.sample_times = times
-    elapsed = time.perf_counter() - started
-    ds = assemble(scene, coords, shape, coeffs, result, elapsed)
-    if output is not None:
-        write_netcdf(ds, output, overwrite)
-    return ds
+    return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)

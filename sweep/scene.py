@@ -8,17 +8,40 @@ A scene is a TOML document (see DESIGN.md) checked against the table in `sweep.s
 Every mistake a user can make raises `SceneError` with a one-line message of the form
 ``WHERE: what is wrong (how to fix it)``, where WHERE names the dotted key, axis or file.
 
+Kinds of value (`sweep.schema`): "float", "int", "bool", "str", and "floats", a TOML list
+of finite numbers (may be empty, each within the key's bounds; ints accepted, bools not).
+A "floats" value is stored as a tuple of Python floats, e.g. ``outputs.snapshot_times``.
+
 Resolution rules worth knowing:
 - A key swept under ``[axes]`` has ``values[key] = None``; its values live in ``axes``.
   If the key is also given as a scalar, the axis wins.
 - ``load.frequency`` and ``load.frequency_ratio`` are alternatives; if neither is given,
   ``load.frequency_ratio = 1.0``.
+- An override that sets a sweepable key as a scalar removes that key's axis, an override
+  of one load frequency key removes the other, and an override of one end-time key
+  (``solver.t_end``, ``solver.transits``) removes the other, so ``--set`` can always
+  replace what the scene file says.
+- ``solver.courant`` above 1 is refused whatever the model (the scheme is unstable there).
+
+Transverse scenes (``model.kind = "transverse"``, the default):
+- ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
+- ``outputs.sample_interval``, ``solver.max_step`` and ``solver.first_step`` must be
+  <= ``solver.t_end``.
 - With ``model.coefficients = "paper"`` the cable data is baked into Eq.32, so its
   parameters cannot be swept, and ``initial.velocity`` defaults to 0.0321 m/s when no
   initial condition is given (MODEL.md: that reproduces the paper's Fig 5 amplitudes).
-- An override that sets a sweepable key as a scalar removes that key's axis, and an
-  override of one load frequency key removes the other, so ``--set`` can always replace
-  what the scene file says.
+
+Longitudinal scenes (``model.kind = "longitudinal"``, MODEL.md sec. 4):
+- ``load.type`` defaults to "constant", the only type allowed (a suddenly applied end load).
+- Only ``length``, ``load_amplitude``, ``youngs_modulus``, ``density`` and ``area`` can be
+  swept.
+- The end time is ``solver.t_end`` (s) or ``solver.transits`` (multiples of l/a), not both;
+  with neither, ``solver.transits = 8.0``. Exactly one of the two values is not None.
+- With ``solver.t_end`` given, every ``outputs.snapshot_times`` entry must be <= it (with
+  transits the end time depends on the point, and is checked when the sweep runs, if at all).
+- Transverse-only keys (tolerances, coefficients, frequencies, ``[initial]``, ``[metrics]``,
+  the time-series outputs, ...) are accepted and ignored, so a resolved scene written by
+  `Scene.to_toml` loads back; the transverse time checks above are not applied.
 """
 
 from __future__ import annotations
@@ -47,6 +70,17 @@ PAPER_FIXED_AXES: tuple[str, ...] = ("youngs_modulus", "density", "area", "inert
 
 FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
 DEFAULT_FREQUENCY_RATIO = 1.0
+
+END_TIME_KEYS: tuple[str, str] = ("solver.t_end", "solver.transits")
+DEFAULT_T_END = 5.0
+"""solver.t_end (s) of a transverse scene that gives none."""
+DEFAULT_TRANSITS = 8.0
+"""solver.transits of a longitudinal scene that gives neither solver.t_end nor transits."""
+
+LONGITUDINAL_AXES: tuple[str, ...] = ("length", "load_amplitude", "youngs_modulus", "density",
+                                      "area")
+"""The axes a longitudinal scene can sweep (the parameters of the wave problem)."""
+LONGITUDINAL_LOAD = "constant"
 RANGE_KEYS: tuple[str, ...] = ("start", "stop", "num", "spacing")
 MAX_AXIS_POINTS = 10_000_000
 
@@ -71,6 +105,10 @@ _HINTS: dict[str, str] = {
     "load.frequency_ratio": "give the load frequency as a multiple of w1, e.g. 2.0",
     "load.frequency": "give the load frequency in Hz",
     "solver.t_end": "give the simulated time in seconds, e.g. 5.0",
+    "solver.transits": "give the end time in wave transits l/a, e.g. 8.0",
+    "solver.intervals": "give the number of spatial intervals per span, e.g. 1000",
+    "solver.courant": "use 1.0, which is exact at the nodes",
+    "outputs.snapshot_times": "give the snapshot times in seconds, e.g. [0.0001, 0.0002]",
     "solver.rtol": "typical values are 1e-6 to 1e-10",
     "solver.atol": "give a small positive absolute tolerance, e.g. 1e-12 (m for q)",
     "solver.max_steps": "give a positive step budget, e.g. 1000000",
@@ -88,7 +126,8 @@ class Scene:
     """A validated, fully resolved scene.
 
     values: every dotted key of `schema.KEYS` -> its value (defaults applied); None for an
-        optional key that is absent and for a key that is swept (see ``axes``).
+        optional key that is absent and for a key that is swept (see ``axes``). A "floats"
+        key (``outputs.snapshot_times``) holds a tuple of floats, or None.
     axes: axis name -> 1-D read-only float64 array, in scene order ([axes] table order,
         then axes added by overrides).
     text: the TOML text as read; source: the built-in name or the path given;
@@ -107,7 +146,10 @@ class Scene:
     overrides: dict[str, Any] = field(default_factory=dict)
 
     def get(self, dotted: str) -> Any:
-        """The resolved value of a dotted key, e.g. ``scene.get("solver.rtol")``."""
+        """The resolved value of a dotted key, e.g. ``scene.get("solver.rtol")``.
+
+        A "floats" key gives a tuple of floats (possibly empty) or None.
+        """
         return self.values[dotted]
 
     def __eq__(self, other: object) -> bool:
@@ -124,7 +166,8 @@ class Scene:
     def to_toml(self) -> str:
         """The resolved scene as TOML: every section, defaults included, axes as lists.
 
-        None-valued keys are left out. `load_scene_text` of the result gives an equal Scene.
+        None-valued keys are left out; a "floats" value is written as a list. `load_scene_text`
+        of the result gives an equal Scene.
         """
         lines = [f"# Resolved scene from {_comment_text(self.source)}: "
                  "defaults written out, axes as explicit lists."]
@@ -310,7 +353,7 @@ def _plain(value: Any) -> Any:
 
 
 def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
-    """Check override keys and parse their values; refuse both load frequency keys at once."""
+    """Check override keys and parse their values; refuse both keys of an either-or pair."""
     parsed: dict[str, Any] = {}
     for key, value in (overrides or {}).items():
         if not isinstance(key, str) or not key.strip():
@@ -321,6 +364,9 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
     frequencies = {_frequency_target(k) for k in parsed} - {None}
     if len(frequencies) == 2:
         _fail("overrides 'load.frequency' and 'load.frequency_ratio'", "give one, not both",
+              "remove one of the two overrides")
+    if all(k in parsed for k in END_TIME_KEYS):
+        _fail("overrides 'solver.t_end' and 'solver.transits'", "give one, not both",
               "remove one of the two overrides")
     return parsed
 
@@ -371,9 +417,13 @@ def _override_axis(doc: dict[str, Any], name: str, value: Any) -> None:
 
 
 def _override_scalar(doc: dict[str, Any], section: str, name: str, value: Any) -> None:
-    """Set a scalar key; it replaces an axis on the same key."""
-    _override_table(doc, section)[name] = value
-    key = schema.BY_DOTTED.get(f"{section}.{name}")
+    """Set a scalar key; it replaces an axis on the same key, or the other end-time key."""
+    table = _override_table(doc, section)
+    table[name] = value
+    dotted = f"{section}.{name}"
+    if dotted in END_TIME_KEYS:
+        table.pop(END_TIME_KEYS[1 - END_TIME_KEYS.index(dotted)].partition(".")[2], None)
+    key = schema.BY_DOTTED.get(dotted)
     if key is not None and key.axis is not None:
         _drop_axis(doc, key.axis)
         _drop_frequency_partner(doc, key.dotted)
@@ -417,7 +467,10 @@ def _build(text: str, source: str, default_name: str,
     _check_model(given, axes)
     _check_frequency_pair(given, axes)
     values = _resolve(given, axes)
-    _check_times(values)
+    if values["model.kind"] == "longitudinal":
+        _check_snapshot_times(values)
+    else:
+        _check_times(values)
     return Scene(name=name, description=description, values=values, axes=axes,
                  text=text, source=source, overrides=applied)
 
@@ -515,6 +568,8 @@ def _unknown_section_key(section: str, dotted: str) -> NoReturn:
 
 def _check_value(where: str, key: schema.Key, raw: Any) -> Any:
     """A value of the key's kind, within its bounds and choices."""
+    if key.kind == "floats":
+        return _as_floats(where, key, raw)
     if isinstance(raw, (dict, list)):
         _fail(where, f"must be a single value, got {_show(raw)}", _container_fix(key, raw))
     if key.kind == "float":
@@ -525,9 +580,56 @@ def _check_value(where: str, key: schema.Key, raw: Any) -> Any:
         value = _as_bool(where, key, raw)
     else:
         value = _as_choice(where, key, raw)
+    if key.dotted == "solver.courant" and value > 1.0:
+        _fail(where, f"must be <= 1, got {_show(value)}", _courant_fix(value))
     if key.kind in ("float", "int"):
         _check_bounds(where, key, value)
     return value
+
+
+def _as_floats(where: str, key: schema.Key, raw: Any) -> tuple[float, ...]:
+    """A tuple of finite floats from a list of numbers (may be empty), each within bounds."""
+    fix = f"write e.g. {key.name} = [0.0001, 0.0002]"
+    if not isinstance(raw, list):
+        _fail(where, f"must be a list of numbers, got {_show(raw)}", fix)
+    values = []
+    for number, item in enumerate(raw, start=1):
+        if isinstance(item, bool) or not isinstance(item, (int, float)):
+            _fail(where, f"item {number} of the list must be a number, got {_show(item)}", fix)
+        try:
+            value = float(item)
+        except OverflowError:
+            value = math.inf
+        if not math.isfinite(value):
+            _fail(where, f"item {number} of the list must be a finite number, got {_show(item)}",
+                  fix)
+        if not _within(key, np.array(value)):
+            _fail(where, f"item {number} of the list must be {_bounds_text(key)}, "
+                         f"got {_show(item)}", _HINTS.get(key.dotted) or _generic_hint(key))
+        values.append(value)
+    return tuple(values)
+
+
+def _courant_fix(courant: float) -> str:
+    """Why a Courant number above 1 is refused, with the growth per step of the worst mode.
+
+    The grid-scale mode (k dx = pi) of the three-level central difference has amplification
+    factors g with g^2 - b g + 1 = 0, b = 2 - 4 C^2; for C > 1, |g| = |b|/2 + sqrt(b^2/4 - 1).
+    """
+    half_b = abs(2.0 - 4.0 * courant * courant) / 2.0
+    growth = half_b + math.sqrt(max(half_b * half_b - 1.0, 0.0))
+    if not math.isfinite(growth):
+        rate = "beyond any bound"
+    elif growth >= 1000.0:
+        rate = f"about {growth:.3g}x per step"
+    elif growth - 1.0 >= 0.01:
+        rate = f"about {growth:.2f}x per step"
+    elif growth > 1.0:
+        rate = f"about {growth:.{min(12, 1 - math.floor(math.log10(growth - 1.0)))}f}x per step"
+    else:
+        rate = "slowly"
+    return ("the explicit central difference is unstable above 1: its grid-scale mode grows "
+            f"{rate} at C = {_show(courant)}; use 1.0, which is exact at the nodes")
 
 
 def _container_fix(key: schema.Key, raw: Any) -> str:
@@ -726,17 +828,40 @@ def _check_monotonic(where: str, values: np.ndarray) -> None:
 # --------------------------------------------------------------------------- cross-key rules
 
 
+def _model_kind(given: dict[str, Any]) -> str:
+    return given.get("model.kind", schema.BY_DOTTED["model.kind"].default)
+
+
 def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules tied to model.kind and model.coefficients."""
-    if given.get("model.kind") == "longitudinal":
-        raise SceneError("scene key 'model.kind': 'longitudinal' (central-difference) is not "
-                         "available in this version; use 'transverse'")
+    if _model_kind(given) == "longitudinal":
+        _check_longitudinal(given, axes)
+        return
+    if given.get("solver.transits") is not None:
+        _fail("scene key 'solver.transits'", "only for model.kind = 'longitudinal'",
+              "use solver.t_end in seconds")
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:
                 _fail(f"axis '{axis}'", "model.coefficients = 'paper' has no such parameter",
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
+
+
+def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of a longitudinal scene: a constant load, its parameters only, one end time."""
+    load_type = given.get("load.type", LONGITUDINAL_LOAD)
+    if load_type != LONGITUDINAL_LOAD:
+        _fail("scene key 'load.type'",
+              f"model.kind = 'longitudinal' takes only '{LONGITUDINAL_LOAD}'",
+              "a suddenly applied end load, MODEL.md sec. 4")
+    for axis in axes:
+        if axis not in LONGITUDINAL_AXES:
+            _fail(f"axis '{axis}'", "model.kind = 'longitudinal' has no such parameter",
+                  f"it sweeps {', '.join(LONGITUDINAL_AXES)}")
+    if all(given.get(k) is not None for k in END_TIME_KEYS):
+        _fail("scene keys 'solver.t_end' and 'solver.transits'", "give one, not both",
+              "remove one of them: t_end is in seconds, transits in multiples of l/a")
 
 
 def _check_frequency_pair(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
@@ -758,6 +883,13 @@ def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray]) -> dict[str, An
 
     if not any(mentioned(d) for d in FREQUENCY_KEYS):
         values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    if values["model.kind"] == "longitudinal":
+        values["load.type"] = given.get("load.type", LONGITUDINAL_LOAD)
+        if not any(mentioned(d) for d in END_TIME_KEYS):
+            values["solver.transits"] = DEFAULT_TRANSITS
+        return values
+    if not mentioned("solver.t_end"):
+        values["solver.t_end"] = DEFAULT_T_END
     paper = values["model.coefficients"] == "paper"
     if paper and not (mentioned("initial.displacement") or mentioned("initial.velocity")):
         values["initial.velocity"] = PAPER_VELOCITY
@@ -765,13 +897,25 @@ def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray]) -> dict[str, An
 
 
 def _check_times(values: dict[str, Any]) -> None:
-    """Intervals and steps must fit inside the simulated time."""
+    """Transverse: intervals and steps must fit inside the simulated time."""
     t_end = values["solver.t_end"]
     for dotted in ("outputs.sample_interval", "solver.max_step", "solver.first_step"):
         value = values[dotted]
         if value is not None and value > t_end:
             _fail(f"scene key '{dotted}'", f"must be <= solver.t_end ({t_end!r} s), got {value!r}",
                   "use a smaller value or a longer solver.t_end")
+
+
+def _check_snapshot_times(values: dict[str, Any]) -> None:
+    """Longitudinal: with solver.t_end given, every snapshot time must be <= it."""
+    t_end, times = values["solver.t_end"], values["outputs.snapshot_times"]
+    if t_end is None or not times:
+        return
+    for number, time in enumerate(times, start=1):
+        if time > t_end:
+            _fail("scene key 'outputs.snapshot_times'",
+                  f"item {number} of the list, {time!r} s, is after solver.t_end ({t_end!r} s)",
+                  "use times <= solver.t_end or a longer solver.t_end")
 
 
 # --------------------------------------------------------------------------- messages

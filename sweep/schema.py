@@ -8,6 +8,7 @@ Kinds of value:
     "int"     an integer
     "bool"    true or false
     "str"     a string; `choices` lists the allowed values
+    "floats"  a list of finite real numbers (may be empty), each within the bounds
 A float key with ``sweepable=True`` may also appear under ``[axes]``, by its axis name.
 """
 
@@ -92,8 +93,14 @@ KEYS: tuple[Key, ...] = (
         long_name="relative tolerance"),
     Key("solver", "atol", "float", 1e-12, units="", minimum=0.0, exclusive_min=True,
         maximum=1.0, long_name="absolute tolerance (m for q, m/s for q')"),
-    Key("solver", "t_end", "float", 5.0, units="s", minimum=0.0, exclusive_min=True,
-        long_name="end of the simulated time"),
+    Key("solver", "t_end", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="end of the simulated time (default: 5 s transverse, 8 transits longitudinal)"),
+    Key("solver", "transits", "float", None, units="1", minimum=0.0, exclusive_min=True,
+        long_name="longitudinal: end time in wave transits l/a, instead of t_end"),
+    Key("solver", "intervals", "int", 1000, units="1", minimum=2,
+        long_name="longitudinal: spatial intervals per span"),
+    Key("solver", "courant", "float", 1.0, units="1", minimum=0.0, exclusive_min=True,
+        maximum=1.0, long_name="longitudinal: Courant number a dt/dx (exact at 1, unstable above)"),
     Key("solver", "max_steps", "int", 1_000_000, units="1", minimum=1,
         long_name="bound on accepted steps per point"),
     Key("solver", "max_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
@@ -116,6 +123,12 @@ KEYS: tuple[Key, ...] = (
     Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
     Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="time-series sample interval (default t_end/1000)"),
+    Key("outputs", "histories", "bool", False,
+        long_name="longitudinal: store end-displacement and fixed-end-force histories"),
+    Key("outputs", "snapshot_times", "floats", None, units="s", minimum=0.0,
+        long_name="longitudinal: times of the field snapshots u(x), N(x), v(x)"),
+    Key("outputs", "normalised", "bool", False,
+        long_name="longitudinal: also store N/P0 and v rho A a/P0 snapshots"),
     # [run]
     Key("run", "threads", "int", 0, units="1", minimum=0,
         long_name="worker threads (0 = all cores)"),

@@ -7,14 +7,16 @@ import pytest
 
 from sweep import schema
 from sweep.errors import SceneError
-from sweep.scene import (PAPER_VELOCITY, Scene, builtin_scenes, load_scene, load_scene_text,
-                         parse_override)
+from sweep.scene import (DEFAULT_T_END, DEFAULT_TRANSITS, PAPER_VELOCITY, Scene, builtin_scenes,
+                         load_scene, load_scene_text, parse_override)
 
 BASE = """
 name = "t"
 [cable]
 length = 1.0
 """
+
+LONG = '[model]\nkind = "longitudinal"\n'
 
 
 def scene_error(text: str, overrides=None) -> str:
@@ -91,9 +93,10 @@ def test_defaults_applied():
     scene = load_scene_text("")
     assert scene.name == "unnamed" and scene.description == ""
     for key in schema.KEYS:
-        if key.dotted not in ("load.frequency_ratio",):
+        if key.dotted not in ("load.frequency_ratio", "solver.t_end"):
             assert scene.get(key.dotted) == key.default
     assert scene.get("load.frequency_ratio") == 1.0
+    assert scene.get("solver.t_end") == DEFAULT_T_END == 5.0
     assert scene.get("solver.max_step") is None
     assert scene.axes == {}
 
@@ -309,7 +312,7 @@ def test_axes_must_be_a_table():
     ('[model]\ncoefficients = "papr"', ["scene key 'model.coefficients'", "'consistent', 'paper'",
                                         "did you mean 'paper'?"]),
     ("[model]\ncoefficients = 1", ["scene key 'model.coefficients'", "string"]),
-    ('[model]\nkind = "longitudinal"', ["scene key 'model.kind'", "not available", "'transverse'"]),
+    ('[model]\nkind = "sideways"', ["scene key 'model.kind'", "'transverse', 'longitudinal'"]),
     ("name = 3", ["scene key 'name'", "non-empty string"]),
     ('name = ""', ["scene key 'name'", "non-empty string"]),
     ("description = 3", ["scene key 'description'", "string"]),
@@ -407,3 +410,254 @@ def test_non_utf8_refused(tmp_path):
     path.write_bytes(b'name = "caf\xe9"\n')
     with pytest.raises(SceneError, match="latin.toml.*UTF-8"):
         load_scene(path)
+
+
+# --------------------------------------------------------------------------- kind "floats"
+
+
+def test_floats_key_valid_list():
+    scene = load_scene_text(LONG + "[outputs]\nsnapshot_times = [0, 1e-4, 2]")
+    times = scene.get("outputs.snapshot_times")
+    assert times == (0.0, 1e-4, 2.0)
+    assert isinstance(times, tuple) and all(type(t) is float for t in times)
+
+
+def test_floats_key_default_none_and_empty_list():
+    assert load_scene_text(LONG).get("outputs.snapshot_times") is None
+    assert load_scene_text(LONG + "[outputs]\nsnapshot_times = []").get(
+        "outputs.snapshot_times") == ()
+
+
+@pytest.mark.parametrize("value, expected", [
+    ("[1e-4, -1e-4]", ["item 2", "-0.0001", ">= 0 s"]),
+    ("[1e-4, nan]", ["item 2", "finite", "nan"]),
+    ("[inf]", ["item 1", "finite", "inf"]),
+    ("[1e-4, true]", ["item 2", "must be a number", "True"]),
+    ('["1e-4"]', ["item 1", "must be a number", "'1e-4'"]),
+    ("[[1e-4]]", ["item 1", "must be a number"]),
+    ("1e-4", ["must be a list of numbers", "0.0001", "snapshot_times = ["]),
+    ('"1e-4"', ["must be a list of numbers"]),
+    ("{a = 1}", ["must be a list of numbers"]),
+])
+def test_floats_key_errors(value, expected):
+    message = scene_error(LONG + f"[outputs]\nsnapshot_times = {value}")
+    assert "scene key 'outputs.snapshot_times'" in message
+    for part in expected:
+        assert part in message, (part, message)
+
+
+def test_floats_key_override():
+    item = parse_override("outputs.snapshot_times=[1e-4, 2e-4]")
+    scene = load_scene_text(LONG, overrides=dict([item]))
+    assert scene.get("outputs.snapshot_times") == (1e-4, 2e-4)
+    scene = load_scene_text(LONG, overrides={"outputs.snapshot_times": "[3e-4]"})
+    assert scene.get("outputs.snapshot_times") == (3e-4,)
+    scene = load_scene_text(LONG, overrides={"outputs.snapshot_times": np.array([1e-4, 5e-4])})
+    assert scene.get("outputs.snapshot_times") == (1e-4, 5e-4)
+    assert "item 1" in scene_error(LONG, {"outputs.snapshot_times": "[nan]"})
+
+
+@pytest.mark.parametrize("times", ["[]", "[0.1, 1e-07, 0.30000000000000004]"])
+def test_floats_key_round_trip(times):
+    scene = load_scene_text(LONG + f"[outputs]\nsnapshot_times = {times}")
+    assert f"snapshot_times = {times}" in scene.to_toml()
+    assert_round_trip(scene)
+    other = load_scene_text(LONG + "[outputs]\nsnapshot_times = [0.5]")
+    assert other != scene
+
+
+# --------------------------------------------------------------------------- longitudinal
+
+
+def test_longitudinal_defaults():
+    scene = load_scene_text(LONG)
+    assert scene.get("model.kind") == "longitudinal"
+    assert scene.get("load.type") == "constant"
+    assert scene.get("solver.transits") == DEFAULT_TRANSITS == 8.0
+    assert scene.get("solver.t_end") is None
+    assert scene.get("solver.intervals") == 1000
+    assert scene.get("solver.courant") == 1.0
+    assert scene.get("outputs.histories") is False
+    assert scene.get("outputs.normalised") is False
+
+
+def test_longitudinal_one_end_time():
+    scene = load_scene_text(LONG + "[solver]\nt_end = 0.01")
+    assert scene.get("solver.t_end") == 0.01 and scene.get("solver.transits") is None
+    scene = load_scene_text(LONG + "[solver]\ntransits = 3")
+    assert scene.get("solver.transits") == 3.0 and scene.get("solver.t_end") is None
+
+
+def test_longitudinal_allowed_axes_and_constant_load():
+    scene = load_scene_text(LONG + """
+[load]
+type = "constant"
+[axes]
+length = [0.5, 1.0]
+load_amplitude = [1, 2]
+youngs_modulus = [1e11, 2e11]
+density = [2700, 8900]
+area = [1e-6, 6e-6]
+""")
+    assert list(scene.axes) == ["length", "load_amplitude", "youngs_modulus", "density", "area"]
+    assert scene.get("load.type") == "constant"
+
+
+def test_longitudinal_accepts_transverse_only_keys():
+    scene = load_scene_text("""
+[model]
+kind = "longitudinal"
+coefficients = "paper"
+[load]
+frequency = 10.0
+[initial]
+velocity = 0.1
+[solver]
+rtol = 1e-6
+[metrics]
+tail = 0.25
+[outputs]
+time_series = true
+sample_interval = 100.0
+""")
+    assert scene.get("model.coefficients") == "paper"
+    assert scene.get("initial.velocity") == 0.1
+    assert scene.get("outputs.sample_interval") == 100.0  # not compared with an end time
+
+
+def test_longitudinal_paper_rules_do_not_apply():
+    scene = load_scene_text('[model]\nkind = "longitudinal"\ncoefficients = "paper"\n'
+                            "[axes]\ndensity = [2700, 8900]")
+    assert scene.get("initial.velocity") == 0.0
+    assert list(scene.axes) == ["density"]
+
+
+def test_longitudinal_refuses_harmonic_load():
+    message = scene_error(LONG + '[load]\ntype = "harmonic"')
+    assert message == ("scene key 'load.type': model.kind = 'longitudinal' takes only 'constant' "
+                       "(a suddenly applied end load, MODEL.md sec. 4)")
+    assert message == scene_error(LONG, {"load.type": "harmonic"})
+
+
+@pytest.mark.parametrize("axis", ["damping_ratio", "frequency_ratio", "frequency", "inertia",
+                                  "membrane", "initial_displacement"])
+def test_longitudinal_refuses_other_axes(axis):
+    message = scene_error(LONG + f"[axes]\n{axis} = [0.1, 0.2]")
+    assert message == (f"axis '{axis}': model.kind = 'longitudinal' has no such parameter "
+                       "(it sweeps length, load_amplitude, youngs_modulus, density, area)")
+
+
+def test_longitudinal_refuses_both_end_times():
+    message = scene_error(LONG + "[solver]\nt_end = 0.01\ntransits = 4")
+    assert "'solver.t_end'" in message and "'solver.transits'" in message
+    assert "give one, not both" in message
+    assert "give one, not both" in scene_error(LONG, {"solver.t_end": 0.01,
+                                                      "solver.transits": 4.0})
+
+
+def test_end_time_override_replaces_the_other():
+    scene = load_scene_text(LONG + "[solver]\ntransits = 4", overrides={"solver.t_end": 0.01})
+    assert scene.get("solver.t_end") == 0.01 and scene.get("solver.transits") is None
+    scene = load_scene_text(LONG + "[solver]\nt_end = 0.01", overrides={"solver.transits": 2})
+    assert scene.get("solver.transits") == 2.0 and scene.get("solver.t_end") is None
+
+
+def test_courant_above_one_refused():
+    message = scene_error(LONG + "[solver]\ncourant = 1.01")
+    assert message == (
+        "scene key 'solver.courant': must be <= 1, got 1.01 (the explicit central difference is "
+        "unstable above 1: its grid-scale mode grows about 1.33x per step at C = 1.01; use 1.0, "
+        "which is exact at the nodes)")
+    assert "unstable" in scene_error(LONG, {"solver.courant": 2})
+    assert "unstable" in scene_error(LONG + "[solver]\ncourant = 1.0000001")
+    assert "unstable" in scene_error(LONG + "[solver]\ncourant = 1e300")
+    assert "unstable" in scene_error("[solver]\ncourant = 1.5")  # transverse too
+
+
+@pytest.mark.parametrize("value", ["0", "-0.5"])
+def test_courant_not_positive_refused(value):
+    message = scene_error(LONG + f"[solver]\ncourant = {value}")
+    assert "scene key 'solver.courant'" in message and "must be > 0 and <= 1" in message
+    assert "unstable" not in message
+
+
+def test_courant_below_one_accepted():
+    assert load_scene_text(LONG + "[solver]\ncourant = 0.5").get("solver.courant") == 0.5
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("[solver]\ntransits = 0", ["scene key 'solver.transits'", "> 0", "transits"]),
+    ("[solver]\nintervals = 1", ["scene key 'solver.intervals'", ">= 2"]),
+    ("[solver]\nintervals = 10.5", ["scene key 'solver.intervals'", "whole number"]),
+    ("[outputs]\nhistories = 1", ["scene key 'outputs.histories'", "true or false"]),
+    ("[outputs]\nnormalised = \"yes\"", ["scene key 'outputs.normalised'", "true or false"]),
+])
+def test_longitudinal_key_errors(text, expected):
+    message = scene_error(LONG + text)
+    for part in expected:
+        assert part in message, (part, message)
+
+
+def test_snapshot_time_after_t_end_refused():
+    message = scene_error(LONG + "[solver]\nt_end = 0.01\n[outputs]\n"
+                                 "snapshot_times = [0.005, 0.01, 0.02]")
+    assert "scene key 'outputs.snapshot_times'" in message
+    assert "item 3" in message and "0.02" in message and "solver.t_end" in message
+    ok = load_scene_text(LONG + "[solver]\nt_end = 0.01\n[outputs]\nsnapshot_times = [0.01]")
+    assert ok.get("outputs.snapshot_times") == (0.01,)
+    # With transits the end time depends on the point: not checked here.
+    late = load_scene_text(LONG + "[outputs]\nsnapshot_times = [100.0]")
+    assert late.get("outputs.snapshot_times") == (100.0,)
+
+
+def test_resolved_longitudinal_scene_round_trip():
+    scene = load_scene_text(LONG + """
+[solver]
+intervals = 400
+courant = 0.75
+[outputs]
+histories = true
+normalised = true
+snapshot_times = [1e-5, 2.5e-5]
+[axes]
+length = [0.5, 1.0]
+load_amplitude = {start = 1, stop = 4, num = 4}
+""", overrides={"name": "bar"})
+    text = scene.to_toml()
+    assert 'kind = "longitudinal"' in text and 'type = "constant"' in text
+    assert "transits = 8.0" in text and "t_end" not in text
+    assert_round_trip(scene)
+    with_t_end = load_scene_text(LONG + "[solver]\nt_end = 0.002")
+    assert "transits" not in with_t_end.to_toml()
+    assert_round_trip(with_t_end)
+
+
+# --------------------------------------------------------------------------- transverse end time
+
+
+def test_transverse_t_end_default():
+    assert load_scene_text("").get("solver.t_end") == 5.0
+    assert load_scene_text('[model]\nkind = "transverse"').get("solver.t_end") == 5.0
+    assert load_scene_text("[solver]\nt_end = 2").get("solver.t_end") == 2.0
+    assert load_scene_text("").get("solver.transits") is None
+    assert_round_trip(load_scene_text(""))
+
+
+def test_transverse_refuses_transits():
+    expected = ("scene key 'solver.transits': only for model.kind = 'longitudinal' "
+                "(use solver.t_end in seconds)")
+    assert scene_error("[solver]\ntransits = 8") == expected
+    assert scene_error(BASE, {"solver.transits": 8}) == expected
+
+
+def test_transverse_time_checks_use_default_t_end():
+    assert "t_end" in scene_error("[outputs]\nsample_interval = 5.5")
+    assert load_scene_text("[outputs]\nsample_interval = 5.0").get("outputs.sample_interval") == 5.0
+
+
+def test_kind_override_switches_rules():
+    scene = load_scene_text(BASE, overrides={"model.kind": "longitudinal"})
+    assert scene.get("load.type") == "constant" and scene.get("solver.transits") == 8.0
+    back = load_scene_text(scene.to_toml(), overrides={"model.kind": "transverse",
+                                                       "solver.t_end": 3.0})
+    assert back.get("solver.t_end") == 3.0 and back.get("solver.transits") is None
