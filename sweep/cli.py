@@ -11,9 +11,10 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from typing import Sequence
 
-from .errors import UserError
+from .errors import CableSweepWarning, UserError
 
 
 class _Parser(argparse.ArgumentParser):
@@ -41,11 +42,11 @@ def _parser() -> argparse.ArgumentParser:
 
 def _summary(ds, seconds: float) -> str:
     import numpy as np
-    from kernels.metrics import STATE_MEANINGS
-    counts = np.bincount(ds["state"].values.ravel(), minlength=len(STATE_MEANINGS))
-    states = ", ".join(f"{c} {m}" for c, m in zip(counts, STATE_MEANINGS) if c)
+    meanings = ds["state"].attrs["flag_meanings"].split()
+    counts = np.bincount(ds["state"].values.ravel(), minlength=len(meanings))
+    states = ", ".join(f"{c} {m}" for c, m in zip(counts, meanings) if c)
     n = int(ds.attrs["n_points"])
-    return f"{ds.attrs['title']}: {n} points in {seconds:.2f} s ({states})"
+    return f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'} in {seconds:.2f} s ({states})"
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -79,9 +80,22 @@ def _scenes() -> int:
     return 0
 
 
+def _one_line_warnings() -> None:
+    """Show cable-sweep's own warnings as one line on stderr, as they happen."""
+    original = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        if issubclass(category, CableSweepWarning):
+            print(f"sweep: warning: {message}", file=sys.stderr)
+        else:
+            original(message, category, filename, lineno, file, line)
+    warnings.showwarning = show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `sweep` console script."""
     args = _parser().parse_args(argv)
+    _one_line_warnings()
     try:
         if args.command == "run":
             return _run(args)

@@ -156,3 +156,33 @@ def test_courant_below_one_warns_once():
     with pytest.warns(sweep.CableSweepWarning, match="ring") as record:
         sweep.run(scene, progress=False)
     assert len([w for w in record if issubclass(w.category, sweep.CableSweepWarning)]) == 1
+
+
+def test_transverse_constant_load_above_buckling_settles_or_diverges():
+    """Eq.28-29 through RK45: post-buckled equilibrium with alpha > 0, divergence with 0."""
+    scene = sweep.load_scene_text("""
+[model]
+membrane = 0.375
+[cable]
+damping_ratio = 0.05
+[load]
+type = "constant"
+amplitude = 8.0
+[initial]
+displacement = 1e-4
+[axes]
+membrane = [0.375, 0.0]
+[solver]
+t_end = 10.0
+""")
+    ds = sweep.run(scene, progress=False)
+    assert float(ds["load_ratio"]) > 1.0                      # above Pcr = EI pi^2 = 6.2 N
+    from kernels import metrics as km
+    steady, gone = ds["state"].values
+    assert steady == km.STEADY and gone == km.DIVERGED
+    EI, rhoA, k = 1.1e11 * 5.73e-12, 8900 * 6e-6, np.pi
+    k1 = EI / rhoA * k ** 4 * (1 - 8.0 / (EI * k ** 2))
+    K3 = 0.375 * 1.1e11 / 8900 * k ** 4 + 8.0 * k ** 4 / (2 * rhoA) - 1.25 * EI / rhoA * k ** 6
+    q_s = np.sqrt(-k1 / K3)                                   # MODEL.md: sqrt(-k1/K3)
+    assert float(ds["amplitude"][0]) == pytest.approx(q_s, rel=1e-3)
+    assert 0 < float(ds["failure_time"][1]) < 10.0
