@@ -28,7 +28,8 @@ TAIL = 6            # tail window as a fraction of t_end, in (0, 1]
 TOL = 7             # settling band / decay threshold, relative
 SAMPLE_DT = 8       # time-series sample interval (s); used only when series has columns
 WANT_SETTLING = 9   # 1.0: compute settling times; 0.0: skip that work
-N_SETTINGS = 10
+MIN_STEP = 10       # smallest step (s) before STEP_TOO_SMALL; SciPy's 10 ulps of t if larger
+N_SETTINGS = 11
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)
@@ -127,12 +128,15 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
     t_stop = t_end
     steps = 0
     rejected = 0
-    while t < t_end:
+    if not abs(y[0]) <= bound:
+        status = mt.DIVERGED
+        t_stop = 0.0
+    while t < t_end and status == mt.RUNNING:
         if steps >= max_steps:
             status = mt.MAX_STEPS
             t_stop = t
             break
-        min_step = 10.0 * abs(np.nextafter(t, math.inf) - t)
+        min_step = max(10.0 * abs(np.nextafter(t, math.inf) - t), settings[MIN_STEP])
         if h_abs > max_step:
             h_abs = max_step
         elif h_abs < min_step:
@@ -202,6 +206,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
         if t_new >= t_tail:
             if straddles_tail:
                 qt = dense_value(q_old, h, Q, 0, (t_tail - t) / h)
+                peak = max(peak, abs(qt))
                 tail_amp = max(tail_amp, abs(qt))
                 tail_qmin = min(tail_qmin, qt)
                 tail_qmax = max(tail_qmax, qt)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 import xarray as xr
@@ -22,13 +23,23 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.is_dir():
         raise UserError(f"output '{out}': directory '{parent}' does not exist (create it first)")
-    if not os.access(parent, os.W_OK | os.X_OK):
+    if not _can_create_in(parent):
         raise UserError(f"output '{out}': directory '{parent}' is not writable (choose another -o path)")
     if out.is_dir():
         raise UserError(f"output '{out}': is a directory (give a file name ending in .nc)")
     if out.exists() and not overwrite:
         raise UserError(f"output '{out}': file exists (use --overwrite, or overwrite=True, to replace it)")
     return out
+
+
+def _can_create_in(directory: Path) -> bool:
+    """Whether a file can really be created in `directory` (os.access says yes to root even on a
+    read-only file system, so try it)."""
+    try:
+        with tempfile.NamedTemporaryFile(dir=directory, prefix=".cable-sweep-probe-"):
+            return True
+    except OSError:
+        return False
 
 
 def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = False) -> Path:

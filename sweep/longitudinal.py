@@ -106,7 +106,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False) -> 
                        snaps[1][lo:hi], snaps[2][lo:hi])
 
     started = time.perf_counter()
-    in_chunks(n, solve_chunk, threads, progress)
+    in_chunks(n, solve_chunk, threads, progress, scene.get("run.chunk_size"))
     elapsed = time.perf_counter() - started
     back = grid_order(order)
     states, reals, steps, hist_u, hist_f = (x[back] for x in (states, reals, steps, hist_u,

@@ -20,6 +20,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 import numpy as np
+import xarray as xr
 
 # Eq.32 as printed (SI, P0 = 4 N).
 PAPER_LOAD = 4.0                      # N, the load Eq.32 was printed for
@@ -80,13 +81,28 @@ def paper(p: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
+def escape_barrier(k: Any, g: Any, h: Any) -> Any:
+    """Positive root q_b (m) of k + g q^2 + h q^4 = 0 for a softening quintic (h < 0, k > 0).
+
+    Started at rest beyond q_b the span escapes (blows up in finite time); NaN where there is
+    no such barrier (h >= 0 or k <= 0).
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q2 = (-g - np.sqrt(g * g - 4.0 * h * k)) / (2.0 * h)
+        valid = (h < 0) & (k > 0)
+        if any(isinstance(v, xr.DataArray) for v in (k, g, h)):
+            return xr.where(valid, np.sqrt(q2), np.nan)
+        return np.where(valid, np.sqrt(q2), np.nan)[()]
+
+
 def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     """Kernel coefficients and derived quantities for one model configuration.
 
     p holds the scene's parameters by axis name (scalars or arrays) plus "coefficients",
     "load_type" and "paper_parametric". Returns the oscillator coefficients under the names of
     `kernels.oscillator.PARAM_NAMES` and the derived quantities natural_frequency (Hz),
-    buckling_load (N), load_ratio (1) and load_frequency (Hz, harmonic load only).
+    buckling_load (N), load_ratio (1), escape_barrier (m, for the mean or constant load) and
+    load_frequency (Hz, harmonic load only).
     """
     c = consistent(p) if p["coefficients"] == "consistent" else paper(p)
     out = {
@@ -111,4 +127,5 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     else:
         out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
                    omega=0.0)
+    out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"])
     return out

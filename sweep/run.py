@@ -55,6 +55,7 @@ def settings_vector(scene: Scene) -> np.ndarray:
     s[tk.TOL] = scene.get("metrics.tolerance")
     s[tk.SAMPLE_DT] = scene.get("outputs.sample_interval") or scene.get("solver.t_end") / 1000.0
     s[tk.WANT_SETTLING] = 1.0 if scene.get("outputs.settling_time") else 0.0
+    s[tk.MIN_STEP] = scene.get("solver.min_step") or 0.0
     return s
 
 
@@ -93,13 +94,14 @@ def grid_order(order: np.ndarray) -> np.ndarray:
 
 
 def in_chunks(n: int, solve_chunk: Callable[[int, int], None], threads: int = 0,
-              progress: bool = False) -> None:
-    """Call solve_chunk(lo, hi) over [0, n) in chunks, on `threads` Numba threads (0 = all),
-    with a progress bar on stderr when `progress` and the run has more than one chunk."""
+              progress: bool = False, chunk_size: int | None = None) -> None:
+    """Call solve_chunk(lo, hi) over [0, n) in chunks of `chunk_size` points (default: enough
+    for every thread, at most 100 chunks), on `threads` Numba threads (0 = all), with a
+    progress bar on stderr when `progress` and the run has more than one chunk."""
     import numba
-    if threads:
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    chunk = max(512 * numba.get_num_threads(), -(-n // 100))
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS) if threads
+                          else numba.config.NUMBA_NUM_THREADS)
+    chunk = chunk_size or max(512 * numba.get_num_threads(), -(-n // 100))
     report = _progress_printer(n, progress and n > chunk)
     for lo in range(0, n, chunk):
         hi = min(n, lo + chunk)
@@ -108,7 +110,8 @@ def in_chunks(n: int, solve_chunk: Callable[[int, int], None], threads: int = 0,
 
 
 def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
-                 threads: int = 0, progress: bool = False) -> KernelResult:
+                 threads: int = 0, progress: bool = False,
+                 chunk_size: int | None = None) -> KernelResult:
     """Run the transverse kernel over the rows of `params` (grid order in, grid order out)."""
     from kernels import transverse as tk
 
@@ -124,7 +127,7 @@ def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
         tk.solve_batch(shuffled[lo:hi], settings, states[lo:hi], reals[lo:hi],
                        counts[lo:hi], series[lo:hi])
 
-    in_chunks(n, solve_chunk, threads, progress)
+    in_chunks(n, solve_chunk, threads, progress, chunk_size)
     back = grid_order(order)
     return KernelResult(states[back], reals[back], counts[back], series[back], np.empty(0))
 
@@ -170,6 +173,7 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False) -> xr
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if scene.get("outputs.time_series") else np.empty(0))
     started = time.perf_counter()
-    result = solve_points(table, settings, times.size, threads=threads, progress=progress)
+    result = solve_points(table, settings, times.size, threads=threads, progress=progress,
+                          chunk_size=scene.get("run.chunk_size"))
     result.sample_times = times
     return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)

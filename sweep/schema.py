@@ -105,6 +105,8 @@ KEYS: tuple[Key, ...] = (
         long_name="bound on accepted steps per point"),
     Key("solver", "max_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="largest step allowed (default: unbounded)"),
+    Key("solver", "min_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="smallest step allowed before a point fails (default: SciPy's 10 ulps of t)"),
     Key("solver", "first_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="first step (default: SciPy's initial-step selection)"),
     # [metrics]
@@ -132,6 +134,8 @@ KEYS: tuple[Key, ...] = (
     # [run]
     Key("run", "threads", "int", 0, units="1", minimum=0,
         long_name="worker threads (0 = all cores)"),
+    Key("run", "chunk_size", "int", None, units="1", minimum=1,
+        long_name="grid points per kernel call (default: chosen from the grid and threads)"),
 )
 
 TOP_LEVEL: dict[str, str] = {"name": "a short name for the sweep",
