@@ -44,7 +44,7 @@ def max_error(courant: float, intervals: int, transits: float, every: int) -> tu
     levels = np.arange(0, n_levels + 1, every)
     params = np.array([[LENGTH, WAVE, EA, P0, transits * LENGTH / WAVE, LENGTH]])
     snaps = [np.empty((1, levels.size, intervals + 1)) for _ in range(3)]
-    lk.solve_batch(params, np.array([intervals, courant, 0.0]), levels * dt,
+    lk.solve_batch(params, np.array([intervals, courant, 0.0, 1e12]), levels * dt,
                    np.empty(1, np.int8), np.empty((1, lk.N_REALS)), np.empty(1, np.int64),
                    np.empty((1, 0)), np.empty((1, 0)), *snaps)
     x = np.linspace(0.0, LENGTH, intervals + 1)

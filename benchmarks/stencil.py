@@ -44,7 +44,7 @@ def kernel_run(lengths: np.ndarray, intervals: int, transits: float,
     n = lengths.size
     params = np.column_stack([lengths, np.full(n, WAVE), np.full(n, EA), np.full(n, P0),
                               transits * lengths / WAVE, lengths])
-    settings = np.array([intervals, 1.0, 0.0])
+    settings = np.array([intervals, 1.0, 0.0, 1e12])
     states = np.empty(n, np.int8)
     reals = np.empty((n, lk.N_REALS))
     steps = np.empty(n, np.int64)

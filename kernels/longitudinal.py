@@ -34,7 +34,8 @@ PARAM_NAMES = ("length", "wave_speed", "axial_stiffness", "load", "t_end", "boun
 INTERVALS = 0       # N, spatial intervals per span
 COURANT = 1         # C = a dt / dx
 SAMPLE_DT = 2       # history sample interval (s); used only when histories have columns
-N_SETTINGS = 3
+MAX_LEVELS = 3      # bound on time levels per span; a span that needs more stops there
+N_SETTINGS = 4
 
 # Columns of the `reals` output.
 PEAK_END_DISPLACEMENT = 0   # max |u(l, t)| (m)
@@ -49,7 +50,8 @@ N_REALS = 6
 INVALID_INPUT = 0
 COMPLETED = 1
 DIVERGED = 2
-STATE_MEANINGS = ("invalid_input", "completed", "diverged")
+MAX_STEPS = 3
+STATE_MEANINGS = ("invalid_input", "completed", "diverged", "max_steps_reached")
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -98,7 +100,8 @@ def solve_span(p, settings, snapshot_times, reals, hist_u, hist_f, snap_u, snap_
     dt = courant * dx / a
     c2 = courant * courant
     ghost = 2.0 * dx * load / ea          # u_{N+1} = u_{N-1} - ghost
-    n_levels = int(math.ceil(p[T_END] / dt - 1e-9))
+    n_needed = math.ceil(p[T_END] / dt - 1e-9)
+    n_levels = int(min(n_needed, settings[MAX_LEVELS]))
     reals[TIME_STEP] = dt
 
     n_snap = snapshot_times.shape[0]
@@ -187,6 +190,9 @@ def solve_span(p, settings, snapshot_times, reals, hist_u, hist_f, snap_u, snap_
         u_end_old = u_end
         u_prev, u_cur, u_next = u_cur, u_next, u_prev
 
+    if state == COMPLETED and n_levels < n_needed:
+        state = MAX_STEPS
+        reals[FAILURE_TIME] = n_levels * dt
     reals[PEAK_END_DISPLACEMENT] = peak_u
     reals[PEAK_FIXED_END_FORCE] = peak_f
     reals[ARRIVAL_TIME] = arrival

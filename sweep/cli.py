@@ -3,7 +3,8 @@
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
     sweep scenes
 
-Exit status: 0 on success, 2 on a user error (one line on stderr), 1 on an internal error.
+Exit status: 0 on success, 2 on a user error (one line on stderr: what is wrong, where, and how
+to fix it; a sweep too large for memory counts as one), 1 on an internal error.
 """
 
 from __future__ import annotations
@@ -18,23 +19,30 @@ from .errors import CableSweepWarning, UserError
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors and exit status 2."""
+    """argparse with one-line errors (what is wrong, then the usage line) and exit status 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"sweep: error: {message} (see 'sweep --help')\n")
+        usage = " ".join(self.format_usage().split())
+        self.exit(2, f"sweep: error: {_one_line(message)} ({usage}; see '{self.prog} --help')\n")
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).splitlines())
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sweep", description="Parameter sweeps of nonlinear cable vibration.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = sub.add_parser("run", help="run a scene and write the result as netCDF")
-    run.add_argument("scene", help="a built-in scene name (see 'sweep scenes') or a .toml file")
-    run.add_argument("-o", "--output", help="netCDF file to write (atomically)")
+    run.add_argument("scene", metavar="SCENE",
+                     help="a built-in scene name (see 'sweep scenes') or a .toml file")
+    run.add_argument("-o", "--output", metavar="OUT.nc", help="netCDF file to write (atomically)")
     run.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                      help="override a dotted scene key, e.g. --set solver.rtol=1e-9 "
                           "or --set axes.length=[0.5,1.0]")
     run.add_argument("--overwrite", action="store_true", help="replace an existing output file")
-    run.add_argument("--threads", type=int, default=None, help="worker threads (default: all)")
+    run.add_argument("--threads", type=int, default=None, metavar="N",
+                     help="worker threads (default: all)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
     sub.add_parser("scenes", help="list the built-in scenes")
     return parser
@@ -55,10 +63,11 @@ def _run(args: argparse.Namespace) -> int:
     from .io import check_output_path
 
     if args.threads is not None and args.threads < 1:
-        raise UserError(f"--threads {args.threads}: must be a positive number of threads")
+        raise UserError(f"--threads {args.threads}: must be a positive number of threads "
+                        "(give --threads 1 or more, or leave it out to use every core)")
     overrides = dict(parse_override(item) for item in args.overrides)
     scene = load_scene(args.scene, overrides=overrides)
-    if args.output:
+    if args.output is not None:
         check_output_path(args.output, args.overwrite)
     started = time.perf_counter()
     ds = run(scene, output=args.output, overwrite=args.overwrite, threads=args.threads,
@@ -81,14 +90,18 @@ def _scenes() -> int:
 
 
 def _one_line_warnings() -> None:
-    """Show cable-sweep's own warnings as one line on stderr, as they happen."""
+    """Show cable-sweep's own warnings as one line on stderr, as they happen (installed once,
+    however often `main` is called in one process)."""
     original = warnings.showwarning
+    if getattr(original, "_cable_sweep", False):
+        return
 
     def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
         if issubclass(category, CableSweepWarning):
-            print(f"sweep: warning: {message}", file=sys.stderr)
+            print(f"sweep: warning: {_one_line(message)}", file=sys.stderr)
         else:
             original(message, category, filename, lineno, file, line)
+    show._cable_sweep = True  # type: ignore[attr-defined]
     warnings.showwarning = show
 
 
@@ -101,7 +114,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run(args)
         return _scenes()
     except UserError as exc:
-        print(f"sweep: error: {exc}", file=sys.stderr)
+        print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("sweep: error: the sweep does not fit in memory (use fewer axis points, fewer "
+              "solver.intervals, fewer snapshot_times or a longer outputs.sample_interval)",
+              file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("sweep: interrupted; no output written", file=sys.stderr)

@@ -17,9 +17,19 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
     Raises UserError naming the file: missing or read-only directory, an existing file
     without `overwrite`, a directory in the way, or a name that is not .nc.
     """
-    out = Path(path)
+    raw = os.fspath(path)
+    if not raw.strip():
+        raise UserError(f"output '{raw}': empty file name (give a file name ending in .nc, "
+                        "e.g. 'out.nc')")
+    out = Path(raw)
+    if raw.endswith(("/", os.sep)) or out.name in ("", ".", ".."):
+        raise UserError(f"output '{raw}': names a directory, not a file (give a file name "
+                        "ending in .nc, e.g. 'results/out.nc')")
+    if out.name == ".nc":
+        raise UserError(f"output '{raw}': has nothing before .nc (give a name such as 'out.nc')")
     if out.suffix != ".nc":
-        raise UserError(f"output '{out}': the name must end in .nc (e.g. '{out.with_suffix('.nc').name}')")
+        suggestion = out.with_name((out.stem.rstrip('.') or 'out') + '.nc')
+        raise UserError(f"output '{raw}': the name must end in .nc (give e.g. '{suggestion}')")
     parent = out.parent if str(out.parent) else Path(".")
     if not parent.is_dir():
         raise UserError(f"output '{out}': directory '{parent}' does not exist (create it first)")

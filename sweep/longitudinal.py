@@ -20,7 +20,7 @@ import xarray as xr
 from . import grid
 from .dataset import derived, flag_attrs, global_attrs
 from .errors import CableSweepWarning
-from .run import grid_order, in_chunks, point_order
+from .run import check_memory, grid_order, in_chunks, point_order
 from .scene import Scene
 
 
@@ -71,25 +71,32 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False) -> 
     from kernels import longitudinal as lk
 
     coords = grid.coordinates(scene)
-    params = grid.parameters(scene, coords)
-    waves = wave_parameters(params, scene.get("solver.t_end"), scene.get("solver.transits"))
     dims = tuple(coords)
     shape = tuple(coords[d].size for d in dims)
-    table = grid.flatten(waves, lk.PARAM_NAMES, dims, shape)
-    n = table.shape[0]
-
+    n = int(np.prod(shape, dtype=np.int64))
     n_int = int(scene.get("solver.intervals"))
     courant = float(scene.get("solver.courant"))
+    snap_times = _snapshot_times(scene)
+    n_snap = snap_times.size
+    fields = 5 if scene.get("outputs.normalised") else 3
+    # Histories need the longest end time; check the snapshots' size before that.
+    check_memory(n, 3.0 * 8 * (lk.N_PARAMS + lk.N_REALS + 1 + fields * n_snap * (n_int + 1)),
+                 "parameters, metrics and snapshots")
+    params = grid.parameters(scene, coords)
+    waves = wave_parameters(params, scene.get("solver.t_end"), scene.get("solver.transits"))
+    table = grid.flatten(waves, lk.PARAM_NAMES, dims, shape)
     _warn_courant(courant)
     t_max = float(np.max(table[:, lk.T_END])) if n else 0.0
     dt_sample = scene.get("outputs.sample_interval") or t_max / 1000.0
     n_hist = int(math.floor(t_max / dt_sample + 1e-9)) + 1 if scene.get("outputs.histories") else 0
-    snap_times = _snapshot_times(scene)
-    n_snap = snap_times.size
+    check_memory(n, 3.0 * 8 * (lk.N_PARAMS + lk.N_REALS + 1 + 2 * n_hist
+                               + fields * n_snap * (n_int + 1)),
+                 "parameters, metrics, histories and snapshots")
     settings = np.zeros(lk.N_SETTINGS)
     settings[lk.INTERVALS] = n_int
     settings[lk.COURANT] = courant
     settings[lk.SAMPLE_DT] = dt_sample
+    settings[lk.MAX_LEVELS] = scene.get("solver.max_steps")
 
     order = point_order(n)
     shuffled = np.ascontiguousarray(table[order])
@@ -119,7 +126,9 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False) -> 
     data: dict[str, xr.DataArray] = {}
     data["state"] = xr.DataArray(field(states), dims=dims, attrs={
         **flag_attrs(lk.STATE_MEANINGS),
-        "comment": "diverged: non-finite values or |u(l)| beyond metrics.divergence_bound"})
+        "comment": "diverged: non-finite values or |u(l)| beyond metrics.divergence_bound; "
+                   "max_steps_reached: the span needed more than solver.max_steps time levels "
+                   "(its metrics cover the levels it took)"})
 
     def scalar(name: str, values: np.ndarray, units: str, long_name: str) -> None:
         data[name] = xr.DataArray(field(values), dims=dims,
@@ -140,7 +149,8 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False) -> 
            "first time |N(0, t)| reaches |P0| (half the 2 P0 step; exact: l/a)")
     scalar("period", r[:, lk.PERIOD], "s",
            "mean time between successive arrivals at the fixed end (exact: 4 l/a)")
-    scalar("failure_time", r[:, lk.FAILURE_TIME], "s", "time at which a diverged span stopped")
+    scalar("failure_time", r[:, lk.FAILURE_TIME], "s",
+           "time at which a diverged or step-limited span stopped")
     scalar("time_step", r[:, lk.TIME_STEP], "s", "time step dt = C dx / a")
     scalar("n_steps", steps, "1", "time steps taken")
     data["courant"] = xr.DataArray(courant, attrs={"units": "1",

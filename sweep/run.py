@@ -34,11 +34,8 @@ class KernelResult:
 def sample_times(t_end: float, dt: float) -> np.ndarray:
     """k * dt for every k with k * dt <= t_end (s); computed as the kernel computes them."""
     n = int(math.floor(t_end / dt)) + 1
-    while n > 1 and (n - 1) * dt > t_end:
-        n -= 1
-    while n * dt <= t_end:
-        n += 1
-    return np.arange(n) * dt
+    k = np.arange(max(n - 2, 0), n + 2)
+    return np.arange(int(k[k * dt <= t_end][-1]) + 1) * dt
 
 
 def settings_vector(scene: Scene) -> np.ndarray:
@@ -76,6 +73,24 @@ def _progress_printer(total: int, enabled: bool) -> Callable[[int], None]:
             sys.stderr.write("\n")
         sys.stderr.flush()
     return report
+
+
+def check_memory(n_points: int, bytes_per_point: float, what: str) -> None:
+    """Refuse, before allocating, a sweep whose arrays would not fit in this machine's memory.
+
+    bytes_per_point counts every array a point needs, with its copies (solve order, grid
+    order, Dataset). Raises UserError when the total passes 80 % of physical memory.
+    """
+    need = n_points * bytes_per_point
+    try:
+        have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return
+    if need > 0.8 * have:
+        raise UserError(f"scene: {n_points:,} points x {bytes_per_point / 1024:,.1f} KiB "
+                        f"({what}) need about {need / 2**30:,.1f} GiB, more than this machine's "
+                        f"{have / 2**30:,.0f} GiB allow (use fewer axis values, or store fewer "
+                        "samples or snapshots)")
 
 
 def point_order(n: int) -> np.ndarray:
@@ -160,18 +175,21 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
 
 def run_transverse(scene: Scene, threads: int = 0, progress: bool = False) -> xr.Dataset:
     """The transverse (RK45) sweep of `scene` as a Dataset."""
+    from kernels import transverse as tk
+    from kernels.oscillator import PARAM_NAMES
+
     coords = grid.coordinates(scene)
-    params = grid.parameters(scene, coords)
-    coeffs = models.oscillator(params)
     dims = tuple(coords)
     shape = tuple(coords[d].size for d in dims)
-
-    from kernels.oscillator import PARAM_NAMES
-    table = grid.flatten(coeffs, PARAM_NAMES, dims, shape)
     settings = settings_vector(scene)
-    from kernels import transverse as tk
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if scene.get("outputs.time_series") else np.empty(0))
+    n_points = int(np.prod(shape, dtype=np.int64))
+    check_memory(n_points, 3.0 * (8 * (len(PARAM_NAMES) + tk.N_REALS + tk.N_COUNTS + times.size)
+                                  + 1), "parameters, metrics and time series")
+    params = grid.parameters(scene, coords)
+    coeffs = models.oscillator(params)
+    table = grid.flatten(coeffs, PARAM_NAMES, dims, shape)
     started = time.perf_counter()
     result = solve_points(table, settings, times.size, threads=threads, progress=progress,
                           chunk_size=scene.get("run.chunk_size"))

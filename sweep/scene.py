@@ -7,6 +7,9 @@ A scene is a TOML document (see DESIGN.md) checked against the table in `sweep.s
 
 Every mistake a user can make raises `SceneError` with a one-line message of the form
 ``WHERE: what is wrong (how to fix it)``, where WHERE names the dotted key, axis or file.
+A scene argument that names no built-in scene and no file is reported as a missing file
+when it looks like a path (holds a '/' or ends in .toml), else as an unknown name. A scene
+file is read as bytes (at most MAX_SCENE_BYTES) and parsed as TOML: nothing in it is executed.
 
 Kinds of value (`sweep.schema`): "float", "int", "bool", "str", and "floats", a TOML list
 of finite numbers (may be empty, each within the key's bounds; ints accepted, bools not).
@@ -26,7 +29,8 @@ Resolution rules worth knowing:
 Transverse scenes (``model.kind = "transverse"``, the default):
 - ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
 - ``outputs.sample_interval``, ``solver.max_step`` and ``solver.first_step`` must be
-  <= ``solver.t_end``.
+  <= ``solver.t_end``; with ``outputs.time_series``, t_end / sample_interval must be
+  <= MAX_SAMPLES (10 million samples per point).
 - With ``model.coefficients = "paper"`` the cable data is baked into Eq.32, so its
   parameters cannot be swept, and ``initial.velocity`` defaults to 0.0321 m/s when no
   initial condition is given (MODEL.md: that reproduces the paper's Fig 5 amplitudes).
@@ -38,7 +42,8 @@ Longitudinal scenes (``model.kind = "longitudinal"``, MODEL.md sec. 4):
 - The end time is ``solver.t_end`` (s) or ``solver.transits`` (multiples of l/a), not both;
   with neither, ``solver.transits = 8.0``. Exactly one of the two values is not None.
 - With ``solver.t_end`` given, every ``outputs.snapshot_times`` entry must be <= it (with
-  transits the end time depends on the point, and is checked when the sweep runs, if at all).
+  transits the end time depends on the point, and is checked when the sweep runs, if at all),
+  and with ``outputs.histories`` t_end / sample_interval must be <= MAX_SAMPLES.
 - Transverse-only keys (tolerances, coefficients, frequencies, ``[initial]``, ``[metrics]``,
   the time-series outputs, ...) are accepted and ignored, so a resolved scene written by
   `Scene.to_toml` loads back; the transverse time checks above are not applied.
@@ -83,6 +88,10 @@ LONGITUDINAL_AXES: tuple[str, ...] = ("length", "load_amplitude", "youngs_modulu
 LONGITUDINAL_LOAD = "constant"
 RANGE_KEYS: tuple[str, ...] = ("start", "stop", "num", "spacing")
 MAX_AXIS_POINTS = 10_000_000
+MAX_SAMPLES = 10_000_000
+"""Most time-series samples per point (solver.t_end / outputs.sample_interval)."""
+MAX_SCENE_BYTES = 256 * 2**20
+"""A scene file longer than this is refused (a device such as /dev/zero never ends)."""
 
 _VALUE_SECTIONS: tuple[str, ...] = tuple(s for s in schema.SECTIONS if s != "axes")
 _COMMON_AXES = ("length", "load_amplitude", "frequency_ratio", "frequency", "damping_ratio")
@@ -109,7 +118,7 @@ _HINTS: dict[str, str] = {
     "solver.intervals": "give the number of spatial intervals per span, e.g. 1000",
     "solver.courant": "use 1.0, which is exact at the nodes",
     "outputs.snapshot_times": "give the snapshot times in seconds, e.g. [0.0001, 0.0002]",
-    "solver.rtol": "typical values are 1e-6 to 1e-10",
+    "solver.rtol": "use e.g. 1e-8; typical values are 1e-6 to 1e-10",
     "solver.atol": "give a small positive absolute tolerance, e.g. 1e-12 (m for q)",
     "solver.max_steps": "give a positive step budget, e.g. 1000000",
     "metrics.tail": "give the tail window as a fraction of t_end, e.g. 0.5",
@@ -232,7 +241,8 @@ def parse_override(item: str) -> tuple[str, Any]:
     key = key.strip()
     if not sep or not key:
         _fail(f"override '{item}'", "must have the form KEY=VALUE",
-              "KEY is a dotted scene key, e.g. solver.rtol=1e-9 or axes.length=[0.5, 1.0]")
+              "write a dotted scene key, '=' and a value, e.g. solver.rtol=1e-9 or "
+              "axes.length=[0.5, 1.0]")
     return key, _parse_value_text(value)
 
 
@@ -264,22 +274,35 @@ def _read_scene(scene: str | os.PathLike) -> tuple[str, str, str]:
     source = os.fspath(scene)
     path = Path(source)
     if not source or not path.exists():
+        if _looks_like_path(source):
+            _fail(f"scene file '{source}'", "no such file",
+                  "check the path; 'sweep scenes' lists the built-in names")
         _fail(f"scene '{source}'", "no built-in scene of that name and no such file",
               "run 'sweep scenes' for the built-in names")
     if path.is_dir():
         _fail(f"scene file '{source}'", "is a directory, not a TOML file",
               "give the path of a .toml scene file")
     try:
-        data = path.read_bytes()
+        with path.open("rb") as handle:
+            data = handle.read(MAX_SCENE_BYTES + 1)
     except OSError as exc:
         _fail(f"scene file '{source}'", f"cannot be read: {exc.strerror or exc}",
               "check the path and its permissions")
+    if len(data) > MAX_SCENE_BYTES:
+        _fail(f"scene file '{source}'", f"is larger than {MAX_SCENE_BYTES // 2**20} MiB",
+              "give a TOML scene file; write long axes as range tables {start, stop, num}")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         _fail(f"scene file '{source}'", f"is not UTF-8 text (bad byte at offset {exc.start})",
               "save the file as UTF-8")
     return source, text, path.stem or "unnamed"
+
+
+def _looks_like_path(source: str) -> bool:
+    """Whether a scene argument that names nothing was meant as a file, not a built-in name."""
+    return (os.sep in source or "/" in source or (os.altsep or "/") in source
+            or source.lower().endswith(".toml"))
 
 
 def _first_description_line(text: str) -> str:
@@ -358,7 +381,7 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
     for key, value in (overrides or {}).items():
         if not isinstance(key, str) or not key.strip():
             _fail(f"override {key!r}", "has no key",
-                  "the form is KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
+                  "write KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
         key = key.strip()
         parsed[key] = _override_value(key, value)
     frequencies = {_frequency_target(k) for k in parsed} - {None}
@@ -469,6 +492,7 @@ def _build(text: str, source: str, default_name: str,
     values = _resolve(given, axes)
     if values["model.kind"] == "longitudinal":
         _check_snapshot_times(values)
+        _check_sample_count(values, "outputs.histories")
     else:
         _check_times(values)
     return Scene(name=name, description=description, values=values, axes=axes,
@@ -515,7 +539,8 @@ def _unknown_top_level(key: str, value: Any) -> NoReturn:
     _fail(f"scene key '{key}'", "unknown top-level key", _suggestion(guess, _SECTIONS_TEXT))
 
 
-_SECTIONS_TEXT = ("the top level holds name, description and the sections "
+_SECTIONS_TEXT = ("remove it, or move it into its section: the top level holds name, "
+                  "description and the sections "
                   + ", ".join(f"[{s}]" for s in schema.SECTIONS))
 
 
@@ -561,7 +586,7 @@ def _check_sections(doc: dict[str, Any]) -> dict[str, Any]:
 
 def _unknown_section_key(section: str, dotted: str) -> NoReturn:
     valid = [k.name for k in schema.KEYS if k.section == section]
-    fallback = f"valid keys in [{section}]: {', '.join(valid)}"
+    fallback = f"remove it, or use one of the valid keys in [{section}]: {', '.join(valid)}"
     _fail(f"scene key '{dotted}'", "unknown key",
           _suggestion(_guess_key(dotted.partition(".")[2], section), fallback))
 
@@ -765,7 +790,8 @@ def _axis_name(entry: str) -> str:
               f"sweepable: {sweepable}; set {key.dotted} as a single value in [{key.section}]")
     candidates = [*schema.BY_AXIS, *(k.dotted for k in schema.BY_AXIS.values())]
     guess = _close(entry, candidates) or next((k.axis for k in same_name if k.axis), None)
-    _fail(f"axis '{entry}'", "unknown axis", _suggestion(guess, f"sweepable: {sweepable}"))
+    _fail(f"axis '{entry}'", "unknown axis",
+          _suggestion(guess, f"use one of the sweepable axes; sweepable: {sweepable}"))
 
 
 def _axis_values(axis: str, raw: Any) -> np.ndarray:
@@ -797,7 +823,7 @@ def _axis_range(where: str, raw: dict) -> np.ndarray:
     unknown = [k for k in raw if k not in RANGE_KEYS]
     if unknown:
         _fail(where, f"unknown key '{unknown[0]}' in range table",
-              f"allowed: {', '.join(RANGE_KEYS)}")
+              f"remove it; a range table takes only {', '.join(RANGE_KEYS)}")
     missing = [k for k in ("start", "stop", "num") if k not in raw]
     if missing:
         _fail(where, f"range table needs '{missing[0]}'", fix)
@@ -854,11 +880,12 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     if load_type != LONGITUDINAL_LOAD:
         _fail("scene key 'load.type'",
               f"model.kind = 'longitudinal' takes only '{LONGITUDINAL_LOAD}'",
-              "a suddenly applied end load, MODEL.md sec. 4")
+              "use load.type = 'constant', a suddenly applied end load (MODEL.md sec. 4), or "
+              "model.kind = 'transverse' for a harmonic load")
     for axis in axes:
         if axis not in LONGITUDINAL_AXES:
             _fail(f"axis '{axis}'", "model.kind = 'longitudinal' has no such parameter",
-                  f"it sweeps {', '.join(LONGITUDINAL_AXES)}")
+                  f"remove the axis; it sweeps {', '.join(LONGITUDINAL_AXES)}")
     if all(given.get(k) is not None for k in END_TIME_KEYS):
         _fail("scene keys 'solver.t_end' and 'solver.transits'", "give one, not both",
               "remove one of them: t_end is in seconds, transits in multiples of l/a")
@@ -904,6 +931,20 @@ def _check_times(values: dict[str, Any]) -> None:
         if value is not None and value > t_end:
             _fail(f"scene key '{dotted}'", f"must be <= solver.t_end ({t_end!r} s), got {value!r}",
                   "use a smaller value or a longer solver.t_end")
+    _check_sample_count(values, "outputs.time_series")
+
+
+def _check_sample_count(values: dict[str, Any], wanted: str) -> None:
+    """Refuse a sample interval that gives more than MAX_SAMPLES samples per point, when the
+    samples are asked for (``wanted``) and solver.t_end is known."""
+    t_end, interval = values["solver.t_end"], values["outputs.sample_interval"]
+    if not values[wanted] or t_end is None or interval is None or t_end / interval <= MAX_SAMPLES:
+        return
+    _fail("scene key 'outputs.sample_interval'",
+          f"{interval!r} s gives {t_end / interval:.3g} samples per point over "
+          f"solver.t_end = {t_end!r} s, more than {MAX_SAMPLES}",
+          f"use outputs.sample_interval >= {t_end / MAX_SAMPLES:.3g} s, or leave it out "
+          "for t_end/1000")
 
 
 def _check_snapshot_times(values: dict[str, Any]) -> None:

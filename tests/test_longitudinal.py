@@ -33,7 +33,7 @@ def run_span(courant, intervals=1000, transits=8.0, length=1.0, load=4.0, levels
     dx = length / intervals
     dt = courant * dx / WAVE
     p = np.array([[length, WAVE, EA, load, transits * length / WAVE, length]])
-    s = np.array([intervals, courant, dt_sample])
+    s = np.array([intervals, courant, dt_sample, 1e12])
     times = np.asarray(levels, dtype=float) * dt
     out = dict(states=np.empty(1, np.int8), reals=np.empty((1, lk.N_REALS)),
                steps=np.empty(1, np.int64), hist_u=np.empty((1, n_hist)),
@@ -109,7 +109,7 @@ def test_invalid_span_gets_a_state():
     p = np.array([[1.0, WAVE, EA, 4.0, 1e-3, 1.0], [-1.0, WAVE, EA, 4.0, 1e-3, 1.0]])
     states = np.empty(2, np.int8)
     reals = np.empty((2, lk.N_REALS))
-    lk.solve_batch(p, np.array([20, 1.0, 0.0]), np.empty(0), states, reals,
+    lk.solve_batch(p, np.array([20, 1.0, 0.0, 1e12]), np.empty(0), states, reals,
                    np.empty(2, np.int64), np.empty((2, 0)), np.empty((2, 0)),
                    *[np.empty((2, 0, 21)) for _ in range(3)])
     assert list(states) == [lk.COMPLETED, lk.INVALID_INPUT]

@@ -535,7 +535,8 @@ def test_longitudinal_paper_rules_do_not_apply():
 def test_longitudinal_refuses_harmonic_load():
     message = scene_error(LONG + '[load]\ntype = "harmonic"')
     assert message == ("scene key 'load.type': model.kind = 'longitudinal' takes only 'constant' "
-                       "(a suddenly applied end load, MODEL.md sec. 4)")
+                       "(use load.type = 'constant', a suddenly applied end load (MODEL.md sec. 4), "
+                       "or model.kind = 'transverse' for a harmonic load)")
     assert message == scene_error(LONG, {"load.type": "harmonic"})
 
 
@@ -544,7 +545,8 @@ def test_longitudinal_refuses_harmonic_load():
 def test_longitudinal_refuses_other_axes(axis):
     message = scene_error(LONG + f"[axes]\n{axis} = [0.1, 0.2]")
     assert message == (f"axis '{axis}': model.kind = 'longitudinal' has no such parameter "
-                       "(it sweeps length, load_amplitude, youngs_modulus, density, area)")
+                       "(remove the axis; it sweeps length, load_amplitude, youngs_modulus, "
+                       "density, area)")
 
 
 def test_longitudinal_refuses_both_end_times():

@@ -287,3 +287,18 @@ def test_undamped_unforced_points_conserve_energy(k0, g0, h, q0, v0, rtol):
                                 settings(rtol=rtol, atol=rtol * 1e-4, t_end=t_end))
     assert states[0] == km.STEADY
     assert potential(reals[0, tk.PEAK]) == pytest.approx(energy, rel=1e3 * rtol)
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_any_work():
+    text = ("[axes]\nlength = {start = 0.1, stop = 1.0, num = 200000}\n"
+            "frequency_ratio = {start = 0.5, stop = 3.0, num = 200000}\n")
+    with pytest.raises(sweep.UserError, match="GiB"):
+        sweep.run(scene(text), progress=False)
+
+
+def test_longitudinal_time_levels_are_bounded_by_max_steps():
+    from kernels import longitudinal as lk
+    ds = run("[model]\nkind = 'longitudinal'\n[solver]\nintervals = 100\ntransits = 50\n"
+             "max_steps = 1000\n")
+    assert int(ds["state"]) == lk.MAX_STEPS and int(ds["n_steps"]) == 1000
+    assert float(ds["failure_time"]) == pytest.approx(1000 * float(ds["time_step"]))
