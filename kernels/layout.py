@@ -1,0 +1,29 @@
+"""Layouts shared by the transverse drivers: the settings vector and the output columns."""
+
+# Entries of the `settings` vector.
+RTOL = 0            # relative tolerance
+ATOL = 1            # absolute tolerance (m and m/s)
+T_END = 2           # end time (s)
+MAX_STEPS = 3       # bound on accepted steps
+MAX_STEP = 4        # largest step (s); inf for none
+FIRST_STEP = 5      # first step (s); 0 for SciPy's automatic choice
+TAIL = 6            # tail window as a fraction of t_end, in (0, 1]
+TOL = 7             # settling band / decay threshold, relative
+SAMPLE_DT = 8       # time-series sample interval (s); used only when series has columns
+WANT_SETTLING = 9   # 1.0: compute settling times; 0.0: skip that work
+MIN_STEP = 10       # smallest step (s) before STEP_TOO_SMALL; SciPy's 10 ulps of t if larger
+N_SETTINGS = 11
+
+# Columns of the `reals` output.
+AMPLITUDE = 0       # max |q| over the tail window (m)
+PEAK = 1            # max |q| over the whole run (m)
+SETTLING = 2        # settling time (s) or NaN
+PERIOD = 3          # mean time between maxima of q in the tail (s) or NaN
+FAILURE_TIME = 4    # time at which a diverged or failed point stopped (s) or NaN
+N_REALS = 5
+
+# Columns of the `counts` output.
+STEPS = 0           # accepted steps
+REJECTED = 1        # rejected step attempts
+RHS_EVALS = 2       # right-hand-side evaluations
+N_COUNTS = 3

@@ -1,0 +1,254 @@
+"""One trajectory as a small state machine, shared by the scalar and the lock-step drivers.
+
+A trajectory's whole state lives in a float64 accumulator row (slots below) plus its extrema
+buffer, so a driver can advance many of them side by side:
+
+    start(...)                         initial state, f(0, y0), SciPy's initial step
+    h = next_attempt(settings, acc)    the step to try now (0.0: the trajectory has ended)
+    ... the driver computes one Dormand-Prince attempt of size h and its error norm ...
+    buf = finish_attempt(...)          SciPy's accept/reject and step-size update; on
+                                       acceptance the in-kernel metrics (metrics module)
+    classify(...)                      state, amplitude, settling time, period, counts
+
+Each point's attempts are SciPy RK45's, in SciPy's order, whatever the driver.
+Units: t in s, q in m, q' in m/s.
+"""
+
+import math
+
+import numba as nb
+import numpy as np
+
+from . import metrics as mt
+from .dopri5 import (MIN_RTOL, dense_coefficients, dense_root, dense_value, initial_step,
+                     step_factor)
+from .layout import (FIRST_STEP, MAX_STEP, MAX_STEPS, MIN_STEP, SAMPLE_DT, TAIL, T_END,
+                     RTOL, ATOL)
+from .oscillator import BOUND, Q0, V0, acceleration
+
+# Slots of a trajectory's accumulator row.
+T = 0               # current time (s)
+Q = 1               # q at T (m)
+V = 2               # q' at T (m/s)
+FQ = 3              # f(T, y), first component (= V)
+FV = 4              # f(T, y), second component (q'', m/s^2)
+H_ABS = 5           # step size to try next (s)
+T_NEW = 6           # end of the attempt in progress (s)
+REJECTED_NOW = 7    # 1.0 after a rejection within the current step
+STATUS = 8          # metrics.RUNNING until the trajectory ends
+T_STOP = 9          # when it ended (s)
+STEPS = 10          # accepted steps
+REJECTED = 11       # rejected attempts
+RHS_EVALS = 12      # right-hand-side evaluations
+PEAK = 13           # running max |q| (m)
+TAIL_AMP = 14       # max |q| over the tail window so far (m)
+TAIL_QMIN = 15      # min q over the tail window (m)
+TAIL_QMAX = 16      # max q over the tail window (m)
+LAST_ABOVE = 17     # last time |q - centre| > threshold (s)
+SAMPLE = 18         # next time-series sample index
+N_EXT = 19          # extrema recorded
+N_SLOTS = 20
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def new_buffer():
+    """An empty extrema buffer (metrics.push_extremum grows it)."""
+    return np.empty((64, 3))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def start(p, settings, acc, series):
+    """Set up a trajectory at t = 0 from its parameter row `p`; q(0) goes to series[0]."""
+    rtol = max(settings[RTOL], MIN_RTOL)
+    t_end = settings[T_END]
+    t_tail = t_end * (1.0 - settings[TAIL])
+    q = p[Q0]
+    v = p[V0]
+    acc[T] = 0.0
+    acc[Q] = q
+    acc[V] = v
+    acc[FQ] = v
+    acc[FV] = acceleration(0.0, q, v, p)
+    acc[RHS_EVALS] = 1.0
+    if settings[FIRST_STEP] > 0.0:
+        acc[H_ABS] = min(settings[FIRST_STEP], t_end)
+    else:
+        y = np.array([q, v])
+        f = np.array([acc[FQ], acc[FV]])
+        acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, settings[ATOL], p)
+        acc[RHS_EVALS] += 1.0
+    acc[T_NEW] = 0.0
+    acc[REJECTED_NOW] = 0.0
+    acc[STATUS] = mt.RUNNING
+    acc[T_STOP] = t_end
+    acc[STEPS] = 0.0
+    acc[REJECTED] = 0.0
+    acc[PEAK] = abs(q)
+    acc[TAIL_AMP] = abs(q) if t_tail <= 0.0 else 0.0
+    acc[TAIL_QMIN] = q if t_tail <= 0.0 else math.inf
+    acc[TAIL_QMAX] = q if t_tail <= 0.0 else -math.inf
+    acc[LAST_ABOVE] = 0.0
+    acc[SAMPLE] = 0.0
+    if series.shape[0] > 0:
+        series[0] = q
+        acc[SAMPLE] = 1.0
+    acc[N_EXT] = 0.0
+    if not abs(q) <= p[BOUND]:
+        acc[STATUS] = mt.DIVERGED
+        acc[T_STOP] = 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def next_attempt(settings, acc):
+    """The step h (s) to attempt from acc[T], as SciPy's RK45 chooses it; 0.0 when the
+    trajectory has ended (reached t_end, or failed: STATUS says which)."""
+    if acc[STATUS] != mt.RUNNING:
+        return 0.0
+    t = acc[T]
+    t_end = settings[T_END]
+    if t >= t_end:
+        return 0.0
+    min_step = max(10.0 * abs(np.nextafter(t, math.inf) - t), settings[MIN_STEP])
+    h_abs = acc[H_ABS]
+    if acc[REJECTED_NOW] == 0.0:
+        if acc[STEPS] >= settings[MAX_STEPS]:
+            acc[STATUS] = mt.MAX_STEPS
+            acc[T_STOP] = t
+            return 0.0
+        if h_abs > settings[MAX_STEP]:
+            h_abs = settings[MAX_STEP]
+        elif h_abs < min_step:
+            h_abs = min_step
+    if h_abs < min_step:
+        acc[STATUS] = mt.STEP_TOO_SMALL
+        acc[T_STOP] = t
+        return 0.0
+    t_new = t + h_abs
+    if t_new > t_end:
+        t_new = t_end
+    h = t_new - t
+    acc[H_ABS] = abs(h)
+    acc[T_NEW] = t_new
+    return h
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _last_time_above(t, h, Qc, q_old, q_new, has_ext, xe, qe, centre, thr, last):
+    """Update the last time |q - centre| > thr with the step [t, t + h]."""
+    if abs(q_new - centre) > thr:
+        return t + h
+    xa = -1.0
+    xb = 1.0
+    q_a = 0.0
+    if has_ext and abs(qe - centre) > thr:
+        xa = xe
+        q_a = qe
+    elif abs(q_old - centre) > thr:
+        xa = 0.0
+        q_a = q_old
+        if has_ext:
+            xb = xe
+    if xa < 0.0:
+        return last
+    side = 1.0 if q_a > centre else -1.0
+    x = dense_root(q_old, h, Qc, 0, centre + side * thr, xa, xb)
+    return t + x * h
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
+                   track, centre, thr_fixed, thr_rel):
+    """Accept or reject the attempt of size h (K: its 7 stage derivatives, (q_new, v_new): its
+    fifth-order solution, err: its error norm) and update the step size as SciPy does. On
+    acceptance, reduce the metrics of the step on its dense output. Returns the extrema buffer
+    (regrown when full). Qc is scratch for the interpolant, shape (2, 4).
+    """
+    acc[RHS_EVALS] += 6.0
+    acc[H_ABS] *= step_factor(err, acc[REJECTED_NOW] != 0.0)
+    if not err < 1.0:
+        acc[REJECTED_NOW] = 1.0
+        acc[REJECTED] += 1.0
+        return buf
+    acc[REJECTED_NOW] = 0.0
+    acc[STEPS] += 1.0
+    t = acc[T]
+    t_new = acc[T_NEW]
+    q_old = acc[Q]
+    v_old = acc[V]
+    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    bound = p[BOUND]
+
+    if not (abs(q_new) <= bound and math.isfinite(v_new)):
+        acc[STATUS] = mt.DIVERGED
+        acc[T_STOP] = t_new
+        if math.isfinite(q_new) and abs(q_new) > bound and abs(q_old) <= bound:
+            dense_coefficients(K, Qc)
+            side = 1.0 if q_new > 0.0 else -1.0
+            acc[T_STOP] = t + dense_root(q_old, h, Qc, 0, side * bound, 0.0, 1.0) * h
+        return buf
+
+    # The interpolant is built only for steps that need it (an extremum, the tail's start,
+    # a sample or a crossing of the tracked threshold).
+    n_samples = series.shape[0]
+    k = int(acc[SAMPLE])
+    dt_sample = settings[SAMPLE_DT]
+    peak = acc[PEAK]
+    has_ext = (v_old > 0.0 and v_new <= 0.0) or (v_old < 0.0 and v_new >= 0.0)
+    straddles_tail = t < t_tail <= t_new
+    has_sample = k < n_samples and k * dt_sample <= t_new
+    thr_now = thr_fixed + thr_rel * max(peak, abs(q_new))
+    may_cross = track and abs(q_new - centre) <= thr_now < abs(q_old - centre)
+    if has_ext or straddles_tail or has_sample or may_cross:
+        dense_coefficients(K, Qc)
+    xe = 0.0
+    qe = 0.0
+    if has_ext:
+        xe = dense_root(v_old, h, Qc, 1, 0.0, 0.0, 1.0)
+        te = t + xe * h
+        qe = dense_value(q_old, h, Qc, 0, xe)
+        kind = mt.MAXIMUM if v_old > 0.0 else mt.MINIMUM
+        n_ext = int(acc[N_EXT])
+        buf = mt.push_extremum(buf, n_ext, te, qe, kind)
+        acc[N_EXT] = n_ext + 1
+        peak = max(peak, abs(qe))
+        if te >= t_tail:
+            acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qe))
+            acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qe)
+            acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qe)
+    peak = max(peak, abs(q_new))
+
+    if t_new >= t_tail:
+        if straddles_tail:
+            qt = dense_value(q_old, h, Qc, 0, (t_tail - t) / h)
+            peak = max(peak, abs(qt))
+            acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qt))
+            acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qt)
+            acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qt)
+        acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(q_new))
+        acc[TAIL_QMIN] = min(acc[TAIL_QMIN], q_new)
+        acc[TAIL_QMAX] = max(acc[TAIL_QMAX], q_new)
+    acc[PEAK] = peak
+
+    if track:
+        thr = thr_fixed + thr_rel * peak
+        acc[LAST_ABOVE] = _last_time_above(t, h, Qc, q_old, q_new, has_ext, xe, qe,
+                                           centre, thr, acc[LAST_ABOVE])
+
+    while k < n_samples and k * dt_sample <= t_new:
+        series[k] = dense_value(q_old, h, Qc, 0, (k * dt_sample - t) / h)
+        k += 1
+    acc[SAMPLE] = k
+
+    acc[T] = t_new
+    acc[Q] = q_new
+    acc[V] = v_new
+    acc[FQ] = K[6, 0]
+    acc[FV] = K[6, 1]
+    return buf
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def end_series(acc, series):
+    """NaN for the samples a trajectory that stopped early never reached."""
+    for j in range(int(acc[SAMPLE]), series.shape[0]):
+        series[j] = math.nan
