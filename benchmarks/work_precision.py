@@ -1,72 +1,128 @@
-"""Work-precision curves of cable-sweep, SciPy RK45 and SciPy DOP853: picks the default rtol.
+"""Work-precision of cable-sweep against SciPy RK45/DOP853 and numbalsoda dop853/lsoda.
+
+Wall time against the error of what a user reads (amplitude, settling time and state, final
+state), on the same points, on the same machine, in the same run; it also picks the default
+rtol.
 
 What it measures
 ----------------
 Reference points: the consistent model (Table 1 cable defaults, damping ratio 0.02, harmonic
 end load 4 N) on lengths 0.3, 0.5, 0.7, 1.0 m x frequency ratios W/w1 0.8, 1.0, 1.9, 2.0, 2.5
-(--lengths, --ratios), from q0 = 1e-3 m at rest, t in [0, 5] s.
+(--lengths, --ratios), from q0 = 1e-3 m at rest, t in [0, 5] s. Tail window [2.5, 5] s and
+tolerance 0.02: the scene defaults (metrics.tail, metrics.tolerance).
 
 Reference solution: SciPy `solve_ivp(method="DOP853", rtol=1e-13, atol=1e-16,
-dense_output=True)`. Reference amplitude = max |q| over [2.5, 5] s (the kernel's tail window):
-the dense output on a 20001-point grid, then every sign change of the velocity component q'
-located with brentq and |q| taken there. Also q(5) and the peak max |q| over [0, 5] s.
-A second DOP853 run at 10x looser tolerances (rtol 1e-12, atol 1e-15) is compared with it and
-printed as the reference's own uncertainty.
+dense_output=True)`, its metrics computed by `reference_metrics.response_metrics` on the dense
+output: every extremum of q (sign changes of q' on a 20001-point grid, located with brentq),
+tail amplitude (max |q| over the tail's extrema and the window ends), peak, state (decayed /
+steady / modulated / unsettled) and settling time, with the kernel's definitions (README "What
+the output holds"; `kernels/metrics.py`) written independently. Also q(5). A second DOP853 run
+at 10x looser tolerances (rtol 1e-12, atol 1e-15) is compared with it and printed as the
+reference's own uncertainty.
 
 For each rtol of --rtols (default 1e-3, 1e-4, ..., 1e-12) with atol = rtol * 1e-4, floored at
 1e-16 (--atol-factor; or one fixed atol for all with --atol). The factor 1e-4 keeps the scene
 default pair (rtol 1e-8, atol 1e-12) on the curve; with q ~ 1e-3 m it makes the relative
 tolerance govern until |q| falls ~10x below q0.
-  - cable-sweep: `sweep.run.solve_points` on all points, 1 thread (wall time for the set:
-    best of repeats filling >= 0.2 s, after a compile warm-up that is reported separately).
-    q(5) comes from the `displacement` time series with sample_interval = t_end (samples at
-    t = 0 and t = 5 s only), the amplitude from the `amplitude` output;
-  - SciPy RK45 and DOP853, one point at a time, dense_output=True (the run that yields the
-    amplitude; the amplitude extraction itself is not timed), one timed run per point.
-Reported per rtol: wall time for the set, mean accepted steps, max relative amplitude error
-|A - A_ref| / A_ref, max relative final-state error |q(5) - q_ref(5)| / max|q_ref|.
+  - cable-sweep: `sweep.run.solve_points` on all points, on 1 thread and on 2 threads (wall time
+    for the set: best of repeats filling >= 0.2 s, after a compile warm-up that is reported
+    separately). Amplitude, state and settling time are the kernel's own outputs; q(5) comes
+    from the `displacement` time series with sample_interval = t_end (samples at t = 0 and 5 s).
+  - SciPy RK45 and DOP853 (`solve_ivp`, plain Python right-hand side), one point at a time,
+    dense_output=True, one timed run per point, 1 thread. Their amplitude, state and settling
+    time come from `reference_metrics` on their own dense output (not timed).
+  - numbalsoda (optional extra: `pip install numbalsoda`; skipped with a message if it is not
+    importable) `dop853` and `lsoda`: a Numba `cfunc` right-hand side with numbalsoda's
+    signature, the 8 oscillator coefficients (m, c, k0, k1, g0, g1, h, W) passed through the data
+    pointer (one more slot of the padded row counts right-hand-side calls: no measurable
+    cost), called from an `@njit(parallel=True)` prange loop over all points, in the same
+    shuffled order as cable-sweep's (`sweep.run.point_order`, which spreads the costly points
+    over the threads); each call returns q, q' on --ns-samples (20001) evenly spaced
+    times on [0, 5] s (numbalsoda has no dense-output object; its 0.3.4 `dop853` integrates
+    [0, 5] s once and fills the output times from DOP853's dense output, `lsoda` interpolates
+    to each output time). Timed like cable-sweep (the prange loop, best of repeats, after a
+    compile warm-up) on 1 and on 2 Numba threads. The timed loop includes filling the output
+    times, which a user needs to read amplitude and settling time: about a quarter of dop853's
+    time at rtol 1e-8 with 20001 samples (measured during development against 2001 samples);
+    --ns-samples 5001 costs less, with an interpolation floor of ~3e-11 on the amplitude.
+    The metrics are then taken from the samples (not timed): q'' at each sample from the
+    right-hand side, a piecewise quintic Hermite interpolant through (q, q', q'')
+    (`reference_metrics.HermiteSamples`) and `reference_metrics` on it, with the sample times
+    as the bracketing grid: the same definitions applied to the sampled signal. Its
+    interpolation error is ~(w dt)^6/46080 of the amplitude: applied to the reference solution
+    sampled the same way it changes the amplitudes by <= 1.1e-13 relative (non-decayed points),
+    settling times by ~1e-13 t_end, and no state. The plain max of the samples would
+    underestimate the amplitude by up to (w dt)^2/8 (2.5e-5 measured at 20001 samples), far
+    above the errors compared here. numbalsoda reports no step counts: "mean steps" is empty.
+Reported per method and rtol: wall time for the set (1 thread; 2 threads for cable-sweep and
+numbalsoda), mean accepted steps, mean right-hand-side evaluations, max relative amplitude
+error |A - A_ref| / A_ref, the settling-time error max |Ts - Ts_ref| / t_end over the points
+whose reference state has a settling time (decayed, steady) and whose result has one, the
+number of points whose state differs from the reference's, and the max relative final-state
+error |q(5) - q_ref(5)| / max|q_ref|.
 
 Decayed points. With 2 % damping the short spans off resonance decay by ~1e-9 before the tail
 window (l = 0.3 m: A_ref ~ 7e-12 m from q0 = 1e-3 m); there the amplitude is set by atol, not
 rtol, and even the reference is only good to ~1e-6 relative. Points whose reference amplitude
 is <= metrics.tolerance (0.02) x peak, the kernel's own "decayed" test, are therefore left out of
-the amplitude-error column `amp err` and the recommendation; `amp err (all)` includes them.
---include-decayed applies the recommendation to all points.
+the amplitude-error column `amp err`, the recommendation and the equal-error ratios;
+`amp err (all)` includes them. --include-decayed applies the recommendation to all points.
 
 Recommendation: the largest rtol (cheapest) whose cable-sweep max relative amplitude error is
 below --threshold (1e-6) on every (non-decayed) reference point, and stays below it for every
 tighter rtol in the list too (so a loose rtol that passes by luck is not picked).
 
-Command (full size; run on an otherwise idle machine, a few minutes, mostly SciPy RK45)
---------------------------------------------------------------------------------------
+Equal-error ratios: the error target is the max amplitude error cable-sweep reaches at
+--target-rtol (1e-8, the default rtol; the nearest rtol run otherwise). Each method's wall time
+at that error is interpolated linearly in log(wall) against log(error) between the two rtols
+that bracket it (the first crossing from the loose end); cable-sweep's speed ratio against each
+peer at 1 thread (and at 2 threads against numbalsoda) is printed.
+
+Command (full size; run on an otherwise idle machine with >= 2 cores; a few minutes, mostly
+SciPy RK45 and the metrics extraction of the SciPy runs)
+--------------------------------------------------------------------------------------------
     PYTHONPATH=. python benchmarks/work_precision.py --plot work_precision.png \
         --json work_precision.json
 
-Small check: python benchmarks/work_precision.py --rtols 1e-4,1e-8
-Prints Markdown tables to stdout; --plot PATH saves wall time vs max amplitude error (PNG).
+Small check: python benchmarks/work_precision.py --rtols 1e-4,1e-8 --lengths 0.5,1.0 \
+    --ratios 1.0,2.0
+Prints Markdown tables to stdout; --plot PATH saves wall time vs max amplitude error and vs
+settling-time error (PNG, two panels).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # the checkout's sweep/kernels
+sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common, reference_metrics
 
 from bench_common import (best_time, markdown_table, parameter_table,  # noqa: E402
-                          solve_scipy, tail_amplitude, write_json)
-from sweep.run import KernelResult, sample_times, settings_vector, solve_points  # noqa: E402
+                          solve_scipy, write_json)
+from kernels import oscillator as osc  # noqa: E402
+from reference_metrics import (HAS_SETTLING, HermiteSamples, response_metrics,  # noqa: E402
+                               self_check)
+from sweep.run import (KernelResult, grid_order, point_order, sample_times,  # noqa: E402
+                       settings_vector, solve_points)
 from sweep.scene import Scene, load_scene_text  # noqa: E402
 
 T_END = 5.0
-TAIL_START = 2.5                 # the scene's default tail window: the last half of [0, t_end]
 DEFAULT_RTOLS = "1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12"
 ATOL_FLOOR = 1e-16
+CABLE = "cable-sweep"
+NS_MAX_STEPS = 2_000_000_000        # numbalsoda mxstep (a C int): no practical bound
+N_COEFFS = 8                        # m, c, k0, k1, g0, g1, h, W: the first 8 parameter columns
+NS_COUNTER = 12                     # slot of the RHS-call counter in a numbalsoda data row
+NS_ROW = 24                         # data row length: 192 bytes, so that one point's counter
+                                    # never shares a cache line with another point's row
+TIE = 1.01                          # equal-error: an error within 1 % of the target reaches it
 
 SCENE = """
 name = "work-precision"
@@ -103,10 +159,12 @@ sample_interval = 5.0
 @dataclass
 class Reference:
     """Reference quantities per point."""
-    amplitude: np.ndarray      # max |q| over [2.5, 5] s (m)
+    amplitude: np.ndarray      # max |q| over the tail window (m)
     peak: np.ndarray           # max |q| over [0, 5] s (m)
     q_end: np.ndarray          # q(5) (m)
     steps: np.ndarray          # accepted DOP853 steps
+    state: np.ndarray          # state names (reference_metrics)
+    settling: np.ndarray       # settling time (s) or NaN
 
 
 @dataclass
@@ -115,10 +173,23 @@ class Measurement:
     method: str
     rtol: float
     atol: float
-    wall_s: float
-    steps: np.ndarray          # accepted steps per point
+    wall_s: float              # 1 thread
+    steps: np.ndarray          # accepted steps per point (NaN: not reported by the solver)
+    rhs_evals: np.ndarray      # right-hand-side evaluations per point
     amplitude: np.ndarray
     q_end: np.ndarray
+    state: np.ndarray          # state names
+    settling: np.ndarray       # settling time (s) or NaN
+    wall2_s: float = math.nan  # 2 threads (cable-sweep and numbalsoda only)
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Settings:
+    """What every method needs to know about the metrics."""
+    tail: float
+    tol: float
+    ns_samples: int
 
 
 def parse_args() -> argparse.Namespace:
@@ -135,7 +206,15 @@ def parse_args() -> argparse.Namespace:
                    help="max relative amplitude error of the recommended rtol (default 1e-6)")
     p.add_argument("--include-decayed", action="store_true",
                    help="judge the recommendation on decayed points too")
-    p.add_argument("--plot", metavar="PATH", help="save wall time vs amplitude error as PNG")
+    p.add_argument("--target-rtol", type=float, default=1e-8,
+                   help="equal-error target: cable-sweep's amplitude error at this rtol "
+                        "(default 1e-8)")
+    p.add_argument("--ns-samples", type=int, default=20001,
+                   help="numbalsoda output times on [0, t_end] (default 20001)")
+    p.add_argument("--no-numbalsoda", action="store_true", help="skip the numbalsoda peers")
+    p.add_argument("--no-scipy", action="store_true",
+                   help="skip the SciPy peers (quick checks only)")
+    p.add_argument("--plot", metavar="PATH", help="save the work-precision plot as PNG")
     p.add_argument("--json", metavar="PATH", help="also write the results as JSON")
     return p.parse_args()
 
@@ -157,20 +236,32 @@ def build_scene(lengths: list[float], ratios: list[float]) -> Scene:
     return load_scene_text(text, source="work_precision.py")
 
 
-def reference_solution(table: np.ndarray, rtol: float, atol: float) -> Reference:
-    """DOP853 at tight tolerances: amplitude (extrema refined), peak, q(5), steps per point."""
-    amp, peak, q_end, steps = (np.empty(len(table)) for _ in range(4))
+def acceleration(row: np.ndarray, t: np.ndarray, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """q'' of the oscillator at samples (t, q, q'), vectorised; coefficients from `row`."""
+    m, c, k0, k1, g0, g1, h, w = (float(row[j]) for j in (
+        osc.MASS, osc.DAMPING, osc.K0, osc.K1, osc.G0, osc.G1, osc.H, osc.OMEGA))
+    cw = np.cos(w * t)
+    q2 = q * q
+    return -(c * v + (k0 + k1 * cw) * q + (g0 + g1 * cw) * q * q2 + h * q * q2 * q2) / m
+
+
+def reference_solution(table: np.ndarray, rtol: float, atol: float, cfg: Settings) -> Reference:
+    """DOP853 at tight tolerances and reference_metrics on its dense output, per point."""
+    n = len(table)
+    amp, peak, q_end, steps, settling = (np.empty(n) for _ in range(5))
+    state = np.empty(n, dtype=object)
     for i, row in enumerate(table):
         sol = solve_scipy(row, T_END, rtol, atol, method="DOP853", dense=True)
-        amp[i] = tail_amplitude(sol, TAIL_START, T_END)
-        peak[i] = max(tail_amplitude(sol, 0.0, T_END), float(np.max(np.abs(sol.y[0]))))
+        m = response_metrics(sol.sol, T_END, cfg.tail, cfg.tol)
+        amp[i], peak[i], settling[i], state[i] = m.amplitude, m.peak, m.settling_time, m.state
         q_end[i] = sol.y[0, -1]
         steps[i] = len(sol.t) - 1
-    return Reference(amp, peak, q_end, steps)
+    return Reference(amp, peak, q_end, steps, state, settling)
 
 
 def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float) -> Measurement:
-    """cable-sweep on all points, 1 thread: best wall time, amplitude and q(t_end)."""
+    """cable-sweep on all points: best wall time on 1 and on 2 threads, and its outputs."""
+    from kernels import metrics as mt
     from kernels import transverse as tk
     tuned = load_scene_text(scene.to_toml(), source="work_precision.py",
                             overrides={"solver.rtol": rtol, "solver.atol": atol})
@@ -179,28 +270,154 @@ def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float) -
     assert times[-1] == T_END, times
     result: list[KernelResult] = []
 
-    def once() -> None:
-        result.append(solve_points(table, settings, times.size, threads=1))
+    def once(threads: int) -> None:
+        result.append(solve_points(table, settings, times.size, threads=threads))
 
-    wall = best_time(once)
+    wall = best_time(lambda: once(1))
     last = result[-1]
-    return Measurement("cable-sweep", rtol, atol, wall, last.counts[:, tk.STEPS].copy(),
-                       last.reals[:, tk.AMPLITUDE].copy(), last.series[:, -1].copy())
+    wall2 = best_time(lambda: once(2)) if max_threads() >= 2 else math.nan
+    m = Measurement(CABLE, rtol, atol, wall, last.counts[:, tk.STEPS].astype(float),
+                    last.counts[:, tk.RHS_EVALS].astype(float),
+                    last.reals[:, tk.AMPLITUDE].copy(), last.series[:, -1].copy(),
+                    np.array([mt.STATE_MEANINGS[s] for s in last.states], dtype=object),
+                    last.reals[:, tk.SETTLING].copy(), wall2)
+    if not np.array_equal(result[-1].reals, last.reals, equal_nan=True):
+        m.notes.append("2-thread outputs differ from 1-thread outputs")
+    return m
 
 
-def run_scipy(table: np.ndarray, method: str, rtol: float, atol: float) -> Measurement:
+def run_scipy(table: np.ndarray, method: str, rtol: float, atol: float,
+              cfg: Settings) -> Measurement:
     """SciPy `method` one point at a time (dense output on); the solves alone are timed."""
+    n = len(table)
     wall = 0.0
-    steps, amp, q_end = (np.empty(len(table)) for _ in range(3))
+    steps, evals, amp, q_end, settling = (np.empty(n) for _ in range(5))
+    state = np.empty(n, dtype=object)
     for i, row in enumerate(table):
         start = time.perf_counter()
         sol = solve_scipy(row, T_END, rtol, atol, method=method, dense=True)
         wall += time.perf_counter() - start
         steps[i] = len(sol.t) - 1
-        amp[i] = tail_amplitude(sol, TAIL_START, T_END)
+        evals[i] = sol.nfev
+        m = response_metrics(sol.sol, T_END, cfg.tail, cfg.tol)
+        amp[i], settling[i], state[i] = m.amplitude, m.settling_time, m.state
         q_end[i] = sol.y[0, -1]
-    return Measurement(f"SciPy {method}", rtol, atol, wall, steps, amp, q_end)
+    return Measurement(f"SciPy {method}", rtol, atol, wall, steps, evals, amp, q_end, state,
+                       settling)
 
+
+def max_threads() -> int:
+    import numba
+    return int(numba.config.NUMBA_NUM_THREADS)
+
+
+# --- numbalsoda ------------------------------------------------------------------------------
+
+class Numbalsoda:
+    """numbalsoda's dop853 and lsoda over all points from a Numba prange loop.
+
+    The right-hand side is a `cfunc` with numbalsoda's signature rhs(t, u, du, p); p points to
+    one row of `data`: the 8 coefficients m, c, k0, k1, g0, g1, h, W, and at NS_COUNTER a
+    counter of calls (rows padded to NS_ROW doubles: no false sharing between threads).
+    """
+
+    SOLVERS = ("dop853", "lsoda")
+
+    def __init__(self) -> None:
+        import numba as nb
+        from numbalsoda import dop853, lsoda, lsoda_sig
+
+        assert (osc.MASS, osc.DAMPING, osc.K0, osc.K1, osc.G0, osc.G1, osc.H, osc.OMEGA) \
+            == tuple(range(N_COEFFS))
+
+        @nb.cfunc(lsoda_sig)
+        def rhs(t, u, du, p):
+            q = u[0]
+            v = u[1]
+            cw = math.cos(p[7] * t)
+            q2 = q * q
+            force = (p[1] * v + (p[2] + p[3] * cw) * q + (p[4] + p[5] * cw) * q * q2
+                     + p[6] * q * q2 * q2)
+            du[0] = v
+            du[1] = -force / p[0]
+            p[NS_COUNTER] += 1.0
+
+        def make_loop(solver):
+            @nb.njit(parallel=True)
+            def loop(funcptr, data, u0, t_eval, rtol, atol, out, ok):
+                for i in nb.prange(data.shape[0]):
+                    data[i, NS_COUNTER] = 0.0
+                    usol, success = solver(funcptr, u0[i], t_eval, data=data[i], rtol=rtol,
+                                           atol=atol, mxstep=NS_MAX_STEPS)
+                    out[i] = usol
+                    ok[i] = success
+            return loop
+
+        self.rhs = rhs
+        self.funcptr = rhs.address
+        self.loops = {"dop853": make_loop(dop853), "lsoda": make_loop(lsoda)}
+
+    def warm_up(self, table: np.ndarray, t_eval: np.ndarray) -> float:
+        """Compile both loops; returns the wall time of that."""
+        start = time.perf_counter()
+        for name in self.SOLVERS:
+            self.solve(name, table[:1], t_eval, 1e-3, 1e-7, threads=1)
+        return time.perf_counter() - start
+
+    def solve(self, name: str, table: np.ndarray, t_eval: np.ndarray, rtol: float, atol: float,
+              threads: int, timed: bool = False):
+        """(samples (n, nt, 2), success (n,), rhs calls (n,), best wall time or NaN), in the
+        order of `table`; solved in cable-sweep's shuffled point order."""
+        import numba
+        n = len(table)
+        order = point_order(n)
+        data = np.zeros((n, NS_ROW))
+        data[:, :N_COEFFS] = table[order, :N_COEFFS]
+        u0 = np.ascontiguousarray(table[order][:, [osc.Q0, osc.V0]])
+        out = np.empty((n, t_eval.size, 2))
+        ok = np.zeros(n, dtype=np.bool_)
+        loop = self.loops[name]
+        numba.set_num_threads(threads)
+
+        def once() -> None:
+            loop(self.funcptr, data, u0, t_eval, rtol, atol, out, ok)
+
+        wall = best_time(once) if timed else math.nan
+        if not timed:
+            once()
+        back = grid_order(order)
+        return out[back], ok[back], data[back, NS_COUNTER], wall
+
+
+def run_numbalsoda(ns: Numbalsoda, name: str, table: np.ndarray, rtol: float, atol: float,
+                   cfg: Settings) -> Measurement:
+    """numbalsoda `name` on all points, timed on 1 and 2 threads; metrics from the samples."""
+    t_eval = np.linspace(0.0, T_END, cfg.ns_samples)
+    out, ok, evals, wall = ns.solve(name, table, t_eval, rtol, atol, threads=1, timed=True)
+    wall2 = math.nan
+    notes = []
+    if max_threads() >= 2:
+        out2, ok2, _, wall2 = ns.solve(name, table, t_eval, rtol, atol, threads=2, timed=True)
+        if not (np.array_equal(out, out2, equal_nan=True) and np.array_equal(ok, ok2)):
+            notes.append("2-thread outputs differ from 1-thread outputs")
+    n = len(table)
+    amp, q_end, settling = (np.full(n, math.nan) for _ in range(3))
+    state = np.full(n, "solver_failed", dtype=object)
+    for i, row in enumerate(table):
+        if not ok[i]:
+            continue
+        q, v = out[i, :, 0], out[i, :, 1]
+        dense = HermiteSamples(t_eval, q, v, acceleration(row, t_eval, q, v))
+        m = response_metrics(dense, T_END, cfg.tail, cfg.tol, grid=t_eval)
+        amp[i], settling[i], state[i] = m.amplitude, m.settling_time, m.state
+        q_end[i] = q[-1]
+    if not ok.all():
+        notes.append(f"{int((~ok).sum())} points failed")
+    return Measurement(f"numbalsoda {name}", rtol, atol, wall, np.full(n, math.nan), evals,
+                       amp, q_end, state, settling, wall2, notes)
+
+
+# --- errors and reporting --------------------------------------------------------------------
 
 def amplitude_errors(amplitude: np.ndarray, ref: Reference) -> np.ndarray:
     """|A - A_ref| / A_ref per point (inf where the method gave no finite amplitude)."""
@@ -214,13 +431,33 @@ def final_state_errors(q_end: np.ndarray, ref: Reference) -> np.ndarray:
     return np.where(np.isfinite(err), err, np.inf)
 
 
+def settling_errors(m: Measurement, ref: Reference) -> np.ndarray:
+    """|Ts - Ts_ref| / t_end on points where both the reference and `m` have a settling time
+    (NaN elsewhere)."""
+    has = np.isin(ref.state, HAS_SETTLING) & np.isfinite(m.settling)
+    return np.where(has, np.abs(m.settling - ref.settling) / T_END, math.nan)
+
+
+def state_mismatches(m: Measurement, ref: Reference) -> int:
+    return int(np.sum(m.state != ref.state))
+
+
+def max_amp_err(m: Measurement, ref: Reference, judged: np.ndarray) -> float:
+    return float(np.max(amplitude_errors(m.amplitude, ref)[judged], initial=0.0))
+
+
+def max_ts_err(m: Measurement, ref: Reference) -> float:
+    err = settling_errors(m, ref)
+    return float(np.nanmax(err)) if np.any(np.isfinite(err)) else math.nan
+
+
 def recommend(runs: list[Measurement], ref: Reference, judged: np.ndarray,
               threshold: float) -> float | None:
     """Largest cable-sweep rtol whose amplitude error (on `judged` points) is below `threshold`
     for it and for every tighter rtol; None if even the tightest fails."""
     best = None
-    for m in sorted((m for m in runs if m.method == "cable-sweep"), key=lambda m: m.rtol):
-        if np.max(amplitude_errors(m.amplitude, ref)[judged], initial=0.0) < threshold:
+    for m in sorted((m for m in runs if m.method == CABLE), key=lambda m: m.rtol):
+        if max_amp_err(m, ref, judged) < threshold:
             best = m.rtol
         else:
             break
@@ -231,9 +468,11 @@ def step_agreement(runs: list[Measurement], n: int) -> str:
     """A line: on how many points cable-sweep and SciPy RK45 took the same accepted steps."""
     parts = []
     for m in runs:
-        if m.method != "cable-sweep":
+        if m.method != CABLE:
             continue
-        rk = next(r for r in runs if r.method == "SciPy RK45" and r.rtol == m.rtol)
+        rk = next((r for r in runs if r.method == "SciPy RK45" and r.rtol == m.rtol), None)
+        if rk is None:
+            continue
         diff = np.abs(m.steps - rk.steps)
         parts.append(f"rtol {m.rtol:.0e}: {int(np.sum(diff == 0))}/{n}"
                      + (f" (max diff {int(diff.max())})" if diff.max() > 0 else ""))
@@ -254,108 +493,273 @@ def point_labels(scene: Scene) -> list[tuple[float, float]]:
     return list(zip(lengths.ravel().tolist(), ratios.ravel().tolist()))
 
 
-def plot(runs: list[Measurement], ref: Reference, judged: np.ndarray, path: str) -> None:
-    """Wall time vs max relative amplitude error, one line per method, rtols annotated."""
+def methods_of(runs: list[Measurement]) -> list[str]:
+    seen: list[str] = []
+    for m in runs:
+        if m.method not in seen:
+            seen.append(m.method)
+    return seen
+
+
+def curve(runs: list[Measurement], method: str) -> list[Measurement]:
+    """The runs of `method`, loosest rtol first."""
+    return sorted((m for m in runs if m.method == method), key=lambda m: -m.rtol)
+
+
+def wall_at_error(ms: list[Measurement], errs: list[float], target: float,
+                  two_threads: bool = False) -> tuple[float, str]:
+    """Wall time at error `target` on the log-log curve (errs per run, loosest rtol first):
+    interpolated between the first pair of rtols whose errors bracket it.
+    An error within TIE (1 %) of the target counts as reaching it (cable-sweep and SciPy RK45
+    take the same steps: their errors differ only by round-off).
+    Returns (wall, how): how is "", "<=" (the loosest rtol is already as accurate: an upper
+    bound) or "not reached" (wall NaN)."""
+    walls = [m.wall2_s if two_threads else m.wall_s for m in ms]
+    if not ms or not all(math.isfinite(w) for w in walls):
+        return math.nan, "not measured"
+    if errs[0] <= target * TIE:
+        return walls[0], "<=" if errs[0] < target / TIE else ""
+    for (e_a, w_a), (e_b, w_b) in zip(zip(errs, walls), zip(errs[1:], walls[1:])):
+        if e_a >= target and e_b <= target * TIE:
+            la, lb = math.log(max(e_a, 1e-300)), math.log(max(e_b, 1e-300))
+            x = 1.0 if la == lb else min(1.0, (math.log(target) - la) / (lb - la))
+            return math.exp(math.log(w_a) + x * (math.log(w_b) - math.log(w_a))), ""
+    return math.nan, "not reached"
+
+
+def equal_error_report(runs: list[Measurement], ref: Reference, judged: np.ndarray,
+                       target_rtol: float) -> tuple[list[str], dict]:
+    """Lines of the equal-error comparison and its JSON record."""
+    cable = curve(runs, CABLE)
+    at = min(cable, key=lambda m: abs(math.log(m.rtol / target_rtol)))
+    target = max_amp_err(at, ref, judged)
+    lines = [f"## Equal-error speed (max amplitude error {target:.2e}: cable-sweep's at rtol "
+             f"{at.rtol:.0e})\n"]
+    if target <= 0 or not math.isfinite(target):
+        return lines + ["No usable target error."], {}
+    walls: dict[str, dict] = {}
+    for method in methods_of(runs):
+        ms = curve(runs, method)
+        errs = [max_amp_err(m, ref, judged) for m in ms]
+        w1, how1 = wall_at_error(ms, errs, target)
+        w2, how2 = wall_at_error(ms, errs, target, two_threads=True)
+        walls[method] = {"wall_1_thread_s": w1, "how_1": how1, "wall_2_threads_s": w2,
+                         "how_2": how2, "best_error": min(errs)}
+    c1 = walls[CABLE]["wall_1_thread_s"]
+    c2 = walls[CABLE]["wall_2_threads_s"]
+    rows = []
+    for method, w in walls.items():
+        def ratio(mine: float, how: str, base: float) -> str:
+            if how == "not measured" or not math.isfinite(base):
+                return ""
+            if how == "not reached":
+                return f"not reached (best {w['best_error']:.1e})"
+            return f"{'<= ' if how == '<=' else ''}{mine / base:.1f}x" if method != CABLE \
+                else "1x"
+        rows.append([method,
+                     (f"{w['how_1'] + ' ' if w['how_1'] == '<=' else ''}"
+                      f"{w['wall_1_thread_s']:.4g}" if math.isfinite(w["wall_1_thread_s"])
+                      else ""),
+                     ratio(w["wall_1_thread_s"], w["how_1"], c1),
+                     (f"{w['how_2'] + ' ' if w['how_2'] == '<=' else ''}"
+                      f"{w['wall_2_threads_s']:.4g}" if math.isfinite(w["wall_2_threads_s"])
+                      else ""),
+                     ratio(w["wall_2_threads_s"], w["how_2"], c2)
+                     if math.isfinite(w["wall_2_threads_s"]) else ""])
+    lines.append(markdown_table(["method", "wall at target, 1 thread (s)",
+                                 "cable-sweep speed ratio, 1 thread", "2 threads (s)",
+                                 "ratio, 2 threads"], rows))
+    lines.append("\nWall time interpolated in log-log between the rtols that bracket the target "
+                 "error; ratio = the peer's wall time / cable-sweep's at the same error, same "
+                 "points, same thread count. '<=': the peer's loosest rtol is already more "
+                 "accurate than the target (its time there is an upper bound).")
+    return lines, {"target_error": target, "target_rtol": at.rtol, "methods": walls}
+
+
+STYLE = {CABLE: ("o", "C0"), "SciPy RK45": ("s", "C1"), "SciPy DOP853": ("^", "C2"),
+         "numbalsoda dop853": ("D", "C3"), "numbalsoda lsoda": ("v", "C4")}
+
+
+def plot(runs: list[Measurement], ref: Reference, judged: np.ndarray, path: str,
+         target: float | None) -> None:
+    """Two panels: wall time vs max amplitude error and vs settling-time error, one line per
+    method (markers: the rtols), dashed: 2 threads."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 5))
-    for method, marker in (("cable-sweep", "o"), ("SciPy RK45", "s"), ("SciPy DOP853", "^")):
-        ms = [m for m in runs if m.method == method]
-        err = [max(np.max(amplitude_errors(m.amplitude, ref)[judged], initial=0.0), 1e-17)
-               for m in ms]
-        ax.loglog(err, [m.wall_s for m in ms], marker=marker, label=method)
-        if method == "cable-sweep":
-            for e, m in zip(err, ms):
-                ax.annotate(f"{m.rtol:.0e}", (e, m.wall_s), textcoords="offset points",
-                            xytext=(4, 4), fontsize=7)
-    ax.set_xlabel("max relative amplitude error (non-decayed points)")
-    ax.set_ylabel(f"wall time for {len(ref.amplitude)} points, 1 thread (s)")
-    ax.set_title("Work-precision, consistent model, t in [0, 5] s")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5), sharey=True)
+    for method in methods_of(runs):
+        ms = curve(runs, method)
+        marker, colour = STYLE.get(method, ("x", None))
+        amp = [max(max_amp_err(m, ref, judged), 1e-17) for m in ms]
+        ts = [max(max_ts_err(m, ref), 1e-17) for m in ms]
+        for ax, err in zip(axes, (amp, ts)):
+            ax.loglog(err, [m.wall_s for m in ms], marker=marker, color=colour,
+                      label=f"{method}, 1 thread")
+            if any(math.isfinite(m.wall2_s) for m in ms):
+                ax.loglog(err, [m.wall2_s for m in ms], marker=marker, color=colour,
+                          linestyle="--", markerfacecolor="none", label=f"{method}, 2 threads")
+            if method == CABLE:
+                for e, m in zip(err, ms):
+                    ax.annotate(f"{m.rtol:.0e}", (e, m.wall_s), textcoords="offset points",
+                                xytext=(4, 4), fontsize=7)
+    if target:
+        axes[0].axvline(target, color="grey", linestyle=":", linewidth=1)
+    axes[0].set_xlabel("max relative amplitude error (non-decayed points)")
+    axes[1].set_xlabel("max settling-time error / t_end (points with a reference settling time)")
+    axes[0].set_ylabel(f"wall time for {len(ref.amplitude)} points (s)")
+    axes[0].set_title("amplitude")
+    axes[1].set_title("settling time")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    rtols = sorted({m.rtol for m in runs}, reverse=True)
+    fig.suptitle(f"Work-precision, consistent model, {len(ref.amplitude)} points, t in [0, 5] s, "
+                 f"rtol {rtols[0]:.0e} ... {rtols[-1]:.0e}; markers: rtols")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
 
 
+def fmt(x: float, spec: str) -> str:
+    return "" if not math.isfinite(x) else format(x, spec)
+
+
 def main() -> None:
     args = parse_args()
+    self_check(verbose=False)            # reference_metrics on closed forms (< 1 s)
     rtols = floats(args.rtols)
     scene = build_scene(floats(args.lengths), floats(args.ratios))
     table = parameter_table(scene)
-    tol = scene.get("metrics.tolerance")
+    cfg = Settings(tail=scene.get("metrics.tail"), tol=scene.get("metrics.tolerance"),
+                   ns_samples=args.ns_samples)
+
+    ns = None
+    ns_compile_s = math.nan
+    ns_message = ""
+    if not args.no_numbalsoda:
+        try:
+            ns = Numbalsoda()
+        except ImportError as exc:
+            ns_message = (f"numbalsoda not installed ({exc}): its rows are skipped "
+                          "(pip install numbalsoda).")
+            print(ns_message, file=sys.stderr)
 
     start = time.perf_counter()
-    ref = reference_solution(table, args.ref_rtol, args.ref_atol)
+    ref = reference_solution(table, args.ref_rtol, args.ref_atol, cfg)
     ref_s = time.perf_counter() - start
-    check = reference_solution(table, args.ref_rtol * 10, args.ref_atol * 10)
-    decayed = ref.amplitude <= tol * ref.peak
+    check = reference_solution(table, args.ref_rtol * 10, args.ref_atol * 10, cfg)
+    decayed = ref.amplitude <= cfg.tol * ref.peak
     judged = np.ones_like(decayed) if args.include_decayed else ~decayed
     compile_s = warm_up(table, scene)
+    if ns is not None:
+        ns_compile_s = ns.warm_up(table, np.linspace(0.0, T_END, args.ns_samples))
 
     runs: list[Measurement] = []
     for rtol in rtols:
         atol = atol_for(rtol, args)
         runs.append(run_cable_sweep(table, scene, rtol, atol))
-        runs.append(run_scipy(table, "RK45", rtol, atol))
-        runs.append(run_scipy(table, "DOP853", rtol, atol))
+        if not args.no_scipy:
+            runs.append(run_scipy(table, "RK45", rtol, atol, cfg))
+            runs.append(run_scipy(table, "DOP853", rtol, atol, cfg))
+        if ns is not None:
+            for name in Numbalsoda.SOLVERS:
+                runs.append(run_numbalsoda(ns, name, table, rtol, atol, cfg))
         print(f"rtol {rtol:g} done", file=sys.stderr, flush=True)
-    runs.sort(key=lambda m: (m.method != "cable-sweep", m.method, -m.rtol))
+    order = methods_of(runs)
+    runs.sort(key=lambda m: (order.index(m.method), -m.rtol))
 
+    n_settle = int(np.isin(ref.state, HAS_SETTLING).sum())
+    states = ", ".join(f"{s} {int(np.sum(ref.state == s))}" for s in sorted(set(ref.state)))
     print(f"# Work-precision: consistent model, {len(table)} reference points "
-          f"({int(decayed.sum())} decayed: A_ref <= {tol:g} x peak), t_end = 5 s, 1 thread\n")
+          f"({int(decayed.sum())} decayed: A_ref <= {cfg.tol:g} x peak), t_end = 5 s\n")
     check_err = amplitude_errors(check.amplitude, ref)
+    check_ts = np.abs(check.settling - ref.settling) / T_END
     print(f"Reference: DOP853 rtol {args.ref_rtol:g} atol {args.ref_atol:g}, "
-          f"{ref.steps.mean():,.0f} mean steps, {ref_s:.1f} s. Against DOP853 at 10x looser: "
+          f"{ref.steps.mean():,.0f} mean steps, {ref_s:.1f} s (with the metrics). Reference "
+          f"states: {states} ({n_settle} with a settling time). Against DOP853 at 10x looser: "
           f"max rel. amplitude diff {np.max(check_err[~decayed], initial=0):.1e} "
-          f"(non-decayed), {np.max(check_err):.1e} (all); max rel. q(5) diff "
+          f"(non-decayed), {np.max(check_err):.1e} (all); max settling-time diff / t_end "
+          f"{np.nanmax(check_ts, initial=0):.1e}; states differing "
+          f"{int(np.sum(check.state != ref.state))}; max rel. q(5) diff "
           f"{np.max(final_state_errors(check.q_end, ref)):.1e}. cable-sweep first call "
-          f"(compile or cache load): {compile_s:.2f} s.\n")
+          f"(compile or cache load): {compile_s:.2f} s"
+          + (f"; numbalsoda loops compile: {ns_compile_s:.2f} s" if ns is not None else "")
+          + ".\n")
+    if ns_message:
+        print(ns_message + "\n")
     rows = []
     for m in runs:
         amp_err = amplitude_errors(m.amplitude, ref)
         rows.append([m.method, f"{m.rtol:.0e}", f"{m.atol:.0e}", f"{m.wall_s:.4f}",
-                     f"{m.steps.mean():,.1f}", f"{np.max(amp_err[~decayed], initial=0):.1e}",
+                     fmt(m.wall2_s, ".4f"),
+                     fmt(float(np.mean(m.steps)), ",.1f"),
+                     fmt(float(np.mean(m.rhs_evals)), ",.0f"),
+                     f"{np.max(amp_err[~decayed], initial=0):.1e}",
                      f"{np.max(amp_err):.1e}",
+                     fmt(max_ts_err(m, ref), ".1e"),
+                     str(state_mismatches(m, ref)),
                      f"{np.max(final_state_errors(m.q_end, ref)):.1e}"])
-    print(markdown_table(["method", "rtol", "atol", "wall (s)", "mean steps", "amp err",
-                          "amp err (all)", "q(5) err"], rows))
-    print("\namp err: max |A - A_ref| / A_ref over non-decayed points; amp err (all): over all "
-          "points; q(5) err: max |q(5) - q_ref(5)| / max|q_ref|.\n")
+    print(markdown_table(["method", "rtol", "atol", "wall 1 thr (s)", "wall 2 thr (s)",
+                          "mean steps", "mean RHS evals", "amp err", "amp err (all)", "Ts err",
+                          "states != ref", "q(5) err"], rows))
+    print(f"\nwall: for all {len(table)} points (cable-sweep and numbalsoda: best of repeats; "
+          "SciPy: one run per point, summed). amp err: max |A - A_ref| / A_ref over "
+          "non-decayed points; amp err (all): over all points; Ts err: max |Ts - Ts_ref| / "
+          "t_end over points where the reference and the method both have a settling time; "
+          f"states != ref: points (of {len(table)}) whose state differs from the reference's; "
+          "q(5) err: max |q(5) - q_ref(5)| / max|q_ref|. SciPy and numbalsoda metrics: "
+          "reference_metrics on their dense output (SciPy) or on a quintic Hermite interpolant "
+          f"of {args.ns_samples} samples (numbalsoda); not timed.\n")
+    for m in runs:
+        for note in m.notes:
+            print(f"Note: {m.method} rtol {m.rtol:.0e}: {note}")
 
-    print(step_agreement(runs, len(table)) + "\n")
+    if any(m.method == "SciPy RK45" for m in runs):
+        print(step_agreement(runs, len(table)) + "\n")
     chosen = recommend(runs, ref, judged, args.threshold)
     which = "all" if args.include_decayed else "non-decayed"
     if chosen is None:
         print(f"Recommended default: none of the rtols keeps the amplitude error below "
-              f"{args.threshold:g} on all {which} reference points.")
+              f"{args.threshold:g} on all {which} reference points.\n")
     else:
         print(f"Recommended default: rtol = {chosen:g}, atol = {atol_for(chosen, args):g} "
               f"(largest rtol with max relative amplitude error < {args.threshold:g} on all "
-              f"{which} reference points, and for every tighter rtol).")
+              f"{which} reference points, and for every tighter rtol).\n")
+
+    lines, equal = equal_error_report(runs, ref, ~decayed, args.target_rtol)
+    print("\n".join(lines))
 
     if args.plot:
-        plot(runs, ref, judged, args.plot)
-        print(f"Plot written to {args.plot}")
+        plot(runs, ref, ~decayed, args.plot, equal.get("target_error"))
+        print(f"\nPlot written to {args.plot}")
     if args.json:
         write_json(args.json, {
             "points": [{"length": l, "frequency_ratio": r, "decayed": bool(d),
-                        "ref_amplitude": a, "ref_peak": pk, "ref_q_end": qe}
-                       for (l, r), d, a, pk, qe in zip(point_labels(scene), decayed,
-                                                        ref.amplitude, ref.peak, ref.q_end)],
+                        "ref_amplitude": a, "ref_peak": pk, "ref_q_end": qe, "ref_state": s,
+                        "ref_settling_time": ts}
+                       for (l, r), d, a, pk, qe, s, ts in zip(
+                           point_labels(scene), decayed, ref.amplitude, ref.peak, ref.q_end,
+                           ref.state, ref.settling)],
             "reference": {"rtol": args.ref_rtol, "atol": args.ref_atol,
                           "mean_steps": float(ref.steps.mean()), "seconds": ref_s},
-            "compile_s": compile_s, "threshold": args.threshold,
-            "recommended_rtol": chosen,
+            "compile_s": compile_s, "numbalsoda_compile_s": ns_compile_s,
+            "numbalsoda": ns_message or f"{args.ns_samples} samples",
+            "threshold": args.threshold, "recommended_rtol": chosen,
             "recommended_atol": None if chosen is None else atol_for(chosen, args),
+            "equal_error": equal,
             "runs": [{"method": m.method, "rtol": m.rtol, "atol": m.atol, "wall_s": m.wall_s,
-                      "mean_steps": float(m.steps.mean()),
+                      "wall_2_threads_s": m.wall2_s,
+                      "mean_steps": float(np.mean(m.steps)),
+                      "mean_rhs_evals": float(np.mean(m.rhs_evals)),
                       "max_rel_amplitude_error": float(np.max(
                           amplitude_errors(m.amplitude, ref)[~decayed], initial=0)),
                       "max_rel_amplitude_error_all": float(np.max(
                           amplitude_errors(m.amplitude, ref))),
+                      "max_settling_time_error_over_t_end": max_ts_err(m, ref),
+                      "states_differing": state_mismatches(m, ref),
                       "max_rel_final_state_error": float(np.max(
-                          final_state_errors(m.q_end, ref)))} for m in runs]})
+                          final_state_errors(m.q_end, ref))),
+                      "notes": m.notes} for m in runs]})
 
 
 if __name__ == "__main__":

@@ -1,14 +1,22 @@
 """Lock-step SIMD driver: LANES trajectories advanced side by side in vector lanes.
 
-Each lane is one trajectory with its own time, step size and accept/reject decision (the
-trajectory module's state machine, SciPy RK45's sequence of attempts). Only the arithmetic of
-an attempt (six right-hand sides, the stage sums, the error norm) runs across the lanes at
-once; that loop has no calls and no branches, so LLVM vectorises it. The load's cos(W t) is
-`fast_cos`, an inlined polynomial with Cody-Waite range reduction (fdlibm's kernels), because a
-libm call would stop vectorisation. A lane whose trajectory ends takes the next point of its
-block at once, so lanes stay busy.
+Each lane is one trajectory with its own time, step size and accept/reject decision: SciPy
+RK45's sequence of attempts, the trajectory module's state machine. Three loops run across
+the lanes with straight-line arithmetic, so LLVM vectorises them:
 
-Results equal the scalar driver's to round-off (the two cos differ by an ulp or so).
+- `_prepare`: the next step of every lane whose step needs no special care;
+- `_attempt`: one Dormand-Prince attempt (six right-hand sides, stage sums, error norm);
+- `_finish`: accept/reject, the step-size update and the metrics of an ordinary step.
+
+Whatever is not ordinary (a lane's first or last step, a step near SciPy's minimum, an extremum
+of q, the tail's start, a time-series sample, a threshold crossing, a divergence) goes to the
+scalar state machine for that lane alone, so the metrics are the scalar driver's. A lane whose
+trajectory ends takes the next point of its block at once.
+
+No libm call may sit in those loops: cos(W t) is `fast_cos` (Cody-Waite reduction and fdlibm's
+kernels) and the controller's err^(-1/5) is `_inv_fifth_root` (range reduction by powers of two
+and Newton's method), both to an ulp or two. Results therefore equal the scalar driver's to
+round-off, not bit for bit.
 """
 
 import math
@@ -18,13 +26,15 @@ import numpy as np
 
 from . import metrics as mt
 from . import trajectory as tj
-from .dopri5 import A, B, C, E, MIN_RTOL, N_STAGES
-from .layout import ATOL, RTOL, TOL, WANT_SETTLING
-from .oscillator import DAMPING, G0, G1, H, K0, K1, MASS, OMEGA
+from .dopri5 import A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, SAFETY
+from .layout import (ATOL, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
+                     WANT_SETTLING)
+from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 from .transverse import classify, reject_point, valid
 
-LANES = 16            # trajectories per lock-step group (a multiple of the SIMD width)
-BLOCK = 64          # points per parallel work item
+LANES = 16             # trajectories per lock-step group (a multiple of the SIMD width)
+MIN_BLOCK = 4 * LANES   # points per parallel work item, at least; a lane refills from its block
+MAX_BLOCK = 1024        # at most, so that every thread gets several blocks
 
 # Cody-Waite split of pi/2 and fdlibm's minimax kernels on [-pi/4, pi/4].
 _TWO_OVER_PI = 0.63661977236758134308
@@ -52,17 +62,17 @@ def fast_cos(x):
 
 # The lanes' working memory is one flat array W, row r of lane j at W[r * LANES + j]: one
 # underlying object with constant offsets between rows, so LLVM proves the rows independent and
-# vectorises across lanes with no run-time alias checks. Rows MASS .. OMEGA hold the
-# oscillator's coefficients (as in oscillator), then:
-W_T = OMEGA + 1       # time (s)
-W_Q = OMEGA + 2       # q (m)
-W_V = OMEGA + 3       # q' (m/s)
-W_H = OMEGA + 4       # step to attempt (s); 0 for an idle lane
-W_K = OMEGA + 5       # stage s, component c at row W_K + 2 s + c (K[0] = f(t, y) on entry)
+# vectorises across lanes with no run-time alias checks. Rows 0 .. tj.N_SLOTS - 1 are the
+# trajectory's accumulator slots (so W[j::LANES] is lane j's accumulator for the scalar
+# state machine), then the parameter row (oscillator columns), then the attempt's work rows.
+W_P = tj.N_SLOTS                  # parameter column c at row W_P + c
+W_H = W_P + N_PARAMS              # signed step of the attempt (s); 0 for an idle lane
+W_K = W_H + 1                     # stage s, component c at row W_K + 2 s + c (s >= 1)
 W_QN = W_K + 2 * (N_STAGES + 1)   # fifth-order q (m)
 W_VN = W_QN + 1                   # fifth-order q' (m/s)
 W_ERR = W_QN + 2                  # SciPy's error norm
-W_ROWS = W_QN + 3
+W_FLAG = W_QN + 3                 # 1: this lane needs the scalar state machine now
+W_ROWS = W_QN + 4
 
 # The tableau as compile-time constants (tuples are frozen into the code).
 _A = tuple(tuple(float(x) for x in row) for row in A)
@@ -70,17 +80,110 @@ _B = tuple(float(x) for x in B)
 _C = tuple(float(x) for x in C)
 _E = tuple(float(x) for x in E)
 
+# Controller: below this error the accepted factor is MAX_FACTOR, SAFETY err^(-1/5) >= 10.
+_ERR_MAX_FACTOR = (SAFETY / MAX_FACTOR) ** 5
+# Newton's start for m^(-1/5) on [1, 2) (least squares, |error| < 2e-5).
+_R4, _R3, _R2, _R1, _R0 = (0.014560562999503732, -0.11387695821308534, 0.36488873237721625,
+                           -0.6453524859268162, 1.3797612706449516)
+_F16, _F8, _F4, _F2, _F1 = (2.0 ** (16 / 5), 2.0 ** (8 / 5), 2.0 ** (4 / 5), 2.0 ** (2 / 5),
+                            2.0 ** (1 / 5))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _inv_fifth_root(x):
+    """x^(-1/5) for 2^-31 <= x < 2^32, to about an ulp, without a libm call (vectorisable)."""
+    r = 1.0
+    if x >= 65536.0:
+        x *= 1.0 / 65536.0
+        r /= _F16
+    if x >= 256.0:
+        x *= 1.0 / 256.0
+        r /= _F8
+    if x >= 16.0:
+        x *= 1.0 / 16.0
+        r /= _F4
+    if x >= 4.0:
+        x *= 0.25
+        r /= _F2
+    if x >= 2.0:
+        x *= 0.5
+        r /= _F1
+    if x < 1.0 / 65536.0:
+        x *= 65536.0
+        r *= _F16
+    if x < 1.0 / 256.0:
+        x *= 256.0
+        r *= _F8
+    if x < 1.0 / 16.0:
+        x *= 16.0
+        r *= _F4
+    if x < 0.25:
+        x *= 4.0
+        r *= _F2
+    if x < 0.5:
+        x *= 2.0
+        r *= _F1
+    if x < 1.0:
+        x *= 2.0
+        r *= _F1
+    y = (((_R4 * x + _R3) * x + _R2) * x + _R1) * x + _R0
+    for _ in range(2):
+        y2 = y * y
+        y = y * (6.0 - x * y2 * y2 * y) * 0.2
+    return r * y
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _step_factor(err, rejected_before):
+    """dopri5.step_factor across lanes (err^(-1/5) by `_inv_fifth_root`)."""
+    root = _inv_fifth_root(min(max(err, 1e-9), 1e9))
+    accept = min(MAX_FACTOR, SAFETY * root)
+    accept = MAX_FACTOR if err < _ERR_MAX_FACTOR else accept
+    accept = min(1.0, accept) if rejected_before else accept
+    reject = SAFETY * root
+    reject = reject if reject > MIN_FACTOR else MIN_FACTOR
+    reject = MIN_FACTOR if err > 1e9 else reject
+    reject = MIN_FACTOR if err != err else reject
+    return accept if err < 1.0 else reject
+
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _accel(W, j, t, q, v):
     """q'' of lane j's oscillator at (t, q, v)."""
-    cw = fast_cos(W[OMEGA * LANES + j] * t)
+    L = LANES
+    cw = fast_cos(W[(W_P + OMEGA) * L + j] * t)
     q2 = q * q
-    force = (W[DAMPING * LANES + j] * v
-             + (W[K0 * LANES + j] + W[K1 * LANES + j] * cw) * q
-             + (W[G0 * LANES + j] + W[G1 * LANES + j] * cw) * q * q2
-             + W[H * LANES + j] * q * q2 * q2)
-    return -force / W[MASS * LANES + j]
+    force = (W[(W_P + DAMPING) * L + j] * v
+             + (W[(W_P + K0) * L + j] + W[(W_P + K1) * L + j] * cw) * q
+             + (W[(W_P + G0) * L + j] + W[(W_P + G1) * L + j] * cw) * q * q2
+             + W[(W_P + H) * L + j] * q * q2 * q2)
+    return -force / W[(W_P + MASS) * L + j]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _prepare(W, settings):
+    """trajectory.next_attempt across lanes, for the lanes whose step is ordinary: running,
+    before t_end, within max_steps, and far above the minimum step (10 ulps of t or
+    solver.min_step), so SciPy's clamp and failure cannot apply. Other lanes get W_FLAG = 1."""
+    L = LANES
+    t_end = settings[T_END]
+    max_step = settings[MAX_STEP]
+    max_steps = settings[MAX_STEPS]
+    min_user = settings[MIN_STEP]
+    for j in range(W.shape[0] // W_ROWS):
+        t = W[tj.T * L + j]
+        h_abs = W[tj.H_ABS * L + j]
+        fresh = W[tj.REJECTED_NOW * L + j] == 0.0
+        h_try = min(h_abs, max_step) if fresh else h_abs
+        ok = ((W[tj.STATUS * L + j] == mt.RUNNING) & (t < t_end)
+              & ((not fresh) | (W[tj.STEPS * L + j] < max_steps))
+              & (h_try > 1e-14 * t) & (h_try > min_user) & (h_try > 1e-300))
+        t_new = min(t + h_try, t_end)
+        h = t_new - t
+        W[W_H * L + j] = h if ok else 0.0
+        W[tj.H_ABS * L + j] = abs(h) if ok else h_abs
+        W[tj.T_NEW * L + j] = t_new if ok else W[tj.T_NEW * L + j]
+        W[W_FLAG * L + j] = 0.0 if ok else 1.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -93,12 +196,12 @@ def _attempt(W, rtol, atol):
     """
     L = LANES
     for j in range(W.shape[0] // W_ROWS):
-        t = W[W_T * L + j]
-        q = W[W_Q * L + j]
-        v = W[W_V * L + j]
+        t = W[tj.T * L + j]
+        q = W[tj.Q * L + j]
+        v = W[tj.V * L + j]
         h = W[W_H * L + j]
-        k1q = W[W_K * L + j]
-        k1v = W[(W_K + 1) * L + j]
+        k1q = W[tj.FQ * L + j]
+        k1v = W[tj.FV * L + j]
         k2q = v + (k1v * _A[1][0]) * h
         k2v = _accel(W, j, t + _C[1] * h, q + (k1q * _A[1][0]) * h, k2q)
         q3 = q + (k1q * _A[2][0] + k2q * _A[2][1]) * h
@@ -145,7 +248,65 @@ def _attempt(W, rtol, atol):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _load_lane(params, settings, point, lane, W, acc, states, reals, counts, series):
+def _finish(W, settings, n_samples):
+    """trajectory.finish_attempt across lanes for rejected attempts and ordinary accepted
+    steps (first metrics pass: threshold tol * peak around 0). An accepted step with anything
+    to locate on the dense output, or a divergence, gets W_FLAG = 1 and is left untouched."""
+    L = LANES
+    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    track = settings[WANT_SETTLING] != 0.0
+    thr_rel = settings[TOL]
+    dt_sample = settings[SAMPLE_DT]
+    for j in range(W.shape[0] // W_ROWS):
+        h = W[W_H * L + j]
+        active = h > 0.0
+        err = W[W_ERR * L + j]
+        accepted = err < 1.0
+        q_old = W[tj.Q * L + j]
+        v_old = W[tj.V * L + j]
+        qn = W[W_QN * L + j]
+        vn = W[W_VN * L + j]
+        t_new = W[tj.T_NEW * L + j]
+        peak = W[tj.PEAK * L + j]
+        peak_new = max(peak, abs(qn))
+        thr = thr_rel * peak_new
+        extremum = ((v_old > 0.0) & (vn <= 0.0)) | ((v_old < 0.0) & (vn >= 0.0))
+        bounded = (abs(qn) <= W[(W_P + BOUND) * L + j]) & (abs(vn) <= 1e308)
+        straddles = (W[tj.T * L + j] < t_tail) & (t_tail <= t_new)
+        sample = W[tj.SAMPLE * L + j]
+        due = (sample < n_samples) & (sample * dt_sample <= t_new)
+        crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
+        event = accepted & (extremum | (not bounded) | straddles | due | crosses)
+        fast = active & (not event)
+        done = fast & accepted
+        rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
+        factor = _step_factor(err, rejected_before)
+        W[W_FLAG * L + j] = 1.0 if active & event else 0.0
+        W[tj.RHS_EVALS * L + j] += 6.0 if fast else 0.0
+        W[tj.H_ABS * L + j] *= factor if fast else 1.0
+        W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if fast else (
+            1.0 if rejected_before else 0.0)
+        W[tj.REJECTED * L + j] += 1.0 if fast & (not accepted) else 0.0
+        W[tj.STEPS * L + j] += 1.0 if done else 0.0
+        W[tj.PEAK * L + j] = peak_new if done else peak
+        in_tail = done & (t_new >= t_tail)
+        W[tj.TAIL_AMP * L + j] = max(W[tj.TAIL_AMP * L + j], abs(qn)) if in_tail else \
+            W[tj.TAIL_AMP * L + j]
+        W[tj.TAIL_QMIN * L + j] = min(W[tj.TAIL_QMIN * L + j], qn) if in_tail else \
+            W[tj.TAIL_QMIN * L + j]
+        W[tj.TAIL_QMAX * L + j] = max(W[tj.TAIL_QMAX * L + j], qn) if in_tail else \
+            W[tj.TAIL_QMAX * L + j]
+        above = done & track & (abs(qn) > thr)
+        W[tj.LAST_ABOVE * L + j] = W[tj.T * L + j] + h if above else W[tj.LAST_ABOVE * L + j]
+        W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
+        W[tj.Q * L + j] = qn if done else q_old
+        W[tj.V * L + j] = vn if done else v_old
+        W[tj.FQ * L + j] = W[(W_K + 12) * L + j] if done else W[tj.FQ * L + j]
+        W[tj.FV * L + j] = W[(W_K + 13) * L + j] if done else W[tj.FV * L + j]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
     """Give `lane` the trajectory of row `point`; an invalid row is answered at once.
     Returns False when the row needs no integration."""
     p = params[point]
@@ -153,77 +314,82 @@ def _load_lane(params, settings, point, lane, W, acc, states, reals, counts, ser
         reject_point(reals[point], counts[point], series[point])
         states[point] = mt.INVALID_INPUT
         return False
-    for c in range(OMEGA + 1):
-        W[c * LANES + lane] = p[c]
-    tj.start(p, settings, acc[lane], series[point])
+    for c in range(N_PARAMS):
+        W[(W_P + c) * LANES + lane] = p[c]
+    tj.start(p, settings, W[lane::LANES], series[point])
     return True
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes."""
+    L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
     atol = settings[ATOL]
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
-    W = np.zeros(W_ROWS * LANES)
-    W[MASS * LANES:(MASS + 1) * LANES] = 1.0
-    acc = np.zeros((LANES, tj.N_SLOTS))
-    bufs = [tj.new_buffer() for _ in range(LANES)]
-    point = np.full(LANES, -1, np.int64)
+    n_samples = series.shape[1]
+    W = np.zeros(W_ROWS * L)
+    for j in range(L):
+        W[(W_P + MASS) * L + j] = 1.0
+        W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
+    bufs = [tj.new_buffer() for _ in range(L)]
+    point = np.full(L, -1, np.int64)
     K = np.empty((N_STAGES + 1, 2))
     Qc = np.empty((2, 4))
     next_point = lo
     while True:
+        _prepare(W, settings)
         busy = 0
-        for j in range(LANES):
-            step = 0.0
-            while True:
-                if point[j] >= 0:
-                    step = tj.next_attempt(settings, acc[j])
-                    if step > 0.0:
+        for j in range(L):
+            if W[W_FLAG * L + j] != 0.0:
+                acc = W[j::L]
+                step = 0.0
+                while True:
+                    if point[j] >= 0:
+                        step = tj.next_attempt(settings, acc)
+                        if step > 0.0:
+                            break
+                        i = point[j]
+                        tj.end_series(acc, series[i])
+                        states[i] = classify(params[i], settings, acc, bufs[j], reals[i],
+                                             counts[i])
+                        point[j] = -1
+                    if next_point >= hi:
                         break
-                    i = point[j]
-                    tj.end_series(acc[j], series[i])
-                    states[i] = classify(params[i], settings, acc[j], bufs[j], reals[i],
-                                         counts[i])
-                    point[j] = -1
-                if next_point >= hi:
-                    break
-                if _load_lane(params, settings, next_point, j, W, acc, states, reals,
-                              counts, series):
-                    point[j] = next_point
-                    bufs[j] = tj.new_buffer()
-                next_point += 1
-            W[W_H * LANES + j] = step
-            if step > 0.0:
+                    if _load_lane(params, settings, next_point, j, W, states, reals, counts,
+                                  series):
+                        point[j] = next_point
+                        bufs[j] = tj.new_buffer()
+                    next_point += 1
+                W[W_H * L + j] = step
+            if W[W_H * L + j] > 0.0:
                 busy += 1
-                W[W_T * LANES + j] = acc[j, tj.T]
-                W[W_Q * LANES + j] = acc[j, tj.Q]
-                W[W_V * LANES + j] = acc[j, tj.V]
-                W[W_K * LANES + j] = acc[j, tj.FQ]
-                W[(W_K + 1) * LANES + j] = acc[j, tj.FV]
         if busy == 0:
             return
         _attempt(W, rtol, atol)
-        for j in range(LANES):
-            if W[W_H * LANES + j] > 0.0:
+        _finish(W, settings, n_samples)
+        for j in range(L):
+            if W[W_FLAG * L + j] != 0.0:
                 i = point[j]
-                for s in range(N_STAGES + 1):
-                    K[s, 0] = W[(W_K + 2 * s) * LANES + j]
-                    K[s, 1] = W[(W_K + 2 * s + 1) * LANES + j]
-                bufs[j] = tj.finish_attempt(params[i], settings, acc[j], K,
-                                            W[W_QN * LANES + j], W[W_VN * LANES + j],
-                                            W[W_ERR * LANES + j], W[W_H * LANES + j], Qc,
-                                            bufs[j], series[i], track, 0.0, 0.0, thr_rel)
+                K[0, 0] = W[tj.FQ * L + j]
+                K[0, 1] = W[tj.FV * L + j]
+                for s in range(1, N_STAGES + 1):
+                    K[s, 0] = W[(W_K + 2 * s) * L + j]
+                    K[s, 1] = W[(W_K + 2 * s + 1) * L + j]
+                bufs[j] = tj.finish_attempt(params[i], settings, W[j::L], K, W[W_QN * L + j],
+                                            W[W_VN * L + j], W[W_ERR * L + j], W[W_H * L + j],
+                                            Qc, bufs[j], series[i], track, 0.0, 0.0, thr_rel)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def solve_batch(params, settings, states, reals, counts, series):
     """Same interface and results (to round-off) as transverse.solve_batch_scalar, several
-    times faster per core: blocks of BLOCK points in parallel, LANES lanes per block."""
+    times faster per core: blocks of points in parallel (n/32 points each, within MIN_BLOCK
+    to MAX_BLOCK), LANES lanes per block. Blocking never changes a point's result."""
     n = params.shape[0]
-    n_blocks = (n + BLOCK - 1) // BLOCK
+    block = max(MIN_BLOCK, min(MAX_BLOCK, n // 32))
+    n_blocks = (n + block - 1) // block
     for b in nb.prange(n_blocks):
-        solve_block(params, settings, b * BLOCK, min(n, (b + 1) * BLOCK), states, reals,
+        solve_block(params, settings, b * block, min(n, (b + 1) * block), states, reals,
                     counts, series)

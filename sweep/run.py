@@ -116,7 +116,7 @@ def in_chunks(n: int, solve_chunk: Callable[[int, int], None], threads: int = 0,
     import numba
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS) if threads
                           else numba.config.NUMBA_NUM_THREADS)
-    chunk = chunk_size or max(512 * numba.get_num_threads(), -(-n // 100))
+    chunk = chunk_size or max(4096 * numba.get_num_threads(), -(-n // 100))
     report = _progress_printer(n, progress and n > chunk)
     for lo in range(0, n, chunk):
         hi = min(n, lo + chunk)
@@ -126,9 +126,15 @@ def in_chunks(n: int, solve_chunk: Callable[[int, int], None], threads: int = 0,
 
 def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
                  threads: int = 0, progress: bool = False,
-                 chunk_size: int | None = None) -> KernelResult:
-    """Run the transverse kernel over the rows of `params` (grid order in, grid order out)."""
+                 chunk_size: int | None = None, driver: str = "lanes") -> KernelResult:
+    """Run the transverse kernel over the rows of `params` (grid order in, grid order out).
+
+    driver: "lanes" (kernels.lanes, lock-step SIMD) or "scalar" (kernels.transverse, one
+    trajectory per iteration); the two agree to round-off.
+    """
+    from kernels import lanes
     from kernels import transverse as tk
+    solve_batch = lanes.solve_batch if driver == "lanes" else tk.solve_batch_scalar
 
     n = params.shape[0]
     order = point_order(n)
@@ -139,8 +145,8 @@ def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
     series = np.empty((n, n_samples))
 
     def solve_chunk(lo: int, hi: int) -> None:
-        tk.solve_batch(shuffled[lo:hi], settings, states[lo:hi], reals[lo:hi],
-                       counts[lo:hi], series[lo:hi])
+        solve_batch(shuffled[lo:hi], settings, states[lo:hi], reals[lo:hi], counts[lo:hi],
+                    series[lo:hi])
 
     in_chunks(n, solve_chunk, threads, progress, chunk_size)
     back = grid_order(order)
@@ -192,6 +198,7 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False) -> xr
     table = grid.flatten(coeffs, PARAM_NAMES, dims, shape)
     started = time.perf_counter()
     result = solve_points(table, settings, times.size, threads=threads, progress=progress,
-                          chunk_size=scene.get("run.chunk_size"))
+                          chunk_size=scene.get("run.chunk_size"),
+                          driver=scene.get("solver.driver"))
     result.sample_times = times
     return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)

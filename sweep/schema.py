@@ -101,6 +101,9 @@ KEYS: tuple[Key, ...] = (
         long_name="longitudinal: spatial intervals per span"),
     Key("solver", "courant", "float", 1.0, units="1", minimum=0.0, exclusive_min=True,
         maximum=1.0, long_name="longitudinal: Courant number a dt/dx (exact at 1, unstable above)"),
+    Key("solver", "driver", "str", "lanes", choices=("lanes", "scalar"),
+        long_name="transverse kernel driver: lock-step SIMD lanes (fast) or one trajectory per "
+                  "thread (SciPy's arithmetic exactly, the reference)"),
     Key("solver", "max_steps", "int", 1_000_000, units="1", minimum=1,
         long_name="bound on accepted steps per point"),
     Key("solver", "max_step", "float", None, units="s", minimum=0.0, exclusive_min=True,

@@ -44,3 +44,30 @@ def test_lanes_equal_scalar_on_a_mixed_grid(rtol):
     np.testing.assert_array_equal(a[2], b[2])
     np.testing.assert_allclose(b[1], a[1], rtol=1e-9, atol=1e-15, equal_nan=True)
     np.testing.assert_allclose(b[3], a[3], rtol=1e-9, atol=1e-15, equal_nan=True)
+
+
+def test_sweep_drivers_agree_and_lanes_is_the_default():
+    import sweep
+    text = """
+[cable]
+damping_ratio = 0.01
+[initial]
+displacement = 1e-3
+[axes]
+length = [0.3, 0.5, 0.9]
+frequency_ratio = [0.8, 1.9, 2.1, 2.6]
+[outputs]
+time_series = true
+sample_interval = 0.05
+[solver]
+t_end = 1.0
+"""
+    scene = sweep.load_scene_text(text)
+    assert scene.get("solver.driver") == "lanes"
+    a = sweep.run(scene, progress=False)
+    b = sweep.run(sweep.load_scene_text(text, overrides={"solver.driver": "scalar"}),
+                  progress=False)
+    for name in ("state", "n_steps", "n_rejected", "n_rhs"):
+        np.testing.assert_array_equal(a[name].values, b[name].values)
+    for name in ("amplitude", "peak_amplitude", "settling_time", "displacement"):
+        np.testing.assert_allclose(a[name].values, b[name].values, rtol=1e-9, atol=1e-15)
