@@ -91,6 +91,9 @@ def parse_args() -> argparse.Namespace:
                    help="points per axis: the grid has N x N points (default 100)")
     p.add_argument("--threads", default="1,2",
                    help="comma-separated thread counts to time (default 1,2)")
+    p.add_argument("--drivers", default="lanes,scalar",
+                   help="kernel drivers to time, comma-separated (default lanes,scalar); the "
+                        "first one's results are checked against SciPy")
     p.add_argument("--rtol", type=float, default=1e-8, help="relative tolerance (default 1e-8)")
     p.add_argument("--atol", type=float, default=1e-12, help="absolute tolerance (default 1e-12)")
     p.add_argument("--scipy-sample", type=int, default=100,
@@ -118,13 +121,14 @@ def compile_time(table: np.ndarray, settings: np.ndarray) -> float:
 
 
 def time_sweep(table: np.ndarray, settings: np.ndarray, threads: int,
-               repeats: int) -> tuple[float, KernelResult]:
+               repeats: int, driver: str = "lanes") -> tuple[float, KernelResult]:
     """Best wall time (s) of solve_points over `repeats` runs on `threads`, and its result."""
     best = np.inf
     result = None
+    solve_points(table[:2], settings, 0, threads=1, driver=driver)      # compile or load
     for _ in range(repeats):
         start = time.perf_counter()
-        result = solve_points(table, settings, 0, threads=threads)
+        result = solve_points(table, settings, 0, threads=threads, driver=driver)
         best = min(best, time.perf_counter() - start)
     return best, result
 
@@ -191,24 +195,28 @@ def main() -> None:
 
     compile_s = compile_time(table, settings)
     runs = []
-    result = None
-    for threads in thread_counts:
-        wall, result = time_sweep(table, settings, threads, args.repeats)
-        steps = int(result.counts[:, 0].sum())
-        runs.append({"threads": threads, "threads_used": threads_used(threads), "wall_s": wall,
-                     "trajectories_per_s": n / wall, "steps_per_s": steps / wall,
-                     "total_steps": steps})
-    rate1 = next((r["trajectories_per_s"] for r in runs if r["threads_used"] == 1), None)
+    results = {}
+    for driver in args.drivers.split(","):
+        for threads in thread_counts:
+            wall, results[driver] = time_sweep(table, settings, threads, args.repeats, driver)
+            steps = int(results[driver].counts[:, 0].sum())
+            runs.append({"driver": driver, "threads": threads,
+                         "threads_used": threads_used(threads), "wall_s": wall,
+                         "trajectories_per_s": n / wall, "steps_per_s": steps / wall,
+                         "total_steps": steps})
     for r in runs:
+        rate1 = next((o["trajectories_per_s"] for o in runs
+                      if o["threads_used"] == 1 and o["driver"] == r["driver"]), None)
         r["parallel_efficiency"] = (r["trajectories_per_s"] / (r["threads_used"] * rate1)
                                     if rate1 else float("nan"))
+    result = next(iter(results.values()))
 
     sample = np.sort(np.random.default_rng(args.seed).choice(
         n, size=min(args.scipy_sample, n), replace=False))
     rows = table[sample]
     scipy_wall, scipy_steps = time_scipy(rows, args.rtol, args.atol)
     scipy_rate = len(rows) / scipy_wall
-    fastest = max(runs, key=lambda r: r["threads_used"])
+    fastest = max(runs, key=lambda r: r["trajectories_per_s"])
     kernel_sample = KernelResult(result.states[sample], result.reals[sample],
                                  result.counts[sample], result.series[sample], np.empty(0))
     agreement = scipy_agreement(rows, kernel_sample, args.rtol, args.atol, args.grid)
@@ -221,7 +229,7 @@ def main() -> None:
           f"{compile_s:.2f} s; best of {args.repeats} runs per thread count.\n")
     headers = ["solver", "threads", "points", "wall (s)", "trajectories/s", "accepted steps/s",
                "mean steps/point", "parallel eff."]
-    rows_out = [["cable-sweep", r["threads_used"], n, f"{r['wall_s']:.3f}",
+    rows_out = [[f"cable-sweep ({r['driver']})", r["threads_used"], n, f"{r['wall_s']:.3f}",
                  f"{r['trajectories_per_s']:,.0f}", f"{r['steps_per_s']:,.3g}",
                  f"{r['total_steps'] / n:,.0f}", f"{r['parallel_efficiency']:.2f}"]
                 for r in runs]
@@ -231,7 +239,7 @@ def main() -> None:
     print(markdown_table(headers, rows_out))
     speedup = fastest["trajectories_per_s"] / scipy_rate
     step_speedup = fastest["steps_per_s"] / (scipy_steps.sum() / scipy_wall)
-    print(f"\ncable-sweep ({fastest['threads_used']} threads) / SciPy RK45: "
+    print(f"\ncable-sweep ({fastest['driver']}, {fastest['threads_used']} threads) / SciPy RK45: "
           f"{speedup:,.0f}x trajectories per second ({step_speedup:,.0f}x accepted steps "
           "per second)\n")
     print(markdown_table(

@@ -33,7 +33,7 @@ from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 from .transverse import classify, reject_point, valid
 
 LANES = 16             # trajectories per lock-step group (a multiple of the SIMD width)
-MIN_BLOCK = 4 * LANES   # points per parallel work item, at least; a lane refills from its block
+MIN_BLOCK = LANES       # points per parallel work item, at least (small grids still use all threads)
 MAX_BLOCK = 1024        # at most, so that every thread gets several blocks
 
 # Cody-Waite split of pi/2 and fdlibm's minimax kernels on [-pi/4, pi/4].

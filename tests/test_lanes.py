@@ -71,3 +71,15 @@ t_end = 1.0
         np.testing.assert_array_equal(a[name].values, b[name].values)
     for name in ("amplitude", "peak_amplitude", "settling_time", "displacement"):
         np.testing.assert_allclose(a[name].values, b[name].values, rtol=1e-9, atol=1e-15)
+
+
+def test_vectorisable_controller_matches_scipy_controller():
+    from kernels.dopri5 import step_factor
+    errs = np.concatenate([np.geomspace(1e-12, 1e12, 4001), [0.0, 1.0, 5.9049e-6, np.inf, np.nan]])
+    for rejected_before in (False, True):
+        ours = np.array([lanes._step_factor(e, rejected_before) for e in errs])
+        ref = np.array([step_factor(e, rejected_before) for e in errs])
+        np.testing.assert_allclose(ours, ref, rtol=2e-15, atol=0)
+    x = np.geomspace(1e-9, 1e9, 10001)
+    roots = np.array([lanes._inv_fifth_root(v) for v in x])
+    np.testing.assert_allclose(roots, x ** -0.2, rtol=1e-15)
