@@ -1,6 +1,7 @@
 """The `sweep` command: run a scene, list the built-in scenes.
 
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
+    sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep scenes
 
 Exit status: 0 on success, 2 on a user error (one line on stderr: what is wrong, where, and how
@@ -44,6 +45,19 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--threads", type=int, default=None, metavar="N",
                      help="worker threads (default: all)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    plot = sub.add_parser("plot", help="draw the figures that fit a result (PNG, or other "
+                                        "formats on request)")
+    plot.add_argument("result", metavar="RESULT.nc", help="a netCDF file written by 'sweep run'")
+    plot.add_argument("-o", "--output-dir", metavar="DIR", default=".",
+                      help="directory to write the figures to (created; default: the current "
+                           "directory); files are named RESULT-FIGURE.FORMAT")
+    plot.add_argument("--format", default="png", metavar="png,svg",
+                      help="comma-separated figure formats (default: png; also svg, pdf, ...)")
+    plot.add_argument("--select", action="append", default=[], metavar="DIM=VALUE",
+                      help="fix a swept axis at one of its values (needed for all but two "
+                           "axes when a result has more than two), e.g. --select length=0.5")
+    plot.add_argument("--dpi", type=float, default=100.0, metavar="N",
+                      help="resolution of raster formats in dots per inch (default: 100)")
     sub.add_parser("scenes", help="list the built-in scenes")
     return parser
 
@@ -80,6 +94,29 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _plot(args: argparse.Namespace) -> int:
+    import matplotlib
+    matplotlib.use("Agg")          # headless: no display needed (the figures never use pyplot)
+    from pathlib import Path
+    from .plot import load_result, parse_select, plot, save
+
+    if not args.dpi > 0:
+        raise UserError(f"--dpi {args.dpi:g}: must be a positive resolution, e.g. --dpi 100")
+    formats = [f for f in args.format.split(",") if f.strip()]
+    if not formats:
+        raise UserError("--format: give at least one format, e.g. --format png,svg")
+    select = parse_select(args.select)
+    ds = load_result(args.result)
+    figures = plot(ds, select)
+    if not figures:
+        raise UserError(f"result '{args.result}': nothing to plot (no swept axis with more than "
+                        "one value and nothing stored over time)")
+    stem = Path(args.result).stem
+    for path in save(figures, args.output_dir, formats, prefix=f"{stem}-", dpi=args.dpi):
+        print(path)
+    return 0
+
+
 def _scenes() -> int:
     from .scene import builtin_scenes
     scenes = builtin_scenes()
@@ -112,6 +149,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "run":
             return _run(args)
+        if args.command == "plot":
+            return _plot(args)
         return _scenes()
     except UserError as exc:
         print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)

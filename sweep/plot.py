@@ -1,0 +1,842 @@
+"""Figures of a cable-sweep result: pick what fits the Dataset, draw it with matplotlib.
+
+    from sweep.plot import plot, save
+    figures = plot(ds)                       # {"amplitude": Figure, "state": Figure, ...}
+    save(figures, "figs", formats=("png", "svg"), prefix="fig5-")
+
+What `plot` draws, by the result's content:
+
+- transverse, one swept axis: amplitude and settling time against it (`plot_line`), markers
+  coloured by `state`;
+- transverse, two swept axes: maps (`plot_map`) of amplitude and settling time with the
+  modulated, unsettled, diverged and failed points marked, and a map of `state`
+  (`plot_state_map`); closed-form overlays where the axes allow: the principal parametric
+  resonance zone W = 2 w1 sqrt(1 +- mu), mu = P0/(2 Pcr) (MODEL.md sec. 2; dotted where
+  damping suppresses it, mu < 2 zeta) and the buckling length where P0 = Pcr;
+- stored time series: q(t), one panel per point (`plot_time_series`, the paper's Fig 5);
+- longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
+  histories (`plot_histories`); with swept axes also the peak end displacement and the
+  dynamic amplification over them.
+
+More than two swept axes: `select={"dim": value, ...}` picks the values of the others (each
+value must be one of the axis's coordinates). Labels read `long_name` and `units` from the
+Dataset. Like xarray's plotting functions, the single-panel ones take `ax=None` and return the
+Axes, and pass extra keyword arguments to matplotlib. Figures are made with the
+object-oriented API (`matplotlib.figure.Figure`): no pyplot, no display and no backend choice
+are needed, and none is forced on the caller.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import textwrap
+import tomllib
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import matplotlib
+import numpy as np
+import xarray as xr
+from matplotlib import colors as mcolors
+from matplotlib import patheffects
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from .errors import UserError
+
+__all__ = ["STATE_STYLES", "label", "load_result", "parse_select", "plot", "plot_histories",
+           "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
+           "save", "select_points", "state_styles", "swept_axes"]
+
+# A fixed colour and map marker per state meaning (CF flag_meanings); marker None: a good
+# state, not marked on maps. Meanings not listed here get a fallback colour and "*".
+STATE_STYLES: dict[str, tuple[str, str | None]] = {
+    "invalid_input": ("#7f7f7f", "s"),
+    "decayed": ("#2ca02c", None),
+    "steady": ("#1f77b4", None),
+    "completed": ("#1f77b4", None),
+    "modulated": ("#ff7f0e", "o"),
+    "unsettled": ("#e6c619", "^"),
+    "diverged": ("#d62728", "X"),
+    "step_size_too_small": ("#9467bd", "P"),
+    "max_steps_reached": ("#8c564b", "D"),
+}
+_FALLBACK_COLOURS = ("#17becf", "#e377c2", "#bcbd22", "#393b79", "#637939")
+_NAN_COLOUR = "0.82"
+_OUTLINE = [patheffects.Stroke(linewidth=3.0, foreground="k"), patheffects.Normal()]
+_DECADES = 6          # a log colour scale spans at most this many decades below the maximum
+_MAX_LABEL = 60
+
+
+# ---------------------------------------------------------------------------------- reading
+
+def load_result(path: str | os.PathLike) -> xr.Dataset:
+    """Open a cable-sweep result (netCDF written by `sweep run`) into memory.
+
+    Raises UserError (one line) for a missing, unreadable or non-netCDF file, and for a netCDF
+    that is not a cable-sweep result (no `cable_sweep_version` attribute or no `state`).
+    """
+    raw = os.fspath(path)
+    p = Path(raw)
+    if not p.exists():
+        raise UserError(f"result '{raw}': no such file (give a netCDF file written by "
+                        "'sweep run ... -o FILE.nc')")
+    if p.is_dir():
+        raise UserError(f"result '{raw}': is a directory, not a netCDF file")
+    try:
+        with xr.open_dataset(p) as opened:
+            ds = opened.load()
+    except Exception as exc:  # noqa: BLE001 - any failure to read means: not a readable netCDF
+        reason = (exc.strerror or " ".join(str(exc).split())[:80]) if isinstance(exc, OSError) \
+            else "not a format xarray recognises"
+        raise UserError(f"result '{raw}': not a readable netCDF file ({reason}); give a file "
+                        "written by 'sweep run ... -o FILE.nc'") from exc
+    missing = [what for what, ok in (("no 'cable_sweep_version' attribute",
+                                      "cable_sweep_version" in ds.attrs),
+                                     ("no 'state' variable", "state" in ds.data_vars)) if not ok]
+    if missing:
+        raise UserError(f"result '{raw}': not a cable-sweep result ({' and '.join(missing)}); "
+                        "give a file written by 'sweep run ... -o FILE.nc'")
+    return ds
+
+
+def parse_select(items: Iterable[str]) -> dict[str, float]:
+    """`["length=0.5", "frequency_ratio=2"]` -> {"length": 0.5, "frequency_ratio": 2.0}."""
+    out: dict[str, float] = {}
+    for item in items:
+        dim, sep, value = item.partition("=")
+        dim, value = dim.strip(), value.strip()
+        if not sep or not dim or not value:
+            raise UserError(f"--select '{item}': expected DIM=VALUE, e.g. --select length=0.5")
+        try:
+            out[dim] = float(value)
+        except ValueError:
+            raise UserError(f"--select '{item}': '{value}' is not a number (give an axis value, "
+                            "e.g. --select length=0.5)") from None
+    return out
+
+
+def _values_text(values: np.ndarray) -> str:
+    v = np.asarray(values)
+    if v.size <= 8:
+        return ", ".join(f"{x:g}" for x in v)
+    return f"{v.size} values from {v.min():g} to {v.max():g}: {v[0]:g}, {v[1]:g}, ..., {v[-1]:g}"
+
+
+def swept_axes(ds: xr.Dataset) -> list[str]:
+    """The result's swept axes with more than one value, in scene order (the dims of state)."""
+    return [d for d in ds["state"].dims if ds.sizes[d] > 1]
+
+
+def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr.Dataset:
+    """`ds` with each axis in `select` fixed at the given value, single-valued axes dropped to
+    scalar coordinates and the remaining axes sorted; at most two swept axes may remain.
+
+    A value must be one of the axis's coordinate values (to 1e-6 relative). Raises UserError
+    for an unknown axis, a value not on the axis, or more than two remaining swept axes.
+    """
+    if "state" not in ds.data_vars:
+        raise UserError("not a cable-sweep result: no 'state' variable")
+    axes = list(ds["state"].dims)
+    for dim, value in (select or {}).items():
+        shown = f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
+        if dim not in axes:
+            raise UserError(f"select {dim}={shown}: '{dim}' is not a swept axis of this result "
+                            f"(its axes: {', '.join(axes) or 'none'})")
+        coord = np.asarray(ds[dim].values, dtype=float)
+        try:
+            target = float(value)
+        except (TypeError, ValueError):
+            raise UserError(f"select {dim}={shown}: not a number") from None
+        scale = float(np.max(np.abs(coord))) if coord.size else 0.0
+        hits = np.flatnonzero(np.isclose(coord, target, rtol=1e-6, atol=1e-12 * scale))
+        if not hits.size:
+            raise UserError(f"select {dim}={shown}: not a value of axis '{dim}' (its values: "
+                            f"{_values_text(coord)})")
+        ds = ds.isel({dim: int(hits[0])})
+        axes.remove(dim)
+    single = {d: 0 for d in axes if ds.sizes[d] == 1}
+    ds = ds.isel(single)
+    axes = [d for d in axes if d not in single]
+    if len(axes) > 2:
+        extra = axes[2:]
+        example = " ".join(f"--select {d}={float(ds[d].values[0]):g}" for d in extra)
+        raise UserError(f"the result has {len(axes)} swept axes ({', '.join(axes)}): pick "
+                        f"the values of all but two to plot, e.g. {example} (select= in "
+                        "Python)")
+    return ds.sortby(axes) if axes else ds
+
+
+# ---------------------------------------------------------------------------------- labels
+
+def label(da: xr.DataArray, units: str | None = None) -> str:
+    """'long_name [units]' from the attributes (shortened: the text before ' (' when that is
+    long, the variable name when still too long; no brackets for dimensionless '1')."""
+    name = str(da.attrs.get("long_name") or da.name or "")
+    if len(name) > 40 and " (" in name and name.index(" (") >= 10:
+        name = name[:name.index(" (")]
+    if len(name) > _MAX_LABEL:
+        name = str(da.name or name).replace("_", " ")
+    units = da.attrs.get("units") if units is None else units
+    return f"{name} [{units}]" if units and units != "1" else name
+
+
+_PREFIXES = ((1.0, ""), (1e-3, "m"), (1e-6, "\u00b5"), (1e-9, "n"))
+
+
+def _scaled(values: np.ndarray, units: str | None) -> tuple[float, str | None]:
+    """A factor and prefixed units for m, s and N, chosen from the largest finite value."""
+    if units not in ("m", "s", "N"):
+        return 1.0, units
+    finite = np.abs(np.asarray(values, dtype=float))
+    finite = finite[np.isfinite(finite)]
+    top = float(finite.max()) if finite.size else 0.0
+    if top == 0.0:
+        return 1.0, units
+    for factor, prefix in _PREFIXES:
+        if top >= 0.999 * factor:
+            return 1.0 / factor, prefix + units
+    factor, prefix = _PREFIXES[-1]
+    return 1.0 / factor, prefix + units
+
+
+def _fmt(value: float, units: str | None) -> str:
+    factor, scaled = _scaled(np.array([value]), units)
+    text = f"{value * factor:.4g}"
+    return f"{text} {scaled}" if scaled and scaled != "1" else text
+
+
+def _point_text(ds: xr.Dataset, dims: Iterable[str]) -> str:
+    def one(d: str) -> str:
+        units = ds[d].attrs.get("units")
+        value = f"{float(ds[d].values):.4g}"
+        return f"{d} = {value} {units}" if units and units != "1" else f"{d} = {value}"
+    return ", ".join(one(d) for d in dims)
+
+
+def _title(ds: xr.Dataset, what: str = "") -> str:
+    """The result's title plus the fixed (selected or single-valued) axis values."""
+    fixed = [d for d in _scene_axes(ds) if d in ds.coords and ds[d].ndim == 0]
+    parts = [str(ds.attrs.get("title", "cable-sweep result"))]
+    if what:
+        parts[0] += f": {what}"
+    if fixed:
+        parts.append(_point_text(ds, fixed))
+    return ", ".join(parts)
+
+
+def _scene_axes(ds: xr.Dataset) -> list[str]:
+    doc = _scene(ds)
+    return list(doc.get("axes", {})) if doc else [c for c in ds.coords
+                                                 if c not in ("time", "snapshot_time",
+                                                              "position")]
+
+
+def _scene(ds: xr.Dataset) -> dict[str, Any]:
+    try:
+        return tomllib.loads(str(ds.attrs.get("scene", "")))
+    except tomllib.TOMLDecodeError:
+        return {}
+
+
+# ---------------------------------------------------------------------------------- states
+
+def state_styles(state: xr.DataArray) -> list[tuple[int, str, str, str | None]]:
+    """(flag value, meaning, colour, map marker) for every flag the `state` variable declares."""
+    values = np.atleast_1d(state.attrs.get("flag_values", []))
+    meanings = str(state.attrs.get("flag_meanings", "")).split()
+    styles = []
+    spare = iter(_FALLBACK_COLOURS * (1 + len(meanings) // len(_FALLBACK_COLOURS)))
+    for value, meaning in zip(values, meanings):
+        colour, marker = STATE_STYLES.get(meaning, (next(spare), "*"))
+        styles.append((int(value), meaning, colour, marker))
+    return styles
+
+
+# ---------------------------------------------------------------------------------- helpers
+
+def _wrap(text: str, width: int) -> str:
+    return textwrap.fill(text, width, break_long_words=False)
+
+
+def _new_axes(figsize: tuple[float, float] = (6.4, 4.8)) -> Axes:
+    return Figure(figsize=figsize, layout="constrained").add_subplot()
+
+
+def _is_log_spaced(values: np.ndarray) -> bool:
+    v = np.asarray(values, dtype=float)
+    if v.size < 3 or np.any(v <= 0):
+        return False
+    d = np.diff(v)
+    if np.allclose(d, d[0], rtol=1e-6):
+        return False
+    r = v[1:] / v[:-1]
+    return bool(np.allclose(r, r[0], rtol=1e-6))
+
+
+def _edges(values: np.ndarray) -> np.ndarray:
+    """Cell edges around sorted centres (geometric for a log-spaced axis)."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 1:
+        return v[0] + (np.array([-0.05, 0.05]) * abs(v[0]) if v[0] else np.array([-0.5, 0.5]))
+    log = _is_log_spaced(v)
+    w = np.log(v) if log else v
+    mid = 0.5 * (w[1:] + w[:-1])
+    e = np.concatenate([[w[0] - (mid[0] - w[0])], mid, [w[-1] + (w[-1] - mid[-1])]])
+    return np.exp(e) if log else e
+
+
+def _wide_range(values: np.ndarray) -> bool:
+    """Positive values over more than two decades: plot them on a log scale."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    return bool(v.size and np.all(v > 0) and v.max() > 100 * v.min())
+
+
+def _crossing(x: np.ndarray, y: np.ndarray, level: float) -> float | None:
+    """The first x in the sampled range where y crosses `level` (log-log interpolation)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    for i in range(x.size - 1):
+        a, b = y[i] - level, y[i + 1] - level
+        if a == 0:
+            return float(x[i])
+        if a * b < 0:
+            if min(x[i], x[i + 1], y[i], y[i + 1]) > 0:
+                t = math.log(level / y[i]) / math.log(y[i + 1] / y[i])
+                return float(x[i] * (x[i + 1] / x[i]) ** t)
+            return float(x[i] + (x[i + 1] - x[i]) * (-a) / (b - a))
+    return float(x[-1]) if y[-1] == level else None
+
+
+def _depends_only_on(da: xr.DataArray, dims: Iterable[str]) -> bool:
+    return set(da.dims) <= set(dims)
+
+
+def _buckling_length(ds: xr.Dataset) -> float | None:
+    """The span length where P0 = Pcr, when length is swept and P0/Pcr varies with it only."""
+    if ds.attrs.get("model_kind") == "longitudinal" or "load_ratio" not in ds \
+            or "length" not in ds.dims or ds["load_ratio"].dims != ("length",):
+        return None
+    return _crossing(ds["length"].values, ds["load_ratio"].values, 1.0)
+
+
+def _legend(ax: Axes, handles: list, title: str | None = None) -> None:
+    if handles:
+        ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+                  ncols=min(2, len(handles)), fontsize="small", title_fontsize="small",
+                  frameon=False, handlelength=3.0)
+
+
+# ---------------------------------------------------------------------------------- one axis
+
+def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, Any] | None = None,
+              ax: Axes | None = None, add_legend: bool = True, **kwargs: Any) -> Axes:
+    """`var` against the one swept axis, markers coloured by `state` (a thin grey line joins
+    them). Points with no value (NaN, e.g. the settling time of a modulated point) are drawn
+    hollow on the bottom edge in their state's colour. With length swept and P0/Pcr depending
+    on it only, a dashed line marks the buckling length (P0 = Pcr) when it is in range.
+    Extra keyword arguments go to `Axes.scatter`. Returns the Axes."""
+    ds = select_points(ds, select)
+    axes = swept_axes(ds)
+    if len(axes) != 1:
+        raise UserError(f"plot_line needs exactly one swept axis; this result has "
+                        f"{len(axes)} ({', '.join(axes) or 'none'}): use plot_map, or "
+                        "select values of the others")
+    (dim,) = axes
+    if var not in ds:
+        raise UserError(f"plot_line: the result has no variable '{var}'")
+    ax = ax if ax is not None else _new_axes()
+    x = ds[dim].values.astype(float)
+    y = ds[var].values.astype(float)
+    state = ds["state"].values
+    log_y = _wide_range(y)
+    factor, units = (1.0, ds[var].attrs.get("units")) if log_y else \
+        _scaled(y, ds[var].attrs.get("units"))
+    ax.plot(x, y * factor, color="0.7", lw=1.0, zorder=1)
+    handles = []
+    nan_any = False
+    kwargs.setdefault("s", 36)
+    for value, meaning, colour, _marker in state_styles(ds["state"]):
+        mask = state == value
+        if not mask.any():
+            continue
+        good = mask & np.isfinite(y)
+        if good.any():
+            ax.scatter(x[good], y[good] * factor, color=colour, zorder=3,
+                       edgecolors="k", linewidths=0.4, **kwargs)
+        bad = mask & ~np.isfinite(y)
+        if bad.any():
+            nan_any = True
+            ax.scatter(x[bad], np.zeros(bad.sum()), marker="v", facecolors="none",
+                       edgecolors=colour, linewidths=1.2, s=kwargs["s"], zorder=3, clip_on=False,
+                       transform=ax.get_xaxis_transform())
+        handles.append(Line2D([], [], ls="none", marker="o", color=colour, markeredgecolor="k",
+                              markeredgewidth=0.4, label=f"{meaning} ({int(mask.sum())})"))
+    # The NaN points are drawn in axes coordinates: keep them in the x range.
+    ax.update_datalim(np.column_stack([x, np.full(x.shape, np.nanmin(y * factor)
+                                                  if np.isfinite(y).any() else 0.0)]),
+                      updatey=False)
+    ax.autoscale_view()
+    if nan_any:
+        handles.append(Line2D([], [], ls="none", marker="v", markerfacecolor="none",
+                              markeredgecolor="0.3", label="no value (NaN)"))
+    if dim == "length":
+        l_cr = _buckling_length(ds)
+        if l_cr is not None:
+            ax.axvline(l_cr, color="k", ls="--", lw=1.0, zorder=2)
+            handles.append(Line2D([], [], color="k", ls="--", lw=1.0,
+                                  label=f"P0 = Pcr, l = {l_cr:.3g} m"))
+    if log_y:
+        ax.set_yscale("log")
+    if _is_log_spaced(x):
+        ax.set_xscale("log")
+    ax.set_xlabel(label(ds[dim]))
+    ax.set_ylabel(label(ds[var], units))
+    ax.set_title(_title(ds), fontsize="medium")
+    ax.grid(True, color="0.92", zorder=0)
+    if add_legend:
+        _legend(ax, handles, "state")
+    return ax
+
+
+# ---------------------------------------------------------------------------------- maps
+
+def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str) -> tuple[str, str]:
+    axes = swept_axes(ds)
+    if len(axes) != 2:
+        raise UserError(f"{who} needs exactly two swept axes; this result has {len(axes)} "
+                        f"({', '.join(axes) or 'none'})" + (": use plot_line" if len(axes) == 1
+                                                            else ""))
+    if x is None and y is None:
+        y, x = axes                      # xarray's convention: rows (first dim) on y
+    elif x is None:
+        x = next(d for d in axes if d != y)
+    elif y is None:
+        y = next(d for d in axes if d != x)
+    if {x, y} != set(axes):
+        raise UserError(f"{who}: x and y must be the swept axes {axes[0]} and {axes[1]}")
+    return x, y
+
+
+def _mesh(ax: Axes, ds: xr.Dataset, x: str, y: str, values: np.ndarray, **kwargs: Any):
+    xv, yv = ds[x].values.astype(float), ds[y].values.astype(float)
+    mesh = ax.pcolormesh(_edges(xv), _edges(yv), values, shading="flat", **kwargs)
+    if _is_log_spaced(xv):
+        ax.set_xscale("log")
+    if _is_log_spaced(yv):
+        ax.set_yscale("log")
+    ax.set_xlabel(label(ds[x]))
+    ax.set_ylabel(label(ds[y]))
+    return mesh
+
+
+def _mark_states(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
+    """Markers at the centres of the cells whose state is not a good one; legend handles."""
+    state = ds["state"].transpose(y, x).values
+    xx, yy = np.meshgrid(ds[x].values, ds[y].values)
+    # Markers fit in their cells: at most 60 % of the smaller cell side (and 30 pt^2).
+    box = ax.get_window_extent()
+    cell = min(box.width / state.shape[1], box.height / state.shape[0]) * 72.0 / ax.figure.dpi
+    size = float(np.clip((0.6 * cell) ** 2, 2.0, 30.0))
+    edge = 0.6 if size >= 12.0 else 0.3
+    handles = []
+    for value, meaning, colour, marker in state_styles(ds["state"]):
+        mask = state == value
+        if marker is None or not mask.any():
+            continue
+        ax.scatter(xx[mask], yy[mask], marker=marker, s=size, color=colour, edgecolors="k",
+                   linewidths=edge, zorder=4)
+        handles.append(Line2D([], [], ls="none", marker=marker, color=colour,
+                              markeredgecolor="k", markeredgewidth=0.6,
+                              label=f"{meaning} ({int(mask.sum())})"))
+    return handles
+
+
+def _damping(ds: xr.Dataset) -> Any:
+    if "damping_ratio" in ds.coords:
+        return ds["damping_ratio"]
+    try:
+        return float(_scene(ds)["cable"]["damping_ratio"])
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+def _overlays(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
+    """Closed-form curves the map's axes allow (MODEL.md sec. 2); their legend handles."""
+    handles: list = []
+    if ds.attrs.get("model_kind") == "longitudinal":
+        return handles
+
+    def draw(along: str, pos: np.ndarray, val: np.ndarray, **style: Any) -> None:
+        # `pos` runs along the `along` axis; `val` is the other map coordinate.
+        px, py = (pos, val) if along == x else (val, pos)
+        ax.plot(px, py, **style)
+
+    l_cr = _buckling_length(ds) if "length" in (x, y) else None
+    if l_cr is not None:
+        (ax.axvline if x == "length" else ax.axhline)(l_cr, color="w", ls=(0, (4, 2)), lw=1.4,
+                                                      zorder=3, path_effects=_OUTLINE)
+        handles.append(Line2D([], [], color="w", ls=(0, (4, 2)), lw=1.4, path_effects=_OUTLINE,
+                              label=f"P0 = Pcr: l = {l_cr:.3g} m"))
+    freq = next((f for f in ("frequency_ratio", "frequency") if f in (x, y)), None)
+    is_harmonic = _scene(ds).get("load", {}).get("type", "harmonic") == "harmonic"
+    if freq is None or ds.attrs.get("coefficients") != "consistent" or not is_harmonic \
+            or "load_ratio" not in ds:
+        return handles
+    other = y if freq == x else x
+    ratio = ds["load_ratio"]
+    base = xr.DataArray(1.0) if freq == "frequency_ratio" else ds.get("natural_frequency")
+    zeta = _damping(ds)
+    parts = [ratio, base] + ([zeta] if isinstance(zeta, xr.DataArray) else [])
+    if base is None or not all(_depends_only_on(p, [other]) for p in parts):
+        return handles
+    pos = ds[other].values.astype(float)
+    dense = np.geomspace(pos[0], pos[-1], 200) if pos[0] > 0 else np.linspace(pos[0], pos[-1], 200)
+
+    def along(da: Any) -> np.ndarray:
+        vals = np.broadcast_to(np.asarray(da.values if isinstance(da, xr.DataArray) else da,
+                                          float), pos.shape)
+        if np.all(vals > 0) and pos[0] > 0:
+            return np.exp(np.interp(np.log(dense), np.log(pos), np.log(vals)))
+        return np.interp(dense, pos, vals)
+
+    mu = 0.5 * along(ratio)
+    w1 = along(base)
+    active = mu >= 2.0 * along(zeta) if zeta is not None else np.ones(dense.shape, bool)
+    unit = "W/w1" if freq == "frequency_ratio" else "f"
+    for sign in (1.0, -1.0):
+        with np.errstate(invalid="ignore"):
+            curve = 2.0 * w1 * np.sqrt(1.0 + sign * mu)
+        on = np.where(active, curve, np.nan)
+        off = np.where(active, np.nan, curve)
+        # Join the solid and dotted parts where they meet.
+        edge = np.flatnonzero(np.diff(active.astype(int)) != 0)
+        off[edge] = curve[edge]
+        off[edge + 1] = curve[edge + 1]
+        draw(other, dense, on, color="w", lw=1.4, zorder=3, path_effects=_OUTLINE)
+        draw(other, dense, off, color="w", lw=1.4, ls=":", zorder=3, path_effects=_OUTLINE)
+    handles.append(Line2D([], [], color="w", lw=1.4, path_effects=_OUTLINE,
+                          label=f"{unit} = 2 {'' if unit == 'W/w1' else 'f1 '}"
+                                "sqrt(1 \u00b1 mu), mu = P0/2Pcr"))
+    if not active.all():
+        handles.append(Line2D([], [], color="w", lw=1.4, ls=":", path_effects=_OUTLINE,
+                              label="damped out: mu < 2 zeta"))
+    return handles
+
+
+def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
+             y: str | None = None, select: Mapping[str, Any] | None = None,
+             ax: Axes | None = None, add_colorbar: bool = True, add_legend: bool = True,
+             mark_states: bool = True, overlays: bool = True, **kwargs: Any) -> Axes:
+    """A pcolormesh map of `var` over the two swept axes (x: the second, y: the first, as
+    xarray draws a 2-D DataArray; or name them). A variable spanning more than two decades gets
+    a log colour scale; cells with no value (NaN) are grey. Points in a state that is not a
+    good one (modulated, unsettled, diverged, failures) are marked at the cell centres, and the
+    closed-form curves the axes allow are drawn in white (see the module docstring). Extra
+    keyword arguments go to `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
+    """
+    ds = select_points(ds, select)
+    x, y = _map_axes(ds, x, y, "plot_map")
+    if var not in ds:
+        raise UserError(f"plot_map: the result has no variable '{var}'")
+    ax = ax if ax is not None else _new_axes((7.0, 6.0))
+    da = ds[var].transpose(y, x) if ds[var].ndim == 2 else ds[var].broadcast_like(
+        ds["state"]).transpose(y, x)
+    values = np.ma.masked_invalid(da.values.astype(float))
+    extend = "neither"
+    if "norm" not in kwargs and "vmin" not in kwargs and _wide_range(values.compressed()):
+        top, low = float(values.max()), float(values.min())
+        floor = top * 10.0 ** -_DECADES
+        extend = "min" if low < floor else "neither"
+        kwargs["norm"] = mcolors.LogNorm(vmin=max(low, floor), vmax=top, clip=False)
+    kwargs.setdefault("cmap", "viridis")
+    mesh = _mesh(ax, ds, x, y, values, **kwargs)
+    ax.set_facecolor(_NAN_COLOUR)
+    handles = []
+    if values.mask.any():
+        handles.append(Patch(facecolor=_NAN_COLOUR, edgecolor="0.5", label="no value (NaN)"))
+    if mark_states:
+        handles += _mark_states(ax, ds, x, y)
+    if overlays:
+        lims = ax.get_xlim(), ax.get_ylim()
+        handles += _overlays(ax, ds, x, y)
+        ax.set_xlim(*lims[0])
+        ax.set_ylim(*lims[1])
+    if add_colorbar:
+        ax.figure.colorbar(mesh, ax=ax, label=label(ds[var]), extend=extend)
+    ax.set_title(_title(ds, str(var)), fontsize="medium")
+    if add_legend:
+        _legend(ax, handles)
+    return ax
+
+
+def plot_state_map(ds: xr.Dataset, *, x: str | None = None, y: str | None = None,
+                   select: Mapping[str, Any] | None = None, ax: Axes | None = None,
+                   add_legend: bool = True, overlays: bool = True, **kwargs: Any) -> Axes:
+    """A map of `state` over the two swept axes, one fixed colour per flag meaning, with the
+    closed-form overlays of `plot_map`. Returns the Axes."""
+    ds = select_points(ds, select)
+    x, y = _map_axes(ds, x, y, "plot_state_map")
+    ax = ax if ax is not None else _new_axes((7.0, 6.0))
+    styles = state_styles(ds["state"])
+    values = [s[0] for s in styles]
+    cmap = mcolors.ListedColormap([s[2] for s in styles])
+    bounds = np.concatenate([[values[0] - 0.5], np.asarray(values[:-1]) + 0.5,
+                             [values[-1] + 0.5]]) if values else np.array([-0.5, 0.5])
+    norm = mcolors.BoundaryNorm(bounds, cmap.N) if values else None
+    state = ds["state"].transpose(y, x).values
+    _mesh(ax, ds, x, y, state, cmap=cmap, norm=norm, edgecolors="face", **kwargs)
+    handles: list = [Patch(facecolor=colour, label=f"{meaning} ({int((state == v).sum())})")
+                     for v, meaning, colour, _m in styles if (state == v).any()]
+    if overlays:
+        lims = ax.get_xlim(), ax.get_ylim()
+        handles += _overlays(ax, ds, x, y)
+        ax.set_xlim(*lims[0])
+        ax.set_ylim(*lims[1])
+    ax.set_title(_title(ds, "state"), fontsize="medium")
+    if add_legend:
+        _legend(ax, handles)
+    return ax
+
+
+# ---------------------------------------------------------------------------------- series
+
+def _points(ds: xr.Dataset, max_points: int) -> tuple[list[dict[str, int]], int]:
+    """Index dicts of up to max_points points, evenly spread over the swept grid; the total."""
+    axes = swept_axes(ds)
+    shape = [ds.sizes[d] for d in axes]
+    total = int(np.prod(shape, dtype=np.int64))
+    flat = np.unique(np.linspace(0, total - 1, min(total, max_points)).round().astype(int))
+    return [dict(zip(axes, map(int, np.unravel_index(i, shape)))) for i in flat], total
+
+
+def _state_meaning(ds: xr.Dataset) -> str:
+    value = int(ds["state"].values)
+    for v, meaning, _c, _m in state_styles(ds["state"]):
+        if v == value:
+            return meaning
+    return str(value)
+
+
+def _state_colour(ds: xr.Dataset) -> str:
+    value = int(ds["state"].values)
+    return next((c for v, _m, c, _k in state_styles(ds["state"]) if v == value), "k")
+
+
+def plot_time_series(ds: xr.Dataset, var: str = "displacement", *,
+                     select: Mapping[str, Any] | None = None, max_panels: int = 8,
+                     fig: Figure | None = None, **kwargs: Any) -> Figure:
+    """The stored response against time, one panel per point (the paper's Fig 5 style), lines
+    in the colour of the point's state; at most `max_panels` points, spread evenly over the
+    grid. Panels share the y scale when their peaks are within a factor 10. Extra keyword
+    arguments go to `Axes.plot`. Returns the Figure."""
+    ds = select_points(ds, select)
+    if var not in ds or "time" not in ds[var].dims:
+        raise UserError(f"plot_time_series: the result stores no '{var}' time series (set "
+                        "outputs.time_series = true in the scene)")
+    points, total = _points(ds, max_panels)
+    n = len(points)
+    data = ds[var]
+    peaks = [float(np.nanmax(np.abs(data.isel(p).values), initial=0.0)) for p in points]
+    share = bool(min(peaks) > 0 and max(peaks) < 10 * min(peaks))
+    factor, units = _scaled(np.array(peaks), data.attrs.get("units"))
+    tfactor, tunits = _scaled(ds["time"].values, ds["time"].attrs.get("units"))
+    fig = fig if fig is not None else Figure(figsize=(7.0, 1.0 + 1.45 * n), layout="constrained")
+    axs = fig.subplots(n, 1, sharex=True, sharey=share, squeeze=False)[:, 0]
+    kwargs.setdefault("lw", 0.8)
+    for ax, p in zip(axs, points):
+        point = ds.isel(p)
+        ax.plot(ds["time"].values * tfactor, point[var].values * factor,
+                color=_state_colour(point), **kwargs)
+        text = _point_text(point, swept_axes(ds)) or "the point"
+        ax.set_title(f"{text}: {_state_meaning(point)}", fontsize="small", loc="left")
+        ax.grid(True, color="0.92")
+    axs[-1].set_xlabel(label(ds["time"], tunits))
+    fig.supylabel(label(data, units), fontsize="medium")
+    shown = "" if n == total else f" ({n} of {total} points)"
+    fig.suptitle(_title(ds, "response against time") + shown, fontsize="medium")
+    return fig
+
+
+def _snapshot_fields(ds: xr.Dataset) -> list[str]:
+    fields = []
+    for base in ("snapshot_displacement", "snapshot_force", "snapshot_velocity"):
+        for name in ((base + "_ratio", base) if base != "snapshot_displacement" else (base,)):
+            if name in ds:
+                fields.append(name)
+                break
+    return fields
+
+
+def plot_snapshots(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
+                   max_times: int = 8, max_lines: int = 10, fig: Figure | None = None,
+                   **kwargs: Any) -> Figure:
+    """Longitudinal snapshots along the span (the paper's Fig 7 style): one row per snapshot
+    time (at most `max_times`, spread evenly), one column per field: displacement u(x), force
+    (N/P0 when stored normalised, else N) and velocity (v rho A a/P0, else m/s) against x/l;
+    one line per point (at most `max_lines`). Extra keyword arguments go to `Axes.plot`.
+    Returns the Figure."""
+    ds = select_points(ds, select)
+    fields = _snapshot_fields(ds)
+    if not fields:
+        raise UserError("plot_snapshots: the result stores no snapshots (set "
+                        "outputs.snapshot_times in a longitudinal scene)")
+    points, total = _points(ds, max_lines)
+    n_times = ds.sizes["snapshot_time"]
+    rows = np.unique(np.linspace(0, n_times - 1, min(n_times, max_times)).round().astype(int))
+    fig = fig if fig is not None else Figure(figsize=(3.3 * len(fields) + 0.8,
+                                                      1.1 + 1.75 * rows.size),
+                                             layout="constrained")
+    axs = fig.subplots(rows.size, len(fields), sharex=True, sharey="col", squeeze=False)
+    x = ds["position"].values
+    kwargs.setdefault("lw", 1.4)
+    for j, name in enumerate(fields):
+        factor, units = _scaled(ds[name].values, ds[name].attrs.get("units"))
+        axs[0, j].set_title(_wrap(label(ds[name], units), 34), fontsize="small")
+        axs[-1, j].set_xlabel(_wrap(label(ds["position"]), 34))
+        for i, k in enumerate(rows):
+            ax = axs[i, j]
+            for n, p in enumerate(points):
+                point = ds.isel(p)
+                ax.plot(x, point[name].isel(snapshot_time=k).values * factor,
+                        color=f"C{n % 10}", label=_point_text(point, swept_axes(ds)) or None,
+                        **kwargs)
+            ax.axhline(0.0, color="0.6", lw=0.6, zorder=0)
+            ax.grid(True, color="0.92")
+    for i, k in enumerate(rows):
+        t = float(ds["snapshot_time"].values[k])
+        text = f"t = {_fmt(t, 's')}"
+        if "transit_time" in ds and ds["transit_time"].ndim == 0:
+            text += f"\n= {t / float(ds['transit_time'].values):.3g} l/a"
+        axs[i, 0].set_ylabel(text, fontsize="small")
+    if len(points) > 1:
+        axs[0, -1].legend(fontsize="x-small", loc="best")
+    shown = "" if len(points) == total else f" ({len(points)} of {total} points)"
+    fig.suptitle(_title(ds, "snapshots along the span") + shown, fontsize="medium")
+    return fig
+
+
+def plot_histories(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
+                   max_lines: int = 10, fig: Figure | None = None, **kwargs: Any) -> Figure:
+    """Longitudinal end histories: the loaded end's displacement u(l, t) and the fixed end's
+    force N(0, t) against time, one line per point (at most `max_lines`); for a single point
+    the closed-form peaks 2 P0 l/EA and 2 P0 are drawn dashed. Returns the Figure."""
+    ds = select_points(ds, select)
+    names = [n for n in ("end_displacement", "fixed_end_force") if n in ds]
+    if not names:
+        raise UserError("plot_histories: the result stores no end histories (set "
+                        "outputs.histories = true in a longitudinal scene)")
+    points, total = _points(ds, max_lines)
+    fig = fig if fig is not None else Figure(figsize=(7.0, 1.2 + 2.6 * len(names)),
+                                             layout="constrained")
+    axs = fig.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
+    tfactor, tunits = _scaled(ds["time"].values, ds["time"].attrs.get("units"))
+    kwargs.setdefault("lw", 1.2)
+    for ax, name in zip(axs, names):
+        factor, units = _scaled(ds[name].values, ds[name].attrs.get("units"))
+        for p in points:
+            point = ds.isel(p)
+            text = _point_text(point, swept_axes(ds))
+            line, = ax.plot(ds["time"].values * tfactor, point[name].values * factor,
+                            label=text or None, **kwargs)
+            if len(points) == 1:
+                exact = _exact_peak(point, name)
+                if exact is not None:
+                    formula = "2 P0 l/EA" if name == "end_displacement" else "2 P0"
+                    ax.axhline(exact * factor, color="0.3", ls="--", lw=0.9,
+                               label=f"exact peak {formula} = "
+                                     f"{_fmt(abs(exact), ds[name].attrs.get('units'))}")
+        ax.axhline(0.0, color="0.6", lw=0.6)
+        ax.set_ylabel(_wrap(label(ds[name], units), 26))
+        ax.grid(True, color="0.92")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small", loc="best")
+    axs[-1].set_xlabel(label(ds["time"], tunits))
+    shown = "" if len(points) == total else f" ({len(points)} of {total} points)"
+    fig.suptitle(_title(ds, "end histories") + shown, fontsize="medium")
+    return fig
+
+
+def _exact_peak(point: xr.Dataset, name: str) -> float | None:
+    """d'Alembert's peak of a history, signed as the history runs (MODEL.md sec. 4)."""
+    values = point[name].values
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return None
+    sign = 1.0 if finite[np.argmax(np.abs(finite))] >= 0 else -1.0
+    if name == "end_displacement" and "static_end_displacement" in point:
+        return sign * 2.0 * abs(float(point["static_end_displacement"].values))
+    if name == "fixed_end_force" and "peak_fixed_end_force" in point \
+            and "force_amplification" in point:
+        load = float(point["peak_fixed_end_force"].values) / float(
+            point["force_amplification"].values)
+        return sign * 2.0 * abs(load) if math.isfinite(load) else None
+    return None
+
+
+# ---------------------------------------------------------------------------------- choose
+
+def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> dict[str, Figure]:
+    """Every figure that fits the result, keyed by name (the file name `save` gives it).
+
+    Transverse: 'amplitude' and 'settling_time' (lines over one swept axis, maps over two),
+    'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
+    'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
+    swept axes. An empty dict when nothing fits (no swept axis and nothing stored over time).
+    """
+    ds = select_points(ds, select)
+    axes = swept_axes(ds)
+    figures: dict[str, Figure] = {}
+    if ds.attrs.get("model_kind") == "longitudinal":
+        scalars = ["peak_end_displacement", "dynamic_amplification"]
+    else:
+        scalars = ["amplitude", "settling_time"]
+    for var in scalars:
+        if var not in ds:
+            continue
+        if len(axes) == 1:
+            figures[var] = plot_line(ds, var).figure
+        elif len(axes) == 2:
+            figures[var] = plot_map(ds, var).figure
+    if len(axes) == 2:
+        figures["state"] = plot_state_map(ds).figure
+    if "displacement" in ds and "time" in ds["displacement"].dims:
+        figures["time_series"] = plot_time_series(ds)
+    if _snapshot_fields(ds):
+        figures["snapshots"] = plot_snapshots(ds)
+    if "end_displacement" in ds or "fixed_end_force" in ds:
+        figures["histories"] = plot_histories(ds)
+    return figures
+
+
+def save(figures: Mapping[str, Figure], directory: str | os.PathLike = ".",
+         formats: Iterable[str] = ("png",), *, prefix: str = "", dpi: float = 100) -> list[Path]:
+    """Write each figure as DIRECTORY/PREFIX + key + .FORMAT (the directory is created);
+    returns the paths written. Raises UserError for an unknown format or an unwritable
+    directory."""
+    formats = [f.strip().lower().lstrip(".") for f in formats if f.strip()]
+    supported = Figure().canvas.get_supported_filetypes()
+    for fmt in formats:
+        if fmt not in supported:
+            raise UserError(f"format '{fmt}': not a figure format matplotlib writes (use one of "
+                            f"{', '.join(sorted(supported))})")
+    out = Path(directory)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"output directory '{out}': could not be created "
+                        f"({exc.strerror or exc})") from exc
+    written = []
+    for key, fig in figures.items():
+        for fmt in formats:
+            path = out / f"{prefix}{key}.{fmt}"
+            try:
+                fig.savefig(path, format=fmt, dpi=dpi)
+            except OSError as exc:
+                raise UserError(f"figure '{path}': could not be written "
+                                f"({exc.strerror or exc})") from exc
+            written.append(path)
+    return written
