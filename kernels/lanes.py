@@ -33,6 +33,7 @@ from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 from .transverse import classify, reject_point, valid
 
 LANES = 16             # trajectories per lock-step group (a multiple of the SIMD width)
+SIMD = 4                # doubles per vector register the loops are rounded to (AVX2)
 MIN_BLOCK = LANES       # points per parallel work item, at least (small grids still use all threads)
 MAX_BLOCK = 1024        # at most, so that every thread gets several blocks
 
@@ -161,7 +162,7 @@ def _accel(W, j, t, q, v):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _prepare(W, settings):
+def _prepare(W, settings, n_run):
     """trajectory.next_attempt across lanes, for the lanes whose step is ordinary: running,
     before t_end, within max_steps, and far above the minimum step (10 ulps of t or
     solver.min_step), so SciPy's clamp and failure cannot apply. Other lanes get W_FLAG = 1."""
@@ -170,7 +171,7 @@ def _prepare(W, settings):
     max_step = settings[MAX_STEP]
     max_steps = settings[MAX_STEPS]
     min_user = settings[MIN_STEP]
-    for j in range(W.shape[0] // W_ROWS):
+    for j in range(n_run):
         t = W[tj.T * L + j]
         h_abs = W[tj.H_ABS * L + j]
         fresh = W[tj.REJECTED_NOW * L + j] == 0.0
@@ -187,15 +188,16 @@ def _prepare(W, settings):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _attempt(W, rtol, atol):
+def _attempt(W, rtol, atol, n_run):
     """One Dormand-Prince attempt in every lane of W.
 
     The stages are written out with scalar locals and the tableau's entries (dopri5.A, B, C,
     E), summed in the scalar step's order; one loop with a run-time trip count runs across the
     lanes with straight-line arithmetic, so LLVM vectorises it rather than unrolling it.
+    Lanes n_run and above are idle and skipped.
     """
     L = LANES
-    for j in range(W.shape[0] // W_ROWS):
+    for j in range(n_run):
         t = W[tj.T * L + j]
         q = W[tj.Q * L + j]
         v = W[tj.V * L + j]
@@ -248,7 +250,7 @@ def _attempt(W, rtol, atol):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _finish(W, settings, n_samples):
+def _finish(W, settings, n_samples, n_run):
     """trajectory.finish_attempt across lanes for rejected attempts and ordinary accepted
     steps (first metrics pass: threshold tol * peak around 0). An accepted step with anything
     to locate on the dense output, or a divergence, gets W_FLAG = 1 and is left untouched."""
@@ -257,7 +259,7 @@ def _finish(W, settings, n_samples):
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
-    for j in range(W.shape[0] // W_ROWS):
+    for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0
         err = W[W_ERR * L + j]
@@ -338,11 +340,12 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
     K = np.empty((N_STAGES + 1, 2))
     Qc = np.empty((2, 4))
     next_point = lo
+    n_run = L          # lanes the vector loops cover: the active ones, rounded up to SIMD width
     while True:
-        _prepare(W, settings)
-        busy = 0
+        _prepare(W, settings, n_run)
+        top = 0
         for j in range(L):
-            if W[W_FLAG * L + j] != 0.0:
+            if j >= n_run or W[W_FLAG * L + j] != 0.0:
                 acc = W[j::L]
                 step = 0.0
                 while True:
@@ -364,12 +367,13 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
                     next_point += 1
                 W[W_H * L + j] = step
             if W[W_H * L + j] > 0.0:
-                busy += 1
-        if busy == 0:
+                top = j + 1
+        if top == 0:
             return
-        _attempt(W, rtol, atol)
-        _finish(W, settings, n_samples)
-        for j in range(L):
+        n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
+        _attempt(W, rtol, atol, n_run)
+        _finish(W, settings, n_samples, n_run)
+        for j in range(n_run):
             if W[W_FLAG * L + j] != 0.0:
                 i = point[j]
                 K[0, 0] = W[tj.FQ * L + j]
