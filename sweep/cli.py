@@ -45,6 +45,18 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--threads", type=int, default=None, metavar="N",
                      help="worker threads (default: all)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    run.add_argument("--resume", action="store_true",
+                     help="finish an interrupted run: compute only the chunks missing from "
+                          "OUT.nc.chunks/")
+    run.add_argument("--backend", choices=("threads", "dask"), default=None,
+                     help="run the chunks in-process (threads, the default) or on dask")
+    run.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                     help="dask: an existing scheduler, e.g. tcp://HOST:8786 (implies --backend "
+                          "dask; default: a LocalCluster started for the run)")
+    run.add_argument("--workers", type=int, default=None, metavar="N",
+                     help="dask LocalCluster worker processes (default: one per core)")
+    run.add_argument("--chunk-size", type=int, default=None, metavar="N",
+                     help="grid points per kernel call or dask task")
     plot = sub.add_parser("plot", help="draw the figures that fit a result (PNG, or other "
                                         "formats on request)")
     plot.add_argument("result", metavar="RESULT.nc", help="a netCDF file written by 'sweep run'")
@@ -80,11 +92,21 @@ def _run(args: argparse.Namespace) -> int:
         raise UserError(f"--threads {args.threads}: must be a positive number of threads "
                         "(give --threads 1 or more, or leave it out to use every core)")
     overrides = dict(parse_override(item) for item in args.overrides)
+    if args.scheduler is not None:
+        overrides["run.scheduler"] = args.scheduler
+        overrides.setdefault("run.backend", "dask")
+    for key, value in (("run.backend", args.backend), ("run.workers", args.workers),
+                       ("run.chunk_size", args.chunk_size)):
+        if value is not None:
+            overrides[key] = value
+    if args.resume and not args.output:
+        raise UserError("--resume: needs -o OUT.nc, the file whose interrupted run to finish")
     scene = load_scene(args.scene, overrides=overrides)
     if args.output is not None:
         check_output_path(args.output, args.overwrite)
     started = time.perf_counter()
-    ds = run(scene, output=args.output, overwrite=args.overwrite, threads=args.threads,
+    ds = run(scene, output=args.output, overwrite=args.overwrite, resume=args.resume,
+             threads=args.threads,
              progress=False if args.quiet else None)
     if not args.quiet:
         line = _summary(ds, time.perf_counter() - started)

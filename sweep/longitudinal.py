@@ -10,6 +10,7 @@ Sign convention: tension positive, so the compressive forces here are negative.
 from __future__ import annotations
 
 import math
+import os
 import time
 import warnings
 from typing import Any
@@ -20,7 +21,8 @@ import xarray as xr
 from . import grid
 from .dataset import derived, flag_attrs, global_attrs
 from .errors import CableSweepWarning
-from .run import check_memory, grid_order, in_chunks, point_order
+from .execute import longitudinal_chunk
+from .run import check_memory, solve_chunked
 from .scene import Scene
 
 
@@ -66,7 +68,9 @@ def _warn_courant(courant: float) -> None:
                       CableSweepWarning, stacklevel=3)
 
 
-def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False) -> xr.Dataset:
+def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
+                     output: str | os.PathLike | None = None, resume: bool = False,
+                     overwrite: bool = False) -> xr.Dataset:
     """The longitudinal (central-difference) sweep of `scene` as a Dataset."""
     from kernels import longitudinal as lk
 
@@ -98,27 +102,21 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False) -> 
     settings[lk.SAMPLE_DT] = dt_sample
     settings[lk.MAX_LEVELS] = scene.get("solver.max_steps")
 
-    order = point_order(n)
-    shuffled = np.ascontiguousarray(table[order])
-    states = np.empty(n, np.int8)
-    reals = np.empty((n, lk.N_REALS))
-    steps = np.empty(n, np.int64)
-    hist_u = np.empty((n, n_hist))
-    hist_f = np.empty((n, n_hist))
-    snaps = [np.empty((n, n_snap, n_int + 1)) for _ in range(3)]
-
-    def solve_chunk(lo: int, hi: int) -> None:
-        lk.solve_batch(shuffled[lo:hi], settings, snap_times, states[lo:hi], reals[lo:hi],
-                       steps[lo:hi], hist_u[lo:hi], hist_f[lo:hi], snaps[0][lo:hi],
-                       snaps[1][lo:hi], snaps[2][lo:hi])
-
     started = time.perf_counter()
-    in_chunks(n, solve_chunk, threads, progress, scene.get("run.chunk_size"))
+    n_nodes = n_int + 1
+    out = solve_chunked(scene, longitudinal_chunk, table, (settings, snap_times, n_hist, n_nodes),
+                        {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
+                         "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
+                         "hist_f": np.empty((n, n_hist)),
+                         "snap_u": np.empty((n, n_snap, n_nodes)),
+                         "snap_f": np.empty((n, n_snap, n_nodes)),
+                         "snap_v": np.empty((n, n_snap, n_nodes))},
+                        output=output, resume=resume, overwrite=overwrite, threads=threads,
+                        progress=progress)
     elapsed = time.perf_counter() - started
-    back = grid_order(order)
-    states, reals, steps, hist_u, hist_f = (x[back] for x in (states, reals, steps, hist_u,
-                                                               hist_f))
-    snaps = [x[back] for x in snaps]
+    states, reals, steps, hist_u, hist_f = (out[k] for k in ("states", "reals", "steps",
+                                                              "hist_u", "hist_f"))
+    snaps = [out["snap_u"], out["snap_f"], out["snap_v"]]
 
     def field(values: np.ndarray) -> np.ndarray:
         return values.reshape(shape + values.shape[1:])

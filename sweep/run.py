@@ -13,7 +13,7 @@ import numpy as np
 import xarray as xr
 
 from . import grid, models
-from .dataset import assemble
+from .dataset import assemble, package_version
 from .errors import UserError
 from .io import check_output_path, write_netcdf
 from .scene import Scene
@@ -56,25 +56,6 @@ def settings_vector(scene: Scene) -> np.ndarray:
     return s
 
 
-def _progress_printer(total: int, enabled: bool) -> Callable[[int], None]:
-    start = time.perf_counter()
-
-    def report(done: int) -> None:
-        if not enabled:
-            return
-        elapsed = time.perf_counter() - start
-        rate = done / elapsed if elapsed > 0 else 0.0
-        left = (total - done) / rate if rate > 0 else math.inf
-        width = 30
-        bar = "#" * int(width * done / total) + "-" * (width - int(width * done / total))
-        sys.stderr.write(f"\r[{bar}] {done}/{total} points  {rate:,.0f}/s  "
-                         f"{left:5.1f} s left ")
-        if done == total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-    return report
-
-
 def check_memory(n_points: int, bytes_per_point: float, what: str) -> None:
     """Refuse, before allocating, a sweep whose arrays would not fit in this machine's memory.
 
@@ -108,56 +89,74 @@ def grid_order(order: np.ndarray) -> np.ndarray:
     return back
 
 
-def in_chunks(n: int, solve_chunk: Callable[[int, int], None], threads: int = 0,
-              progress: bool = False, chunk_size: int | None = None) -> None:
-    """Call solve_chunk(lo, hi) over [0, n) in chunks of `chunk_size` points (default: enough
-    for every thread, at most 100 chunks), on `threads` Numba threads (0 = all), with a
-    progress bar on stderr when `progress` and the run has more than one chunk."""
-    import numba
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS) if threads
-                          else numba.config.NUMBA_NUM_THREADS)
-    chunk = chunk_size or max(4096 * numba.get_num_threads(), -(-n // 100))
-    report = _progress_printer(n, progress and n > chunk)
-    for lo in range(0, n, chunk):
-        hi = min(n, lo + chunk)
-        solve_chunk(lo, hi)
-        report(hi)
-
-
 def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
                  threads: int = 0, progress: bool = False,
                  chunk_size: int | None = None, driver: str = "lanes") -> KernelResult:
-    """Run the transverse kernel over the rows of `params` (grid order in, grid order out).
-
-    driver: "lanes" (kernels.lanes, lock-step SIMD) or "scalar" (kernels.transverse, one
-    trajectory per iteration); the two agree to round-off.
-    """
-    from kernels import lanes
+    """Run the transverse kernel over the rows of `params` in-process (grid order in, grid
+    order out). driver: "lanes" (kernels.lanes, lock-step SIMD) or "scalar"
+    (kernels.transverse, one trajectory per iteration); the two agree to round-off."""
+    from .execute import _set_threads, default_chunk_size, execute, transverse_chunk
     from kernels import transverse as tk
-    solve_batch = lanes.solve_batch if driver == "lanes" else tk.solve_batch_scalar
-
     n = params.shape[0]
     order = point_order(n)
-    shuffled = np.ascontiguousarray(params[order])
-    states = np.empty(n, np.int8)
-    reals = np.empty((n, tk.N_REALS))
-    counts = np.empty((n, tk.N_COUNTS), np.int64)
-    series = np.empty((n, n_samples))
-
-    def solve_chunk(lo: int, hi: int) -> None:
-        solve_batch(shuffled[lo:hi], settings, states[lo:hi], reals[lo:hi], counts[lo:hi],
-                    series[lo:hi])
-
-    in_chunks(n, solve_chunk, threads, progress, chunk_size)
+    outputs = {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
+               "counts": np.empty((n, tk.N_COUNTS), np.int64),
+               "series": np.empty((n, n_samples))}
+    _set_threads(threads)
+    execute(transverse_chunk, np.ascontiguousarray(params[order]), (settings, n_samples, driver),
+            outputs, chunk_size=chunk_size or default_chunk_size(n, "threads", 0),
+            threads=threads, progress=progress)
     back = grid_order(order)
-    return KernelResult(states[back], reals[back], counts[back], series[back], np.empty(0))
+    return KernelResult(outputs["states"][back], outputs["reals"][back],
+                        outputs["counts"][back], outputs["series"][back], np.empty(0))
+
+
+def run_fingerprint(scene: Scene) -> str:
+    """What decides a run's results: every scene value but the run.* keys, and the axes."""
+    from .execute import fingerprint
+    values = {k: v for k, v in scene.values.items() if not k.startswith("run.")}
+    axes = {k: [float(x) for x in v] for k, v in scene.axes.items()}
+    return fingerprint(sorted(values.items()), sorted(axes.items()), package_version())
+
+
+def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict], table: np.ndarray, args: tuple,
+                  outputs: dict[str, np.ndarray], *, output: str | os.PathLike | None = None,
+                  resume: bool = False, overwrite: bool = False, threads: int = 0,
+                  progress: bool = False) -> dict[str, np.ndarray]:
+    """Solve the rows of `table` (grid order) in chunks on the scene's backend; with `output`,
+    persist every finished chunk next to it and, when resuming, compute only the missing ones.
+    Returns `outputs` in grid order."""
+    from .execute import ChunkStore, default_chunk_size, execute
+    n = table.shape[0]
+    order = point_order(n)
+    backend = scene.get("run.backend")
+    workers = scene.get("run.workers")
+    chunk = scene.get("run.chunk_size") or default_chunk_size(n, backend, workers or
+                                                              (os.cpu_count() or 1))
+    store = None
+    done: dict = {}
+    if output is not None:
+        store = ChunkStore(output, run_fingerprint(scene))
+        done, chunk = store.open(resume, overwrite, chunk)
+    computed = execute(chunk_fn, np.ascontiguousarray(table[order]), args, outputs,
+                       chunk_size=chunk, backend=backend, threads=threads,
+                       scheduler=scene.get("run.scheduler"), workers=workers,
+                       progress=progress, store=store, done=done)
+    if resume:
+        sys.stderr.write(f"resumed: {len(done)} chunks of {len(done) + computed} were already "
+                         f"done, {computed} computed\n")
+    back = grid_order(order)
+    return {name: values[back] for name, values in outputs.items()}
 
 
 def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: bool = False,
-        threads: int | None = None, progress: bool | None = None) -> xr.Dataset:
+        resume: bool = False, threads: int | None = None,
+        progress: bool | None = None) -> xr.Dataset:
     """Run every point of `scene` and return the result Dataset; with `output`, also write it
     as netCDF atomically (checked before any work: an existing file needs `overwrite=True`).
 
+    With `output`, every finished chunk is kept in `<output>.chunks/` until the file is written:
+    a run that was killed is finished with `resume=True`, which computes only the missing chunks.
     threads: worker threads (default: the scene's run.threads, 0 = all cores).
     progress: a progress bar on stderr (default: only when stderr is a terminal).
     """
@@ -169,17 +168,22 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         progress = sys.stderr.isatty()
     if threads is None:
         threads = scene.get("run.threads")
+    persist = dict(output=output, resume=resume, overwrite=overwrite)
     if scene.get("model.kind") == "longitudinal":
         from .longitudinal import run_longitudinal
-        ds = run_longitudinal(scene, threads=threads, progress=progress)
+        ds = run_longitudinal(scene, threads=threads, progress=progress, **persist)
     else:
-        ds = run_transverse(scene, threads=threads, progress=progress)
+        ds = run_transverse(scene, threads=threads, progress=progress, **persist)
     if output is not None:
+        from .execute import ChunkStore
         write_netcdf(ds, output, overwrite)
+        ChunkStore(output, "").remove()
     return ds
 
 
-def run_transverse(scene: Scene, threads: int = 0, progress: bool = False) -> xr.Dataset:
+def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
+                   output: str | os.PathLike | None = None, resume: bool = False,
+                   overwrite: bool = False) -> xr.Dataset:
     """The transverse (RK45) sweep of `scene` as a Dataset."""
     from kernels import transverse as tk
     from kernels.oscillator import PARAM_NAMES
@@ -197,8 +201,14 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False) -> xr
     coeffs = models.oscillator(params)
     table = grid.flatten(coeffs, PARAM_NAMES, dims, shape)
     started = time.perf_counter()
-    result = solve_points(table, settings, times.size, threads=threads, progress=progress,
-                          chunk_size=scene.get("run.chunk_size"),
-                          driver=scene.get("solver.driver"))
-    result.sample_times = times
+    from .execute import transverse_chunk
+    n = table.shape[0]
+    out = solve_chunked(scene, transverse_chunk, table,
+                        (settings, times.size, scene.get("solver.driver")),
+                        {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
+                         "counts": np.empty((n, tk.N_COUNTS), np.int64),
+                         "series": np.empty((n, times.size))},
+                        output=output, resume=resume, overwrite=overwrite, threads=threads,
+                        progress=progress)
+    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"], times)
     return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)

@@ -104,13 +104,23 @@ def test_existing_output_is_refused_before_any_work(tmp_path):
     xr.open_dataset(out).close()
 
 
-def test_failed_write_leaves_nothing_behind(tmp_path, monkeypatch):
+def test_failed_write_leaves_no_partial_file_and_keeps_the_results(tmp_path, monkeypatch):
+    original = xr.Dataset.to_netcdf
+
     def boom(self, *args, **kwargs):
         raise RuntimeError("disk on fire")
     monkeypatch.setattr(xr.Dataset, "to_netcdf", boom)
     with pytest.raises(RuntimeError):
         sweep.run(sweep.load_scene_text(SMALL), output=tmp_path / "y.nc", progress=False)
-    assert list(tmp_path.iterdir()) == []
+    # No partial netCDF, no temporary file: only the finished chunks, kept for a resume.
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["y.nc.chunks"]
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", original)
+    ds = sweep.run(sweep.load_scene_text(SMALL), output=tmp_path / "y.nc", resume=True,
+                   progress=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["y.nc"]
+    fresh = sweep.run(sweep.load_scene_text(SMALL), progress=False)
+    for name in fresh.data_vars:
+        np.testing.assert_array_equal(ds[name].values, fresh[name].values)
 
 
 def test_cli_run_writes_netcdf_and_summarises(tmp_path):
