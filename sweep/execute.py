@@ -24,6 +24,7 @@ import numpy as np
 from .errors import UserError
 
 STORE_SUFFIX = ".chunks"
+IN_FLIGHT = 2          # dask tasks submitted ahead per worker thread
 
 
 # --- chunk kernels (top-level functions: dask pickles them by name) -------------------------
@@ -171,49 +172,48 @@ def default_chunk_size(n: int, backend: str, workers: int) -> int:
     return max(4096 * numba.get_num_threads(), -(-n // 100))
 
 
-def execute(chunk_fn: Callable[..., dict], table: np.ndarray, args: tuple,
-            outputs: dict[str, np.ndarray], *, chunk_size: int, backend: str = "threads",
-            threads: int = 0, scheduler: str | None = None, workers: int = 0,
-            progress: bool = False, store: ChunkStore | None = None,
+def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.ndarray], n: int,
+            args: tuple, place: Callable[[int, int, dict], None], *, chunk_size: int,
+            backend: str = "threads", threads: int = 0, scheduler: str | None = None,
+            workers: int = 0, progress: bool = False, store: ChunkStore | None = None,
             done: dict | None = None) -> int:
-    """Fill `outputs` (first axis = rows of `table`) chunk by chunk; returns chunks computed.
+    """Solve points 0..n-1 (solve order) chunk by chunk; returns the number of chunks computed.
 
-    chunk_fn(table[lo:hi], *args, threads=...) returns arrays named as `outputs`. Chunks in
-    `done` (from a store) are copied in, not computed; every computed chunk goes to `store`.
+    rows_for(lo, hi) builds the kernel's parameter rows of a chunk just before it runs, so the
+    whole table never sits in memory; chunk_fn(rows, *args, threads=...) returns the chunk's
+    output arrays by name, and place(lo, hi, arrays) stores them. Chunks in `done` (from a
+    store) are placed, not computed; every computed chunk is also written to `store`.
     """
-    n = table.shape[0]
-    ranges = chunk_ranges(n, chunk_size)
     report = progress_printer(n, progress and n > chunk_size)
     finished = 0
     for (lo, hi), arrays in (done or {}).items():
-        for name, values in arrays.items():
-            outputs[name][lo:hi] = values
+        place(lo, hi, arrays)
         finished += hi - lo
-    todo = [r for r in ranges if r not in (done or {})]
+    todo = [r for r in chunk_ranges(n, chunk_size) if r not in (done or {})]
     if finished:
         report(finished)
 
     def collect(lo: int, hi: int, arrays: dict) -> None:
         nonlocal finished
-        for name, values in arrays.items():
-            outputs[name][lo:hi] = values
+        place(lo, hi, arrays)
         if store is not None:
             store.save(lo, hi, arrays)
         finished += hi - lo
         report(finished)
 
     if backend == "dask":
-        _execute_dask(chunk_fn, table, args, todo, collect, scheduler, workers)
+        _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers)
     else:
         _set_threads(threads)
         for lo, hi in todo:
-            collect(lo, hi, chunk_fn(table[lo:hi], *args, threads=threads))
+            collect(lo, hi, chunk_fn(rows_for(lo, hi), *args, threads=threads))
     return len(todo)
 
 
-def _execute_dask(chunk_fn, table, args, todo, collect, scheduler, workers) -> None:
+def _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers) -> None:
     """Each chunk a task on a dask.distributed cluster: the one at `scheduler` (an address), or
-    a LocalCluster of `workers` single-threaded worker processes started for this run."""
+    a LocalCluster of `workers` single-threaded worker processes started for this run. At most
+    IN_FLIGHT tasks per worker thread are submitted at a time, so memory stays bounded."""
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError as exc:
@@ -233,15 +233,26 @@ def _execute_dask(chunk_fn, table, args, todo, collect, scheduler, workers) -> N
                                    dashboard_address=None, host="127.0.0.1")
             client = Client(cluster)
         with client:
-            per_worker = 1                       # numba threads per task: one per worker thread
+            slots = IN_FLIGHT * max(1, sum(client.nthreads().values()))
+            pending = iter(todo)
             futures = {}
-            for lo, hi in todo:
-                fut = client.submit(chunk_fn, table[lo:hi], *args, threads=per_worker,
-                                    pure=False)
-                futures[fut] = (lo, hi)
-            for fut in as_completed(futures):
-                lo, hi = futures[fut]
+
+            def submit_next(queue) -> None:
+                for lo, hi in pending:
+                    # one Numba thread per task: one per dask worker thread, no oversubscription
+                    fut = client.submit(chunk_fn, rows_for(lo, hi), *args, threads=1, pure=False)
+                    futures[fut] = (lo, hi)
+                    if queue is not None:
+                        queue.add(fut)
+                    return
+
+            for _ in range(slots):
+                submit_next(None)
+            queue = as_completed(list(futures))
+            for fut in queue:
+                lo, hi = futures.pop(fut)
                 collect(lo, hi, fut.result())
+                submit_next(queue)
     finally:
         if cluster is not None:
             cluster.close()

@@ -55,3 +55,23 @@ def flatten(values: dict[str, Any], names: tuple[str, ...], dims: tuple[str, ...
         else:
             table[:, j] = float(value)
     return table
+
+
+def point_values(params: dict[str, Any], dims: tuple[str, ...], shape: tuple[int, ...],
+                 points: np.ndarray) -> dict[str, Any]:
+    """The parameters at grid points `points` (flat C-order indices): each axis coordinate
+    replaced by its values at those points, scalars kept."""
+    if not shape:
+        return dict(params)                      # no axes: one point, all scalars
+    index = np.unravel_index(points, shape)
+    return {name: value.values[index[dims.index(value.dims[0])]]
+            if isinstance(value, xr.DataArray) else value
+            for name, value in params.items()}
+
+
+def rows(values: dict[str, Any], names: tuple[str, ...], m: int) -> np.ndarray:
+    """The named values (scalars or length-m arrays) as m parameter rows, C-contiguous."""
+    table = np.empty((m, len(names)))
+    for j, name in enumerate(names):
+        table[:, j] = values[name]
+    return table

@@ -104,7 +104,8 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
 
     started = time.perf_counter()
     n_nodes = n_int + 1
-    out = solve_chunked(scene, longitudinal_chunk, table, (settings, snap_times, n_hist, n_nodes),
+    out = solve_chunked(scene, longitudinal_chunk, lambda points: table[points],
+                        (settings, snap_times, n_hist, n_nodes),
                         {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
                          "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
                          "hist_f": np.empty((n, n_hist)),

@@ -102,13 +102,18 @@ def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
     outputs = {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
                "counts": np.empty((n, tk.N_COUNTS), np.int64),
                "series": np.empty((n, n_samples))}
+
+    def place(lo: int, hi: int, arrays: dict) -> None:
+        for name, values in arrays.items():
+            outputs[name][order[lo:hi]] = values
+
     _set_threads(threads)
-    execute(transverse_chunk, np.ascontiguousarray(params[order]), (settings, n_samples, driver),
-            outputs, chunk_size=chunk_size or default_chunk_size(n, "threads", 0),
+    execute(transverse_chunk, lambda lo, hi: np.ascontiguousarray(params[order[lo:hi]]), n,
+            (settings, n_samples, driver), place,
+            chunk_size=chunk_size or default_chunk_size(n, "threads", 0),
             threads=threads, progress=progress)
-    back = grid_order(order)
-    return KernelResult(outputs["states"][back], outputs["reals"][back],
-                        outputs["counts"][back], outputs["series"][back], np.empty(0))
+    return KernelResult(outputs["states"], outputs["reals"], outputs["counts"],
+                        outputs["series"], np.empty(0))
 
 
 def run_fingerprint(scene: Scene) -> str:
@@ -119,15 +124,17 @@ def run_fingerprint(scene: Scene) -> str:
     return fingerprint(sorted(values.items()), sorted(axes.items()), package_version())
 
 
-def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict], table: np.ndarray, args: tuple,
+def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
+                  rows_at: Callable[[np.ndarray], np.ndarray], args: tuple,
                   outputs: dict[str, np.ndarray], *, output: str | os.PathLike | None = None,
                   resume: bool = False, overwrite: bool = False, threads: int = 0,
                   progress: bool = False) -> dict[str, np.ndarray]:
-    """Solve the rows of `table` (grid order) in chunks on the scene's backend; with `output`,
-    persist every finished chunk next to it and, when resuming, compute only the missing ones.
-    Returns `outputs` in grid order."""
+    """Solve every grid point in chunks on the scene's backend, filling `outputs` (grid order,
+    first axis = points). rows_at(flat indices) gives the kernel's parameter rows of those
+    points. With `output`, every finished chunk is persisted next to it and, when resuming,
+    only the missing chunks are computed."""
     from .execute import ChunkStore, default_chunk_size, execute
-    n = table.shape[0]
+    n = next(iter(outputs.values())).shape[0]
     order = point_order(n)
     backend = scene.get("run.backend")
     workers = scene.get("run.workers")
@@ -138,15 +145,20 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict], table: np.ndarray
     if output is not None:
         store = ChunkStore(output, run_fingerprint(scene))
         done, chunk = store.open(resume, overwrite, chunk)
-    computed = execute(chunk_fn, np.ascontiguousarray(table[order]), args, outputs,
+
+    def place(lo: int, hi: int, arrays: dict) -> None:
+        points = order[lo:hi]
+        for name, values in arrays.items():
+            outputs[name][points] = values
+
+    computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args, place,
                        chunk_size=chunk, backend=backend, threads=threads,
                        scheduler=scene.get("run.scheduler"), workers=workers,
                        progress=progress, store=store, done=done)
     if resume:
         sys.stderr.write(f"resumed: {len(done)} chunks of {len(done) + computed} were already "
                          f"done, {computed} computed\n")
-    back = grid_order(order)
-    return {name: values[back] for name, values in outputs.items()}
+    return outputs
 
 
 def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: bool = False,
@@ -195,19 +207,25 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if scene.get("outputs.time_series") else np.empty(0))
     n_points = int(np.prod(shape, dtype=np.int64))
-    check_memory(n_points, 3.0 * (8 * (len(PARAM_NAMES) + tk.N_REALS + tk.N_COUNTS + times.size)
-                                  + 1), "parameters, metrics and time series")
+    # Outputs (and their Dataset copies), the solve order and a few derived quantities: the
+    # parameter rows are built chunk by chunk and never held for the whole grid.
+    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + times.size)) + 40,
+                 "metrics and time series")
     params = grid.parameters(scene, coords)
-    coeffs = models.oscillator(params)
-    table = grid.flatten(coeffs, PARAM_NAMES, dims, shape)
+    coeffs = models.oscillator(params)          # derived quantities, on the axes they need
+
+    def rows_at(points: np.ndarray) -> np.ndarray:
+        at = grid.point_values(params, dims, shape, points)
+        return grid.rows(models.oscillator(at), PARAM_NAMES, points.size)
+
     started = time.perf_counter()
     from .execute import transverse_chunk
-    n = table.shape[0]
-    out = solve_chunked(scene, transverse_chunk, table,
+    out = solve_chunked(scene, transverse_chunk, rows_at,
                         (settings, times.size, scene.get("solver.driver")),
-                        {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
-                         "counts": np.empty((n, tk.N_COUNTS), np.int64),
-                         "series": np.empty((n, times.size))},
+                        {"states": np.empty(n_points, np.int8),
+                         "reals": np.empty((n_points, tk.N_REALS)),
+                         "counts": np.empty((n_points, tk.N_COUNTS), np.int64),
+                         "series": np.empty((n_points, times.size))},
                         output=output, resume=resume, overwrite=overwrite, threads=threads,
                         progress=progress)
     result = KernelResult(out["states"], out["reals"], out["counts"], out["series"], times)
