@@ -35,7 +35,6 @@ import tomllib
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
-import matplotlib
 import numpy as np
 import xarray as xr
 from matplotlib import colors as mcolors
