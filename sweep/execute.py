@@ -35,15 +35,30 @@ def _set_threads(threads: int) -> None:
                           else numba.config.NUMBA_NUM_THREADS)
 
 
+def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:
+    """Empty transverse outputs of n points, by name (the kernel's output arrays)."""
+    from kernels import transverse as tk
+    return {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
+            "counts": np.empty((n, tk.N_COUNTS), np.int64), "series": np.empty((n, n_samples))}
+
+
+def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
+                         n_nodes: int) -> dict[str, np.ndarray]:
+    """Empty longitudinal outputs of n spans, by name (the kernel's output arrays)."""
+    from kernels import longitudinal as lk
+    return {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
+            "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
+            "hist_f": np.empty((n, n_hist)), "snap_u": np.empty((n, n_snap, n_nodes)),
+            "snap_f": np.empty((n, n_snap, n_nodes)), "snap_v": np.empty((n, n_snap, n_nodes))}
+
+
 def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, driver: str,
                      threads: int = 0) -> dict[str, np.ndarray]:
     """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series)."""
     from kernels import lanes
     from kernels import transverse as tk
     _set_threads(threads)
-    n = params.shape[0]
-    out = {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
-           "counts": np.empty((n, tk.N_COUNTS), np.int64), "series": np.empty((n, n_samples))}
+    out = transverse_outputs(params.shape[0], n_samples)
     solve = lanes.solve_batch if driver == "lanes" else tk.solve_batch_scalar
     solve(params, settings, out["states"], out["reals"], out["counts"], out["series"])
     return out
@@ -54,12 +69,7 @@ def longitudinal_chunk(params: np.ndarray, settings: np.ndarray, snapshot_times:
     """Central-difference kernel over `params` rows; outputs by name."""
     from kernels import longitudinal as lk
     _set_threads(threads)
-    n = params.shape[0]
-    n_snap = snapshot_times.size
-    out = {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
-           "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
-           "hist_f": np.empty((n, n_hist)), "snap_u": np.empty((n, n_snap, n_nodes)),
-           "snap_f": np.empty((n, n_snap, n_nodes)), "snap_v": np.empty((n, n_snap, n_nodes))}
+    out = longitudinal_outputs(params.shape[0], n_hist, snapshot_times.size, n_nodes)
     lk.solve_batch(params, settings, snapshot_times, out["states"], out["reals"], out["steps"],
                    out["hist_u"], out["hist_f"], out["snap_u"], out["snap_f"], out["snap_v"])
     return out
@@ -204,7 +214,6 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     if backend == "dask":
         _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers)
     else:
-        _set_threads(threads)
         for lo, hi in todo:
             collect(lo, hi, chunk_fn(rows_for(lo, hi), *args, threads=threads))
     return len(todo)

@@ -21,7 +21,7 @@ import xarray as xr
 from . import grid
 from .dataset import derived, flag_attrs, global_attrs
 from .errors import CableSweepWarning
-from .execute import longitudinal_chunk
+from .execute import longitudinal_chunk, longitudinal_outputs
 from .run import check_memory, solve_chunked
 from .scene import Scene
 
@@ -106,12 +106,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
     n_nodes = n_int + 1
     out = solve_chunked(scene, longitudinal_chunk, lambda points: table[points],
                         (settings, snap_times, n_hist, n_nodes),
-                        {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
-                         "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
-                         "hist_f": np.empty((n, n_hist)),
-                         "snap_u": np.empty((n, n_snap, n_nodes)),
-                         "snap_f": np.empty((n, n_snap, n_nodes)),
-                         "snap_v": np.empty((n, n_snap, n_nodes))},
+                        longitudinal_outputs(n, n_hist, n_snap, n_nodes),
                         output=output, resume=resume, overwrite=overwrite, threads=threads,
                         progress=progress)
     elapsed = time.perf_counter() - started

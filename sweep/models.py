@@ -41,6 +41,7 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
     ei = p["youngs_modulus"] * p["inertia"]
     rho_a = p["density"] * p["area"]
     w1_sq = ei / rho_a * k ** 4
+    w1 = np.sqrt(w1_sq)
     load = p["load_amplitude"]
     return {
         "mass": 1.0,
@@ -50,9 +51,9 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
         "h": -21.0 / 16.0 * ei / rho_a * k ** 8,
         "k_load": -load * k ** 2 / rho_a,
         "g_load": load * k ** 4 / (2.0 * rho_a),
-        "omega_1": np.sqrt(w1_sq),
+        "omega_1": w1,
         "buckling_load": ei * k ** 2,
-        "omega_ref": np.sqrt(w1_sq),
+        "omega_ref": w1,
     }
 
 

@@ -95,25 +95,25 @@ def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
     """Run the transverse kernel over the rows of `params` in-process (grid order in, grid
     order out). driver: "lanes" (kernels.lanes, lock-step SIMD) or "scalar"
     (kernels.transverse, one trajectory per iteration); the two agree to round-off."""
-    from .execute import _set_threads, default_chunk_size, execute, transverse_chunk
-    from kernels import transverse as tk
+    from .execute import default_chunk_size, execute, transverse_chunk, transverse_outputs
     n = params.shape[0]
     order = point_order(n)
-    outputs = {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
-               "counts": np.empty((n, tk.N_COUNTS), np.int64),
-               "series": np.empty((n, n_samples))}
-
-    def place(lo: int, hi: int, arrays: dict) -> None:
-        for name, values in arrays.items():
-            outputs[name][order[lo:hi]] = values
-
-    _set_threads(threads)
+    outputs = transverse_outputs(n, n_samples)
     execute(transverse_chunk, lambda lo, hi: np.ascontiguousarray(params[order[lo:hi]]), n,
-            (settings, n_samples, driver), place,
+            (settings, n_samples, driver), placer(outputs, order),
             chunk_size=chunk_size or default_chunk_size(n, "threads", 0),
             threads=threads, progress=progress)
     return KernelResult(outputs["states"], outputs["reals"], outputs["counts"],
                         outputs["series"], np.empty(0))
+
+
+def placer(outputs: dict[str, np.ndarray], order: np.ndarray) -> Callable[[int, int, dict], None]:
+    """place(lo, hi, arrays): put a chunk's results (points order[lo:hi]) into grid order."""
+    def place(lo: int, hi: int, arrays: dict) -> None:
+        points = order[lo:hi]
+        for name, values in arrays.items():
+            outputs[name][points] = values
+    return place
 
 
 def run_fingerprint(scene: Scene) -> str:
@@ -145,13 +145,8 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
     if output is not None:
         store = ChunkStore(output, run_fingerprint(scene))
         done, chunk = store.open(resume, overwrite, chunk)
-
-    def place(lo: int, hi: int, arrays: dict) -> None:
-        points = order[lo:hi]
-        for name, values in arrays.items():
-            outputs[name][points] = values
-
-    computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args, place,
+    computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args,
+                       placer(outputs, order),
                        chunk_size=chunk, backend=backend, threads=threads,
                        scheduler=scene.get("run.scheduler"), workers=workers,
                        progress=progress, store=store, done=done)
@@ -219,13 +214,10 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
         return grid.rows(models.oscillator(at), PARAM_NAMES, points.size)
 
     started = time.perf_counter()
-    from .execute import transverse_chunk
+    from .execute import transverse_chunk, transverse_outputs
     out = solve_chunked(scene, transverse_chunk, rows_at,
                         (settings, times.size, scene.get("solver.driver")),
-                        {"states": np.empty(n_points, np.int8),
-                         "reals": np.empty((n_points, tk.N_REALS)),
-                         "counts": np.empty((n_points, tk.N_COUNTS), np.int64),
-                         "series": np.empty((n_points, times.size))},
+                        transverse_outputs(n_points, times.size),
                         output=output, resume=resume, overwrite=overwrite, threads=threads,
                         progress=progress)
     result = KernelResult(out["states"], out["reals"], out["counts"], out["series"], times)
