@@ -268,6 +268,7 @@ def _finish(W, settings, n_samples, n_run):
         v_old = W[tj.V * L + j]
         qn = W[W_QN * L + j]
         vn = W[W_VN * L + j]
+        fv_new = W[(W_K + 13) * L + j]      # f(t_new, y_new), second component (FSAL)
         t_new = W[tj.T_NEW * L + j]
         peak = W[tj.PEAK * L + j]
         peak_new = max(peak, abs(qn))
@@ -303,8 +304,10 @@ def _finish(W, settings, n_samples, n_run):
         W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
         W[tj.Q * L + j] = qn if done else q_old
         W[tj.V * L + j] = vn if done else v_old
-        W[tj.FQ * L + j] = W[(W_K + 12) * L + j] if done else W[tj.FQ * L + j]
-        W[tj.FV * L + j] = W[(W_K + 13) * L + j] if done else W[tj.FV * L + j]
+        # Every value is loaded unconditionally above: a load under a condition would stop
+        # LLVM vectorising this loop.
+        W[tj.FQ * L + j] = vn if done else W[tj.FQ * L + j]
+        W[tj.FV * L + j] = fv_new if done else W[tj.FV * L + j]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
