@@ -26,7 +26,7 @@ import numpy as np
 
 from . import metrics as mt
 from . import trajectory as tj
-from .dopri5 import A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, SAFETY
+from .dopri5 import A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P, SAFETY
 from .layout import (ATOL, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
@@ -72,14 +72,22 @@ W_K = W_H + 1                     # stage s, component c at row W_K + 2 s + c (s
 W_QN = W_K + 2 * (N_STAGES + 1)   # fifth-order q (m)
 W_VN = W_QN + 1                   # fifth-order q' (m/s)
 W_ERR = W_QN + 2                  # SciPy's error norm
-W_FLAG = W_QN + 3                 # 1: this lane needs the scalar state machine now
-W_ROWS = W_QN + 4
+W_FLAG = W_QN + 3                 # NEEDS_SCALAR or HAS_EXTREMUM: the scalar state machine's turn
+W_XE = W_QN + 4                   # the accepted step's extremum of q: x = (t - t_old)/h, or -1
+W_QE = W_QN + 5                   # q there (m)
+W_ROWS = W_QN + 6
+
+# W_FLAG values.
+ORDINARY = 0.0        # nothing for the scalar state machine to do
+NEEDS_SCALAR = 1.0    # this lane's step or metrics need the scalar state machine
+HAS_EXTREMUM = 2.0    # as NEEDS_SCALAR, and the step holds an extremum of q for `_locate_extrema`
 
 # The tableau as compile-time constants (tuples are frozen into the code).
 _A = tuple(tuple(float(x) for x in row) for row in A)
 _B = tuple(float(x) for x in B)
 _C = tuple(float(x) for x in C)
 _E = tuple(float(x) for x in E)
+_P = tuple(tuple(float(x) for x in row) for row in P)
 
 # Controller: below this error the accepted factor is MAX_FACTOR, SAFETY err^(-1/5) >= 10.
 _ERR_MAX_FACTOR = (SAFETY / MAX_FACTOR) ** 5
@@ -184,7 +192,7 @@ def _prepare(W, settings, n_run):
         W[W_H * L + j] = h if ok else 0.0
         W[tj.H_ABS * L + j] = abs(h) if ok else h_abs
         W[tj.T_NEW * L + j] = t_new if ok else W[tj.T_NEW * L + j]
-        W[W_FLAG * L + j] = 0.0 if ok else 1.0
+        W[W_FLAG * L + j] = ORDINARY if ok else NEEDS_SCALAR
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -251,9 +259,15 @@ def _attempt(W, rtol, atol, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _finish(W, settings, n_samples, n_run):
-    """trajectory.finish_attempt across lanes for rejected attempts and ordinary accepted
-    steps (first metrics pass: threshold tol * peak around 0). An accepted step with anything
-    to locate on the dense output, or a divergence, gets W_FLAG = 1 and is left untouched."""
+    """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
+    ordinary accepted step the first metrics pass (threshold tol * peak around 0) and the move
+    to the step's end. An accepted step with anything to locate on the dense output, or a
+    divergence, is left for trajectory.record_step: W_FLAG = NEEDS_SCALAR, or HAS_EXTREMUM
+    when it holds an extremum of q (`_locate_extrema` finds it first).
+
+    Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
+    vectorising this loop.
+    """
     L = LANES
     t_tail = settings[T_END] * (1.0 - settings[TAIL])
     track = settings[WANT_SETTLING] != 0.0
@@ -279,18 +293,18 @@ def _finish(W, settings, n_samples, n_run):
         sample = W[tj.SAMPLE * L + j]
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
-        event = accepted & (extremum | (not bounded) | straddles | due | crosses)
-        fast = active & (not event)
-        done = fast & accepted
+        event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
+        done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
         factor = _step_factor(err, rejected_before)
-        W[W_FLAG * L + j] = 1.0 if active & event else 0.0
-        W[tj.RHS_EVALS * L + j] += 6.0 if fast else 0.0
-        W[tj.H_ABS * L + j] *= factor if fast else 1.0
-        W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if fast else (
+        W[W_FLAG * L + j] = ((HAS_EXTREMUM if extremum & bounded else NEEDS_SCALAR) if event
+                             else ORDINARY)
+        W[tj.RHS_EVALS * L + j] += 6.0 if active else 0.0
+        W[tj.H_ABS * L + j] *= factor if active else 1.0
+        W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if active else (
             1.0 if rejected_before else 0.0)
-        W[tj.REJECTED * L + j] += 1.0 if fast & (not accepted) else 0.0
-        W[tj.STEPS * L + j] += 1.0 if done else 0.0
+        W[tj.REJECTED * L + j] += 1.0 if active & (not accepted) else 0.0
+        W[tj.STEPS * L + j] += 1.0 if active & accepted else 0.0
         W[tj.PEAK * L + j] = peak_new if done else peak
         in_tail = done & (t_new >= t_tail)
         W[tj.TAIL_AMP * L + j] = max(W[tj.TAIL_AMP * L + j], abs(qn)) if in_tail else \
@@ -304,10 +318,84 @@ def _finish(W, settings, n_samples, n_run):
         W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
         W[tj.Q * L + j] = qn if done else q_old
         W[tj.V * L + j] = vn if done else v_old
-        # Every value is loaded unconditionally above: a load under a condition would stop
-        # LLVM vectorising this loop.
         W[tj.FQ * L + j] = vn if done else W[tj.FQ * L + j]
         W[tj.FV * L + j] = fv_new if done else W[tj.FV * L + j]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _dense_row(k0, k1, k2, k3, k4, k5, k6, c):
+    """Column c of K^T P for one component (dopri5.dense_coefficients, same summation order)."""
+    s = 0.0
+    s += k0 * _P[0][c]
+    s += k1 * _P[1][c]
+    s += k2 * _P[2][c]
+    s += k3 * _P[3][c]
+    s += k4 * _P[4][c]
+    s += k5 * _P[5][c]
+    s += k6 * _P[6][c]
+    return s
+
+
+NEWTON_ITERATIONS = 3       # safeguarded Newton steps for an extremum's position
+NEWTON_RESIDUAL = 1e-14     # |q'(x)| / (|q'_old| + |q'_new|) at which the root is at round-off
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _locate_extrema(W, n_run):
+    """For lanes flagged HAS_EXTREMUM: the x in [0, 1] where the step's interpolated q'
+    vanishes (W_XE) and q there (W_QE), by NEWTON_ITERATIONS steps of Newton's method
+    safeguarded by the sign bracket, from the linear guess. Where the residual is not down to
+    round-off (NEWTON_RESIDUAL), W_XE = -1 and trajectory.record_step's bracketed root finder
+    takes over. Other lanes compute too (straight-line code vectorises); their results are
+    ignored.
+    """
+    L = LANES
+    for j in range(n_run):
+        want = W[W_FLAG * L + j] == HAS_EXTREMUM
+        h = W[W_H * L + j]
+        q0 = W[tj.Q * L + j]
+        v0 = W[tj.V * L + j]
+        v1 = W[W_VN * L + j]
+        kq0 = W[tj.FQ * L + j]
+        kv0 = W[tj.FV * L + j]
+        kq1 = W[(W_K + 2) * L + j]
+        kv1 = W[(W_K + 3) * L + j]
+        kq2 = W[(W_K + 4) * L + j]
+        kv2 = W[(W_K + 5) * L + j]
+        kq3 = W[(W_K + 6) * L + j]
+        kv3 = W[(W_K + 7) * L + j]
+        kq4 = W[(W_K + 8) * L + j]
+        kv4 = W[(W_K + 9) * L + j]
+        kq5 = W[(W_K + 10) * L + j]
+        kv5 = W[(W_K + 11) * L + j]
+        kq6 = W[(W_K + 12) * L + j]
+        kv6 = W[(W_K + 13) * L + j]
+        cv0 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 0)
+        cv1 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 1)
+        cv2 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 2)
+        cv3 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 3)
+        positive = v0 > 0.0
+        xa = 0.0
+        xb = 1.0
+        x = v0 / (v0 - v1) if v0 != v1 else 0.5
+        x = x if (x >= 0.0) & (x <= 1.0) else 0.5
+        for _ in range(NEWTON_ITERATIONS):
+            g = v0 + h * (x * (cv0 + x * (cv1 + x * (cv2 + x * cv3))))
+            dg = h * (cv0 + x * (2.0 * cv1 + x * (3.0 * cv2 + x * (4.0 * cv3))))
+            same = (g > 0.0) == positive
+            xa = x if same else xa
+            xb = xb if same else x
+            x_new = x - g / dg
+            x_new = x_new if (xa <= x_new) & (x_new <= xb) else 0.5 * (xa + xb)
+            x = x if g == 0.0 else x_new
+        g = v0 + h * (x * (cv0 + x * (cv1 + x * (cv2 + x * cv3))))
+        converged = abs(g) <= NEWTON_RESIDUAL * (abs(v0) + abs(v1))
+        cq0 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 0)
+        cq1 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 1)
+        cq2 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 2)
+        cq3 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 3)
+        W[W_XE * L + j] = x if want & converged else -1.0
+        W[W_QE * L + j] = q0 + h * (x * (cq0 + x * (cq1 + x * (cq2 + x * cq3))))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -376,17 +464,32 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, rtol, atol, n_run)
         _finish(W, settings, n_samples, n_run)
+        n_flagged = 0
+        n_extrema = 0
         for j in range(n_run):
-            if W[W_FLAG * L + j] != 0.0:
-                i = point[j]
-                K[0, 0] = W[tj.FQ * L + j]
-                K[0, 1] = W[tj.FV * L + j]
-                for s in range(1, N_STAGES + 1):
-                    K[s, 0] = W[(W_K + 2 * s) * L + j]
-                    K[s, 1] = W[(W_K + 2 * s + 1) * L + j]
-                bufs[j] = tj.finish_attempt(params[i], settings, W[j::L], K, W[W_QN * L + j],
-                                            W[W_VN * L + j], W[W_ERR * L + j], W[W_H * L + j],
-                                            Qc, bufs[j], series[i], track, 0.0, 0.0, thr_rel)
+            n_flagged += W[W_FLAG * L + j] != ORDINARY
+            n_extrema += W[W_FLAG * L + j] == HAS_EXTREMUM
+        if n_flagged == 0:
+            continue
+        if n_extrema > 0:
+            _locate_extrema(W, n_run)
+        for j in range(n_run):
+            flag = W[W_FLAG * L + j]
+            if flag == ORDINARY:
+                continue
+            i = point[j]
+            K[0, 0] = W[tj.FQ * L + j]
+            K[0, 1] = W[tj.FV * L + j]
+            for s in range(1, N_STAGES + 1):
+                K[s, 0] = W[(W_K + 2 * s) * L + j]
+                K[s, 1] = W[(W_K + 2 * s + 1) * L + j]
+            xe = W[W_XE * L + j] if flag == HAS_EXTREMUM else -1.0
+            acc = W[j::L]
+            if acc[tj.N_EXT] >= bufs[j].shape[0]:
+                bufs[j] = tj.with_room(bufs[j], acc)
+            tj.record_step(W[(W_P + BOUND) * L + j], settings, acc, K, W[W_QN * L + j],
+                           W[W_VN * L + j], W[W_H * L + j], Qc, bufs[j], series[i], track,
+                           0.0, 0.0, thr_rel, xe, W[W_QE * L + j])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", parallel=True)

@@ -6,8 +6,8 @@ buffer, so a driver can advance many of them side by side:
     start(...)                         initial state, f(0, y0), SciPy's initial step
     h = next_attempt(settings, acc)    the step to try now (0.0: the trajectory has ended)
     ... the driver computes one Dormand-Prince attempt of size h and its error norm ...
-    buf = finish_attempt(...)          SciPy's accept/reject and step-size update; on
-                                       acceptance the in-kernel metrics (metrics module)
+    buf = finish_attempt(...)          SciPy's accept/reject and step-size update (`control`);
+                                       on acceptance the in-kernel metrics (`record_step`)
     classify(...)                      state, amplitude, settling time, period, counts
 
 Each point's attempts are SciPy RK45's, in SciPy's order, whatever the driver.
@@ -52,8 +52,20 @@ N_SLOTS = 20
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def new_buffer():
-    """An empty extrema buffer (metrics.push_extremum grows it)."""
+    """An empty extrema buffer, room for 64 extrema (`with_room` grows it)."""
     return np.empty((64, 3))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def with_room(buf, acc):
+    """The extrema buffer with room for one more extremum: `buf` itself, or a copy twice its
+    size when full. Drivers call it before `record_step`, which never allocates."""
+    n = int(acc[N_EXT])
+    if n < buf.shape[0]:
+        return buf
+    bigger = np.empty((2 * buf.shape[0], 3))
+    bigger[:n] = buf[:n]
+    return bigger
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -133,50 +145,69 @@ def next_attempt(settings, acc):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _last_time_above(t, h, Qc, q_old, q_new, has_ext, xe, qe, centre, thr, last):
-    """Update the last time |q - centre| > thr with the step [t, t + h]."""
+def _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr):
+    """Where in the step |q - centre| last fell to thr, as a bracket for the root finder.
+
+    Returns (xa, xb, side): the crossing lies in [xa, xb] (x = (t - t_old)/h) at
+    q = centre + side * thr; xa = 2.0 when |q - centre| ends the step above thr (the step's end
+    is the last time above); xa = -1.0 when |q - centre| stays within thr all step.
+    """
     if abs(q_new - centre) > thr:
-        return t + h
-    xa = -1.0
-    xb = 1.0
-    q_a = 0.0
+        return 2.0, 1.0, 0.0
     if has_ext and abs(qe - centre) > thr:
-        xa = xe
-        q_a = qe
-    elif abs(q_old - centre) > thr:
-        xa = 0.0
-        q_a = q_old
-        if has_ext:
-            xb = xe
-    if xa < 0.0:
-        return last
-    side = 1.0 if q_a > centre else -1.0
-    x = dense_root(q_old, h, Qc, 0, centre + side * thr, xa, xb)
-    return t + x * h
+        return xe, 1.0, 1.0 if qe > centre else -1.0
+    if abs(q_old - centre) > thr:
+        return 0.0, xe if has_ext else 1.0, 1.0 if q_old > centre else -1.0
+    return -1.0, 1.0, 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def control(acc, err):
+    """SciPy's accept/reject and step-size update for an attempt with error norm `err`;
+    counts the attempt. Returns True when the attempt is accepted."""
+    acc[RHS_EVALS] += 6.0
+    acc[H_ABS] *= step_factor(err, acc[REJECTED_NOW] != 0.0)
+    if not err < 1.0:
+        acc[REJECTED_NOW] = 1.0
+        acc[REJECTED] += 1.0
+        return False
+    acc[REJECTED_NOW] = 0.0
+    acc[STEPS] += 1.0
+    return True
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
                    track, centre, thr_fixed, thr_rel):
     """Accept or reject the attempt of size h (K: its 7 stage derivatives, (q_new, v_new): its
-    fifth-order solution, err: its error norm) and update the step size as SciPy does. On
-    acceptance, reduce the metrics of the step on its dense output. Returns the extrema buffer
-    (regrown when full). Qc is scratch for the interpolant, shape (2, 4).
+    fifth-order solution, err: its error norm) and update the step size as SciPy does
+    (`control`); on acceptance reduce the step's metrics (`record_step`). Returns the extrema
+    buffer (regrown when full). Qc is scratch for the interpolant, shape (2, 4).
     """
-    acc[RHS_EVALS] += 6.0
-    acc[H_ABS] *= step_factor(err, acc[REJECTED_NOW] != 0.0)
-    if not err < 1.0:
-        acc[REJECTED_NOW] = 1.0
-        acc[REJECTED] += 1.0
-        return buf
-    acc[REJECTED_NOW] = 0.0
-    acc[STEPS] += 1.0
+    if control(acc, err):
+        if acc[N_EXT] >= buf.shape[0]:
+            buf = with_room(buf, acc)
+        record_step(p[BOUND], settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
+                    centre, thr_fixed, thr_rel, -1.0, 0.0)
+    return buf
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
+                thr_fixed, thr_rel, xe_known, qe_known):
+    """Reduce the metrics of an accepted step [acc[T], acc[T_NEW]] on its dense output and
+    advance the trajectory to its end. `bound`: the divergence bound on |q| (m); `buf` must
+    have room for one more extremum (`with_room`).
+
+    If the driver has already located the step's extremum of q, xe_known in [0, 1] is its
+    x = (t - t_old)/h and qe_known q there; xe_known < 0 means: locate it here. The interpolant
+    (Qc, from K) is built only when something needs it.
+    """
     t = acc[T]
     t_new = acc[T_NEW]
     q_old = acc[Q]
     v_old = acc[V]
     t_tail = settings[T_END] * (1.0 - settings[TAIL])
-    bound = p[BOUND]
 
     if not (abs(q_new) <= bound and math.isfinite(v_new)):
         acc[STATUS] = mt.DIVERGED
@@ -185,30 +216,31 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
             dense_coefficients(K, Qc)
             side = 1.0 if q_new > 0.0 else -1.0
             acc[T_STOP] = t + dense_root(q_old, h, Qc, 0, side * bound, 0.0, 1.0) * h
-        return buf
+        return
 
-    # The interpolant is built only for steps that need it (an extremum, the tail's start,
-    # a sample or a crossing of the tracked threshold).
     n_samples = series.shape[0]
     k = int(acc[SAMPLE])
     dt_sample = settings[SAMPLE_DT]
     peak = acc[PEAK]
     has_ext = (v_old > 0.0 and v_new <= 0.0) or (v_old < 0.0 and v_new >= 0.0)
-    straddles_tail = t < t_tail <= t_new
-    has_sample = k < n_samples and k * dt_sample <= t_new
-    thr_now = thr_fixed + thr_rel * max(peak, abs(q_new))
-    may_cross = track and abs(q_new - centre) <= thr_now < abs(q_old - centre)
-    if has_ext or straddles_tail or has_sample or may_cross:
-        dense_coefficients(K, Qc)
+    have_qc = False
     xe = 0.0
     qe = 0.0
     if has_ext:
-        xe = dense_root(v_old, h, Qc, 1, 0.0, 0.0, 1.0)
+        if xe_known >= 0.0:
+            xe = xe_known
+            qe = qe_known
+        else:
+            dense_coefficients(K, Qc)
+            have_qc = True
+            xe = dense_root(v_old, h, Qc, 1, 0.0, 0.0, 1.0)
+            qe = dense_value(q_old, h, Qc, 0, xe)
         te = t + xe * h
-        qe = dense_value(q_old, h, Qc, 0, xe)
         kind = mt.MAXIMUM if v_old > 0.0 else mt.MINIMUM
         n_ext = int(acc[N_EXT])
-        buf = mt.push_extremum(buf, n_ext, te, qe, kind)
+        buf[n_ext, mt.EXT_T] = te
+        buf[n_ext, mt.EXT_Q] = qe
+        buf[n_ext, mt.EXT_KIND] = kind
         acc[N_EXT] = n_ext + 1
         peak = max(peak, abs(qe))
         if te >= t_tail:
@@ -218,7 +250,10 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
     peak = max(peak, abs(q_new))
 
     if t_new >= t_tail:
-        if straddles_tail:
+        if t < t_tail:
+            if not have_qc:
+                dense_coefficients(K, Qc)
+                have_qc = True
             qt = dense_value(q_old, h, Qc, 0, (t_tail - t) / h)
             peak = max(peak, abs(qt))
             acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qt))
@@ -231,20 +266,30 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
 
     if track:
         thr = thr_fixed + thr_rel * peak
-        acc[LAST_ABOVE] = _last_time_above(t, h, Qc, q_old, q_new, has_ext, xe, qe,
-                                           centre, thr, acc[LAST_ABOVE])
+        xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
+        if xa > 1.0:
+            acc[LAST_ABOVE] = t + h
+        elif xa >= 0.0:
+            if not have_qc:
+                dense_coefficients(K, Qc)
+                have_qc = True
+            x = dense_root(q_old, h, Qc, 0, centre + side * thr, xa, xb)
+            acc[LAST_ABOVE] = t + x * h
 
-    while k < n_samples and k * dt_sample <= t_new:
-        series[k] = dense_value(q_old, h, Qc, 0, (k * dt_sample - t) / h)
-        k += 1
-    acc[SAMPLE] = k
+    if k < n_samples and k * dt_sample <= t_new:
+        if not have_qc:
+            dense_coefficients(K, Qc)
+            have_qc = True
+        while k < n_samples and k * dt_sample <= t_new:
+            series[k] = dense_value(q_old, h, Qc, 0, (k * dt_sample - t) / h)
+            k += 1
+        acc[SAMPLE] = k
 
     acc[T] = t_new
     acc[Q] = q_new
     acc[V] = v_new
     acc[FQ] = K[6, 0]
     acc[FV] = K[6, 1]
-    return buf
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
