@@ -15,6 +15,7 @@ import numba as nb
 import numpy as np
 
 from .oscillator import acceleration
+from .vecmath import exp2_fast, log2_fast
 
 # --- the tableau (Dormand & Prince 1980; dense output with Shampine's optimal c6) -------------
 N_STAGES = 6
@@ -46,6 +47,11 @@ SAFETY = 0.9          # multiply asymptotic step estimates by this
 MIN_FACTOR = 0.2      # smallest allowed step decrease
 MAX_FACTOR = 10.0     # largest allowed step increase
 ERROR_EXPONENT = -1.0 / (ERROR_ESTIMATOR_ORDER + 1)
+
+# --- an optional PI controller (Gustafsson 1991, in Hairer & Wanner's DOPRI5 form) -------------
+PI_BETA = 0.08                        # weight of the previous accepted step's error
+PI_ALPHA = 0.2 - 0.75 * PI_BETA       # weight of this attempt's error (0.14)
+PI_MIN_ERR_PREV = 1e-4                # floor on the previous error (Hairer's facold)
 MIN_RTOL = 100 * np.finfo(float).eps   # SciPy raises smaller rtol to this
 
 
@@ -113,6 +119,34 @@ def step_factor(err, rejected_before):
     if not factor > MIN_FACTOR:          # also catches NaN
         factor = MIN_FACTOR
     return factor
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def pi_step_factor(err, log2_err_prev, rejected_before):
+    """Step-size factor of the PI controller (vectorisable; both drivers use this function).
+
+    Accepted (err < 1): SAFETY err^-PI_ALPHA err_prev^PI_BETA within [MIN_FACTOR, MAX_FACTOR],
+    capped at 1 right after a rejection; err_prev is the previous accepted step's error, at
+    least PI_MIN_ERR_PREV, given as its log2 (`pi_log2_err`). Rejected:
+    max(MIN_FACTOR, SAFETY err^-PI_ALPHA); a non-finite error gives MIN_FACTOR.
+    Powers to ~1e-9 (vecmath.exp2_fast / log2_fast): ample for a step-size factor.
+    """
+    log_err = log2_fast(min(max(err, 1e-18), 1e18))
+    accepted = err < 1.0
+    y = -PI_ALPHA * log_err + (PI_BETA * log2_err_prev if accepted else 0.0)
+    factor = SAFETY * exp2_fast(min(max(y, -30.0), 30.0))
+    accept = min(MAX_FACTOR, max(MIN_FACTOR, factor))
+    accept = min(1.0, accept) if rejected_before else accept
+    reject = max(MIN_FACTOR, factor)
+    reject = MIN_FACTOR if err != err else reject
+    return accept if accepted else reject
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def pi_log2_err(err):
+    """log2 of an accepted step's error for the PI controller's memory (floored at
+    PI_MIN_ERR_PREV)."""
+    return log2_fast(max(err, PI_MIN_ERR_PREV))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -14,7 +14,7 @@ scalar state machine for that lane alone, so the metrics are the scalar driver's
 trajectory ends takes the next point of its block at once.
 
 No libm call may sit in those loops: cos(W t) is `fast_cos` (Cody-Waite reduction and fdlibm's
-kernels) and the controller's err^(-1/5) is `_inv_fifth_root` (range reduction by powers of two
+kernels) and the controller's err^(-1/5) is `inv_fifth_root` (range reduction by powers of two
 and Newton's method), both to an ulp or two. Results therefore equal the scalar driver's to
 round-off, not bit for bit.
 """
@@ -26,40 +26,18 @@ import numpy as np
 
 from . import metrics as mt
 from . import trajectory as tj
-from .dopri5 import A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P, SAFETY
-from .layout import (ATOL, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
+from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
+                     SAFETY, pi_log2_err, pi_step_factor)
+from .layout import (ATOL, CONTROLLER, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 from .transverse import classify, reject_point, valid
+from .vecmath import fast_cos, inv_fifth_root
 
 LANES = 16             # trajectories per lock-step group (a multiple of the SIMD width)
 SIMD = 4                # doubles per vector register the loops are rounded to (AVX2)
 MIN_BLOCK = LANES       # points per parallel work item, at least (small grids still use all threads)
 MAX_BLOCK = 1024        # at most, so that every thread gets several blocks
-
-# Cody-Waite split of pi/2 and fdlibm's minimax kernels on [-pi/4, pi/4].
-_TWO_OVER_PI = 0.63661977236758134308
-_PIO2_1 = 1.57079632673412561417e+00
-_PIO2_2 = 6.07710050630396597660e-11
-_PIO2_2T = 2.02226624879595063154e-21
-_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
-_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
-_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
-_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def fast_cos(x):
-    """cos(x) without a libm call, to about an ulp for |x| < 1e5 (vectorisable)."""
-    k = math.floor(x * _TWO_OVER_PI + 0.5)
-    r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_2T
-    z = r * r
-    s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
-    c = 1.0 - 0.5 * z + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-    quadrant = k - 4.0 * math.floor(0.25 * k)     # 0, 1, 2, 3 as floats: vectorisable
-    v = s if (quadrant == 1.0) | (quadrant == 3.0) else c
-    return -v if (quadrant == 1.0) | (quadrant == 2.0) else v
-
 
 # The lanes' working memory is one flat array W, row r of lane j at W[r * LANES + j]: one
 # underlying object with constant offsets between rows, so LLVM proves the rows independent and
@@ -75,7 +53,8 @@ W_ERR = W_QN + 2                  # SciPy's error norm
 W_FLAG = W_QN + 3                 # NEEDS_SCALAR or HAS_EXTREMUM: the scalar state machine's turn
 W_XE = W_QN + 4                   # the accepted step's extremum of q: x = (t - t_old)/h, or -1
 W_QE = W_QN + 5                   # q there (m)
-W_ROWS = W_QN + 6
+W_FACTOR = W_QN + 6               # the PI controller's step-size factor for the attempt
+W_ROWS = W_QN + 7
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -91,61 +70,10 @@ _P = tuple(tuple(float(x) for x in row) for row in P)
 
 # Controller: below this error the accepted factor is MAX_FACTOR, SAFETY err^(-1/5) >= 10.
 _ERR_MAX_FACTOR = (SAFETY / MAX_FACTOR) ** 5
-# Newton's start for m^(-1/5) on [1, 2) (least squares, |error| < 2e-5).
-_R4, _R3, _R2, _R1, _R0 = (0.014560562999503732, -0.11387695821308534, 0.36488873237721625,
-                           -0.6453524859268162, 1.3797612706449516)
-_F16, _F8, _F4, _F2, _F1 = (2.0 ** (16 / 5), 2.0 ** (8 / 5), 2.0 ** (4 / 5), 2.0 ** (2 / 5),
-                            2.0 ** (1 / 5))
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _inv_fifth_root(x):
-    """x^(-1/5) for 2^-31 <= x < 2^32, to about an ulp, without a libm call (vectorisable)."""
-    r = 1.0
-    if x >= 65536.0:
-        x *= 1.0 / 65536.0
-        r /= _F16
-    if x >= 256.0:
-        x *= 1.0 / 256.0
-        r /= _F8
-    if x >= 16.0:
-        x *= 1.0 / 16.0
-        r /= _F4
-    if x >= 4.0:
-        x *= 0.25
-        r /= _F2
-    if x >= 2.0:
-        x *= 0.5
-        r /= _F1
-    if x < 1.0 / 65536.0:
-        x *= 65536.0
-        r *= _F16
-    if x < 1.0 / 256.0:
-        x *= 256.0
-        r *= _F8
-    if x < 1.0 / 16.0:
-        x *= 16.0
-        r *= _F4
-    if x < 0.25:
-        x *= 4.0
-        r *= _F2
-    if x < 0.5:
-        x *= 2.0
-        r *= _F1
-    if x < 1.0:
-        x *= 2.0
-        r *= _F1
-    y = (((_R4 * x + _R3) * x + _R2) * x + _R1) * x + _R0
-    for _ in range(2):
-        y2 = y * y
-        y = y * (6.0 - x * y2 * y2 * y) * 0.2
-    return r * y
-
-
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _step_factor(err, rejected_before):
-    """dopri5.step_factor across lanes (err^(-1/5) by `_inv_fifth_root`)."""
-    root = _inv_fifth_root(min(max(err, 1e-9), 1e9))
+    """dopri5.step_factor across lanes (err^(-1/5) by `vecmath.inv_fifth_root`)."""
+    root = inv_fifth_root(min(max(err, 1e-9), 1e9))
     accept = min(MAX_FACTOR, SAFETY * root)
     accept = MAX_FACTOR if err < _ERR_MAX_FACTOR else accept
     accept = min(1.0, accept) if rejected_before else accept
@@ -258,6 +186,20 @@ def _attempt(W, rtol, atol, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def _pi_factors(W, n_run):
+    """The PI controller's step-size factor for every lane's attempt (W_FACTOR), and the
+    memory of an accepted attempt's error (LOG2_ERR_PREV). Its own loop: `_finish` stays as
+    fast as with SciPy's controller when this one is not used."""
+    L = LANES
+    for j in range(n_run):
+        err = W[W_ERR * L + j]
+        memory = W[tj.LOG2_ERR_PREV * L + j]
+        W[W_FACTOR * L + j] = pi_step_factor(err, memory, W[tj.REJECTED_NOW * L + j] != 0.0)
+        remember = (W[W_H * L + j] > 0.0) & (err < 1.0)
+        W[tj.LOG2_ERR_PREV * L + j] = pi_log2_err(err) if remember else memory
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _finish(W, settings, n_samples, n_run):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
     ordinary accepted step the first metrics pass (threshold tol * peak around 0) and the move
@@ -265,14 +207,16 @@ def _finish(W, settings, n_samples, n_run):
     divergence, is left for trajectory.record_step: W_FLAG = NEEDS_SCALAR, or HAS_EXTREMUM
     when it holds an extremum of q (`_locate_extrema` finds it first).
 
+    SciPy's controller is computed here; the PI controller's factor comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
-    vectorising this loop.
+    vectorising the loop.
     """
     L = LANES
     t_tail = settings[T_END] * (1.0 - settings[TAIL])
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
+    use_pi = settings[CONTROLLER] != 0.0
     for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0
@@ -296,7 +240,7 @@ def _finish(W, settings, n_samples, n_run):
         event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
         done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
-        factor = _step_factor(err, rejected_before)
+        factor = W[W_FACTOR * L + j] if use_pi else _step_factor(err, rejected_before)
         W[W_FLAG * L + j] = ((HAS_EXTREMUM if extremum & bounded else NEEDS_SCALAR) if event
                              else ORDINARY)
         W[tj.RHS_EVALS * L + j] += 6.0 if active else 0.0
@@ -422,6 +366,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     n_samples = series.shape[1]
+    use_pi = settings[CONTROLLER] != 0.0
     W = np.zeros(W_ROWS * L)
     for j in range(L):
         W[(W_P + MASS) * L + j] = 1.0
@@ -463,6 +408,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, rtol, atol, n_run)
+        if use_pi:
+            _pi_factors(W, n_run)
         _finish(W, settings, n_samples, n_run)
         n_flagged = 0
         n_extrema = 0

@@ -12,7 +12,8 @@ TOL = 7             # settling band / decay threshold, relative
 SAMPLE_DT = 8       # time-series sample interval (s); used only when series has columns
 WANT_SETTLING = 9   # 1.0: compute settling times; 0.0: skip that work
 MIN_STEP = 10       # smallest step (s) before STEP_TOO_SMALL; SciPy's 10 ulps of t if larger
-N_SETTINGS = 11
+CONTROLLER = 11     # step-size controller: 0.0 SciPy's (step for step as solve_ivp), 1.0 PI
+N_SETTINGS = 12
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)

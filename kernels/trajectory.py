@@ -20,10 +20,10 @@ import numba as nb
 import numpy as np
 
 from . import metrics as mt
-from .dopri5 import (MIN_RTOL, dense_coefficients, dense_root, dense_value, initial_step,
-                     step_factor)
-from .layout import (FIRST_STEP, MAX_STEP, MAX_STEPS, MIN_STEP, SAMPLE_DT, TAIL, T_END,
-                     RTOL, ATOL)
+from .dopri5 import (MIN_RTOL, PI_MIN_ERR_PREV, dense_coefficients, dense_root, dense_value,
+                     initial_step, pi_log2_err, pi_step_factor, step_factor)
+from .layout import (ATOL, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL,
+                     SAMPLE_DT, TAIL, T_END)
 from .oscillator import BOUND, Q0, V0, acceleration
 
 # Slots of a trajectory's accumulator row.
@@ -47,7 +47,8 @@ TAIL_QMAX = 16      # max q over the tail window (m)
 LAST_ABOVE = 17     # last time |q - centre| > threshold (s)
 SAMPLE = 18         # next time-series sample index
 N_EXT = 19          # extrema recorded
-N_SLOTS = 20
+LOG2_ERR_PREV = 20  # log2 of the last accepted step's error norm (PI controller)
+N_SLOTS = 21
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -105,6 +106,7 @@ def start(p, settings, acc, series):
         series[0] = q
         acc[SAMPLE] = 1.0
     acc[N_EXT] = 0.0
+    acc[LOG2_ERR_PREV] = pi_log2_err(PI_MIN_ERR_PREV)
     if not abs(q) <= p[BOUND]:
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = 0.0
@@ -162,17 +164,24 @@ def _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def control(acc, err):
-    """SciPy's accept/reject and step-size update for an attempt with error norm `err`;
-    counts the attempt. Returns True when the attempt is accepted."""
+def control(settings, acc, err):
+    """Accept or reject an attempt with error norm `err` and update the step size: SciPy's
+    controller, or the PI controller when settings[CONTROLLER] is 1. Counts the attempt.
+    Returns True when the attempt is accepted."""
     acc[RHS_EVALS] += 6.0
-    acc[H_ABS] *= step_factor(err, acc[REJECTED_NOW] != 0.0)
+    rejected_before = acc[REJECTED_NOW] != 0.0
+    if settings[CONTROLLER] != 0.0:
+        acc[H_ABS] *= pi_step_factor(err, acc[LOG2_ERR_PREV], rejected_before)
+    else:
+        acc[H_ABS] *= step_factor(err, rejected_before)
     if not err < 1.0:
         acc[REJECTED_NOW] = 1.0
         acc[REJECTED] += 1.0
         return False
     acc[REJECTED_NOW] = 0.0
     acc[STEPS] += 1.0
+    if settings[CONTROLLER] != 0.0:
+        acc[LOG2_ERR_PREV] = pi_log2_err(err)
     return True
 
 
@@ -184,7 +193,7 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
     (`control`); on acceptance reduce the step's metrics (`record_step`). Returns the extrema
     buffer (regrown when full). Qc is scratch for the interpolant, shape (2, 4).
     """
-    if control(acc, err):
+    if control(settings, acc, err):
         if acc[N_EXT] >= buf.shape[0]:
             buf = with_room(buf, acc)
         record_step(p[BOUND], settings, acc, K, q_new, v_new, h, Qc, buf, series, track,

@@ -104,6 +104,9 @@ KEYS: tuple[Key, ...] = (
     Key("solver", "driver", "str", "lanes", choices=("lanes", "scalar"),
         long_name="transverse kernel driver: lock-step SIMD lanes (fast) or one trajectory per "
                   "thread (SciPy's arithmetic exactly, the reference)"),
+    Key("solver", "controller", "str", "scipy", choices=("scipy", "pi"),
+        long_name="transverse step-size controller: SciPy RK45's (step for step as solve_ivp) "
+                  "or PI (Gustafsson; fewer rejected steps)"),
     Key("solver", "max_steps", "int", 1_000_000, units="1", minimum=1,
         long_name="bound on accepted steps per point"),
     Key("solver", "max_step", "float", None, units="s", minimum=0.0, exclusive_min=True,

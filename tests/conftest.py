@@ -22,7 +22,7 @@ def param_row(m=1.0, c=0.0, k0=1.0, k1=0.0, g0=0.0, g1=0.0, h=0.0, omega=0.0,
 
 def settings(rtol=1e-8, atol=1e-12, t_end=5.0, max_steps=10**6, max_step=math.inf,
              first_step=0.0, tail=0.5, tol=0.02, sample_dt=0.01, settling=True,
-             min_step=0.0) -> np.ndarray:
+             min_step=0.0, controller="scipy") -> np.ndarray:
     """A kernel settings vector (kernels.transverse)."""
     s = np.zeros(tk.N_SETTINGS)
     s[tk.RTOL], s[tk.ATOL], s[tk.T_END] = rtol, atol, t_end
@@ -30,6 +30,7 @@ def settings(rtol=1e-8, atol=1e-12, t_end=5.0, max_steps=10**6, max_step=math.in
     s[tk.TAIL], s[tk.TOL], s[tk.SAMPLE_DT] = tail, tol, sample_dt
     s[tk.WANT_SETTLING] = 1.0 if settling else 0.0
     s[tk.MIN_STEP] = min_step
+    s[tk.CONTROLLER] = 1.0 if controller == "pi" else 0.0
     return s
 
 

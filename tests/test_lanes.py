@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kernels import lanes
+from kernels import lanes, vecmath
 from kernels import transverse as tk
 
 from conftest import param_row, settings
@@ -22,13 +22,13 @@ def _solve(fn, rows, s, n_samples=0):
 def test_fast_cos_matches_libm_to_round_off():
     x = np.concatenate([np.linspace(-2e4, 2e4, 400001), np.pi / 2 * np.arange(-50, 50)])
     W = np.zeros(1)
-    got = np.array([lanes.fast_cos(float(v)) for v in x[::97]])
+    got = np.array([vecmath.fast_cos(float(v)) for v in x[::97]])
     np.testing.assert_allclose(got, np.cos(x[::97]), rtol=0, atol=4.5e-16)
     del W
 
 
-@pytest.mark.parametrize("rtol", [1e-5, 1e-8])
-def test_lanes_equal_scalar_on_a_mixed_grid(rtol):
+@pytest.mark.parametrize("rtol, controller", [(1e-5, "scipy"), (1e-8, "scipy"), (1e-6, "pi")])
+def test_lanes_equal_scalar_on_a_mixed_grid(rtol, controller):
     rng = np.random.default_rng(7)
     rows = [param_row(c=rng.uniform(0, 2), k0=rng.uniform(-5, 400), k1=rng.uniform(-100, 100),
                       g0=rng.uniform(-1e3, 1e5), g1=rng.uniform(0, 1e3), h=rng.uniform(-1e4, 1e4),
@@ -37,7 +37,8 @@ def test_lanes_equal_scalar_on_a_mixed_grid(rtol):
     rows.append(param_row(m=0.0))                      # invalid
     rows.append(param_row(k0=-1.0, g0=-1.0, q0=1.0))   # diverges
     rows = np.stack(rows)
-    s = settings(rtol=rtol, atol=rtol * 1e-4, t_end=2.0, sample_dt=0.05, max_steps=20000)
+    s = settings(rtol=rtol, atol=rtol * 1e-4, t_end=2.0, sample_dt=0.05, max_steps=20000,
+                 controller=controller)
     a = _solve(tk.solve_batch_scalar, rows, s, 41)
     b = _solve(lanes.solve_batch, rows, s, 41)
     np.testing.assert_array_equal(a[0], b[0])
@@ -81,5 +82,46 @@ def test_vectorisable_controller_matches_scipy_controller():
         ref = np.array([step_factor(e, rejected_before) for e in errs])
         np.testing.assert_allclose(ours, ref, rtol=2e-15, atol=0)
     x = np.geomspace(1e-9, 1e9, 10001)
-    roots = np.array([lanes._inv_fifth_root(v) for v in x])
+    roots = np.array([vecmath.inv_fifth_root(v) for v in x])
     np.testing.assert_allclose(roots, x ** -0.2, rtol=1e-15)
+
+
+def test_controller_powers_are_accurate():
+    x = np.geomspace(2.0 ** -62, 2.0 ** 63, 20001)
+    logs = np.array([vecmath.log2_fast(v) for v in x])
+    np.testing.assert_allclose(logs, np.log2(x), rtol=0, atol=1e-8)
+    y = np.linspace(-31.0, 31.0, 20001)
+    np.testing.assert_allclose([vecmath.exp2_fast(v) for v in y], 2.0 ** y, rtol=1e-8)
+
+
+def test_pi_controller_factor_follows_its_formula():
+    from kernels.dopri5 import (MAX_FACTOR, MIN_FACTOR, PI_ALPHA, PI_BETA, SAFETY, pi_log2_err,
+                                pi_step_factor)
+    prev = 3e-3
+    memory = pi_log2_err(prev)
+    for err in (1e-9, 1e-3, 0.5, 0.99, 1.5, 40.0, 1e6):
+        raw = SAFETY * err ** -PI_ALPHA * (prev ** PI_BETA if err < 1 else 1.0)
+        want = min(MAX_FACTOR, max(MIN_FACTOR, raw)) if err < 1 else max(MIN_FACTOR, raw)
+        assert pi_step_factor(err, memory, False) == pytest.approx(want, rel=1e-8)
+    assert pi_step_factor(0.5, memory, True) <= 1.0
+    assert pi_step_factor(np.nan, memory, False) == MIN_FACTOR
+    assert pi_log2_err(1e-12) == pytest.approx(np.log2(1e-4), abs=1e-8)   # floored
+
+
+def test_pi_controller_is_accurate_and_rejects_less():
+    """Against SciPy DOP853 at rtol 1e-13 (independent): the PI controller's final state is as
+    accurate as SciPy's controller's at the same tolerance, with fewer rejected steps."""
+    from scipy.integrate import solve_ivp
+    row = param_row(c=0.3, k0=900.0, k1=200.0, g0=4e5, omega=58.0, q0=4e-3)
+    s_end = 3.0
+    ref = solve_ivp(lambda t, y: [y[1], -(0.3 * y[1] + (900 + 200 * np.cos(58 * t)) * y[0]
+                                         + 4e5 * y[0] ** 3)],
+                    (0, s_end), [4e-3, 0.0], method="DOP853", rtol=1e-13, atol=1e-16).y[0, -1]
+    out = {}
+    for controller in ("scipy", "pi"):
+        s = settings(rtol=1e-6, atol=1e-10, t_end=s_end, sample_dt=s_end, controller=controller)
+        states, reals, counts, series = _solve(lanes.solve_batch, row[None, :], s, 2)
+        out[controller] = (abs(series[0, -1] - ref), counts[0, tk.REJECTED])
+    assert out["pi"][0] < 1e-6 * 4e-3 * 100
+    assert out["pi"][0] <= 3 * out["scipy"][0]
+    assert out["pi"][1] < out["scipy"][1]
