@@ -29,6 +29,15 @@ rtol 1e-8 and atol 1e-12 (the scene defaults) unless --rtol / --atol are given.
    - whether the accepted step counts (cable-sweep `n_steps` vs len(sol.t) - 1) and the
      right-hand-side evaluation counts (`n_rhs` vs sol.nfev) are equal point by point.
 
+4. At equal error (--equal-error): every solver over a ladder of rtols (--ladder; atol = rtol x
+   1e-4), its max final-state error max_i |q_i(5) - q_ref,i(5)| / max_t |q_ref,i| on the SciPy
+   sample against DOP853 at rtol 1e-13 / atol 1e-16 (independent of every solver timed), and its
+   throughput: cable-sweep (lanes, SciPy's controller and the PI controller) and numbalsoda
+   dop853 (a Numba prange loop over all points, output at t = 0 and 5 s only, its cheapest
+   case; the optional `bench` extra) over the whole grid on the most threads, SciPy RK45 on the
+   sample. Throughput at the --target error is interpolated in log-log between the two rungs
+   that bracket it; the ratios compare solvers at that same error.
+
 Command (full size; run on an otherwise idle machine)
 ------------------------------------------------------
     PYTHONPATH=. python benchmarks/reference_sweep.py --json reference_sweep.json
@@ -40,6 +49,7 @@ Prints Markdown tables to stdout; --json PATH also writes every number as JSON.
 from __future__ import annotations
 
 import argparse
+import math
 import platform
 import sys
 import time
@@ -103,6 +113,12 @@ def parse_args() -> argparse.Namespace:
                    help="timed runs per thread count; the best is reported (default 3)")
     p.add_argument("--grid", type=int, default=20001,
                    help="dense-output grid points on [2.5, 5] s for SciPy's amplitude")
+    p.add_argument("--equal-error", action="store_true",
+                   help="also compare every solver at equal final-state error (item 4)")
+    p.add_argument("--ladder", default="1e-4,3e-5,1e-5,3e-6,1e-6,3e-7,1e-7,3e-8",
+                   help="rtols of the equal-error comparison")
+    p.add_argument("--target", type=float, default=1e-5,
+                   help="final-state error at which solvers are compared (default 1e-5)")
     p.add_argument("--json", metavar="PATH", help="also write the results as JSON")
     return p.parse_args()
 
@@ -176,6 +192,92 @@ def scipy_agreement(rows: np.ndarray, kernel: KernelResult, rtol: float, atol: f
         "rhs_evals_equal": int(rhs_equal.sum()),
         "points": len(rows),
     }
+
+
+def final_state_reference(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """q(5) and max_t |q| of each row by SciPy DOP853 at rtol 1e-13, atol 1e-16."""
+    q_end = np.empty(len(rows))
+    q_max = np.empty(len(rows))
+    for i, row in enumerate(rows):
+        sol = solve_scipy(row, T_END, 1e-13, 1e-16, method="DOP853", dense=True)
+        q_end[i] = sol.y[0, -1]
+        q_max[i] = np.abs(sol.sol(np.linspace(0.0, T_END, 20001))[0]).max()
+    return q_end, q_max
+
+
+def at_target(rungs: list[dict[str, float]], target: float) -> float:
+    """Trajectories/s at final-state error `target`, log-log interpolated between the cheapest
+    rung at or below the target and the rung just looser; NaN when no rung reaches it."""
+    rungs = sorted(rungs, key=lambda r: -r["rtol"])
+    for k, r in enumerate(rungs):
+        if r["error"] <= target:
+            if k == 0 or not rungs[k - 1]["error"] > target:
+                return r["rate"]
+            a, b = rungs[k - 1], r
+            w = (math.log(target) - math.log(a["error"])) / (math.log(b["error"]) - math.log(a["error"]))
+            return math.exp(math.log(a["rate"]) + w * (math.log(b["rate"]) - math.log(a["rate"])))
+    return math.nan
+
+
+def equal_error(table: np.ndarray, sample: np.ndarray, rtols: list[float], threads: int,
+                repeats: int, target: float) -> tuple[str, dict[str, object]]:
+    """Item 4: every solver over the rtol ladder; Markdown and a JSON-able dict."""
+    from kernels import transverse as tk
+    rows = table[sample]
+    q_ref, q_max = final_state_reference(rows)
+
+    def error(q_end: np.ndarray) -> float:
+        return float(np.max(np.abs(q_end - q_ref) / q_max))
+
+    rungs: dict[str, list[dict[str, float]]] = {}
+    for rtol in rtols:
+        atol = rtol * 1e-4
+        for name, controller in (("cable-sweep (lanes)", 0.0), ("cable-sweep (lanes, PI)", 1.0)):
+            scene = build_scene(2, rtol, atol)
+            settings = settings_vector(scene)
+            settings[tk.CONTROLLER] = controller
+            settings[tk.SAMPLE_DT] = T_END
+            solve_points(table[:2], settings, 2, threads=1)
+            best = np.inf
+            for _ in range(repeats):
+                start = time.perf_counter()
+                res = solve_points(table, settings, 2, threads=threads)
+                best = min(best, time.perf_counter() - start)
+            rungs.setdefault(name, []).append({"rtol": rtol, "rate": len(table) / best,
+                                               "error": error(res.series[sample, -1])})
+        if NUMBALSODA is not None:
+            t_eval = np.array([0.0, T_END])
+            out, ok, _, wall = NUMBALSODA.solve("dop853", table, t_eval, rtol, atol,
+                                                threads=threads, timed=True)
+            err = error(out[sample, -1, 0]) if ok[sample].all() else math.nan
+            rungs.setdefault("numbalsoda dop853", []).append(
+                {"rtol": rtol, "rate": len(table) / wall, "error": err})
+        start = time.perf_counter()
+        q_end = np.array([solve_scipy(row, T_END, rtol, atol).y[0, -1] for row in rows])
+        rungs.setdefault("SciPy RK45 (Python RHS)", []).append(
+            {"rtol": rtol, "rate": len(rows) / (time.perf_counter() - start),
+             "error": error(q_end)})
+    lines = [f"Max final-state error on the {len(rows)}-point sample (vs DOP853 at rtol 1e-13) "
+             f"and trajectories/s; cable-sweep and numbalsoda on {threads} threads over all "
+             f"{len(table)} points, SciPy on 1 thread over the sample.\n"]
+    names = list(rungs)
+    header = ["rtol"] + [f"{n}: error" for n in names] + [f"{n}: traj/s" for n in names]
+    body = []
+    for k, rtol in enumerate(rtols):
+        body.append([f"{rtol:g}"] + [f"{rungs[n][k]['error']:.1e}" for n in names]
+                    + [f"{rungs[n][k]['rate']:,.0f}" for n in names])
+    lines.append(markdown_table(header, body))
+    rates = {n: at_target(rungs[n], target) for n in names}
+    mine = rates["cable-sweep (lanes)"]
+    lines.append(f"\nAt max final-state error {target:g} (log-log interpolation):\n")
+    lines.append(markdown_table(
+        ["solver", "trajectories/s", "cable-sweep (lanes) / solver", "cable-sweep (PI) / solver"],
+        [[n, f"{rates[n]:,.0f}", f"{mine / rates[n]:,.1f}x",
+          f"{rates['cable-sweep (lanes, PI)'] / rates[n]:,.1f}x"] for n in names]))
+    return "\n".join(lines), {"target": target, "rungs": rungs, "at_target": rates}
+
+
+NUMBALSODA = None
 
 
 def state_counts(states: np.ndarray) -> dict[str, int]:
@@ -256,8 +358,23 @@ def main() -> None:
     states = state_counts(result.states)
     print("\nStates of the sweep: " + ", ".join(f"{k} {v}" for k, v in states.items()))
 
+    equal = None
+    if args.equal_error:
+        global NUMBALSODA
+        try:
+            from work_precision import Numbalsoda
+            NUMBALSODA = Numbalsoda()
+            NUMBALSODA.solve("dop853", table[:2], np.array([0.0, T_END]), 1e-5, 1e-9, threads=1)
+        except ImportError as exc:
+            print(f"numbalsoda not available ({exc}); pip install '.[bench]' to include it",
+                  file=sys.stderr)
+        text, equal = equal_error(table, sample, [float(r) for r in args.ladder.split(",")],
+                                  max(r["threads_used"] for r in runs), args.repeats, args.target)
+        print("\n## At equal final-state error\n")
+        print(text)
+
     if args.json:
-        write_json(args.json, {
+        write_json(args.json, {"equal_error": equal,
             "grid_points": n, "points_per_axis": args.points_per_axis, "rtol": args.rtol,
             "atol": args.atol, "compile_s": compile_s, "repeats": args.repeats,
             "cable_sweep": runs,

@@ -1,22 +1,27 @@
 """Lock-step SIMD driver: LANES trajectories advanced side by side in vector lanes.
 
 Each lane is one trajectory with its own time, step size and accept/reject decision: SciPy
-RK45's sequence of attempts, the trajectory module's state machine. Three loops run across
-the lanes with straight-line arithmetic, so LLVM vectorises them:
+RK45's sequence of attempts (or the PI controller's), the trajectory module's state machine.
+These loops run across the lanes with straight-line arithmetic, so LLVM vectorises them:
 
 - `_prepare`: the next step of every lane whose step needs no special care;
 - `_attempt`: one Dormand-Prince attempt (six right-hand sides, stage sums, error norm);
-- `_finish`: accept/reject, the step-size update and the metrics of an ordinary step.
+- `_pi_factors`: the PI controller's step-size factors (only when that controller is chosen);
+- `_finish`: accept/reject and the step-size update of every lane, and the metrics of an
+  ordinary accepted step;
+- `_locate_extrema`: for the steps that hold an extremum of q, where it lies on the dense
+  output (safeguarded Newton), run only when some lane has one.
 
-Whatever is not ordinary (a lane's first or last step, a step near SciPy's minimum, an extremum
-of q, the tail's start, a time-series sample, a threshold crossing, a divergence) goes to the
-scalar state machine for that lane alone, so the metrics are the scalar driver's. A lane whose
-trajectory ends takes the next point of its block at once.
+Whatever else is not ordinary (a lane's first or last step, a step near SciPy's minimum, the
+extremum's bookkeeping, the tail's start, a time-series sample, a threshold crossing, a
+divergence) goes to the scalar state machine (`trajectory.record_step`) for that lane alone, so
+the metrics are the scalar driver's. A lane whose trajectory ends takes the next point of its
+block at once.
 
-No libm call may sit in those loops: cos(W t) is `fast_cos` (Cody-Waite reduction and fdlibm's
-kernels) and the controller's err^(-1/5) is `inv_fifth_root` (range reduction by powers of two
-and Newton's method), both to an ulp or two. Results therefore equal the scalar driver's to
-round-off, not bit for bit.
+No libm call may sit in those loops: cos(W t) is `vecmath.fast_cos` (Cody-Waite reduction and
+fdlibm's kernels) and the controller's err^(-1/5) is `vecmath.inv_fifth_root` (range reduction
+by powers of two and Newton's method), both to an ulp or two. Results therefore equal the
+scalar driver's to round-off, not bit for bit.
 """
 
 import math

@@ -72,6 +72,13 @@ t_end = 1.0
         np.testing.assert_array_equal(a[name].values, b[name].values)
     for name in ("amplitude", "peak_amplitude", "settling_time", "displacement"):
         np.testing.assert_allclose(a[name].values, b[name].values, rtol=1e-9, atol=1e-15)
+    assert scene.get("solver.controller") == "scipy"
+    c = sweep.run(sweep.load_scene_text(text, overrides={"solver.controller": "pi"}),
+                  progress=False)
+    assert int(c["n_rejected"].sum()) < int(a["n_rejected"].sum())
+    np.testing.assert_allclose(c["amplitude"].values, a["amplitude"].values, rtol=1e-3)
+    with pytest.raises(sweep.SceneError, match="solver.controller"):
+        sweep.load_scene_text(text, overrides={"solver.controller": "pid"})
 
 
 def test_vectorisable_controller_matches_scipy_controller():
