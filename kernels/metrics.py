@@ -46,19 +46,6 @@ EXT_KIND = 2   # MAXIMUM or MINIMUM
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def push_extremum(buf, n, t, q, kind):
-    """Append (t, q, kind) to the extrema buffer, doubling it when full. Returns the buffer."""
-    if n >= buf.shape[0]:
-        bigger = np.empty((2 * buf.shape[0], 3))
-        bigger[:n] = buf[:n]
-        buf = bigger
-    buf[n, EXT_T] = t
-    buf[n, EXT_Q] = q
-    buf[n, EXT_KIND] = kind
-    return buf
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
 def tail_counts(buf, n, t_tail):
     """Number of maxima and minima at t >= t_tail, and the response period from the maxima."""
     n_max = 0
