@@ -41,8 +41,6 @@ from .vecmath import fast_cos, inv_fifth_root
 
 LANES = 16             # trajectories per lock-step group (a multiple of the SIMD width)
 SIMD = 4                # doubles per vector register the loops are rounded to (AVX2)
-MIN_BLOCK = LANES       # points per parallel work item, at least (small grids still use all threads)
-MAX_BLOCK = 1024        # at most, so that every thread gets several blocks
 
 # The lanes' working memory is one flat array W, row r of lane j at W[r * LANES + j]: one
 # underlying object with constant offsets between rows, so LLVM proves the rows independent and
@@ -364,7 +362,8 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series):
-    """Solve rows lo..hi-1 of `params` through LANES lock-step lanes."""
+    """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
+    results (to round-off) of transverse.solve_block, several times faster per core."""
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
     atol = settings[ATOL]
@@ -442,16 +441,3 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
             tj.record_step(W[(W_P + BOUND) * L + j], settings, acc, K, W[W_QN * L + j],
                            W[W_VN * L + j], W[W_H * L + j], Qc, bufs[j], series[i], track,
                            0.0, 0.0, thr_rel, xe, W[W_QE * L + j])
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def solve_batch(params, settings, states, reals, counts, series):
-    """Same interface and results (to round-off) as transverse.solve_batch_scalar, several
-    times faster per core: blocks of points in parallel (n/32 points each, within MIN_BLOCK
-    to MAX_BLOCK), LANES lanes per block. Blocking never changes a point's result."""
-    n = params.shape[0]
-    block = max(MIN_BLOCK, min(MAX_BLOCK, n // 32))
-    n_blocks = (n + block - 1) // block
-    for b in nb.prange(n_blocks):
-        solve_block(params, settings, b * block, min(n, (b + 1) * block), states, reals,
-                    counts, series)

@@ -31,6 +31,8 @@ DIVERGED = 5
 STEP_TOO_SMALL = 6
 MAX_STEPS = 7
 RUNNING = -1
+SECOND_PASS = -2      # internal: STEADY at rest away from zero, its settling time still to be found
+                      # by transverse.settle_second_pass; never left in a result
 
 STATE_MEANINGS = ("invalid_input", "decayed", "steady", "modulated", "unsettled", "diverged",
                   "step_size_too_small", "max_steps_reached")

@@ -65,7 +65,9 @@ def with_room(buf, acc):
     if n < buf.shape[0]:
         return buf
     bigger = np.empty((2 * buf.shape[0], 3))
-    bigger[:n] = buf[:n]
+    for i in range(n):          # a loop, not a slice copy: that compiles seconds of error text
+        for c in range(3):
+            bigger[i, c] = buf[i, c]
     return bigger
 
 

@@ -1,12 +1,16 @@
 """Batched transverse drivers: adaptive RK45 trajectories over the rows of a parameter table.
 
-`solve_batch(params, settings, states, reals, counts, series)` is the whole interface the
-sweep layer uses: rows of `params` (columns in `oscillator`) in, per-point metrics out. Two
-drivers stand behind it with the same results to round-off:
+`solve_block(params, settings, lo, hi, states, reals, counts, series)` is the interface the
+sweep layer uses: rows lo..hi-1 of `params` (columns in `oscillator`) in, per-point metrics
+out. Two drivers have it, with the same results to round-off:
 
-- `solve_batch_scalar`: one trajectory per parallel iteration (the reference);
-- `kernels.lanes.solve_batch`: LANES trajectories advanced in lock-step in SIMD lanes, each
+- `solve_block` here: one trajectory after another (the reference);
+- `kernels.lanes.solve_block`: LANES trajectories advanced in lock-step in SIMD lanes, each
   with its own step size and accept/reject (the default: several times faster per core).
+
+Both release the GIL; sweep.threads runs blocks on Python threads (no Numba parallel region,
+whose compilation alone took ~3 s cold). A point at rest away from zero is left SECOND_PASS;
+`settle_second_pass` finishes it (compiled only when a sweep has one).
 
 Units: t in s, q in m, q' in m/s.
 """
@@ -120,13 +124,33 @@ def classify(p, settings, acc, buf, reals, counts):
             return mt.UNSETTLED
         return mt.MODULATED
     if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band:
-        # At rest away from zero (e.g. post-buckled): settle on the final value, second pass.
-        if want_settling:
-            second, _ = integrate(p, settings, True, acc[tj.Q], band, 0.0, np.empty(0))
-            reals[SETTLING] = second[tj.LAST_ABOVE]
-            counts[RHS_EVALS] += int(second[tj.RHS_EVALS])
-        return mt.STEADY
+        # At rest away from zero (e.g. post-buckled): its settling time (on the final value)
+        # needs a second integration, left to settle_second_pass so that the drivers do not
+        # compile the scalar integrator for a case most sweeps never meet.
+        return mt.SECOND_PASS if want_settling else mt.STEADY
     return mt.UNSETTLED
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def settle_second_pass(params, settings, states, reals, counts):
+    """Finish the points a driver left as SECOND_PASS (at rest away from zero): integrate
+    again to find the final value, then a second time tracking |q - q_final| against the band
+    tol * amplitude; the settling time is the last time q was outside it. The state becomes
+    STEADY; counts[RHS_EVALS] gains the second pass's evaluations (as if done in one go).
+    Other rows are left as they are. Returns how many points were finished."""
+    done = 0
+    for i in range(params.shape[0]):
+        if states[i] != mt.SECOND_PASS:
+            continue
+        p = params[i]
+        first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0))
+        band = settings[TOL] * first[tj.TAIL_AMP]
+        second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0))
+        reals[i, SETTLING] = second[tj.LAST_ABOVE]
+        counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
+        states[i] = mt.STEADY
+        done += 1
+    return done
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -141,16 +165,15 @@ def solve_point(p, settings, reals, counts, series):
     return classify(p, settings, acc, buf, reals, counts)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def solve_batch_scalar(params, settings, states, reals, counts, series):
-    """Solve every row of `params` (n, N_PARAMS) in parallel, one trajectory per iteration.
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_block(params, settings, lo, hi, states, reals, counts, series):
+    """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
     counts (n, N_COUNTS) int64, series (n, n_samples) q samples at k * SAMPLE_DT (n_samples may
-    be 0). Each point's result depends only on its own row.
+    be 0). Each point's result depends only on its own row. Releases the GIL: the sweep layer
+    runs blocks on several threads (sweep.threads). Points left SECOND_PASS are finished by
+    settle_second_pass.
     """
-    for i in nb.prange(params.shape[0]):
+    for i in range(lo, hi):
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i])
-
-
-solve_batch = solve_batch_scalar

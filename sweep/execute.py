@@ -55,12 +55,10 @@ def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
 def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, driver: str,
                      threads: int = 0) -> dict[str, np.ndarray]:
     """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series)."""
-    from kernels import lanes
-    from kernels import transverse as tk
-    _set_threads(threads)
+    from .threads import solve_transverse
     out = transverse_outputs(params.shape[0], n_samples)
-    solve = lanes.solve_batch if driver == "lanes" else tk.solve_batch_scalar
-    solve(params, settings, out["states"], out["reals"], out["counts"], out["series"])
+    solve_transverse(params, settings, out["states"], out["reals"], out["counts"], out["series"],
+                     driver=driver, threads=threads)
     return out
 
 

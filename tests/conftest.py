@@ -9,6 +9,7 @@ import pytest
 
 from kernels import oscillator as osc
 from kernels import transverse as tk
+from sweep.threads import solve_transverse
 
 
 def param_row(m=1.0, c=0.0, k0=1.0, k1=0.0, g0=0.0, g1=0.0, h=0.0, omega=0.0,
@@ -42,7 +43,7 @@ def solve(rows, s, n_samples=0):
     reals = np.empty((n, tk.N_REALS))
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     series = np.empty((n, n_samples))
-    tk.solve_batch(rows, s, states, reals, counts, series)
+    solve_transverse(rows, s, states, reals, counts, series, driver="scalar")
     return states, reals, counts, series
 
 

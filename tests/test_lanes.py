@@ -9,13 +9,14 @@ from kernels import lanes, vecmath
 from kernels import transverse as tk
 
 from conftest import param_row, settings
+from sweep.threads import solve_transverse
 
 
-def _solve(fn, rows, s, n_samples=0):
+def _solve(driver, rows, s, n_samples=0):
     n = rows.shape[0]
     out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)), np.empty((n, tk.N_COUNTS), np.int64),
            np.empty((n, n_samples)))
-    fn(rows, s, *out)
+    solve_transverse(rows, s, *out, driver=driver)
     return out
 
 
@@ -39,8 +40,8 @@ def test_lanes_equal_scalar_on_a_mixed_grid(rtol, controller):
     rows = np.stack(rows)
     s = settings(rtol=rtol, atol=rtol * 1e-4, t_end=2.0, sample_dt=0.05, max_steps=20000,
                  controller=controller)
-    a = _solve(tk.solve_batch_scalar, rows, s, 41)
-    b = _solve(lanes.solve_batch, rows, s, 41)
+    a = _solve("scalar", rows, s, 41)
+    b = _solve("lanes", rows, s, 41)
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[2], b[2])
     np.testing.assert_allclose(b[1], a[1], rtol=1e-9, atol=1e-15, equal_nan=True)
@@ -127,8 +128,51 @@ def test_pi_controller_is_accurate_and_rejects_less():
     out = {}
     for controller in ("scipy", "pi"):
         s = settings(rtol=1e-6, atol=1e-10, t_end=s_end, sample_dt=s_end, controller=controller)
-        states, reals, counts, series = _solve(lanes.solve_batch, row[None, :], s, 2)
+        states, reals, counts, series = _solve("lanes", row[None, :], s, 2)
         out[controller] = (abs(series[0, -1] - ref), counts[0, tk.REJECTED])
     assert out["pi"][0] < 1e-6 * 4e-3 * 100
     assert out["pi"][0] <= 3 * out["scipy"][0]
     assert out["pi"][1] < out["scipy"][1]
+
+
+def test_second_pass_points_in_a_threaded_lanes_batch():
+    """Points at rest away from zero (overdamped creep, a damped post-buckled swing) get their
+    settling time from the second pass whichever driver and thread count ran them; results do
+    not depend on the thread count."""
+    from kernels import metrics as km
+    creep = [param_row(c=5.0, k0=-1.0, g0=1.0, q0=q0) for q0 in (0.1, 0.3, 2.0)]
+    swing = [param_row(c=1.0, k0=-1.0, g0=1.0, q0=q0) for q0 in (0.2, -0.5)]
+    rng = np.random.default_rng(3)
+    others = [param_row(c=rng.uniform(0, 1), k0=rng.uniform(50, 400), omega=rng.uniform(5, 30),
+                        q0=rng.uniform(-0.01, 0.01)) for _ in range(300)]
+    rows = np.stack(others[:150] + creep + others[150:] + swing)
+    s = settings(rtol=1e-8, t_end=40.0, tol=0.02)
+    a = _solve("scalar", rows, s)
+    b = _solve("lanes", rows, s)
+    assert not np.any(a[0] == km.SECOND_PASS) and not np.any(b[0] == km.SECOND_PASS)
+    second = [150, 151, 152, 303, 304]
+    assert np.all(b[0][second] == km.STEADY)
+    assert np.all(np.isfinite(b[1][second, tk.SETTLING]))
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[2], b[2])
+    np.testing.assert_allclose(b[1], a[1], rtol=1e-9, atol=1e-15, equal_nan=True)
+    for driver, ref in (("lanes", b), ("scalar", a)):
+        n = rows.shape[0]
+        out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)),
+               np.empty((n, tk.N_COUNTS), np.int64), np.empty((n, 0)))
+        solve_transverse(rows, s, *out, driver=driver, threads=1)
+        for got, want in zip(out, ref):
+            np.testing.assert_array_equal(got, want)
+
+
+def test_guided_blocks_cover_every_row_once():
+    from sweep.threads import MIN_BLOCK, next_block
+    for n, threads in ((1, 2), (129, 2), (10_000, 2), (77_777, 3)):
+        lo, seen = 0, []
+        while lo < n:
+            hi = next_block(lo, n, threads)
+            assert hi > lo and (hi - lo >= MIN_BLOCK or hi == n)
+            seen.append((lo, hi))
+            lo = hi
+        assert seen[0][0] == 0 and seen[-1][1] == n
+        assert all(a[1] == b[0] for a, b in zip(seen, seen[1:]))
