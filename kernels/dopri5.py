@@ -193,21 +193,23 @@ def dense_coefficients(K, Q):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def dense_value(y_old_i, h, Q, i, x):
-    """Component i of the interpolant at x = (t - t_old)/h in [0, 1]."""
-    return y_old_i + h * (x * (Q[i, 0] + x * (Q[i, 1] + x * (Q[i, 2] + x * Q[i, 3]))))
+def dense_value(y_old_i, h, c, x):
+    """One component of the interpolant at x = (t - t_old)/h in [0, 1]: y_old_i its value at
+    the step's start, c its row of dense_coefficients (Q[i])."""
+    return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * c[3]))))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def dense_root(y_old_i, h, Q, i, target, xa, xb):
-    """x in [xa, xb] where component i of the interpolant equals `target`.
+def dense_root(y_old_i, h, c, target, xa, xb):
+    """x in [xa, xb] where one component of the interpolant (row c = Q[i] of
+    dense_coefficients) equals `target`.
 
     Requires a bracket: the values at xa and xb lie on opposite sides of `target` (or the one
     at xb equals it). Illinois false position with bisection as a guard; converges to a few
     ulps of x.
     """
-    fa = dense_value(y_old_i, h, Q, i, xa) - target
-    fb = dense_value(y_old_i, h, Q, i, xb) - target
+    fa = dense_value(y_old_i, h, c, xa) - target
+    fb = dense_value(y_old_i, h, c, xb) - target
     if fb == 0.0:
         return xb
     if fa == 0.0:
@@ -219,7 +221,7 @@ def dense_root(y_old_i, h, Q, i, target, xa, xb):
         x = xb - fb * (xb - xa) / (fb - fa)
         if not (xa < x < xb):
             x = 0.5 * (xa + xb)
-        fx = dense_value(y_old_i, h, Q, i, x) - target
+        fx = dense_value(y_old_i, h, c, x) - target
         if fx == 0.0:
             return x
         if (fx > 0.0) == (fb > 0.0):

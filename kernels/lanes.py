@@ -33,7 +33,7 @@ from . import metrics as mt
 from . import trajectory as tj
 from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      SAFETY, pi_log2_err, pi_step_factor)
-from .layout import (ATOL, CONTROLLER, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
+from .layout import (ATOL, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 from .transverse import classify, reject_point, valid
@@ -203,14 +203,15 @@ def _pi_factors(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _finish(W, settings, n_samples, n_run):
+def _finish(W, settings, n_samples, n_run, pi):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
     ordinary accepted step the first metrics pass (threshold tol * peak around 0) and the move
     to the step's end. An accepted step with anything to locate on the dense output, or a
     divergence, is left for trajectory.record_step: W_FLAG = NEEDS_SCALAR, or HAS_EXTREMUM
     when it holds an extremum of q (`_locate_extrema` finds it first).
 
-    SciPy's controller is computed here; the PI controller's factor comes from `_pi_factors`.
+    SciPy's controller is computed here when `pi` is None; otherwise the PI controller's factor
+    comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
     vectorising the loop.
     """
@@ -219,7 +220,6 @@ def _finish(W, settings, n_samples, n_run):
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
-    use_pi = settings[CONTROLLER] != 0.0
     for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0
@@ -243,7 +243,7 @@ def _finish(W, settings, n_samples, n_run):
         event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
         done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
-        factor = W[W_FACTOR * L + j] if use_pi else _step_factor(err, rejected_before)
+        factor = _step_factor(err, rejected_before) if pi is None else W[W_FACTOR * L + j]
         W[W_FLAG * L + j] = ((HAS_EXTREMUM if extremum & bounded else NEEDS_SCALAR) if event
                              else ORDINARY)
         W[tj.RHS_EVALS * L + j] += 6.0 if active else 0.0
@@ -361,16 +361,21 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, pi):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
-    results (to round-off) of transverse.solve_block, several times faster per core."""
+    results (to round-off) of transverse.solve_block, several times faster per core.
+
+    `pi` picks the step-size controller and must match settings[CONTROLLER]: None for SciPy's,
+    True for the PI controller. None is a type of its own to Numba, which prunes the branches
+    on `pi is None` at compile time: each controller is its own specialisation, and SciPy's
+    compiles without the PI controller's code.
+    """
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
     atol = settings[ATOL]
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     n_samples = series.shape[1]
-    use_pi = settings[CONTROLLER] != 0.0
     W = np.zeros(W_ROWS * L)
     for j in range(L):
         W[(W_P + MASS) * L + j] = 1.0
@@ -380,7 +385,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
     K = np.empty((N_STAGES + 1, 2))
     Qc = np.empty((2, 4))
     next_point = lo
-    n_run = L          # lanes the vector loops cover: the active ones, rounded up to SIMD width
+    n_run = min(L, hi - lo)   # lanes the vector loops cover: the active ones, rounded up to SIMD
+                              # width (min() keeps it a run-time int: one compiled _prepare)
     while True:
         _prepare(W, settings, n_run)
         top = 0
@@ -412,9 +418,9 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series):
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, rtol, atol, n_run)
-        if use_pi:
+        if pi is not None:
             _pi_factors(W, n_run)
-        _finish(W, settings, n_samples, n_run)
+        _finish(W, settings, n_samples, n_run, pi)
         n_flagged = 0
         n_extrema = 0
         for j in range(n_run):

@@ -25,6 +25,7 @@ from .dopri5 import (MIN_RTOL, PI_MIN_ERR_PREV, dense_coefficients, dense_root, 
 from .layout import (ATOL, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL,
                      SAMPLE_DT, TAIL, T_END)
 from .oscillator import BOUND, Q0, V0, acceleration
+from .vecmath import log2_fast
 
 # Slots of a trajectory's accumulator row.
 T = 0               # current time (s)
@@ -49,6 +50,10 @@ SAMPLE = 18         # next time-series sample index
 N_EXT = 19          # extrema recorded
 LOG2_ERR_PREV = 20  # log2 of the last accepted step's error norm (PI controller)
 N_SLOTS = 21
+
+# The PI controller's memory before the first accepted step: pi_log2_err(PI_MIN_ERR_PREV),
+# computed once here (the same arithmetic in Python) rather than compiled into `start`.
+_LOG2_ERR_PREV_START = log2_fast.py_func(PI_MIN_ERR_PREV)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -88,8 +93,10 @@ def start(p, settings, acc, series):
     if settings[FIRST_STEP] > 0.0:
         acc[H_ABS] = min(settings[FIRST_STEP], t_end)
     else:
-        y = np.array([q, v])
-        f = np.array([acc[FQ], acc[FV]])
+        y = np.empty(2)
+        f = np.empty(2)
+        y[0], y[1] = q, v
+        f[0], f[1] = acc[FQ], acc[FV]
         acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, settings[ATOL], p)
         acc[RHS_EVALS] += 1.0
     acc[T_NEW] = 0.0
@@ -108,7 +115,7 @@ def start(p, settings, acc, series):
         series[0] = q
         acc[SAMPLE] = 1.0
     acc[N_EXT] = 0.0
-    acc[LOG2_ERR_PREV] = pi_log2_err(PI_MIN_ERR_PREV)
+    acc[LOG2_ERR_PREV] = _LOG2_ERR_PREV_START
     if not abs(q) <= p[BOUND]:
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = 0.0
@@ -226,7 +233,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
         if math.isfinite(q_new) and abs(q_new) > bound and abs(q_old) <= bound:
             dense_coefficients(K, Qc)
             side = 1.0 if q_new > 0.0 else -1.0
-            acc[T_STOP] = t + dense_root(q_old, h, Qc, 0, side * bound, 0.0, 1.0) * h
+            acc[T_STOP] = t + dense_root(q_old, h, Qc[0], side * bound, 0.0, 1.0) * h
         return
 
     n_samples = series.shape[0]
@@ -244,8 +251,8 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
         else:
             dense_coefficients(K, Qc)
             have_qc = True
-            xe = dense_root(v_old, h, Qc, 1, 0.0, 0.0, 1.0)
-            qe = dense_value(q_old, h, Qc, 0, xe)
+            xe = dense_root(v_old, h, Qc[1], 0.0, 0.0, 1.0)
+            qe = dense_value(q_old, h, Qc[0], xe)
         te = t + xe * h
         kind = mt.MAXIMUM if v_old > 0.0 else mt.MINIMUM
         n_ext = int(acc[N_EXT])
@@ -265,7 +272,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
             if not have_qc:
                 dense_coefficients(K, Qc)
                 have_qc = True
-            qt = dense_value(q_old, h, Qc, 0, (t_tail - t) / h)
+            qt = dense_value(q_old, h, Qc[0], (t_tail - t) / h)
             peak = max(peak, abs(qt))
             acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qt))
             acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qt)
@@ -284,7 +291,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
             if not have_qc:
                 dense_coefficients(K, Qc)
                 have_qc = True
-            x = dense_root(q_old, h, Qc, 0, centre + side * thr, xa, xb)
+            x = dense_root(q_old, h, Qc[0], centre + side * thr, xa, xb)
             acc[LAST_ABOVE] = t + x * h
 
     if k < n_samples and k * dt_sample <= t_new:
@@ -292,7 +299,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
             dense_coefficients(K, Qc)
             have_qc = True
         while k < n_samples and k * dt_sample <= t_new:
-            series[k] = dense_value(q_old, h, Qc, 0, (k * dt_sample - t) / h)
+            series[k] = dense_value(q_old, h, Qc[0], (k * dt_sample - t) / h)
             k += 1
         acc[SAMPLE] = k
 

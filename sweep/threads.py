@@ -54,11 +54,18 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     from kernels import transverse as tk
     if driver not in ("lanes", "scalar"):
         raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
-    solve_block = lanes.solve_block if driver == "lanes" else tk.solve_block
+    if driver == "scalar":
+        def solve_block(lo: int, hi: int) -> None:
+            tk.solve_block(params, settings, lo, hi, states, reals, counts, series)
+    else:
+        pi = True if settings[tk.CONTROLLER] != 0.0 else None   # see lanes.solve_block
+
+        def solve_block(lo: int, hi: int) -> None:
+            lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi)
     n = params.shape[0]
     n_threads = min(thread_count(threads), -(-n // MIN_BLOCK))
     if n_threads <= 1:
-        solve_block(params, settings, 0, n, states, reals, counts, series)
+        solve_block(0, n)
     else:
         start = 0
         lock = threading.Lock()
@@ -72,7 +79,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                     hi = start = next_block(lo, n, n_threads)
                 if lo >= n:
                     return
-                solve_block(params, settings, lo, hi, states, reals, counts, series)
+                solve_block(lo, hi)
 
         with ThreadPoolExecutor(n_threads, thread_name_prefix="cable-sweep") as pool:
             try:
