@@ -14,6 +14,10 @@ interpreter (sys.executable), stdout and stderr captured:
    times, default 1, each with its own empty directory).
 5. warm: the same command with the same NUMBA_CACHE_DIR as the (last) cold run, the kernels
    then load from that cache; --repeats runs (default 3).
+6. kernel start, cold and warm: in a fresh process, after the imports and the scene, the wall
+   time of the first kernel call (`sweep.run.solve_points` on one point of the scene): the
+   compile latency itself (cold: empty cache, everything the scene needs is compiled; warm:
+   loaded from the cache, including Numba's own one-time set-up of its compiler context).
 
 Python's own bytecode caches (__pycache__/*.pyc) are left as they are: "cold" means an empty
 Numba cache, the state right after `pip install`. The subprocesses get PYTHONPATH set to the
@@ -51,6 +55,19 @@ sys.path.insert(0, str(ROOT))
 from bench_common import markdown_table, write_json  # noqa: E402
 
 SUMMARY = re.compile(r"points? in ([0-9.]+) s")
+
+KERNEL_START = """
+import sys, time
+sys.path.insert(0, {bench!r})
+from bench_common import parameter_table
+from sweep import load_scene
+from sweep.run import settings_vector, solve_points
+scene = load_scene({scene!r})
+table, settings = parameter_table(scene), settings_vector(scene)
+start = time.perf_counter()
+solve_points(table[:1], settings, 0, threads=1)
+print(time.perf_counter() - start)
+"""
 
 
 def parse_args() -> argparse.Namespace:
@@ -133,12 +150,26 @@ def main() -> None:
                                + " -o TMP/out.nc --overwrite", warm_walls, warm_runs))
         out_bytes = Path(out).stat().st_size
 
+        snippet = KERNEL_START.format(bench=str(ROOT / "benchmarks"), scene=args.scene)
+        kernel = [py, "-c", snippet]
+        cold_k = []
+        for i in range(args.cold_repeats):
+            cache_k = tempfile.mkdtemp(prefix=f"numba-cache-k{i}-", dir=tmp)
+            cold_k.append(float(timed(kernel, {**env, "NUMBA_CACHE_DIR": cache_k}, tmp)[1]))
+        warm_k = [float(timed(kernel, {**env, "NUMBA_CACHE_DIR": cache_k}, tmp)[1])
+                  for _ in range(args.repeats)]
+        for name, values in (("kernel start, cold (first call, empty cache)", cold_k),
+                             ("kernel start, warm (first call, cache from the cold run)", warm_k)):
+            results.append(summary(name, "first solve_points call on one point of "
+                                   + args.scene + " (after the imports)", values, []))
+
     print(f"# Start-up: `sweep run {args.scene}` from the command line, cold and warm Numba "
           "cache\n")
     print(f"Python {platform.python_version()} ({py}); package from "
           f"{'the installed package' if args.installed else f'PYTHONPATH={ROOT}'}; "
           f"{args.repeats} run(s) per row, {args.cold_repeats} cold; output {out_bytes:,} bytes. "
-          "Wall time of the whole subprocess, seconds; 'run (CLI)' is the time the CLI reports "
+          "Wall time of the whole subprocess, seconds (kernel-start rows: the first kernel call "
+          "alone); 'run (CLI)' is the time the CLI reports "
           "for the sweep itself.\n")
     rows = []
     for r in results:
@@ -153,9 +184,12 @@ def main() -> None:
     warm = by["CLI, warm (cache from the cold run)"]["median_s"]
     imp = by["import sweep"]["median_s"]
     bare = by["bare interpreter"]["median_s"]
+    k_cold = by["kernel start, cold (first call, empty cache)"]["min_s"]
+    k_warm = by["kernel start, warm (first call, cache from the cold run)"]["median_s"]
     print(f"\nJIT compilation costs about {cold - warm:.2f} s once (cold {cold:.2f} s - warm "
           f"{warm:.2f} s); a warm run is {warm - imp:.2f} s beyond `import sweep` "
-          f"({imp:.2f} s, of which {bare:.2f} s is the bare interpreter).")
+          f"({imp:.2f} s, of which {bare:.2f} s is the bare interpreter). The kernel's own "
+          f"start (first call): {k_cold:.2f} s cold, {k_warm:.3f} s warm.")
 
     if args.json:
         write_json(args.json, {"scene": args.scene, "repeats": args.repeats,
