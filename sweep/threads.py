@@ -22,6 +22,7 @@ import numpy as np
 MIN_BLOCK = 128        # points per block, at least (smaller blocks leave lanes idle as they drain)
 MAX_BLOCK = 1024       # at most
 SHARE = 2              # a block is at most 1/SHARE of a thread's share of the points left
+LANES_PER_THREAD = 16  # a thread for every 16 points (one lanes group), at most
 
 
 def thread_count(threads: int = 0) -> int:
@@ -34,10 +35,12 @@ def thread_count(threads: int = 0) -> int:
 
 def next_block(lo: int, n: int, n_threads: int) -> int:
     """End of the block that starts at row `lo` of n, on n_threads threads: guided scheduling,
-    blocks shrinking with the points left (within MIN_BLOCK..MAX_BLOCK), so the threads finish
-    together while early blocks stay long enough to keep the lanes full."""
+    blocks shrinking with the points left, from MAX_BLOCK down to MIN_BLOCK (or to an equal
+    share of a small grid), so the threads finish together while blocks stay long enough to
+    keep the lanes full."""
+    floor = min(MIN_BLOCK, -(-n // n_threads))
     size = (n - lo) // (SHARE * n_threads)
-    return min(n, lo + max(MIN_BLOCK, min(MAX_BLOCK, size)))
+    return min(n, lo + max(floor, min(MAX_BLOCK, size)))
 
 
 def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarray,
@@ -63,7 +66,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         def solve_block(lo: int, hi: int) -> None:
             lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi)
     n = params.shape[0]
-    n_threads = min(thread_count(threads), -(-n // MIN_BLOCK))
+    n_threads = min(thread_count(threads), -(-n // LANES_PER_THREAD))
     if n_threads <= 1:
         solve_block(0, n)
     else:

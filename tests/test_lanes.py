@@ -167,12 +167,13 @@ def test_second_pass_points_in_a_threaded_lanes_batch():
 
 def test_guided_blocks_cover_every_row_once():
     from sweep.threads import MIN_BLOCK, next_block
-    for n, threads in ((1, 2), (129, 2), (10_000, 2), (77_777, 3)):
+    for n, threads in ((1, 2), (100, 2), (129, 2), (10_000, 2), (77_777, 3)):
         lo, seen = 0, []
         while lo < n:
             hi = next_block(lo, n, threads)
-            assert hi > lo and (hi - lo >= MIN_BLOCK or hi == n)
+            assert hi > lo and (hi - lo >= min(MIN_BLOCK, -(-n // threads)) or hi == n)
             seen.append((lo, hi))
             lo = hi
         assert seen[0][0] == 0 and seen[-1][1] == n
+        assert len(seen) >= min(threads, n)       # every thread gets a block, small grids too
         assert all(a[1] == b[0] for a, b in zip(seen, seen[1:]))
