@@ -5,5 +5,8 @@
 - `oscillator`: the modal oscillator right-hand side
   m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = 0.
 - `metrics`: in-kernel response metrics (extrema, crossings, state classification).
-- `transverse`: the batched driver, one adaptive trajectory per parallel iteration.
+- `trajectory`: one trajectory's state machine (SciPy's RK45 step sequence, metrics per step).
+- `transverse`: the scalar driver, one adaptive trajectory after another over a block of points.
+- `lanes`: the lock-step SIMD driver, 16 trajectories side by side (the default).
+- `vecmath`: vectorisable cos and powers for the lanes' loops.
 """

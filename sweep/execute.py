@@ -246,7 +246,7 @@ def _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers) -
 
             def submit_next(queue) -> None:
                 for lo, hi in pending:
-                    # one Numba thread per task: one per dask worker thread, no oversubscription
+                    # one kernel thread per task: one per dask worker thread, no oversubscription
                     fut = client.submit(chunk_fn, rows_for(lo, hi), *args, threads=1, pure=False)
                     futures[fut] = (lo, hi)
                     if queue is not None:
