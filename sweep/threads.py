@@ -4,9 +4,9 @@ Each driver's kernel (`kernels.lanes.solve_block`, `kernels.transverse.solve_blo
 contiguous block of rows and releases the GIL, so plain threads run blocks side by side. They
 draw blocks from one queue, shrinking as the points run out (guided scheduling): a thread
 whose points were cheap takes more, which balances the ~3x cost spread between short and long
-spans better than a static schedule. There is no Numba
-parallel region to compile (that alone took ~3 s on a cold cache), and a point's result never
-depends on the blocks or the number of threads.
+spans better than a static schedule. There is no Numba parallel region to compile (that alone
+took ~3 s on a cold cache), and a point's result never depends on the blocks or the number of
+threads.
 
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
 `kernels.transverse.settle_second_pass`, compiled only when a sweep has one.
