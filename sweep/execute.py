@@ -30,9 +30,12 @@ IN_FLIGHT = 2          # dask tasks submitted ahead per worker thread
 # --- chunk kernels (top-level functions: dask pickles them by name) -------------------------
 
 def _set_threads(threads: int) -> None:
+    """Numba's thread count for a parallel kernel (the longitudinal one), by the same rule as
+    the transverse kernel's Python threads (threads.thread_count)."""
     import numba
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS) if threads
-                          else numba.config.NUMBA_NUM_THREADS)
+
+    from .threads import thread_count
+    numba.set_num_threads(thread_count(threads))
 
 
 def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:

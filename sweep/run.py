@@ -176,6 +176,9 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         progress = sys.stderr.isatty()
     if threads is None:
         threads = scene.get("run.threads")
+    if not isinstance(threads, (int, np.integer)) or isinstance(threads, bool) or threads < 0:
+        raise UserError(f"sweep.run: threads = {threads!r} is not a thread count (give an integer "
+                        ">= 1, or 0 or None for every core)")
     persist = dict(output=output, resume=resume, overwrite=overwrite)
     if scene.get("model.kind") == "longitudinal":
         from .longitudinal import run_longitudinal

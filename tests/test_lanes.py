@@ -177,3 +177,10 @@ def test_guided_blocks_cover_every_row_once():
         assert seen[0][0] == 0 and seen[-1][1] == n
         assert len(seen) >= min(threads, n)       # every thread gets a block, small grids too
         assert all(a[1] == b[0] for a, b in zip(seen, seen[1:]))
+
+
+def test_sweep_run_refuses_a_negative_thread_count():
+    import sweep
+    scene = sweep.load_scene("paper-fig5")
+    with pytest.raises(sweep.UserError, match="threads = -1"):
+        sweep.run(scene, threads=-1)
