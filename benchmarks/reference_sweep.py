@@ -32,7 +32,8 @@ rtol 1e-8 and atol 1e-12 (the scene defaults) unless --rtol / --atol are given.
 4. At equal error (--equal-error): every solver over a ladder of rtols (--ladder; atol = rtol x
    1e-4), its max final-state error max_i |q_i(5) - q_ref,i(5)| / max_t |q_ref,i| on the SciPy
    sample against DOP853 at rtol 1e-13 / atol 1e-16 (independent of every solver timed), and its
-   throughput: cable-sweep (lanes, SciPy's controller and the PI controller) and numbalsoda
+   throughput: cable-sweep (lanes: RK45 with SciPy's controller and with the PI controller,
+   and DOP853 with SciPy's controller, `solver.method = "dop853"`) and numbalsoda
    dop853 (a Numba prange loop over all points, output at t = 0 and 5 s only, its cheapest
    case; the optional `bench` extra) over the whole grid on the most threads, SciPy RK45 on the
    sample. Throughput at the --target error is interpolated in log-log between the two rungs
@@ -232,10 +233,13 @@ def equal_error(table: np.ndarray, sample: np.ndarray, rtols: list[float], threa
     rungs: dict[str, list[dict[str, float]]] = {}
     for rtol in rtols:
         atol = rtol * 1e-4
-        for name, controller in (("cable-sweep (lanes)", 0.0), ("cable-sweep (lanes, PI)", 1.0)):
+        for name, controller, method in (("cable-sweep (lanes)", 0.0, 0.0),
+                                         ("cable-sweep (lanes, PI)", 1.0, 0.0),
+                                         ("cable-sweep (lanes, DOP853)", 0.0, 1.0)):
             scene = build_scene(2, rtol, atol)
             settings = settings_vector(scene)
             settings[tk.CONTROLLER] = controller
+            settings[tk.METHOD] = method
             settings[tk.SAMPLE_DT] = T_END
             solve_points(table[:2], settings, 2, threads=1)
             best = np.inf
@@ -271,9 +275,11 @@ def equal_error(table: np.ndarray, sample: np.ndarray, rtols: list[float], threa
     mine = rates["cable-sweep (lanes)"]
     lines.append(f"\nAt max final-state error {target:g} (log-log interpolation):\n")
     lines.append(markdown_table(
-        ["solver", "trajectories/s", "cable-sweep (lanes) / solver", "cable-sweep (PI) / solver"],
+        ["solver", "trajectories/s", "cable-sweep (lanes) / solver", "cable-sweep (PI) / solver",
+         "cable-sweep (DOP853) / solver"],
         [[n, f"{rates[n]:,.0f}", f"{mine / rates[n]:,.1f}x",
-          f"{rates['cable-sweep (lanes, PI)'] / rates[n]:,.1f}x"] for n in names]))
+          f"{rates['cable-sweep (lanes, PI)'] / rates[n]:,.1f}x",
+          f"{rates['cable-sweep (lanes, DOP853)'] / rates[n]:,.1f}x"] for n in names]))
     return "\n".join(lines), {"target": target, "rungs": rungs, "at_target": rates}
 
 

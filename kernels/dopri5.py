@@ -55,14 +55,16 @@ PI_MIN_ERR_PREV = 1e-4                # floor on the previous error (Hairer's fa
 MIN_RTOL = 100 * np.finfo(float).eps   # SciPy raises smaller rtol to this
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def rk_step(t, y, h, p, K, y_new):
-    """One Dormand-Prince step of size h (s) from (t, y); K[0] must hold f(t, y).
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def explicit_rk_step(t, y, h, p, K, y_new, A, B, C):
+    """One step of size h (s) from (t, y) of the explicit Runge-Kutta method with tableau
+    (A, B, C), as SciPy's `rk_step`; K[0] must hold f(t, y).
 
-    Fills K[1..6] with the stage derivatives (K[6] = f(t + h, y_new)) and y_new with the
-    fifth-order solution. Six right-hand-side evaluations.
+    Fills K[1..n_stages - 1] with the stage derivatives, K[n_stages] with f(t + h, y_new), and
+    y_new with the solution (weights B). n_stages right-hand-side evaluations.
     """
-    for s in range(1, N_STAGES):
+    n_stages = B.shape[0]
+    for s in range(1, n_stages):
         dq = 0.0
         dv = 0.0
         for j in range(s):
@@ -74,13 +76,23 @@ def rk_step(t, y, h, p, K, y_new):
         K[s, 1] = acceleration(t + C[s] * h, q, v, p)
     sq = 0.0
     sv = 0.0
-    for j in range(N_STAGES):
+    for j in range(n_stages):
         sq += K[j, 0] * B[j]
         sv += K[j, 1] * B[j]
     y_new[0] = y[0] + h * sq
     y_new[1] = y[1] + h * sv
-    K[N_STAGES, 0] = y_new[1]
-    K[N_STAGES, 1] = acceleration(t + h, y_new[0], y_new[1], p)
+    K[n_stages, 0] = y_new[1]
+    K[n_stages, 1] = acceleration(t + h, y_new[0], y_new[1], p)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def rk_step(t, y, h, p, K, y_new):
+    """One Dormand-Prince step of size h (s) from (t, y); K[0] must hold f(t, y).
+
+    Fills K[1..6] with the stage derivatives (K[6] = f(t + h, y_new)) and y_new with the
+    fifth-order solution. Six right-hand-side evaluations.
+    """
+    explicit_rk_step(t, y, h, p, K, y_new, A, B, C)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -101,21 +113,22 @@ def error_norm(K, h, y, y_new, rtol, atol):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def step_factor(err, rejected_before):
-    """SciPy RK45's step-size factor for an error norm `err`.
+def step_factor(err, rejected_before, exponent):
+    """SciPy's step-size factor for an error norm `err`; `exponent` is -1/(order + 1) of the
+    method's error estimator (ERROR_EXPONENT: -1/5 for RK45, dop853.ERROR_EXPONENT: -1/8).
 
-    Accepted (err < 1): min(MAX_FACTOR, SAFETY err^(-1/5)), capped at 1 after a rejection.
-    Rejected: max(MIN_FACTOR, SAFETY err^(-1/5)); a non-finite error gives MIN_FACTOR.
+    Accepted (err < 1): min(MAX_FACTOR, SAFETY err^exponent), capped at 1 after a rejection.
+    Rejected: max(MIN_FACTOR, SAFETY err^exponent); a non-finite error gives MIN_FACTOR.
     """
     if err < 1.0:
         if err == 0.0:
             factor = MAX_FACTOR
         else:
-            factor = min(MAX_FACTOR, SAFETY * err ** ERROR_EXPONENT)
+            factor = min(MAX_FACTOR, SAFETY * err ** exponent)
         if rejected_before:
             factor = min(1.0, factor)
         return factor
-    factor = SAFETY * err ** ERROR_EXPONENT
+    factor = SAFETY * err ** exponent
     if not factor > MIN_FACTOR:          # also catches NaN
         factor = MIN_FACTOR
     return factor
@@ -155,8 +168,9 @@ def _rms2(a, b):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p):
-    """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4). One evaluation."""
+def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p, order):
+    """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4) for a method whose
+    error estimator has order `order` (ERROR_ESTIMATOR_ORDER for RK45). One evaluation."""
     interval = abs(t_bound - t0)
     if interval == 0.0:
         return 0.0
@@ -177,26 +191,28 @@ def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p):
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (ERROR_ESTIMATOR_ORDER + 1))
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
     return min(100.0 * h0, h1, interval, max_step)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def dense_coefficients(K, Q):
-    """Q = K^T P: the quartic interpolant of the last step, shape (2, 4)."""
+    """Q[:, :4] = K^T P: the quartic interpolant of the last step; Q has shape (2, 5), the
+    layout of a quintic (dop853.hermite_coefficients), and Q[:, 4] = 0."""
     for i in range(2):
         for k in range(4):
             s = 0.0
             for j in range(N_STAGES + 1):
                 s += K[j, i] * P[j, k]
             Q[i, k] = s
+        Q[i, 4] = 0.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def dense_value(y_old_i, h, c, x):
     """One component of the interpolant at x = (t - t_old)/h in [0, 1]: y_old_i its value at
-    the step's start, c its row of dense_coefficients (Q[i])."""
-    return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * c[3]))))
+    the step's start, c its row of dense_coefficients or dop853.hermite_coefficients (Q[i])."""
+    return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * c[4])))))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -29,6 +29,7 @@ import math
 import numba as nb
 import numpy as np
 
+from . import dop853
 from . import metrics as mt
 from . import trajectory as tj
 from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
@@ -71,14 +72,29 @@ _C = tuple(float(x) for x in C)
 _E = tuple(float(x) for x in E)
 _P = tuple(tuple(float(x) for x in row) for row in P)
 
-# Controller: below this error the accepted factor is MAX_FACTOR, SAFETY err^(-1/5) >= 10.
+# DOP853's tableau (rows of A and entries of B, E3, E5 that are zero are left out of the sums).
+_A8 = tuple(tuple(float(x) for x in row) for row in dop853.A)
+_B8 = tuple(float(x) for x in dop853.B)
+_C8 = tuple(float(x) for x in dop853.C)
+_E3 = tuple(float(x) for x in dop853.E3)
+_E5 = tuple(float(x) for x in dop853.E5)
+
+# Controller: below this error the accepted factor is MAX_FACTOR, SAFETY err^(-1/5) >= 10
+# (RK45), SAFETY err^(-1/8) >= 10 (DOP853).
 _ERR_MAX_FACTOR = (SAFETY / MAX_FACTOR) ** 5
+_ERR_MAX_FACTOR_8 = (SAFETY / MAX_FACTOR) ** 8
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _step_factor(err, rejected_before):
-    """dopri5.step_factor across lanes (err^(-1/5) by `vecmath.inv_fifth_root`)."""
-    root = inv_fifth_root(min(max(err, 1e-9), 1e9))
+def _step_factor(err, rejected_before, eighth):
+    """dopri5.step_factor across lanes: RK45's (eighth None; err^(-1/5) by
+    `vecmath.inv_fifth_root`) or DOP853's (eighth True; err^(-1/8) as three square roots)."""
+    if eighth is None:
+        root = inv_fifth_root(min(max(err, 1e-9), 1e9))
+        err_max_factor = _ERR_MAX_FACTOR
+    else:
+        root = 1.0 / math.sqrt(math.sqrt(math.sqrt(min(max(err, 1e-18), 1e18))))
+        err_max_factor = _ERR_MAX_FACTOR_8
     accept = min(MAX_FACTOR, SAFETY * root)
-    accept = MAX_FACTOR if err < _ERR_MAX_FACTOR else accept
+    accept = MAX_FACTOR if err < err_max_factor else accept
     accept = min(1.0, accept) if rejected_before else accept
     reject = SAFETY * root
     reject = reject if reject > MIN_FACTOR else MIN_FACTOR
@@ -189,6 +205,96 @@ def _attempt(W, rtol, atol, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def _attempt8(W, rtol, atol, n_run):
+    """One DOP853 attempt in every lane of W (as `_attempt`): the eighth-order solution
+    (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage (W_K + 12, W_K + 13) and
+    SciPy's DOP853 error norm (W_ERR). The other stages stay in registers: the DOP853 dense
+    output needs only the step's ends (dop853.hermite_coefficients).
+    """
+    L = LANES
+    for j in range(n_run):
+        t = W[tj.T * L + j]
+        q = W[tj.Q * L + j]
+        v = W[tj.V * L + j]
+        h = W[W_H * L + j]
+        kq0 = W[tj.FQ * L + j]
+        kv0 = W[tj.FV * L + j]
+        q1 = q + (kq0 * _A8[1][0]) * h
+        kq1 = v + (kv0 * _A8[1][0]) * h
+        kv1 = _accel(W, j, t + _C8[1] * h, q1, kq1)
+        q2 = q + (kq0 * _A8[2][0] + kq1 * _A8[2][1]) * h
+        kq2 = v + (kv0 * _A8[2][0] + kv1 * _A8[2][1]) * h
+        kv2 = _accel(W, j, t + _C8[2] * h, q2, kq2)
+        q3 = q + (kq0 * _A8[3][0] + kq2 * _A8[3][2]) * h
+        kq3 = v + (kv0 * _A8[3][0] + kv2 * _A8[3][2]) * h
+        kv3 = _accel(W, j, t + _C8[3] * h, q3, kq3)
+        q4 = q + (kq0 * _A8[4][0] + kq2 * _A8[4][2] + kq3 * _A8[4][3]) * h
+        kq4 = v + (kv0 * _A8[4][0] + kv2 * _A8[4][2] + kv3 * _A8[4][3]) * h
+        kv4 = _accel(W, j, t + _C8[4] * h, q4, kq4)
+        q5 = q + (kq0 * _A8[5][0] + kq3 * _A8[5][3] + kq4 * _A8[5][4]) * h
+        kq5 = v + (kv0 * _A8[5][0] + kv3 * _A8[5][3] + kv4 * _A8[5][4]) * h
+        kv5 = _accel(W, j, t + _C8[5] * h, q5, kq5)
+        q6 = q + (kq0 * _A8[6][0] + kq3 * _A8[6][3] + kq4 * _A8[6][4] + kq5 * _A8[6][5]) * h
+        kq6 = v + (kv0 * _A8[6][0] + kv3 * _A8[6][3] + kv4 * _A8[6][4] + kv5 * _A8[6][5]) * h
+        kv6 = _accel(W, j, t + _C8[6] * h, q6, kq6)
+        q7 = q + (kq0 * _A8[7][0] + kq3 * _A8[7][3] + kq4 * _A8[7][4] + kq5 * _A8[7][5]
+                  + kq6 * _A8[7][6]) * h
+        kq7 = v + (kv0 * _A8[7][0] + kv3 * _A8[7][3] + kv4 * _A8[7][4] + kv5 * _A8[7][5]
+                    + kv6 * _A8[7][6]) * h
+        kv7 = _accel(W, j, t + _C8[7] * h, q7, kq7)
+        q8 = q + (kq0 * _A8[8][0] + kq3 * _A8[8][3] + kq4 * _A8[8][4] + kq5 * _A8[8][5]
+                  + kq6 * _A8[8][6] + kq7 * _A8[8][7]) * h
+        kq8 = v + (kv0 * _A8[8][0] + kv3 * _A8[8][3] + kv4 * _A8[8][4] + kv5 * _A8[8][5]
+                    + kv6 * _A8[8][6] + kv7 * _A8[8][7]) * h
+        kv8 = _accel(W, j, t + _C8[8] * h, q8, kq8)
+        q9 = q + (kq0 * _A8[9][0] + kq3 * _A8[9][3] + kq4 * _A8[9][4] + kq5 * _A8[9][5]
+                  + kq6 * _A8[9][6] + kq7 * _A8[9][7] + kq8 * _A8[9][8]) * h
+        kq9 = v + (kv0 * _A8[9][0] + kv3 * _A8[9][3] + kv4 * _A8[9][4] + kv5 * _A8[9][5]
+                    + kv6 * _A8[9][6] + kv7 * _A8[9][7] + kv8 * _A8[9][8]) * h
+        kv9 = _accel(W, j, t + _C8[9] * h, q9, kq9)
+        q10 = q + (kq0 * _A8[10][0] + kq3 * _A8[10][3] + kq4 * _A8[10][4] + kq5 * _A8[10][5]
+                  + kq6 * _A8[10][6] + kq7 * _A8[10][7] + kq8 * _A8[10][8] + kq9 * _A8[10][9]) * h
+        kq10 = v + (kv0 * _A8[10][0] + kv3 * _A8[10][3] + kv4 * _A8[10][4] + kv5 * _A8[10][5]
+                     + kv6 * _A8[10][6] + kv7 * _A8[10][7] + kv8 * _A8[10][8]
+                     + kv9 * _A8[10][9]) * h
+        kv10 = _accel(W, j, t + _C8[10] * h, q10, kq10)
+        q11 = q + (kq0 * _A8[11][0] + kq3 * _A8[11][3] + kq4 * _A8[11][4] + kq5 * _A8[11][5]
+                  + kq6 * _A8[11][6] + kq7 * _A8[11][7] + kq8 * _A8[11][8] + kq9 * _A8[11][9]
+                  + kq10 * _A8[11][10]) * h
+        kq11 = v + (kv0 * _A8[11][0] + kv3 * _A8[11][3] + kv4 * _A8[11][4] + kv5 * _A8[11][5]
+                     + kv6 * _A8[11][6] + kv7 * _A8[11][7] + kv8 * _A8[11][8]
+                     + kv9 * _A8[11][9] + kv10 * _A8[11][10]) * h
+        kv11 = _accel(W, j, t + _C8[11] * h, q11, kq11)
+        qn = q + h * (kq0 * _B8[0] + kq5 * _B8[5] + kq6 * _B8[6] + kq7 * _B8[7] + kq8 * _B8[8]
+                      + kq9 * _B8[9] + kq10 * _B8[10] + kq11 * _B8[11])
+        vn = v + h * (kv0 * _B8[0] + kv5 * _B8[5] + kv6 * _B8[6] + kv7 * _B8[7] + kv8 * _B8[8]
+                      + kv9 * _B8[9] + kv10 * _B8[10] + kv11 * _B8[11])
+        fv_new = _accel(W, j, t + h, qn, vn)
+        e5q = (kq0 * _E5[0] + kq5 * _E5[5] + kq6 * _E5[6] + kq7 * _E5[7] + kq8 * _E5[8]
+               + kq9 * _E5[9] + kq10 * _E5[10] + kq11 * _E5[11])
+        e5v = (kv0 * _E5[0] + kv5 * _E5[5] + kv6 * _E5[6] + kv7 * _E5[7] + kv8 * _E5[8]
+               + kv9 * _E5[9] + kv10 * _E5[10] + kv11 * _E5[11])
+        e3q = (kq0 * _E3[0] + kq5 * _E3[5] + kq6 * _E3[6] + kq7 * _E3[7] + kq8 * _E3[8]
+               + kq9 * _E3[9] + kq10 * _E3[10] + kq11 * _E3[11])
+        e3v = (kv0 * _E3[0] + kv5 * _E3[5] + kv6 * _E3[6] + kv7 * _E3[7] + kv8 * _E3[8]
+               + kv9 * _E3[9] + kv10 * _E3[10] + kv11 * _E3[11])
+        sq = atol + max(abs(q), abs(qn)) * rtol
+        sv = atol + max(abs(v), abs(vn)) * rtol
+        e5q /= sq
+        e5v /= sv
+        e3q /= sq
+        e3v /= sv
+        e5 = e5q * e5q + e5v * e5v
+        e3 = e3q * e3q + e3v * e3v
+        err = abs(h) * e5 / math.sqrt((e5 + dop853.ERR3_WEIGHT * e3) * 2.0)
+        W[(W_K + 12) * L + j] = vn
+        W[(W_K + 13) * L + j] = fv_new
+        W[W_QN * L + j] = qn
+        W[W_VN * L + j] = vn
+        W[W_ERR * L + j] = 0.0 if (e5 == 0.0) & (e3 == 0.0) else err
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _pi_factors(W, n_run):
     """The PI controller's step-size factor for every lane's attempt (W_FACTOR), and the
     memory of an accepted attempt's error (LOG2_ERR_PREV). Its own loop: `_finish` stays as
@@ -203,15 +309,15 @@ def _pi_factors(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _finish(W, settings, n_samples, n_run, pi):
+def _finish(W, settings, n_samples, n_run, pi, eighth):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
     ordinary accepted step the first metrics pass (threshold tol * peak around 0) and the move
     to the step's end. An accepted step with anything to locate on the dense output, or a
     divergence, is left for trajectory.record_step: W_FLAG = NEEDS_SCALAR, or HAS_EXTREMUM
     when it holds an extremum of q (`_locate_extrema` finds it first).
 
-    SciPy's controller is computed here when `pi` is None; otherwise the PI controller's factor
-    comes from `_pi_factors`.
+    SciPy's controller is computed here when `pi` is None (RK45's, or DOP853's when `eighth` is
+    True); otherwise the PI controller's factor comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
     vectorising the loop.
     """
@@ -220,6 +326,7 @@ def _finish(W, settings, n_samples, n_run, pi):
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
+    rhs_per_attempt = 6.0 if eighth is None else float(dop853.RHS_PER_ATTEMPT)
     for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0
@@ -243,10 +350,13 @@ def _finish(W, settings, n_samples, n_run, pi):
         event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
         done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
-        factor = _step_factor(err, rejected_before) if pi is None else W[W_FACTOR * L + j]
+        if pi is None:
+            factor = _step_factor(err, rejected_before, eighth)
+        else:
+            factor = W[W_FACTOR * L + j]
         W[W_FLAG * L + j] = ((HAS_EXTREMUM if extremum & bounded else NEEDS_SCALAR) if event
                              else ORDINARY)
-        W[tj.RHS_EVALS * L + j] += 6.0 if active else 0.0
+        W[tj.RHS_EVALS * L + j] += rhs_per_attempt if active else 0.0
         W[tj.H_ABS * L + j] *= factor if active else 1.0
         W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if active else (
             1.0 if rejected_before else 0.0)
@@ -287,14 +397,37 @@ NEWTON_ITERATIONS = 3       # safeguarded Newton steps for an extremum's positio
 NEWTON_RESIDUAL = 1e-14     # |q'(x)| / (|q'_old| + |q'_new|) at which the root is at round-off
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _newton_extremum(v0, v1, h, c0, c1, c2, c3):
+    """x in [0, 1] where q'(x) = v0 + h x (c0 + x (c1 + x (c2 + x c3))) vanishes (v0, v1: q' at
+    the step's ends, of opposite signs), by NEWTON_ITERATIONS steps of Newton's method
+    safeguarded by the sign bracket, from the linear guess; and whether the residual is down to
+    round-off (NEWTON_RESIDUAL)."""
+    positive = v0 > 0.0
+    xa = 0.0
+    xb = 1.0
+    x = v0 / (v0 - v1) if v0 != v1 else 0.5
+    x = x if (x >= 0.0) & (x <= 1.0) else 0.5
+    for _ in range(NEWTON_ITERATIONS):
+        g = v0 + h * (x * (c0 + x * (c1 + x * (c2 + x * c3))))
+        dg = h * (c0 + x * (2.0 * c1 + x * (3.0 * c2 + x * (4.0 * c3))))
+        same = (g > 0.0) == positive
+        xa = x if same else xa
+        xb = xb if same else x
+        x_new = x - g / dg
+        x_new = x_new if (xa <= x_new) & (x_new <= xb) else 0.5 * (xa + xb)
+        x = x if g == 0.0 else x_new
+    g = v0 + h * (x * (c0 + x * (c1 + x * (c2 + x * c3))))
+    return x, abs(g) <= NEWTON_RESIDUAL * (abs(v0) + abs(v1))
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _locate_extrema(W, n_run):
-    """For lanes flagged HAS_EXTREMUM: the x in [0, 1] where the step's interpolated q'
-    vanishes (W_XE) and q there (W_QE), by NEWTON_ITERATIONS steps of Newton's method
-    safeguarded by the sign bracket, from the linear guess. Where the residual is not down to
-    round-off (NEWTON_RESIDUAL), W_XE = -1 and trajectory.record_step's bracketed root finder
-    takes over. Other lanes compute too (straight-line code vectorises); their results are
-    ignored.
+    """For lanes flagged HAS_EXTREMUM after an RK45 attempt: the x in [0, 1] where the step's
+    interpolated q' vanishes (W_XE, by `_newton_extremum`) and q there (W_QE). Where the
+    residual is not down to round-off, W_XE = -1 and trajectory.record_step's bracketed root
+    finder takes over. Other lanes compute too (straight-line code vectorises); their results
+    are ignored.
     """
     L = LANES
     for j in range(n_run):
@@ -321,28 +454,36 @@ def _locate_extrema(W, n_run):
         cv1 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 1)
         cv2 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 2)
         cv3 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 3)
-        positive = v0 > 0.0
-        xa = 0.0
-        xb = 1.0
-        x = v0 / (v0 - v1) if v0 != v1 else 0.5
-        x = x if (x >= 0.0) & (x <= 1.0) else 0.5
-        for _ in range(NEWTON_ITERATIONS):
-            g = v0 + h * (x * (cv0 + x * (cv1 + x * (cv2 + x * cv3))))
-            dg = h * (cv0 + x * (2.0 * cv1 + x * (3.0 * cv2 + x * (4.0 * cv3))))
-            same = (g > 0.0) == positive
-            xa = x if same else xa
-            xb = xb if same else x
-            x_new = x - g / dg
-            x_new = x_new if (xa <= x_new) & (x_new <= xb) else 0.5 * (xa + xb)
-            x = x if g == 0.0 else x_new
-        g = v0 + h * (x * (cv0 + x * (cv1 + x * (cv2 + x * cv3))))
-        converged = abs(g) <= NEWTON_RESIDUAL * (abs(v0) + abs(v1))
+        x, converged = _newton_extremum(v0, v1, h, cv0, cv1, cv2, cv3)
         cq0 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 0)
         cq1 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 1)
         cq2 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 2)
         cq3 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 3)
         W[W_XE * L + j] = x if want & converged else -1.0
         W[W_QE * L + j] = q0 + h * (x * (cq0 + x * (cq1 + x * (cq2 + x * cq3))))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _locate_extrema8(W, n_run):
+    """`_locate_extrema` after a DOP853 attempt: on the quintic Hermite interpolant of q
+    (dop853.hermite_terms, the dense output trajectory.record_step uses for DOP853)."""
+    L = LANES
+    for j in range(n_run):
+        want = W[W_FLAG * L + j] == HAS_EXTREMUM
+        h = W[W_H * L + j]
+        q0 = W[tj.Q * L + j]
+        v0 = W[tj.V * L + j]
+        a0 = W[tj.FV * L + j]
+        q1 = W[W_QN * L + j]
+        v1 = W[W_VN * L + j]
+        a1 = W[(W_K + 13) * L + j]
+        c3, c4, c5 = dop853.hermite_terms(q0, v0, a0, q1, v1, a1, h)
+        hh = h * h
+        x, converged = _newton_extremum(v0, v1, h, a0, 3.0 * c3 / hh, 4.0 * c4 / hh,
+                                        5.0 * c5 / hh)
+        W[W_XE * L + j] = x if want & converged else -1.0
+        W[W_QE * L + j] = q0 + h * (x * (v0 + x * (0.5 * h * a0 + x * (c3 / h + x * (
+            c4 / h + x * (c5 / h))))))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -361,14 +502,15 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series, pi):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
 
     `pi` picks the step-size controller and must match settings[CONTROLLER]: None for SciPy's,
-    True for the PI controller. None is a type of its own to Numba, which prunes the branches
-    on `pi is None` at compile time: each controller is its own specialisation, and SciPy's
-    compiles without the PI controller's code.
+    True for the PI controller; `eighth` the method, matching settings[METHOD]: None for RK45,
+    True for DOP853 (SciPy's controller only). None is a type of its own to Numba, which
+    prunes the branches on `pi is None` at compile time: each combination is its own
+    specialisation, compiled without the others' code.
     """
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
@@ -382,8 +524,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
     bufs = [tj.new_buffer() for _ in range(L)]
     point = np.full(L, -1, np.int64)
-    K = np.empty((N_STAGES + 1, 2))
-    Qc = np.empty((2, 4))
+    K = np.empty((N_STAGES + 1 if eighth is None else 2, 2))   # DOP853: f at both ends only
+    Qc = np.empty((2, 5))
     next_point = lo
     n_run = min(L, hi - lo)   # lanes the vector loops cover: the active ones, rounded up to SIMD
                               # width (min() keeps it a run-time int: one compiled _prepare)
@@ -417,10 +559,13 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi):
         if top == 0:
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
-        _attempt(W, rtol, atol, n_run)
+        if eighth is None:
+            _attempt(W, rtol, atol, n_run)
+        else:
+            _attempt8(W, rtol, atol, n_run)
         if pi is not None:
             _pi_factors(W, n_run)
-        _finish(W, settings, n_samples, n_run, pi)
+        _finish(W, settings, n_samples, n_run, pi, eighth)
         n_flagged = 0
         n_extrema = 0
         for j in range(n_run):
@@ -429,7 +574,10 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi):
         if n_flagged == 0:
             continue
         if n_extrema > 0:
-            _locate_extrema(W, n_run)
+            if eighth is None:
+                _locate_extrema(W, n_run)
+            else:
+                _locate_extrema8(W, n_run)
         for j in range(n_run):
             flag = W[W_FLAG * L + j]
             if flag == ORDINARY:
@@ -437,9 +585,13 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi):
             i = point[j]
             K[0, 0] = W[tj.FQ * L + j]
             K[0, 1] = W[tj.FV * L + j]
-            for s in range(1, N_STAGES + 1):
-                K[s, 0] = W[(W_K + 2 * s) * L + j]
-                K[s, 1] = W[(W_K + 2 * s + 1) * L + j]
+            if eighth is None:
+                for s in range(1, N_STAGES + 1):
+                    K[s, 0] = W[(W_K + 2 * s) * L + j]
+                    K[s, 1] = W[(W_K + 2 * s + 1) * L + j]
+            else:
+                K[1, 0] = W[(W_K + 2 * N_STAGES) * L + j]
+                K[1, 1] = W[(W_K + 2 * N_STAGES + 1) * L + j]
             xe = W[W_XE * L + j] if flag == HAS_EXTREMUM else -1.0
             acc = W[j::L]
             if acc[tj.N_EXT] >= bufs[j].shape[0]:

@@ -13,7 +13,8 @@ SAMPLE_DT = 8       # time-series sample interval (s); used only when series has
 WANT_SETTLING = 9   # 1.0: compute settling times; 0.0: skip that work
 MIN_STEP = 10       # smallest step (s) before STEP_TOO_SMALL; SciPy's 10 ulps of t if larger
 CONTROLLER = 11     # step-size controller: 0.0 SciPy's (step for step as solve_ivp), 1.0 PI
-N_SETTINGS = 12
+METHOD = 12         # integrator: 0.0 RK45 (Dormand-Prince 5(4)), 1.0 DOP853 (8(5,3))
+N_SETTINGS = 13
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)

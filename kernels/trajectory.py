@@ -5,12 +5,13 @@ buffer, so a driver can advance many of them side by side:
 
     start(...)                         initial state, f(0, y0), SciPy's initial step
     h = next_attempt(settings, acc)    the step to try now (0.0: the trajectory has ended)
-    ... the driver computes one Dormand-Prince attempt of size h and its error norm ...
+    ... the driver computes one attempt of size h (RK45 or DOP853) and its error norm ...
     buf = finish_attempt(...)          SciPy's accept/reject and step-size update (`control`);
                                        on acceptance the in-kernel metrics (`record_step`)
     classify(...)                      state, amplitude, settling time, period, counts
 
-Each point's attempts are SciPy RK45's, in SciPy's order, whatever the driver.
+Each point's attempts are SciPy's RK45's or DOP853's (settings[METHOD]), in SciPy's order,
+whatever the driver.
 Units: t in s, q in m, q' in m/s.
 """
 
@@ -20,9 +21,11 @@ import numba as nb
 import numpy as np
 
 from . import metrics as mt
-from .dopri5 import (MIN_RTOL, PI_MIN_ERR_PREV, dense_coefficients, dense_root, dense_value,
-                     initial_step, pi_log2_err, pi_step_factor, step_factor)
-from .layout import (ATOL, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL,
+from . import dop853
+from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR_PREV,
+                     dense_coefficients, dense_root, dense_value, initial_step, pi_log2_err,
+                     pi_step_factor, step_factor)
+from .layout import (ATOL, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, RTOL,
                      SAMPLE_DT, TAIL, T_END)
 from .oscillator import BOUND, Q0, V0, acceleration
 from .vecmath import log2_fast
@@ -97,7 +100,9 @@ def start(p, settings, acc, series):
         f = np.empty(2)
         y[0], y[1] = q, v
         f[0], f[1] = acc[FQ], acc[FV]
-        acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, settings[ATOL], p)
+        order = dop853.ERROR_ESTIMATOR_ORDER if settings[METHOD] != 0.0 else ERROR_ESTIMATOR_ORDER
+        acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, settings[ATOL], p,
+                                  order)
         acc[RHS_EVALS] += 1.0
     acc[T_NEW] = 0.0
     acc[REJECTED_NOW] = 0.0
@@ -175,14 +180,16 @@ def _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def control(settings, acc, err):
     """Accept or reject an attempt with error norm `err` and update the step size: SciPy's
-    controller, or the PI controller when settings[CONTROLLER] is 1. Counts the attempt.
-    Returns True when the attempt is accepted."""
-    acc[RHS_EVALS] += 6.0
+    controller (for RK45 or DOP853, settings[METHOD]), or the PI controller (RK45 only) when
+    settings[CONTROLLER] is 1. Counts the attempt. Returns True when it is accepted."""
+    eighth = settings[METHOD] != 0.0
+    acc[RHS_EVALS] += dop853.RHS_PER_ATTEMPT if eighth else 6.0
     rejected_before = acc[REJECTED_NOW] != 0.0
     if settings[CONTROLLER] != 0.0:
         acc[H_ABS] *= pi_step_factor(err, acc[LOG2_ERR_PREV], rejected_before)
     else:
-        acc[H_ABS] *= step_factor(err, rejected_before)
+        exponent = dop853.ERROR_EXPONENT if eighth else ERROR_EXPONENT
+        acc[H_ABS] *= step_factor(err, rejected_before, exponent)
     if not err < 1.0:
         acc[REJECTED_NOW] = 1.0
         acc[REJECTED] += 1.0
@@ -197,10 +204,10 @@ def control(settings, acc, err):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
                    track, centre, thr_fixed, thr_rel):
-    """Accept or reject the attempt of size h (K: its 7 stage derivatives, (q_new, v_new): its
-    fifth-order solution, err: its error norm) and update the step size as SciPy does
-    (`control`); on acceptance reduce the step's metrics (`record_step`). Returns the extrema
-    buffer (regrown when full). Qc is scratch for the interpolant, shape (2, 4).
+    """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
+    y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
+    SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
+    the extrema buffer (regrown when full). Qc is scratch for the interpolant, shape (2, 5).
     """
     if control(settings, acc, err):
         if acc[N_EXT] >= buf.shape[0]:
@@ -208,6 +215,18 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
         record_step(p[BOUND], settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
                     centre, thr_fixed, thr_rel, -1.0, 0.0)
     return buf
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def interpolant(settings, acc, K, q_new, v_new, h, Qc):
+    """Qc: the dense output of the accepted step from acc's state to (q_new, v_new), K its
+    stage derivatives (only the last, f(t + h, y_new), for DOP853). RK45: its own quartic;
+    DOP853: the quintic Hermite interpolant (dop853.hermite_coefficients)."""
+    if settings[METHOD] != 0.0:
+        dop853.hermite_coefficients(acc[Q], acc[V], acc[FV], q_new, v_new,
+                                    K[K.shape[0] - 1, 1], h, Qc)
+    else:
+        dense_coefficients(K, Qc)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -219,7 +238,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
 
     If the driver has already located the step's extremum of q, xe_known in [0, 1] is its
     x = (t - t_old)/h and qe_known q there; xe_known < 0 means: locate it here. The interpolant
-    (Qc, from K) is built only when something needs it.
+    (Qc, `interpolant`) is built only when something needs it.
     """
     t = acc[T]
     t_new = acc[T_NEW]
@@ -231,7 +250,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = t_new
         if math.isfinite(q_new) and abs(q_new) > bound and abs(q_old) <= bound:
-            dense_coefficients(K, Qc)
+            interpolant(settings, acc, K, q_new, v_new, h, Qc)
             side = 1.0 if q_new > 0.0 else -1.0
             acc[T_STOP] = t + dense_root(q_old, h, Qc[0], side * bound, 0.0, 1.0) * h
         return
@@ -249,7 +268,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
             xe = xe_known
             qe = qe_known
         else:
-            dense_coefficients(K, Qc)
+            interpolant(settings, acc, K, q_new, v_new, h, Qc)
             have_qc = True
             xe = dense_root(v_old, h, Qc[1], 0.0, 0.0, 1.0)
             qe = dense_value(q_old, h, Qc[0], xe)
@@ -270,7 +289,7 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
     if t_new >= t_tail:
         if t < t_tail:
             if not have_qc:
-                dense_coefficients(K, Qc)
+                interpolant(settings, acc, K, q_new, v_new, h, Qc)
                 have_qc = True
             qt = dense_value(q_old, h, Qc[0], (t_tail - t) / h)
             peak = max(peak, abs(qt))
@@ -289,14 +308,14 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
             acc[LAST_ABOVE] = t + h
         elif xa >= 0.0:
             if not have_qc:
-                dense_coefficients(K, Qc)
+                interpolant(settings, acc, K, q_new, v_new, h, Qc)
                 have_qc = True
             x = dense_root(q_old, h, Qc[0], centre + side * thr, xa, xb)
             acc[LAST_ABOVE] = t + x * h
 
     if k < n_samples and k * dt_sample <= t_new:
         if not have_qc:
-            dense_coefficients(K, Qc)
+            interpolant(settings, acc, K, q_new, v_new, h, Qc)
             have_qc = True
         while k < n_samples and k * dt_sample <= t_new:
             series[k] = dense_value(q_old, h, Qc[0], (k * dt_sample - t) / h)
@@ -306,8 +325,8 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
     acc[T] = t_new
     acc[Q] = q_new
     acc[V] = v_new
-    acc[FQ] = K[6, 0]
-    acc[FV] = K[6, 1]
+    acc[FQ] = K[K.shape[0] - 1, 0]
+    acc[FV] = K[K.shape[0] - 1, 1]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

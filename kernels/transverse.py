@@ -1,4 +1,5 @@
-"""Batched transverse drivers: adaptive RK45 trajectories over the rows of a parameter table.
+"""Batched transverse drivers: adaptive RK45 (or DOP853) trajectories over the rows of a
+parameter table.
 
 `solve_block(params, settings, lo, hi, states, reals, counts, series)` is the interface the
 sweep layer uses: rows lo..hi-1 of `params` (columns in `oscillator`) in, per-point metrics
@@ -22,17 +23,19 @@ import numpy as np
 
 from . import metrics as mt
 from . import trajectory as tj
+from . import dop853
 from .dopri5 import MIN_RTOL, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
 from .layout import (AMPLITUDE, ATOL, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
-                     REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
+                     METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, MASS, N_PARAMS
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
-    """Integrate one point from t = 0 to t_end with SciPy's RK45, reducing metrics on the fly.
+    """Integrate one point from t = 0 to t_end with SciPy's RK45 or DOP853 (settings[METHOD]),
+    reducing metrics on the fly.
 
     When `track`, the accumulator's LAST_ABOVE is the last time |q - centre| exceeded
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
@@ -41,8 +44,9 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
     atol = settings[ATOL]
     acc = np.empty(tj.N_SLOTS)
     buf = tj.new_buffer()
-    K = np.empty((7, 2))
-    Qc = np.empty((2, 4))
+    eighth = settings[METHOD] != 0.0
+    K = np.empty((dop853.N_STAGES + 1 if eighth else 7, 2))
+    Qc = np.empty((2, 5))
     y = np.empty(2)
     y_new = np.empty(2)
     tj.start(p, settings, acc, series)
@@ -54,8 +58,12 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
         y[1] = acc[tj.V]
         K[0, 0] = acc[tj.FQ]
         K[0, 1] = acc[tj.FV]
-        rk_step(acc[tj.T], y, h, p, K, y_new)
-        err = error_norm(K, h, y, y_new, rtol, atol)
+        if eighth:
+            dop853.rk_step(acc[tj.T], y, h, p, K, y_new)
+            err = dop853.error_norm(K, h, y, y_new, rtol, atol)
+        else:
+            rk_step(acc[tj.T], y, h, p, K, y_new)
+            err = error_norm(K, h, y, y_new, rtol, atol)
         buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
                                 series, track, centre, thr_fixed, thr_rel)
     tj.end_series(acc, series)

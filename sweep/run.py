@@ -54,6 +54,7 @@ def settings_vector(scene: Scene) -> np.ndarray:
     s[tk.WANT_SETTLING] = 1.0 if scene.get("outputs.settling_time") else 0.0
     s[tk.MIN_STEP] = scene.get("solver.min_step") or 0.0
     s[tk.CONTROLLER] = 1.0 if scene.get("solver.controller") == "pi" else 0.0
+    s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
     return s
 
 

@@ -866,6 +866,10 @@ def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     if given.get("solver.transits") is not None:
         _fail("scene key 'solver.transits'", "only for model.kind = 'longitudinal'",
               "use solver.t_end in seconds")
+    if given.get("solver.method") == "dop853" and given.get("solver.controller") == "pi":
+        _fail("scene keys 'solver.method' and 'solver.controller'",
+              "the PI controller is tuned for method 'rk45' only",
+              "use solver.controller = 'scipy' with method 'dop853'")
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:

@@ -62,9 +62,11 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
             tk.solve_block(params, settings, lo, hi, states, reals, counts, series)
     else:
         pi = True if settings[tk.CONTROLLER] != 0.0 else None   # see lanes.solve_block
+        eighth = True if settings[tk.METHOD] != 0.0 else None
 
         def solve_block(lo: int, hi: int) -> None:
-            lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi)
+            lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi,
+                              eighth)
     n = params.shape[0]
     n_threads = min(thread_count(threads), -(-n // LANES_PER_THREAD))
     if n_threads <= 1:

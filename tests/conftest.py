@@ -23,7 +23,7 @@ def param_row(m=1.0, c=0.0, k0=1.0, k1=0.0, g0=0.0, g1=0.0, h=0.0, omega=0.0,
 
 def settings(rtol=1e-8, atol=1e-12, t_end=5.0, max_steps=10**6, max_step=math.inf,
              first_step=0.0, tail=0.5, tol=0.02, sample_dt=0.01, settling=True,
-             min_step=0.0, controller="scipy") -> np.ndarray:
+             min_step=0.0, controller="scipy", method="rk45") -> np.ndarray:
     """A kernel settings vector (kernels.transverse)."""
     s = np.zeros(tk.N_SETTINGS)
     s[tk.RTOL], s[tk.ATOL], s[tk.T_END] = rtol, atol, t_end
@@ -32,18 +32,20 @@ def settings(rtol=1e-8, atol=1e-12, t_end=5.0, max_steps=10**6, max_step=math.in
     s[tk.WANT_SETTLING] = 1.0 if settling else 0.0
     s[tk.MIN_STEP] = min_step
     s[tk.CONTROLLER] = 1.0 if controller == "pi" else 0.0
+    s[tk.METHOD] = 1.0 if method == "dop853" else 0.0
     return s
 
 
-def solve(rows, s, n_samples=0):
-    """Run the batched kernel; returns (states, reals, counts, series)."""
+def solve(rows, s, n_samples=0, driver="scalar"):
+    """Run the batched kernel (the scalar driver unless told); returns (states, reals, counts,
+    series)."""
     rows = np.atleast_2d(np.asarray(rows, dtype=float))
     n = rows.shape[0]
     states = np.empty(n, np.int8)
     reals = np.empty((n, tk.N_REALS))
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     series = np.empty((n, n_samples))
-    solve_transverse(rows, s, states, reals, counts, series, driver="scalar")
+    solve_transverse(rows, s, states, reals, counts, series, driver=driver)
     return states, reals, counts, series
 
 
