@@ -13,7 +13,8 @@ rtol 1e-8 and atol 1e-12 (the scene defaults) unless --rtol / --atol are given.
    The first call (JIT compile, or loading numba's on-disk cache) is timed separately on two
    points; for a true cold compile run with an empty cache: NUMBA_CACHE_DIR=$(mktemp -d).
    Each thread count is timed --repeats times; the best (smallest) wall time is reported.
-2. SciPy: `solve_ivp(method="RK45")` one point at a time on a random sample of the same grid
+2. SciPy: `solve_ivp(method="RK45")` (with --method dop853: "DOP853", and cable-sweep runs
+   solver.method = "dop853") one point at a time on a random sample of the same grid
    (--scipy-sample points, fixed --seed), same rtol/atol, plain Python right-hand side with
    the coefficients of the same parameter rows. Timed without dense output (integration
    only, SciPy's most favourable case), once per point. The speed-up is
@@ -120,6 +121,9 @@ def parse_args() -> argparse.Namespace:
                    help="rtols of the equal-error comparison")
     p.add_argument("--target", type=float, default=1e-5,
                    help="final-state error at which solvers are compared (default 1e-5)")
+    p.add_argument("--method", choices=("rk45", "dop853"), default="rk45",
+                   help="cable-sweep's solver.method for items 1-3; SciPy runs the same method "
+                        "(default rk45)")
     p.add_argument("--json", metavar="PATH", help="also write the results as JSON")
     return p.parse_args()
 
@@ -156,18 +160,21 @@ def threads_used(requested: int) -> int:
     return min(requested, numba.config.NUMBA_NUM_THREADS)
 
 
-def time_scipy(rows: np.ndarray, rtol: float, atol: float) -> tuple[float, np.ndarray]:
-    """Total wall time (s) of solve_ivp(RK45) over `rows`, one at a time, and the step counts."""
+def time_scipy(rows: np.ndarray, rtol: float, atol: float,
+               method: str = "RK45") -> tuple[float, np.ndarray]:
+    """Total wall time (s) of solve_ivp(method) over `rows`, one at a time, and the step
+    counts."""
     steps = np.empty(len(rows), np.int64)
     start = time.perf_counter()
     for i, row in enumerate(rows):
-        steps[i] = len(solve_scipy(row, T_END, rtol, atol).t) - 1
+        steps[i] = len(solve_scipy(row, T_END, rtol, atol, method=method).t) - 1
     return time.perf_counter() - start, steps
 
 
 def scipy_agreement(rows: np.ndarray, kernel: KernelResult, rtol: float, atol: float,
-                    n_grid: int) -> dict[str, object]:
-    """Compare SciPy RK45 with cable-sweep's amplitude, step and evaluation counts on `rows`.
+                    n_grid: int, method: str = "RK45") -> dict[str, object]:
+    """Compare SciPy (`method`) with cable-sweep's amplitude, step and evaluation counts on
+    `rows`.
 
     `kernel` holds cable-sweep's results for the same rows, in the same order.
     """
@@ -177,14 +184,16 @@ def scipy_agreement(rows: np.ndarray, kernel: KernelResult, rtol: float, atol: f
     step_diff = np.empty(len(rows), np.int64)
     rhs_equal = np.empty(len(rows), bool)
     for i, row in enumerate(rows):
-        sol = solve_scipy(row, T_END, rtol, atol, dense=True)
+        sol = solve_scipy(row, T_END, rtol, atol, dense=True, method=method)
         amp = kernel.reals[i, tk.AMPLITUDE]
         amp_grid = tail_amplitude(sol, TAIL_START, T_END, n_grid, refine=False)
         amp_refined = tail_amplitude(sol, TAIL_START, T_END, n_grid, refine=True)
         grid_diff[i] = abs(amp - amp_grid) / amp_grid
         refined_diff[i] = abs(amp - amp_refined) / amp_refined
         step_diff[i] = abs(kernel.counts[i, tk.STEPS] - (len(sol.t) - 1))
-        rhs_equal[i] = kernel.counts[i, tk.RHS_EVALS] == sol.nfev
+        # DOP853's dense output costs SciPy three more evaluations per step (not the kernel's)
+        dense_evals = 3 * (len(sol.t) - 1) if method == "DOP853" else 0
+        rhs_equal[i] = kernel.counts[i, tk.RHS_EVALS] == sol.nfev - dense_evals
     return {
         "max_rel_amplitude_diff_grid": float(np.nanmax(grid_diff)),
         "max_rel_amplitude_diff_refined": float(np.nanmax(refined_diff)),
@@ -294,11 +303,14 @@ def state_counts(states: np.ndarray) -> dict[str, int]:
 
 
 def main() -> None:
+    from kernels import transverse as tk
     args = parse_args()
     thread_counts = [int(s) for s in args.threads.split(",") if s.strip()]
     scene = build_scene(args.points_per_axis, args.rtol, args.atol)
     table = parameter_table(scene)
     settings = settings_vector(scene)
+    settings[tk.METHOD] = 1.0 if args.method == "dop853" else 0.0
+    peer = args.method.upper()
     n = len(table)
 
     compile_s = compile_time(table, settings)
@@ -322,16 +334,16 @@ def main() -> None:
     sample = np.sort(np.random.default_rng(args.seed).choice(
         n, size=min(args.scipy_sample, n), replace=False))
     rows = table[sample]
-    scipy_wall, scipy_steps = time_scipy(rows, args.rtol, args.atol)
+    scipy_wall, scipy_steps = time_scipy(rows, args.rtol, args.atol, peer)
     scipy_rate = len(rows) / scipy_wall
     fastest = max(runs, key=lambda r: r["trajectories_per_s"])
     kernel_sample = KernelResult(result.states[sample], result.reals[sample],
                                  result.counts[sample], result.series[sample], np.empty(0))
-    agreement = scipy_agreement(rows, kernel_sample, args.rtol, args.atol, args.grid)
+    agreement = scipy_agreement(rows, kernel_sample, args.rtol, args.atol, args.grid, peer)
 
     print(f"# Reference sweep: paper preset, {args.points_per_axis} lengths x "
           f"{args.points_per_axis} frequency ratios = {n} points, q0 = 4e-3 m, t_end = 5 s, "
-          f"rtol = {args.rtol:g}, atol = {args.atol:g}\n")
+          f"rtol = {args.rtol:g}, atol = {args.atol:g}, solver.method = {args.method}\n")
     print(f"Machine: {platform.processor() or platform.machine()}, Python "
           f"{platform.python_version()}; first kernel call (compile or cache load): "
           f"{compile_s:.2f} s; best of {args.repeats} runs per thread count.\n")
@@ -341,13 +353,13 @@ def main() -> None:
                  f"{r['trajectories_per_s']:,.0f}", f"{r['steps_per_s']:,.3g}",
                  f"{r['total_steps'] / n:,.0f}", f"{r['parallel_efficiency']:.2f}"]
                 for r in runs]
-    rows_out.append(["SciPy RK45 (Python RHS)", 1, len(rows), f"{scipy_wall:.3f}",
+    rows_out.append([f"SciPy {peer} (Python RHS)", 1, len(rows), f"{scipy_wall:.3f}",
                      f"{scipy_rate:,.1f}", f"{scipy_steps.sum() / scipy_wall:,.3g}",
                      f"{scipy_steps.mean():,.0f}", ""])
     print(markdown_table(headers, rows_out))
     speedup = fastest["trajectories_per_s"] / scipy_rate
     step_speedup = fastest["steps_per_s"] / (scipy_steps.sum() / scipy_wall)
-    print(f"\ncable-sweep ({fastest['driver']}, {fastest['threads_used']} threads) / SciPy RK45: "
+    print(f"\ncable-sweep ({fastest['driver']}, {fastest['threads_used']} threads) / SciPy {peer}: "
           f"{speedup:,.0f}x trajectories per second ({step_speedup:,.0f}x accepted steps "
           "per second)\n")
     print(markdown_table(

@@ -28,6 +28,8 @@ tolerance govern until |q| falls ~10x below q0.
     for the set: best of repeats filling >= 0.2 s, after a compile warm-up that is reported
     separately). Amplitude, state and settling time are the kernel's own outputs; q(5) comes
     from the `displacement` time series with sample_interval = t_end (samples at t = 0 and 5 s).
+  - with --pi / --dop853, cable-sweep again with solver.controller = "pi" / solver.method =
+    "dop853" (its own curve, timed the same way).
   - SciPy RK45 and DOP853 (`solve_ivp`, plain Python right-hand side), one point at a time,
     dense_output=True, one timed run per point, 1 thread. Their amplitude, state and settling
     time come from `reference_metrics` on their own dense output (not timed).
@@ -118,6 +120,7 @@ DEFAULT_RTOLS = "1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12"
 ATOL_FLOOR = 1e-16
 CABLE = "cable-sweep"
 CABLE_PI = "cable-sweep (PI)"      # solver.controller = "pi"
+CABLE_DOP853 = "cable-sweep (DOP853)"   # solver.method = "dop853"
 NS_MAX_STEPS = 2_000_000_000        # numbalsoda mxstep (a C int): no practical bound
 N_COEFFS = 8                        # m, c, k0, k1, g0, g1, h, W: the first 8 parameter columns
 NS_COUNTER = 12                     # slot of the RHS-call counter in a numbalsoda data row
@@ -214,6 +217,8 @@ def parse_args() -> argparse.Namespace:
                    help="numbalsoda output times on [0, t_end] (default 20001)")
     p.add_argument("--pi", action="store_true",
                    help="also run cable-sweep with the PI controller (solver.controller = pi)")
+    p.add_argument("--dop853", action="store_true",
+                   help="also run cable-sweep with DOP853 (solver.method = dop853)")
     p.add_argument("--no-numbalsoda", action="store_true", help="skip the numbalsoda peers")
     p.add_argument("--no-scipy", action="store_true",
                    help="skip the SciPy peers (quick checks only)")
@@ -263,13 +268,14 @@ def reference_solution(table: np.ndarray, rtol: float, atol: float, cfg: Setting
 
 
 def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float,
-                    controller: str = "scipy") -> Measurement:
+                    controller: str = "scipy", method: str = "rk45") -> Measurement:
     """cable-sweep on all points: best wall time on 1 and on 2 threads, and its outputs."""
     from kernels import metrics as mt
     from kernels import transverse as tk
     tuned = load_scene_text(scene.to_toml(), source="work_precision.py",
                             overrides={"solver.rtol": rtol, "solver.atol": atol,
-                                       "solver.controller": controller})
+                                       "solver.controller": controller,
+                                       "solver.method": method})
     settings = settings_vector(tuned)
     times = sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
     assert times[-1] == T_END, times
@@ -281,7 +287,8 @@ def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float,
     wall = best_time(lambda: once(1))
     last = result[-1]
     wall2 = best_time(lambda: once(2)) if max_threads() >= 2 else math.nan
-    m = Measurement(CABLE if controller == "scipy" else CABLE_PI, rtol, atol, wall, last.counts[:, tk.STEPS].astype(float),
+    name = CABLE_DOP853 if method == "dop853" else CABLE if controller == "scipy" else CABLE_PI
+    m = Measurement(name, rtol, atol, wall, last.counts[:, tk.STEPS].astype(float),
                     last.counts[:, tk.RHS_EVALS].astype(float),
                     last.reals[:, tk.AMPLITUDE].copy(), last.series[:, -1].copy(),
                     np.array([mt.STATE_MEANINGS[s] for s in last.states], dtype=object),
@@ -581,7 +588,8 @@ def equal_error_report(runs: list[Measurement], ref: Reference, judged: np.ndarr
     return lines, {"target_error": target, "target_rtol": at.rtol, "methods": walls}
 
 
-STYLE = {CABLE: ("o", "C0"), CABLE_PI: ("P", "C5"), "SciPy RK45": ("s", "C1"),
+STYLE = {CABLE: ("o", "C0"), CABLE_PI: ("P", "C5"), CABLE_DOP853: ("X", "C6"),
+         "SciPy RK45": ("s", "C1"),
          "SciPy DOP853": ("^", "C2"),
          "numbalsoda dop853": ("D", "C3"), "numbalsoda lsoda": ("v", "C4")}
 
@@ -666,6 +674,8 @@ def main() -> None:
         runs.append(run_cable_sweep(table, scene, rtol, atol))
         if args.pi:
             runs.append(run_cable_sweep(table, scene, rtol, atol, controller="pi"))
+        if args.dop853:
+            runs.append(run_cable_sweep(table, scene, rtol, atol, method="dop853"))
         if not args.no_scipy:
             runs.append(run_scipy(table, "RK45", rtol, atol, cfg))
             runs.append(run_scipy(table, "DOP853", rtol, atol, cfg))
