@@ -1,16 +1,19 @@
 """Lock-step SIMD driver: LANES trajectories advanced side by side in vector lanes.
 
 Each lane is one trajectory with its own time, step size and accept/reject decision: SciPy
-RK45's sequence of attempts (or the PI controller's), the trajectory module's state machine.
+RK45's or DOP853's sequence of attempts (or the PI controller's), the trajectory module's
+state machine.
 These loops run across the lanes with straight-line arithmetic, so LLVM vectorises them:
 
 - `_prepare`: the next step of every lane whose step needs no special care;
 - `_attempt`: one Dormand-Prince attempt (six right-hand sides, stage sums, error norm);
+  `_attempt8` its DOP853 counterpart (twelve right-hand sides; solver.method = "dop853");
 - `_pi_factors`: the PI controller's step-size factors (only when that controller is chosen);
 - `_finish`: accept/reject and the step-size update of every lane, and the metrics of an
   ordinary accepted step;
-- `_locate_extrema`: for the steps that hold an extremum of q, where it lies on the dense
-  output (safeguarded Newton), run only when some lane has one.
+- `_locate_extrema` (`_locate_extrema8` for DOP853's Hermite interpolant): for the steps that
+  hold an extremum of q, where it lies on the dense output (safeguarded Newton), run only when
+  some lane has one.
 
 Whatever else is not ordinary (a lane's first or last step, a step near SciPy's minimum, the
 extremum's bookkeeping, the tail's start, a time-series sample, a threshold crossing, a
