@@ -20,6 +20,7 @@ from .vecmath import exp2_fast, log2_fast
 # --- the tableau (Dormand & Prince 1980; dense output with Shampine's optimal c6) -------------
 N_STAGES = 6
 ERROR_ESTIMATOR_ORDER = 4
+RHS_PER_ATTEMPT = N_STAGES       # stages 2..6 and f(t + h, y_new)
 C = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
 A = np.array([
     [0.0, 0.0, 0.0, 0.0, 0.0],

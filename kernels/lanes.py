@@ -36,7 +36,7 @@ from . import dop853
 from . import metrics as mt
 from . import trajectory as tj
 from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
-                     SAFETY, pi_log2_err, pi_step_factor)
+                     RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
 from .layout import (ATOL, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
@@ -283,18 +283,11 @@ def _attempt8(W, rtol, atol, n_run):
                + kv9 * _E3[9] + kv10 * _E3[10] + kv11 * _E3[11])
         sq = atol + max(abs(q), abs(qn)) * rtol
         sv = atol + max(abs(v), abs(vn)) * rtol
-        e5q /= sq
-        e5v /= sv
-        e3q /= sq
-        e3v /= sv
-        e5 = e5q * e5q + e5v * e5v
-        e3 = e3q * e3q + e3v * e3v
-        err = abs(h) * e5 / math.sqrt((e5 + dop853.ERR3_WEIGHT * e3) * 2.0)
         W[(W_K + 12) * L + j] = vn
         W[(W_K + 13) * L + j] = fv_new
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
-        W[W_ERR * L + j] = 0.0 if (e5 == 0.0) & (e3 == 0.0) else err
+        W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -329,7 +322,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
-    rhs_per_attempt = 6.0 if eighth is None else float(dop853.RHS_PER_ATTEMPT)
+    rhs_per_attempt = float(RHS_PER_ATTEMPT if eighth is None else dop853.RHS_PER_ATTEMPT)
     for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0

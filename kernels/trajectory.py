@@ -23,6 +23,7 @@ import numpy as np
 from . import metrics as mt
 from . import dop853
 from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR_PREV,
+                     RHS_PER_ATTEMPT,
                      dense_coefficients, dense_root, dense_value, initial_step, pi_log2_err,
                      pi_step_factor, step_factor)
 from .layout import (ATOL, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, RTOL,
@@ -183,7 +184,7 @@ def control(settings, acc, err):
     controller (for RK45 or DOP853, settings[METHOD]), or the PI controller (RK45 only) when
     settings[CONTROLLER] is 1. Counts the attempt. Returns True when it is accepted."""
     eighth = settings[METHOD] != 0.0
-    acc[RHS_EVALS] += dop853.RHS_PER_ATTEMPT if eighth else 6.0
+    acc[RHS_EVALS] += dop853.RHS_PER_ATTEMPT if eighth else RHS_PER_ATTEMPT
     rejected_before = acc[REJECTED_NOW] != 0.0
     if settings[CONTROLLER] != 0.0:
         acc[H_ABS] *= pi_step_factor(err, acc[LOG2_ERR_PREV], rejected_before)
