@@ -7,6 +7,7 @@ import pytest
 
 from kernels import lanes, vecmath
 from kernels import transverse as tk
+from kernels.oscillator import Q0
 
 from conftest import param_row, settings
 from sweep.threads import solve_transverse
@@ -18,6 +19,33 @@ def _solve(driver, rows, s, n_samples=0):
            np.empty((n, n_samples)))
     solve_transverse(rows, s, *out, driver=driver)
     return out
+
+
+def _assert_equal_to_round_off(rows, s, a, b, n_samples):
+    """The lanes results b equal the scalar driver's a to round-off, as these trajectories
+    amplify it: the scalar driver's own results with q0 moved by one ulp either way show by how
+    much, element by element (~1e-9 relative on the mixed grid, ~1e-6 for the period of a
+    died-out swing, whose extrema are flat). b may differ from a by 5 times that, plus 1e-9
+    relative (lengths also 1e-12 of the point's peak |q|, the response's scale)."""
+    moved = []
+    for direction in (np.inf, -np.inf):
+        nudged = rows.copy()
+        nudged[:, Q0] = np.nextafter(nudged[:, Q0], direction)
+        moved.append(_solve("scalar", nudged, s, n_samples))
+    peak = np.abs(a[1][:, tk.PEAK])
+
+    def check(got, want, up, down, atol):
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+        spread = np.maximum(np.abs(up - want), np.abs(down - want))
+        excess = np.abs(got - want) - (atol + 1e-9 * np.abs(want) + 5.0 * spread)
+        assert not np.nanmax(excess, initial=-1.0) > 0.0, (
+            f"differs beyond round-off at {np.unravel_index(np.nanargmax(excess), excess.shape)}")
+
+    for col in range(tk.N_REALS):
+        length = col in (tk.AMPLITUDE, tk.PEAK)
+        check(b[1][:, col], a[1][:, col], moved[0][1][:, col], moved[1][1][:, col],
+              1e-12 * peak if length else 1e-15)
+    check(b[3], a[3], moved[0][3], moved[1][3], 1e-12 * peak[:, None])
 
 
 def test_fast_cos_matches_libm_to_round_off():
@@ -45,8 +73,7 @@ def test_lanes_equal_scalar_on_a_mixed_grid(rtol, controller, method):
     b = _solve("lanes", rows, s, 41)
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[2], b[2])
-    np.testing.assert_allclose(b[1], a[1], rtol=1e-9, atol=1e-15, equal_nan=True)
-    np.testing.assert_allclose(b[3], a[3], rtol=1e-9, atol=1e-15, equal_nan=True)
+    _assert_equal_to_round_off(rows, s, a, b, 41)
 
 
 def test_sweep_drivers_agree_and_lanes_is_the_default():
@@ -175,13 +202,15 @@ def test_second_pass_points_in_a_threaded_lanes_batch(method):
     assert np.all(b[0][second] == km.STEADY)
     assert np.all(np.isfinite(b[1][second, tk.SETTLING]))
     np.testing.assert_array_equal(a[0], b[0])
-    np.testing.assert_array_equal(a[2], b[2])
-    # The period of a swing that has died out comes from nearly flat extrema, whose position on
-    # the dense output is ill-conditioned: there round-off moves it ~1e-8 (DOP853's long steps).
-    others = [c for c in range(tk.N_REALS) if c != tk.PERIOD]
-    np.testing.assert_allclose(b[1][:, others], a[1][:, others], rtol=1e-9, atol=1e-15,
-                               equal_nan=True)
-    np.testing.assert_allclose(b[1][:, tk.PERIOD], a[1][:, tk.PERIOD], rtol=1e-7, equal_nan=True)
+    # At rest away from zero the error estimate is mostly round-off (the state barely moves), so
+    # whether a late attempt passes can turn on it: on the q0 = 2 creep SciPy's own DOP853 takes
+    # 74 steps, the scalar driver 75. There one step either way; everywhere else the same steps.
+    same = np.setdiff1d(np.arange(rows.shape[0]), second)
+    np.testing.assert_array_equal(a[2][same], b[2][same])
+    assert np.all(np.abs(a[2][second, tk.STEPS] - b[2][second, tk.STEPS]) <= 1)
+    # (The period of a swing that has died out comes from nearly flat extrema, whose position on
+    # the dense output is ill-conditioned: there round-off moves it ~1e-6.)
+    _assert_equal_to_round_off(rows, s, a, b, 0)
     for driver, ref in (("lanes", b), ("scalar", a)):
         n = rows.shape[0]
         out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)),
