@@ -320,7 +320,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
     SciPy's controller is computed here when `pi` is None (RK45's, or DOP853's when `eighth` is
     True); otherwise the PI controller's factor comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
-    vectorising the loop.
+    vectorising the loop. Returns how many lanes it flagged, and how many of those HAS_EXTREMUM.
     """
     L = LANES
     t_tail = settings[T_END] * (1.0 - settings[TAIL])
@@ -328,6 +328,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
     rhs_per_attempt = float(RHS_PER_ATTEMPT if eighth is None else dop853.RHS_PER_ATTEMPT)
+    n_flagged = 0
+    n_extrema = 0
     for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0
@@ -357,6 +359,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
             factor = W[W_FACTOR * L + j]
         W[W_FLAG * L + j] = ((HAS_EXTREMUM if extremum & bounded else NEEDS_SCALAR) if event
                              else ORDINARY)
+        n_flagged += 1 if event else 0
+        n_extrema += 1 if event & extremum & bounded else 0
         W[tj.RHS_EVALS * L + j] += rhs_per_attempt if active else 0.0
         W[tj.H_ABS * L + j] *= factor if active else 1.0
         W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if active else (
@@ -378,6 +382,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
         W[tj.V * L + j] = vn if done else v_old
         W[tj.FQ * L + j] = vn if done else W[tj.FQ * L + j]
         W[tj.FV * L + j] = fv_new if done else W[tj.FV * L + j]
+    return n_flagged, n_extrema
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -479,12 +484,13 @@ def _locate_extrema8(W, n_run):
         v1 = W[W_VN * L + j]
         a1 = W[(W_K + 13) * L + j]
         c3, c4, c5 = dop853.hermite_terms(q0, v0, a0, q1, v1, a1, h)
-        hh = h * h
-        x, converged = _newton_extremum(v0, v1, h, a0, 3.0 * c3 / hh, 4.0 * c4 / hh,
-                                        5.0 * c5 / hh)
+        inv_h = 1.0 / h               # one division: they hold up the vector units
+        inv_hh = inv_h * inv_h
+        x, converged = _newton_extremum(v0, v1, h, a0, 3.0 * c3 * inv_hh, 4.0 * c4 * inv_hh,
+                                        5.0 * c5 * inv_hh)
         W[W_XE * L + j] = x if want & converged else -1.0
-        W[W_QE * L + j] = q0 + h * (x * (v0 + x * (0.5 * h * a0 + x * (c3 / h + x * (
-            c4 / h + x * (c5 / h))))))
+        W[W_QE * L + j] = q0 + h * (x * (v0 + x * (0.5 * h * a0 + x * inv_h * (c3 + x * (
+            c4 + x * c5)))))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -566,12 +572,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             _attempt8(W, rtol, atol, n_run)
         if pi is not None:
             _pi_factors(W, n_run)
-        _finish(W, settings, n_samples, n_run, pi, eighth)
-        n_flagged = 0
-        n_extrema = 0
-        for j in range(n_run):
-            n_flagged += W[W_FLAG * L + j] != ORDINARY
-            n_extrema += W[W_FLAG * L + j] == HAS_EXTREMUM
+        n_flagged, n_extrema = _finish(W, settings, n_samples, n_run, pi, eighth)
         if n_flagged == 0:
             continue
         if n_extrema > 0:
