@@ -26,8 +26,9 @@ default pair (rtol 1e-8, atol 1e-12) on the curve; with q ~ 1e-3 m it makes the 
 tolerance govern until |q| falls ~10x below q0.
   - cable-sweep: `sweep.run.solve_points` on all points, on 1 thread and on 2 threads (wall time
     for the set: best of repeats filling >= 0.2 s, after a compile warm-up that is reported
-    separately; the --pi and --dop853 kernels are warmed up too). Amplitude, state and settling time are the kernel's own outputs; q(5) comes
-    from the `displacement` time series with sample_interval = t_end (samples at t = 0 and 5 s).
+    separately; the --pi and --dop853 kernels are warmed up too). Amplitude, state and settling
+    time are the kernel's own outputs; q(5) comes from the `displacement` time series with
+    sample_interval = t_end (samples at t = 0 and 5 s).
   - with --pi / --dop853, cable-sweep again with solver.controller = "pi" / solver.method =
     "dop853" (its own curve, timed the same way).
   - SciPy RK45 and DOP853 (`solve_ivp`, plain Python right-hand side), one point at a time,
@@ -267,15 +268,18 @@ def reference_solution(table: np.ndarray, rtol: float, atol: float, cfg: Setting
     return Reference(amp, peak, q_end, steps, state, settling)
 
 
+def variant(scene: Scene, overrides: dict[str, object]) -> Scene:
+    """The scene with some keys overridden (solver.rtol, solver.method, ...)."""
+    return load_scene_text(scene.to_toml(), source="work_precision.py", overrides=overrides)
+
+
 def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float,
                     controller: str = "scipy", method: str = "rk45") -> Measurement:
     """cable-sweep on all points: best wall time on 1 and on 2 threads, and its outputs."""
     from kernels import metrics as mt
     from kernels import transverse as tk
-    tuned = load_scene_text(scene.to_toml(), source="work_precision.py",
-                            overrides={"solver.rtol": rtol, "solver.atol": atol,
-                                       "solver.controller": controller,
-                                       "solver.method": method})
+    tuned = variant(scene, {"solver.rtol": rtol, "solver.atol": atol,
+                            "solver.controller": controller, "solver.method": method})
     settings = settings_vector(tuned)
     times = sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
     assert times[-1] == T_END, times
@@ -668,8 +672,7 @@ def main() -> None:
     for wanted, key, value in ((args.pi, "solver.controller", "pi"),
                                (args.dop853, "solver.method", "dop853")):
         if wanted:      # each variant is its own kernel: compile it before anything is timed
-            warm_up(table, load_scene_text(scene.to_toml(), source="work_precision.py",
-                                           overrides={key: value}))
+            warm_up(table, variant(scene, {key: value}))
     if ns is not None:
         ns_compile_s = ns.warm_up(table, np.linspace(0.0, T_END, args.ns_samples))
 

@@ -359,10 +359,10 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
             factor = _step_factor(err, rejected_before, eighth)
         else:
             factor = W[W_FACTOR * L + j]
-        W[W_FLAG * L + j] = ((HAS_EXTREMUM if extremum & bounded else NEEDS_SCALAR) if event
-                             else ORDINARY)
+        locate = extremum & bounded
+        W[W_FLAG * L + j] = (HAS_EXTREMUM if locate else NEEDS_SCALAR) if event else ORDINARY
         n_flagged += 1 if event else 0
-        n_extrema += 1 if event & extremum & bounded else 0
+        n_extrema += 1 if event & locate else 0
         W[tj.RHS_EVALS * L + j] += rhs_per_attempt if active else 0.0
         W[tj.H_ABS * L + j] *= factor if active else 1.0
         W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if active else (
