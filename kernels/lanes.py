@@ -58,7 +58,8 @@ SIMD = 4                # doubles per vector register the loops are rounded to (
 # vectorises across lanes with no run-time alias checks. Rows 0 .. tj.N_SLOTS - 1 are the
 # trajectory's accumulator slots (so W[j::LANES] is lane j's accumulator for the scalar
 # state machine), then the parameter row (oscillator columns), then the attempt's work rows.
-W_P = tj.N_SLOTS                  # parameter column c at row W_P + c
+W_P = tj.N_SLOTS                  # parameter column c at row W_P + c (the oscillator's
+                                  # coefficients divided by -m: see `_load_lane`)
 W_H = W_P + N_PARAMS              # signed step of the attempt (s); 0 for an idle lane
 W_K = W_H + 1                     # stage s, component c at row W_K + 2 s + c (s >= 1)
 W_QN = W_K + 2 * (N_STAGES + 1)   # fifth-order q (m)
@@ -115,15 +116,16 @@ def _step_factor(err, rejected_before, eighth):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _accel(W, j, t, q, v):
-    """q'' of lane j's oscillator at (t, q, v)."""
+    """q'' (m/s^2) of lane j's oscillator at (t, q, v), from the lane's coefficients divided by
+    -m (`_load_lane`): no division in the stage chain, and the velocity term added last, so each
+    stage waits on the previous one for two fused multiply-adds rather than for a division."""
     L = LANES
     cw = fast_cos(W[(W_P + OMEGA) * L + j] * t)
     q2 = q * q
-    force = (W[(W_P + DAMPING) * L + j] * v
-             + (W[(W_P + K0) * L + j] + W[(W_P + K1) * L + j] * cw) * q
-             + (W[(W_P + G0) * L + j] + W[(W_P + G1) * L + j] * cw) * q * q2
-             + W[(W_P + H) * L + j] * q * q2 * q2)
-    return -force / W[(W_P + MASS) * L + j]
+    a = ((W[(W_P + K0) * L + j] + W[(W_P + K1) * L + j] * cw) * q
+         + (W[(W_P + G0) * L + j] + W[(W_P + G1) * L + j] * cw) * q * q2
+         + W[(W_P + H) * L + j] * q * q2 * q2)
+    return a + W[(W_P + DAMPING) * L + j] * v
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -508,6 +510,9 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
         return False
     for c in range(N_PARAMS):
         W[(W_P + c) * LANES + lane] = p[c]
+    minus_inv_m = -1.0 / p[MASS]            # _accel's coefficients: per unit mass, negated
+    for c in (DAMPING, K0, K1, G0, G1, H):
+        W[(W_P + c) * LANES + lane] = p[c] * minus_inv_m
     tj.start(p, settings, W[lane::LANES], series[point])
     return True
 
@@ -531,7 +536,6 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     n_samples = series.shape[1]
     W = np.zeros(W_ROWS * L)
     for j in range(L):
-        W[(W_P + MASS) * L + j] = 1.0
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
     bufs = [tj.new_buffer() for _ in range(L)]
     point = np.full(L, -1, np.int64)

@@ -1,7 +1,9 @@
 """Elementary functions written so that LLVM can vectorise the loops that call them.
 
 A libm call inside a loop stops LLVM vectorising it; these are straight-line arithmetic
-(selects, polynomials, Newton steps) accurate to an ulp or two over the ranges stated:
+(selects, polynomials, Newton steps) accurate to an ulp or two over the ranges stated. They
+round with `np.floor`, which stays a float (`math.floor` returns an integer: two vector
+conversions per call, with no single instruction for them before AVX-512):
 
 - `fast_cos(x)`: cos x for |x| < 1e5 (Cody-Waite reduction, fdlibm's kernels);
 - `inv_fifth_root(x)`: x^(-1/5) for 2^-31 <= x < 2^32 (power-of-two reduction, Newton);
@@ -11,6 +13,7 @@ A libm call inside a loop stops LLVM vectorising it; these are straight-line ari
 import math
 
 import numba as nb
+import numpy as np
 
 # Cody-Waite split of pi/2 and fdlibm's minimax kernels on [-pi/4, pi/4].
 _TWO_OVER_PI = 0.63661977236758134308
@@ -26,12 +29,12 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def fast_cos(x):
     """cos(x) without a libm call, to about an ulp for |x| < 1e5 (vectorisable)."""
-    k = math.floor(x * _TWO_OVER_PI + 0.5)
+    k = np.floor(x * _TWO_OVER_PI + 0.5)
     r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_2T
     z = r * r
     s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
     c = 1.0 - 0.5 * z + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-    quadrant = k - 4.0 * math.floor(0.25 * k)     # 0, 1, 2, 3 as floats: vectorisable
+    quadrant = k - 4.0 * np.floor(0.25 * k)       # 0, 1, 2, 3 as floats: vectorisable
     v = s if (quadrant == 1.0) | (quadrant == 3.0) else c
     return -v if (quadrant == 1.0) | (quadrant == 2.0) else v
 
@@ -148,7 +151,7 @@ def log2_fast(x):
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def exp2_fast(y):
     """2^y for |y| < 32, to about 1e-9 relative (vectorisable)."""
-    n = math.floor(y + 0.5)
+    n = np.floor(y + 0.5)
     r = (y - n) * _LN2                  # |r| <= ln2 / 2
     e = 1.0 + r * (1.0 + r * (0.5 + r * (1.0 / 6 + r * (1.0 / 24 + r * (1.0 / 120 + r * (
         1.0 / 720 + r * (1.0 / 5040 + r / 40320)))))))
