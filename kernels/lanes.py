@@ -23,10 +23,12 @@ block at once.
 
 No libm call may sit in those loops: cos(W t) is `vecmath.fast_cos` (Cody-Waite reduction and
 fdlibm's kernels) and the controller's err^(-1/5) is `vecmath.inv_fifth_root` (range reduction
-by powers of two and Newton's method), both to an ulp or two, and the loops fuse multiply-adds
-(`_CONTRACT`). Results therefore equal the scalar driver's to round-off, not bit for bit: to what
-a trajectory makes of round-off, which on strongly nonlinear points reaches ~1e-9 relative
-(tests/test_lanes.py measures it with a one-ulp change of q(0) in the scalar driver).
+by powers of two and Newton's method), both to an ulp or two; the loops fuse multiply-adds
+(`_CONTRACT`), and the right-hand side uses each point's coefficients divided by -m (`_accel`)
+rather than dividing by m. Results therefore equal the scalar driver's to round-off, not bit
+for bit: to what a trajectory makes of round-off, which on strongly nonlinear points reaches
+~1e-9 relative (tests/test_lanes.py measures it with a one-ulp change of q(0) in the scalar
+driver).
 """
 
 import math
