@@ -519,6 +519,18 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
     return True
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe):
+    """trajectory.record_step for lane j (point i) after an accepted attempt. The lane's views of
+    W and of the point's time-series row are taken here, where Numba keeps no reference counts
+    (`_nrt=False`; nothing here allocates): taken in solve_block, each view cost two atomic
+    counter updates per flagged lane."""
+    L = LANES
+    tj.record_step(W[(W_P + BOUND) * L + j], settings, W[j::L], K, W[W_QN * L + j],
+                   W[W_VN * L + j], W[W_H * L + j], Qc, buf, series[i], track,
+                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j])
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
@@ -540,6 +552,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
     bufs = [tj.new_buffer() for _ in range(L)]
+    capacity = np.full(L, bufs[0].shape[0], np.int64)   # rows of each lane's buffer
     point = np.full(L, -1, np.int64)
     K = np.empty((N_STAGES + 1 if eighth is None else 2, 2))   # DOP853: f at both ends only
     Qc = np.empty((2, 5))
@@ -569,6 +582,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                                   series):
                         point[j] = next_point
                         bufs[j] = tj.new_buffer()
+                        capacity[j] = bufs[j].shape[0]
                     next_point += 1
                 W[W_H * L + j] = step
             if W[W_H * L + j] > 0.0:
@@ -605,9 +619,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                 K[1, 0] = W[(W_K + 2 * N_STAGES) * L + j]
                 K[1, 1] = W[(W_K + 2 * N_STAGES + 1) * L + j]
             xe = W[W_XE * L + j] if flag == HAS_EXTREMUM else -1.0
-            acc = W[j::L]
-            if acc[tj.N_EXT] >= bufs[j].shape[0]:
-                bufs[j] = tj.with_room(bufs[j], acc)
-            tj.record_step(W[(W_P + BOUND) * L + j], settings, acc, K, W[W_QN * L + j],
-                           W[W_VN * L + j], W[W_H * L + j], Qc, bufs[j], series[i], track,
-                           0.0, 0.0, thr_rel, xe, W[W_QE * L + j])
+            if W[tj.N_EXT * L + j] >= capacity[j]:
+                bufs[j] = tj.with_room(bufs[j], W[j::L])
+                capacity[j] = bufs[j].shape[0]
+            _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe)
