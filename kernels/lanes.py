@@ -83,7 +83,7 @@ _A = tuple(tuple(float(x) for x in row) for row in A)
 _B = tuple(float(x) for x in B)
 _C = tuple(float(x) for x in C)
 _E = tuple(float(x) for x in E)
-_P = tuple(tuple(float(x) for x in row) for row in P)
+_P_COLUMNS = tuple(tuple(float(row[c]) for row in P) for c in range(4))   # P[:, c]
 
 # DOP853's tableau (rows of A and entries of B, E3, E5 that are zero are left out of the sums).
 _A8 = tuple(tuple(float(x) for x in row) for row in dop853.A)
@@ -392,16 +392,17 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _dense_row(k0, k1, k2, k3, k4, k5, k6, c):
-    """Column c of K^T P for one component (dopri5.dense_coefficients, same summation order)."""
+def _dense_row(k0, k1, k2, k3, k4, k5, k6, p):
+    """Column c of K^T P for one component, p = _P_COLUMNS[c] (dopri5.dense_coefficients, same
+    summation order)."""
     s = 0.0
-    s += k0 * _P[0][c]
-    s += k1 * _P[1][c]
-    s += k2 * _P[2][c]
-    s += k3 * _P[3][c]
-    s += k4 * _P[4][c]
-    s += k5 * _P[5][c]
-    s += k6 * _P[6][c]
+    s += k0 * p[0]
+    s += k1 * p[1]
+    s += k2 * p[2]
+    s += k3 * p[3]
+    s += k4 * p[4]
+    s += k5 * p[5]
+    s += k6 * p[6]
     return s
 
 
@@ -464,15 +465,15 @@ def _locate_extrema(W, n_run):
         kv5 = W[(W_K + 11) * L + j]
         kq6 = W[(W_K + 12) * L + j]
         kv6 = W[(W_K + 13) * L + j]
-        cv0 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 0)
-        cv1 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 1)
-        cv2 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 2)
-        cv3 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, 3)
+        cv0 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, _P_COLUMNS[0])
+        cv1 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, _P_COLUMNS[1])
+        cv2 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, _P_COLUMNS[2])
+        cv3 = _dense_row(kv0, kv1, kv2, kv3, kv4, kv5, kv6, _P_COLUMNS[3])
         x, converged = _newton_extremum(v0, v1, h, cv0, cv1, cv2, cv3)
-        cq0 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 0)
-        cq1 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 1)
-        cq2 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 2)
-        cq3 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, 3)
+        cq0 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, _P_COLUMNS[0])
+        cq1 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, _P_COLUMNS[1])
+        cq2 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, _P_COLUMNS[2])
+        cq3 = _dense_row(kq0, kq1, kq2, kq3, kq4, kq5, kq6, _P_COLUMNS[3])
         W[W_XE * L + j] = x if want & converged else -1.0
         W[W_QE * L + j] = q0 + h * (x * (cq0 + x * (cq1 + x * (cq2 + x * cq3))))
 
