@@ -553,7 +553,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
     bufs = [tj.new_buffer() for _ in range(L)]
-    capacity = np.full(L, bufs[0].shape[0], np.int64)   # rows of each lane's buffer
+    capacity = np.full(L, bufs[0].shape[0], np.int64)   # rows of bufs[j], read without the list:
+                                                        # a list access costs two atomic updates
     point = np.full(L, -1, np.int64)
     K = np.empty((N_STAGES + 1 if eighth is None else 2, 2))   # DOP853: f at both ends only
     Qc = np.empty((2, 5))
