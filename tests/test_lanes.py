@@ -275,3 +275,58 @@ def test_lanes_loops_are_vectorised(name, args):
     packed = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+pd", m))
     scalar = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+sd", m))
     assert packed >= 20 and packed >= 0.4 * scalar, (name, packed, scalar)
+
+
+_BOUNDS_CHECKED_RUN = """
+import sys
+import numpy as np
+sys.path[:0] = [{tests!r}, {root!r}]
+from conftest import param_row, settings
+from kernels import lanes
+from kernels import transverse as tk
+rows = np.load({rows!r})
+s = settings(rtol=1e-6, t_end=5.0, sample_dt=0.05)
+n = rows.shape[0]
+out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)), np.empty((n, tk.N_COUNTS), np.int64),
+       np.empty((n, 101)))
+lanes.solve_block(rows, s, 0, n, *out, None, None)
+np.savez({result!r}, *out)
+"""
+
+
+def test_lanes_stay_in_bounds_as_lanes_reload_and_buffers_grow(tmp_path):
+    """Every array access of the lanes driver stays in bounds. Numba does not check indices,
+    and the flagged lanes' bookkeeping (`_record_lane`) runs without reference counting, so a
+    wrong index or buffer capacity would corrupt memory silently: here the driver is compiled
+    afresh with NUMBA_BOUNDSCHECK=1 (an out-of-range index raises IndexError) on 40 points for
+    16 lanes (lanes reload), ~200-300 extrema per point against 64 buffer rows (each lane's
+    buffer grows, and is replaced for the next point) and a 101-sample time series. Its results
+    must also equal the scalar driver's to round-off."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    rng = np.random.default_rng(5)
+    rows = np.stack([param_row(c=rng.uniform(0.0, 0.5), k0=rng.uniform(2e4, 4e4),
+                               g0=rng.uniform(0.0, 1e6), q0=rng.uniform(-0.01, 0.01),
+                               v0=rng.uniform(-1.0, 1.0)) for _ in range(40)])
+    np.save(tmp_path / "rows.npy", rows)
+    tests = Path(__file__).resolve().parent
+    script = _BOUNDS_CHECKED_RUN.format(tests=str(tests), root=str(tests.parent),
+                                        rows=str(tmp_path / "rows.npy"),
+                                        result=str(tmp_path / "result.npz"))
+    env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    run = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True,
+                         timeout=600)
+    assert run.returncode == 0, run.stderr[-3000:]
+    with np.load(tmp_path / "result.npz") as f:
+        b = tuple(f[f"arr_{k}"] for k in range(4))
+
+    s = settings(rtol=1e-6, t_end=5.0, sample_dt=0.05)
+    a = _solve("scalar", rows, s, 101)
+    extrema = 2.0 * s[tk.T_END] / a[1][:, tk.PERIOD]        # maxima and minima over [0, t_end]
+    assert np.nanmin(extrema) > 128.0                         # two doublings of 64 rows
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_array_equal(a[2], b[2])
+    _assert_equal_to_round_off(rows, s, a, b, 101)
