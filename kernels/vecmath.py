@@ -10,8 +10,6 @@ conversions per call, with no single instruction for them before AVX-512):
 - `log2_fast(x)`, `exp2_fast(y)`: to about 1e-9, for the step-size controller.
 """
 
-import math
-
 import numba as nb
 import numpy as np
 
