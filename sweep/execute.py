@@ -9,6 +9,7 @@ the backend, the chunking or the number of workers: each point depends on its ow
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -17,7 +18,7 @@ import shutil
 import sys
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -167,6 +168,43 @@ def progress_printer(total: int, enabled: bool) -> Callable[[int], None]:
     return report
 
 
+@contextlib.contextmanager
+def announce_compilation(enabled: bool) -> Iterator[None]:
+    """Within the block, say on stderr when Numba compiles a kernel (a cold start: seconds with
+    nothing else on the screen; not when it loads one from its cache) and, at the end, how long
+    compiling took. Only in-process compiles are seen (not a dask worker's)."""
+    if not enabled:
+        yield
+        return
+    from numba.core import event
+
+    class Notice(event.Listener):
+        depth = 0
+        seconds = 0.0
+        started = 0.0
+
+        def on_start(self, ev: event.Event) -> None:
+            if self.depth == 0:
+                if self.seconds == 0.0:
+                    sys.stderr.write("compiling the Numba kernels this sweep needs (once: later "
+                                     "runs load them from Numba's cache) ...\n")
+                    sys.stderr.flush()
+                self.started = time.perf_counter()
+            self.depth += 1
+
+        def on_end(self, ev: event.Event) -> None:
+            self.depth -= 1
+            if self.depth == 0:
+                self.seconds += time.perf_counter() - self.started
+
+    notice = Notice()
+    with event.install_listener("numba:compile", notice):
+        yield
+    if notice.seconds > 0.0:
+        sys.stderr.write(f"compiled in {notice.seconds:.1f} s\n")
+        sys.stderr.flush()
+
+
 # --- execution ------------------------------------------------------------------------------
 
 def chunk_ranges(n: int, chunk_size: int) -> list[tuple[int, int]]:
@@ -215,8 +253,9 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     if backend == "dask":
         _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers)
     else:
-        for lo, hi in todo:
-            collect(lo, hi, chunk_fn(rows_for(lo, hi), *args, threads=threads))
+        with announce_compilation(progress):
+            for lo, hi in todo:
+                collect(lo, hi, chunk_fn(rows_for(lo, hi), *args, threads=threads))
     return len(todo)
 
 

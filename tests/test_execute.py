@@ -119,3 +119,41 @@ def test_a_killed_run_resumes_and_writes_the_same_file(tmp_path):
     assert whole.returncode == 0, err
     with xr.open_dataset(tmp_path / "out.nc") as a, xr.open_dataset(tmp_path / "whole.nc") as b:
         assert_same_result(a, b)
+
+
+def _chunk_compiling_a_fresh_function(rows: np.ndarray, threads: int = 0) -> dict:
+    """A chunk kernel whose first call compiles: a Numba function made anew (no cache)."""
+    import numba
+
+    @numba.njit
+    def double(x):
+        return 2.0 * x
+
+    return {"value": np.array([double(float(r)) for r in rows])}
+
+
+def test_progress_says_when_the_kernels_compile_and_only_then(capsys):
+    """With progress on, a run whose kernels Numba compiles (a cold start: seconds with nothing
+    on the screen) says so on stderr, and how long it took; one whose kernels are loaded or
+    already compiled says nothing; with progress off, nothing either."""
+    from sweep.execute import execute
+
+    values = np.zeros(6)
+
+    def place(lo, hi, arrays):
+        values[lo:hi] = arrays["value"]
+
+    for progress in (True, False):
+        execute(_chunk_compiling_a_fresh_function, lambda lo, hi: np.arange(lo, hi), 6, (),
+                place, chunk_size=3, progress=progress)
+        err = capsys.readouterr().err
+        np.testing.assert_array_equal(values, 2.0 * np.arange(6))
+        if progress:
+            assert "compiling the Numba kernels" in err and "compiled in" in err, err
+            assert err.count("compiling") == 1        # once, though each chunk compiled anew
+        else:
+            assert "compil" not in err, err
+    scene = sweep.load_scene_text(SCENE)
+    sweep.run(scene, progress=False)                  # compiled (or loaded) here
+    sweep.run(scene, progress=True)
+    assert "compil" not in capsys.readouterr().err
