@@ -19,7 +19,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import OptimizeResult, brentq
 
-from kernels import oscillator as osc
+from sweep.kernels import oscillator as osc
 from sweep import grid, models
 from sweep.scene import Scene
 

@@ -26,7 +26,7 @@ EA = E * A
 
 
 def exact_u(x: np.ndarray, t: float) -> np.ndarray:
-    """d'Alembert's solution by images (MODEL.md sec. 4)."""
+    """d'Alembert's solution by images (docs/model.md sec. 4)."""
     s = LENGTH - x
     e0 = P0 / EA
     u = np.zeros_like(x)
@@ -38,7 +38,7 @@ def exact_u(x: np.ndarray, t: float) -> np.ndarray:
 
 def max_error(courant: float, intervals: int, transits: float, every: int) -> tuple[float, int]:
     """(max nodal error / peak, levels compared) for one Courant number."""
-    from kernels import longitudinal as lk
+    from sweep.kernels import longitudinal as lk
     dt = courant * (LENGTH / intervals) / WAVE
     n_levels = int(math.ceil(transits * LENGTH / WAVE / dt - 1e-9))
     levels = np.arange(0, n_levels + 1, every)

@@ -88,7 +88,7 @@ def vm_hwm_kib() -> int:
 def child_baseline(scene_file: str) -> dict:
     """Import sweep and kernels, run the kernel on the 2 points of `scene_file`."""
     import sweep
-    from kernels import oscillator as osc
+    from sweep.kernels import oscillator as osc
     from sweep import grid, models
     from sweep.run import settings_vector, solve_points
     scene = sweep.load_scene(scene_file)
@@ -142,8 +142,8 @@ def last_json(stdout: str) -> dict:
 
 def estimate_bytes_per_point() -> float:
     """check_memory's estimate in sweep.run_transverse (no time series)."""
-    from kernels import transverse as tk
-    from kernels.oscillator import PARAM_NAMES
+    from sweep.kernels import transverse as tk
+    from sweep.kernels.oscillator import PARAM_NAMES
     return 3.0 * (8 * (len(PARAM_NAMES) + tk.N_REALS + tk.N_COUNTS) + 1)
 
 

@@ -178,7 +178,7 @@ def scipy_agreement(rows: np.ndarray, kernel: KernelResult, rtol: float, atol: f
 
     `kernel` holds cable-sweep's results for the same rows, in the same order.
     """
-    from kernels import transverse as tk
+    from sweep.kernels import transverse as tk
     grid_diff = np.empty(len(rows))
     refined_diff = np.empty(len(rows))
     step_diff = np.empty(len(rows), np.int64)
@@ -232,7 +232,7 @@ def at_target(rungs: list[dict[str, float]], target: float) -> float:
 def equal_error(table: np.ndarray, sample: np.ndarray, rtols: list[float], threads: int,
                 repeats: int, target: float) -> tuple[str, dict[str, object]]:
     """Item 4: every solver over the rtol ladder; Markdown and a JSON-able dict."""
-    from kernels import transverse as tk
+    from sweep.kernels import transverse as tk
     rows = table[sample]
     q_ref, q_max = final_state_reference(rows)
 
@@ -297,13 +297,13 @@ NUMBALSODA = None
 
 def state_counts(states: np.ndarray) -> dict[str, int]:
     """Number of points in each response state that occurs."""
-    from kernels.metrics import STATE_MEANINGS
+    from sweep.kernels.metrics import STATE_MEANINGS
     values, counts = np.unique(states, return_counts=True)
     return {STATE_MEANINGS[v]: int(c) for v, c in zip(values, counts)}
 
 
 def main() -> None:
-    from kernels import transverse as tk
+    from sweep.kernels import transverse as tk
     args = parse_args()
     thread_counts = [int(s) for s in args.threads.split(",") if s.strip()]
     scene = build_scene(args.points_per_axis, args.rtol, args.atol)

@@ -2,7 +2,7 @@
 
 What it measures
 ----------------
-The longitudinal problem of MODEL.md sec. 4 (Table 1 cable, P0 = 4 N, C = 1) on --spans spans
+The longitudinal problem of docs/model.md sec. 4 (Table 1 cable, P0 = 4 N, C = 1) on --spans spans
 of lengths evenly spread over [0.5, 1.5] m, --intervals intervals each, --transits wave
 transits l/a. One point-update is one node advanced one time level.
 
@@ -39,7 +39,7 @@ def kernel_run(lengths: np.ndarray, intervals: int, transits: float,
                threads: int) -> tuple[float, int, np.ndarray]:
     """(wall seconds, point-updates, peak end displacement per span) for the Numba kernel."""
     import numba
-    from kernels import longitudinal as lk
+    from sweep.kernels import longitudinal as lk
     numba.set_num_threads(threads)
     n = lengths.size
     params = np.column_stack([lengths, np.full(n, WAVE), np.full(n, EA), np.full(n, P0),

@@ -131,7 +131,7 @@ def best_of(fn, runs: int) -> tuple[float, object]:
 def measure(n_target: int, thread_counts: list[int], repeats: int,
             max_repeats: int) -> list[dict[str, object]]:
     """Kernel and sweep.run timings of one grid size on each thread count."""
-    from kernels import transverse as tk
+    from sweep.kernels import transverse as tk
     n_length, n_ratio = grid_shape(n_target)
     scene = build_scene(n_length, n_ratio)
     table = parameter_table(scene)

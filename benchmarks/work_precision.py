@@ -109,7 +109,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common, r
 
 from bench_common import (best_time, markdown_table, parameter_table,  # noqa: E402
                           solve_scipy, write_json)
-from kernels import oscillator as osc  # noqa: E402
+from sweep.kernels import oscillator as osc  # noqa: E402
 from reference_metrics import (HAS_SETTLING, HermiteSamples, response_metrics,  # noqa: E402
                                self_check)
 from sweep.run import (KernelResult, grid_order, point_order, sample_times,  # noqa: E402
@@ -276,8 +276,8 @@ def variant(scene: Scene, overrides: dict[str, object]) -> Scene:
 def run_cable_sweep(table: np.ndarray, scene: Scene, rtol: float, atol: float,
                     controller: str = "scipy", method: str = "rk45") -> Measurement:
     """cable-sweep on all points: best wall time on 1 and on 2 threads, and its outputs."""
-    from kernels import metrics as mt
-    from kernels import transverse as tk
+    from sweep.kernels import metrics as mt
+    from sweep.kernels import transverse as tk
     tuned = variant(scene, {"solver.rtol": rtol, "solver.atol": atol,
                             "solver.controller": controller, "solver.method": method})
     settings = settings_vector(tuned)

@@ -1,7 +1,7 @@
 """Length sweep: how the span length moves a cable into parametric resonance.
 
 A harmonic end load P0 cos(W t) at twice each span's own natural frequency (W = 2 w1) drives
-the principal parametric resonance (MODEL.md sec. 2). With mu = P0 / (2 Pcr) it grows only
+the principal parametric resonance (docs/model.md sec. 2). With mu = P0 / (2 Pcr) it grows only
 where mu > 2 zeta: short spans are stiff (Pcr large) and stay still, long ones respond, and
 past l = pi sqrt(EI / P0) (about 1.25 m here) the peak load exceeds the buckling load.
 

@@ -8,7 +8,7 @@ Eq.38 with c = C^2:
     u_j^{n+1} = 2 u_j^n - u_j^{n-1} + C^2 (u_{j+1}^n - 2 u_j^n + u_{j-1}^n)
 
 The loaded end uses a ghost node u_{N+1} = u_{N-1} - 2 dx P0/EA in the same update; the first
-level is the Taylor step u^1 = u^0 + (C^2/2) D2 u^0 (MODEL.md sec. 4). At C = 1 the nodal values
+level is the Taylor step u^1 = u^0 + (C^2/2) D2 u^0 (docs/model.md sec. 4). At C = 1 the nodal values
 are d'Alembert's exactly; C > 1 is unstable and is refused by the scene layer.
 
 One span advances through all its time levels while its three levels of nodes sit in cache;

@@ -1,4 +1,4 @@
-"""Response metrics reduced inside the kernel, without storing the trajectory (MODEL.md sec. 3).
+"""Response metrics reduced inside the kernel, without storing the trajectory (docs/model.md sec. 3).
 
 While it integrates, the driver records every extremum of q (located on the dense output), the
 running peak |q|, the tail window's max |q| and range, and the last time |q - centre| exceeded

@@ -1,4 +1,4 @@
-"""The modal oscillator of MODEL.md in general form (SI units).
+"""The modal oscillator of docs/model.md in general form (SI units).
 
     m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = 0
 

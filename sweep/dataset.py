@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from kernels import metrics as km
-from kernels import transverse as tk
+from sweep.kernels import metrics as km
+from sweep.kernels import transverse as tk
 
 from .scene import Scene
 

@@ -41,7 +41,7 @@ def _set_threads(threads: int) -> None:
 
 def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:
     """Empty transverse outputs of n points, by name (the kernel's output arrays)."""
-    from kernels import transverse as tk
+    from sweep.kernels import transverse as tk
     return {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
             "counts": np.empty((n, tk.N_COUNTS), np.int64), "series": np.empty((n, n_samples))}
 
@@ -49,7 +49,7 @@ def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:
 def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
                          n_nodes: int) -> dict[str, np.ndarray]:
     """Empty longitudinal outputs of n spans, by name (the kernel's output arrays)."""
-    from kernels import longitudinal as lk
+    from sweep.kernels import longitudinal as lk
     return {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
             "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
             "hist_f": np.empty((n, n_hist)), "snap_u": np.empty((n, n_snap, n_nodes)),
@@ -69,7 +69,7 @@ def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, d
 def longitudinal_chunk(params: np.ndarray, settings: np.ndarray, snapshot_times: np.ndarray,
                        n_hist: int, n_nodes: int, threads: int = 0) -> dict[str, np.ndarray]:
     """Central-difference kernel over `params` rows; outputs by name."""
-    from kernels import longitudinal as lk
+    from sweep.kernels import longitudinal as lk
     _set_threads(threads)
     out = longitudinal_outputs(params.shape[0], n_hist, snapshot_times.size, n_nodes)
     lk.solve_batch(params, settings, snapshot_times, out["states"], out["reals"], out["steps"],

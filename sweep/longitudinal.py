@@ -1,7 +1,7 @@
 """Longitudinal sweeps: cable data -> central-difference kernel over every span -> Dataset.
 
 The span is fixed at x = 0 and loaded by a constant compressive force P0 at x = l from t = 0
-(MODEL.md sec. 4). Exact facts the outputs can be read against: the front travels at
+(docs/model.md sec. 4). Exact facts the outputs can be read against: the front travels at
 a = sqrt(E/rho); the loaded end moves in a triangle wave of peak 2 P0 l/EA and period 4 l/a;
 the fixed-end force is a square wave between 0 and 2 P0 (dynamic amplification 2).
 Sign convention: tension positive, so the compressive forces here are negative.
@@ -72,7 +72,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
                      output: str | os.PathLike | None = None, resume: bool = False,
                      overwrite: bool = False) -> xr.Dataset:
     """The longitudinal (central-difference) sweep of `scene` as a Dataset."""
-    from kernels import longitudinal as lk
+    from sweep.kernels import longitudinal as lk
 
     coords = grid.coordinates(scene)
     dims = tuple(coords)

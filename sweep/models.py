@@ -5,7 +5,7 @@
 Every function here works element-wise on floats, NumPy arrays or xarray DataArrays, so the
 derived quantities keep exactly the dimensions of the axes they depend on.
 
-Two coefficient sets (MODEL.md sec. 2):
+Two coefficient sets (docs/model.md sec. 2):
 - "consistent": the Galerkin projection of the paper's Eq.17 on sin(pi x / l), re-derived;
   divided by rho A l / 2, so m = 1 and q is the midspan deflection in metres.
 - "paper": Eq.32 exactly as printed (Table 1 cable baked in), including its errors: the
@@ -30,7 +30,7 @@ PAPER_COS_CUBIC = {"printed": 0.54, "corrected": 18.7 / 1.86 ** 2}    # x pi^2 l
 
 
 def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
-    """Coefficients of the re-derived modal equation (MODEL.md sec. 2), m = 1.
+    """Coefficients of the re-derived modal equation (docs/model.md sec. 2), m = 1.
 
     p: youngs_modulus (Pa), density (kg/m^3), area (m^2), inertia (m^4), length (m),
     membrane (alpha, 1), load_amplitude (N, compression > 0).

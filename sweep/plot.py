@@ -11,7 +11,7 @@ What `plot` draws, by the result's content:
 - transverse, two swept axes: maps (`plot_map`) of amplitude and settling time with the
   modulated, unsettled, diverged and failed points marked, and a map of `state`
   (`plot_state_map`); closed-form overlays where the axes allow: the principal parametric
-  resonance zone W = 2 w1 sqrt(1 +- mu), mu = P0/(2 Pcr) (MODEL.md sec. 2; dotted where
+  resonance zone W = 2 w1 sqrt(1 +- mu), mu = P0/(2 Pcr) (docs/model.md sec. 2; dotted where
   damping suppresses it, mu < 2 zeta) and the buckling length where P0 = Pcr;
 - stored time series: q(t), one panel per point (`plot_time_series`, the paper's Fig 5);
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
@@ -464,7 +464,7 @@ def _damping(ds: xr.Dataset) -> Any:
 
 
 def _overlays(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
-    """Closed-form curves the map's axes allow (MODEL.md sec. 2); their legend handles."""
+    """Closed-form curves the map's axes allow (docs/model.md sec. 2); their legend handles."""
     handles: list = []
     if ds.attrs.get("model_kind") == "longitudinal":
         return handles
@@ -760,7 +760,7 @@ def plot_histories(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
 
 
 def _exact_peak(point: xr.Dataset, name: str) -> float | None:
-    """d'Alembert's peak of a history, signed as the history runs (MODEL.md sec. 4)."""
+    """d'Alembert's peak of a history, signed as the history runs (docs/model.md sec. 4)."""
     values = point[name].values
     finite = values[np.isfinite(values)]
     if not finite.size:

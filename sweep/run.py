@@ -40,7 +40,7 @@ def sample_times(t_end: float, dt: float) -> np.ndarray:
 
 def settings_vector(scene: Scene) -> np.ndarray:
     """The kernel's settings vector (kernels.transverse) from the scene's solver/metrics keys."""
-    from kernels import transverse as tk
+    from sweep.kernels import transverse as tk
     s = np.zeros(tk.N_SETTINGS)
     s[tk.RTOL] = scene.get("solver.rtol")
     s[tk.ATOL] = scene.get("solver.atol")
@@ -197,8 +197,8 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
                    output: str | os.PathLike | None = None, resume: bool = False,
                    overwrite: bool = False) -> xr.Dataset:
     """The transverse (RK45) sweep of `scene` as a Dataset."""
-    from kernels import transverse as tk
-    from kernels.oscillator import PARAM_NAMES
+    from sweep.kernels import transverse as tk
+    from sweep.kernels.oscillator import PARAM_NAMES
 
     coords = grid.coordinates(scene)
     dims = tuple(coords)

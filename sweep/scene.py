@@ -1,6 +1,6 @@
 """Scene files: load a sweep description from TOML, validate it, and write it back.
 
-A scene is a TOML document (see DESIGN.md) checked against the table in `sweep.schema`.
+A scene is a TOML document (see docs/architecture.md) checked against the table in `sweep.schema`.
 `load_scene` takes a built-in name (a file in ``sweep/scenes/``) or a path, applies
 ``KEY=VALUE`` overrides to the parsed document, validates everything, and returns a
 `Scene`: every scalar key resolved (defaults applied) plus one float64 array per axis.
@@ -33,9 +33,9 @@ Transverse scenes (``model.kind = "transverse"``, the default):
   <= MAX_SAMPLES (10 million samples per point).
 - With ``model.coefficients = "paper"`` the cable data is baked into Eq.32, so its
   parameters cannot be swept, and ``initial.velocity`` defaults to 0.0321 m/s when no
-  initial condition is given (MODEL.md: that reproduces the paper's Fig 5 amplitudes).
+  initial condition is given (docs/model.md: that reproduces the paper's Fig 5 amplitudes).
 
-Longitudinal scenes (``model.kind = "longitudinal"``, MODEL.md sec. 4):
+Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
 - ``load.type`` defaults to "constant", the only type allowed (a suddenly applied end load).
 - Only ``length``, ``load_amplitude``, ``youngs_modulus``, ``density`` and ``area`` can be
   swept.
@@ -884,7 +884,7 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     if load_type != LONGITUDINAL_LOAD:
         _fail("scene key 'load.type'",
               f"model.kind = 'longitudinal' takes only '{LONGITUDINAL_LOAD}'",
-              "use load.type = 'constant', a suddenly applied end load (MODEL.md sec. 4), or "
+              "use load.type = 'constant', a suddenly applied end load (docs/model.md sec. 4), or "
               "model.kind = 'transverse' for a harmonic load")
     for axis in axes:
         if axis not in LONGITUDINAL_AXES:

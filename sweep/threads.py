@@ -52,9 +52,9 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count).
     """
-    from kernels import lanes
-    from kernels import metrics as mt
-    from kernels import transverse as tk
+    from sweep.kernels import lanes
+    from sweep.kernels import metrics as mt
+    from sweep.kernels import transverse as tk
     if driver not in ("lanes", "scalar"):
         raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
     if driver == "scalar":

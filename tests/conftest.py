@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from kernels import oscillator as osc
-from kernels import transverse as tk
+from sweep.kernels import oscillator as osc
+from sweep.kernels import transverse as tk
 from sweep.threads import solve_transverse
 
 

@@ -8,9 +8,9 @@ import re
 import numpy as np
 import pytest
 
-from kernels import lanes, vecmath
-from kernels import transverse as tk
-from kernels.oscillator import Q0
+from sweep.kernels import lanes, vecmath
+from sweep.kernels import transverse as tk
+from sweep.kernels.oscillator import Q0
 
 from conftest import param_row, settings
 from sweep.threads import solve_transverse
@@ -125,7 +125,7 @@ t_end = 1.0
 
 @pytest.mark.parametrize("eighth, exponent", [(None, -1 / 5), (True, -1 / 8)])
 def test_vectorisable_controller_matches_scipy_controller(eighth, exponent):
-    from kernels.dopri5 import step_factor
+    from sweep.kernels.dopri5 import step_factor
     errs = np.concatenate([np.geomspace(1e-12, 1e12, 4001),
                            [0.0, 1.0, 5.9049e-6, 0.09 ** 8, np.inf, np.nan]])
     for rejected_before in (False, True):
@@ -153,7 +153,7 @@ def test_controller_powers_are_accurate():
 
 
 def test_pi_controller_factor_follows_its_formula():
-    from kernels.dopri5 import (MAX_FACTOR, MIN_FACTOR, PI_ALPHA, PI_BETA, SAFETY, pi_log2_err,
+    from sweep.kernels.dopri5 import (MAX_FACTOR, MIN_FACTOR, PI_ALPHA, PI_BETA, SAFETY, pi_log2_err,
                                 pi_step_factor)
     prev = 3e-3
     memory = pi_log2_err(prev)
@@ -190,7 +190,7 @@ def test_second_pass_points_in_a_threaded_lanes_batch(method):
     """Points at rest away from zero (overdamped creep, a damped post-buckled swing) get their
     settling time from the second pass whichever driver and thread count ran them; results do
     not depend on the thread count."""
-    from kernels import metrics as km
+    from sweep.kernels import metrics as km
     creep = [param_row(c=5.0, k0=-1.0, g0=1.0, q0=q0) for q0 in (0.1, 0.3, 2.0)]
     swing = [param_row(c=1.0, k0=-1.0, g0=1.0, q0=q0) for q0 in (0.2, -0.5)]
     rng = np.random.default_rng(3)
@@ -282,8 +282,8 @@ import sys
 import numpy as np
 sys.path[:0] = [{tests!r}, {root!r}]
 from conftest import param_row, settings
-from kernels import lanes
-from kernels import transverse as tk
+from sweep.kernels import lanes
+from sweep.kernels import transverse as tk
 rows = np.load({rows!r})
 s = settings(rtol=1e-6, t_end=5.0, sample_dt=0.05)
 n = rows.shape[0]

@@ -1,4 +1,4 @@
-"""The central-difference kernel against the exact d'Alembert solution (MODEL.md sec. 4)."""
+"""The central-difference kernel against the exact d'Alembert solution (docs/model.md sec. 4)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import sweep
-from kernels import longitudinal as lk
+from sweep.kernels import longitudinal as lk
 
 E, RHO, A = 1.1e11, 8900.0, 6e-6
 WAVE = math.sqrt(E / RHO)
@@ -177,12 +177,12 @@ t_end = 10.0
 """)
     ds = sweep.run(scene, progress=False)
     assert float(ds["load_ratio"]) > 1.0                      # above Pcr = EI pi^2 = 6.2 N
-    from kernels import metrics as km
+    from sweep.kernels import metrics as km
     steady, gone = ds["state"].values
     assert steady == km.STEADY and gone == km.DIVERGED
     EI, rhoA, k = 1.1e11 * 5.73e-12, 8900 * 6e-6, np.pi
     k1 = EI / rhoA * k ** 4 * (1 - 8.0 / (EI * k ** 2))
     K3 = 0.375 * 1.1e11 / 8900 * k ** 4 + 8.0 * k ** 4 / (2 * rhoA) - 1.25 * EI / rhoA * k ** 6
-    q_s = np.sqrt(-k1 / K3)                                   # MODEL.md: sqrt(-k1/K3)
+    q_s = np.sqrt(-k1 / K3)                                   # docs/model.md: sqrt(-k1/K3)
     assert float(ds["amplitude"][0]) == pytest.approx(q_s, rel=1e-3)
     assert 0 < float(ds["failure_time"][1]) < 10.0

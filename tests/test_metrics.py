@@ -9,8 +9,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from kernels import metrics as km
-from kernels import transverse as tk
+from sweep.kernels import metrics as km
+from sweep.kernels import transverse as tk
 
 from conftest import param_row, rhs, settings, solve
 

@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 
 import sweep
-from kernels import metrics as km
+from sweep.kernels import metrics as km
 
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]   # installed or checkout, as imported
 
@@ -39,7 +39,7 @@ def cli(*args, cwd=None):
 
 
 def test_paper_fig5_amplitudes():
-    """Within 10 % of the paper's 4.1, 3.8, 3.4, 3.0 mm; and MODEL.md's re-run of Eq.32."""
+    """Within 10 % of the paper's 4.1, 3.8, 3.4, 3.0 mm; and docs/model.md's re-run of Eq.32."""
     ds = sweep.run(sweep.load_scene("paper-fig5"), progress=False)
     amp_mm = ds["amplitude"].values * 1e3
     np.testing.assert_allclose(amp_mm, [4.1, 3.8, 3.4, 3.0], rtol=0.10)

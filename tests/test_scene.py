@@ -535,7 +535,7 @@ def test_longitudinal_paper_rules_do_not_apply():
 def test_longitudinal_refuses_harmonic_load():
     message = scene_error(LONG + '[load]\ntype = "harmonic"')
     assert message == ("scene key 'load.type': model.kind = 'longitudinal' takes only 'constant' "
-                       "(use load.type = 'constant', a suddenly applied end load (MODEL.md sec. 4), "
+                       "(use load.type = 'constant', a suddenly applied end load (docs/model.md sec. 4), "
                        "or model.kind = 'transverse' for a harmonic load)")
     assert message == scene_error(LONG, {"load.type": "harmonic"})
 

@@ -12,8 +12,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings as hsettings, strategies as st
 
 import sweep
-from kernels import metrics as km
-from kernels import transverse as tk
+from sweep.kernels import metrics as km
+from sweep.kernels import transverse as tk
 
 from conftest import param_row, settings, solve
 
@@ -30,7 +30,7 @@ def run(text: str, **overrides):
 
 
 def barrier_closed_form(length: float) -> float:
-    """MODEL.md: positive root of w1^2 + K3 q^2 + K5 q^4 = 0 (unloaded, alpha = 3/8)."""
+    """docs/model.md: positive root of w1^2 + K3 q^2 + K5 q^4 = 0 (unloaded, alpha = 3/8)."""
     k = np.pi / length
     ei_ra = TABLE1["E"] * TABLE1["I"] / (TABLE1["rho"] * TABLE1["A"])
     w1sq = ei_ra * k ** 4
@@ -297,7 +297,7 @@ def test_a_grid_too_large_for_memory_is_refused_before_any_work():
 
 
 def test_longitudinal_time_levels_are_bounded_by_max_steps():
-    from kernels import longitudinal as lk
+    from sweep.kernels import longitudinal as lk
     ds = run("[model]\nkind = 'longitudinal'\n[solver]\nintervals = 100\ntransits = 50\n"
              "max_steps = 1000\n")
     assert int(ds["state"]) == lk.MAX_STEPS and int(ds["n_steps"]) == 1000
