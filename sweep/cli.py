@@ -3,6 +3,8 @@
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep scenes
+    sweep keys [SECTION | KEY] [--markdown]
+    sweep --version
 
 Exit status: 0 on success, 2 on a user error (one line on stderr: what is wrong, where, and how
 to fix it; a sweep too large for memory counts as one), 1 on an internal error.
@@ -17,6 +19,19 @@ import warnings
 from typing import Sequence
 
 from .errors import CableSweepWarning, UserError
+
+VERSION = "0.1.0"
+"""The version a source checkout reports when cable-sweep is not installed (keep it equal to
+pyproject.toml's; tests/test_keys.py checks)."""
+
+
+def package_version() -> str:
+    """The installed cable-sweep's version (package metadata), else `VERSION`."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("cable-sweep")
+    except PackageNotFoundError:
+        return VERSION
 
 
 class _Parser(argparse.ArgumentParser):
@@ -33,6 +48,8 @@ def _one_line(text: str) -> str:
 
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sweep", description="Parameter sweeps of nonlinear cable vibration.")
+    parser.add_argument("--version", action="version",
+                        version=f"sweep (cable-sweep) {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     run = sub.add_parser("run", help="run a scene and write the result as netCDF")
     run.add_argument("scene", metavar="SCENE",
@@ -71,6 +88,11 @@ def _parser() -> argparse.ArgumentParser:
     plot.add_argument("--dpi", type=float, default=100.0, metavar="N",
                       help="resolution of raster formats in dots per inch (default: 100)")
     sub.add_parser("scenes", help="list the built-in scenes")
+    keys = sub.add_parser("keys", help="every scene key: type, default, units, allowed values")
+    keys.add_argument("which", nargs="?", default=None, metavar="SECTION | KEY",
+                      help="only this section (e.g. solver) or dotted key (e.g. solver.rtol)")
+    keys.add_argument("--markdown", action="store_true",
+                      help="the whole reference as a Markdown page (docs/scene-keys.md)")
     return parser
 
 
@@ -148,6 +170,15 @@ def _scenes() -> int:
     return 0
 
 
+def _keys(args: argparse.Namespace) -> int:
+    from .keys import markdown, text
+    if args.markdown and args.which is not None:
+        raise UserError(f"keys {args.which} --markdown: the Markdown page covers every "
+                        "key; leave out the section or key, or drop --markdown")
+    sys.stdout.write(markdown() if args.markdown else text(args.which))
+    return 0
+
+
 def _one_line_warnings() -> None:
     """Show cable-sweep's own warnings as one line on stderr, as they happen (installed once,
     however often `main` is called in one process)."""
@@ -173,6 +204,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run(args)
         if args.command == "plot":
             return _plot(args)
+        if args.command == "keys":
+            return _keys(args)
         return _scenes()
     except UserError as exc:
         print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)
