@@ -106,7 +106,7 @@ def text(which: str | None = None) -> str:
     for key in _select(which):
         head = f"{key.dotted}  {key.kind}"
         default = toml_value(key.default)
-        head += f" = {default}" if default else " (no default)"
+        head += f" = {default}" if default else " (no fixed default)"
         if key.units and key.units != "1":
             head += f"  [{key.units}]"
         if key.axis is not None:
