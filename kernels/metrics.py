@@ -49,7 +49,7 @@ EXT_KIND = 2   # MAXIMUM or MINIMUM
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def tail_counts(buf, n, t_tail):
-    """Number of maxima and minima at t >= t_tail, and the response period from the maxima."""
+    """Number of maxima and minima at t >= t_tail, and the mean spacing (s) of those maxima."""
     n_max = 0
     n_min = 0
     first_max = math.nan
@@ -69,22 +69,24 @@ def tail_counts(buf, n, t_tail):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def last_envelope_violation(buf, n, band):
-    """Time of the last extremum farther than `band` (m) from the final level of its kind.
+def last_envelope_violation(buf, n, band, k=1):
+    """Time (s) of the last extremum farther than `band` (m) from the final level of its class.
 
-    The final level of the maxima is the last maximum, that of the minima the last minimum.
+    The maxima are split into k classes by their position counted from the last maximum
+    (position j belongs to class j mod k), and so are the minima; the final level of a class is
+    its last extremum. k = 1: every maximum is compared with the last maximum, every minimum with
+    the last minimum; k = 2 suits a period-2 orbit whose maxima alternate between two levels.
     Returns 0.0 when no extremum lies outside its band.
     """
-    level_max = math.nan
-    level_min = math.nan
+    levels = np.empty((2, k))
+    seen = np.zeros(2, np.int64)
     for i in range(n - 1, -1, -1):
-        if buf[i, EXT_KIND] == MAXIMUM and math.isnan(level_max):
-            level_max = buf[i, EXT_Q]
-        if buf[i, EXT_KIND] == MINIMUM and math.isnan(level_min):
-            level_min = buf[i, EXT_Q]
-    for i in range(n - 1, -1, -1):
-        level = level_max if buf[i, EXT_KIND] == MAXIMUM else level_min
-        if abs(buf[i, EXT_Q] - level) > band:
+        kind = 0 if buf[i, EXT_KIND] == MAXIMUM else 1
+        j = seen[kind]
+        seen[kind] = j + 1
+        if j < k:
+            levels[kind, j] = buf[i, EXT_Q]
+        elif abs(buf[i, EXT_Q] - levels[kind, j % k]) > band:
             return buf[i, EXT_T]
     return 0.0
 
@@ -111,3 +113,76 @@ def tail_trend(buf, n, t_tail, t_end):
         falling = falling and quarter[j + 1] < quarter[j]
         rising = rising and quarter[j + 1] > quarter[j]
     return falling or rising
+
+
+# Periodic orbits of higher order (period-k: k maxima per period whose levels differ).
+MAX_ORDER = 8        # the largest k tried
+MIN_PER_CLASS = 3    # extrema each class needs in the tail before k >= 2 is believed
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def level_spread(buf, n, k):
+    """Largest range (m) of the last k maxima or of the last k minima: how far apart the final
+    levels of the k classes of `last_envelope_violation` lie."""
+    lo = np.full(2, math.inf)
+    hi = np.full(2, -math.inf)
+    seen = np.zeros(2, np.int64)
+    for i in range(n - 1, -1, -1):
+        kind = 0 if buf[i, EXT_KIND] == MAXIMUM else 1
+        if seen[kind] < k:
+            seen[kind] += 1
+            lo[kind] = min(lo[kind], buf[i, EXT_Q])
+            hi[kind] = max(hi[kind], buf[i, EXT_Q])
+    spread = 0.0
+    for kind in range(2):
+        if seen[kind] > 0:
+            spread = max(spread, hi[kind] - lo[kind])
+    return spread
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def periodic_order(buf, n, t_tail, band, n_max, n_min):
+    """The smallest k in 2..MAX_ORDER for which the tail is a period-k orbit, and its settling
+    time (s); (0, nan) when there is none.
+
+    Period-k: every extremum lies within +-band (m) of the final level of its class
+    (`last_envelope_violation` with k classes) from before t_tail (s) on; the tail holds at least
+    MIN_PER_CLASS maxima and minima per class (n_max, n_min: the tail's counts); and the final
+    levels of the classes differ by more than the band (else k = 1 would have held). A transient
+    whose extrema drift one way cannot pass: the range of a class then exceeds that of the last
+    k levels.
+    """
+    for k in range(2, MAX_ORDER + 1):
+        if n_max < MIN_PER_CLASS * k or n_min < MIN_PER_CLASS * k:
+            break
+        if level_spread(buf, n, k) <= band:
+            continue
+        t_settle = last_envelope_violation(buf, n, band, k)
+        if t_settle < t_tail:
+            return k, t_settle
+    return 0, math.nan
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def orbit_period(buf, n, t_tail, k):
+    """Period (s) of a period-k orbit: k times the mean spacing of the tail's maxima, measured
+    over a whole number of periods ending at the last maximum."""
+    n_max = 0
+    last = math.nan
+    for i in range(n - 1, -1, -1):
+        if buf[i, EXT_T] < t_tail:
+            break
+        if buf[i, EXT_KIND] == MAXIMUM:
+            if n_max == 0:
+                last = buf[i, EXT_T]
+            n_max += 1
+    periods = (n_max - 1) // k
+    if periods < 1:
+        return math.nan
+    seen = 0
+    for i in range(n - 1, -1, -1):
+        if buf[i, EXT_KIND] == MAXIMUM:
+            if seen == periods * k:
+                return (last - buf[i, EXT_T]) / periods
+            seen += 1
+    return math.nan

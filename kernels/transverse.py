@@ -128,6 +128,14 @@ def classify(p, settings, acc, buf, reals, counts):
             if want_settling:
                 reals[SETTLING] = t_settle
             return mt.STEADY
+        k, t_settle = mt.periodic_order(buf, n_ext, t_tail, band, n_max, n_min)
+        if k > 0:
+            # A period-k orbit (maxima alternating between k levels): steady, its period k
+            # maxima long.
+            reals[PERIOD] = mt.orbit_period(buf, n_ext, t_tail, k)
+            if want_settling:
+                reals[SETTLING] = t_settle
+            return mt.STEADY
         if mt.tail_trend(buf, n_ext, t_tail, settings[T_END]):
             return mt.UNSETTLED
         return mt.MODULATED

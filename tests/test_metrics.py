@@ -194,3 +194,110 @@ def test_points_are_independent_of_their_neighbours_and_of_threads():
         for a, b in zip(alone[j], one):
             np.testing.assert_array_equal(a[0], b[i])
     assert one[0][7] == km.DIVERGED
+
+
+def _period2_row() -> np.ndarray:
+    """Consistent model, l = 0.943 m, zeta = 0.0378, P0 = 11.81 N at W/w1 = 0.9467, q0 = 3e-4 m
+    (the paper's inertia 5.73e-12 m^4 written out): a period-2 orbit, maxima at two levels."""
+    from sweep import models
+    from sweep.kernels import oscillator as osc
+    c = models.oscillator(dict(
+        youngs_modulus=1.1e11, density=8900.0, area=6e-6, inertia=5.73e-12, length=0.943,
+        membrane=0.375, load_amplitude=11.81, damping_ratio=0.0378, frequency_ratio=0.9467,
+        initial_displacement=3e-4, initial_velocity=0.0, coefficients="consistent",
+        load_type="harmonic", paper_parametric="printed"))
+    return np.array([float(c[name]) for name in osc.PARAM_NAMES])
+
+
+@pytest.mark.parametrize("driver", ["scalar", "lanes"])
+def test_period_two_orbit_is_steady_with_its_true_period(driver):
+    """Maxima alternating between two levels: steady, period two maxima long, settling time the
+    last extremum off its own level; checked against DOP853 at rtol 1e-12 over 60 s."""
+    row = _period2_row()
+    t_end, tol = 13.0, 0.02
+    states, reals, _, _ = solve(row, settings(t_end=t_end, tol=tol, rtol=1e-10), driver=driver)
+    sol = solve_ivp(rhs(row), (0, 60.0), row[8:10], method="DOP853", rtol=1e-12, atol=1e-16,
+                    dense_output=True)
+    times, peaks = _envelope_peaks(sol, 0.0, 60.0)
+    is_max = -(row[2] * peaks + row[4] * peaks ** 3 + row[6] * peaks ** 5
+               + (row[3] * peaks + row[5] * peaks ** 3) * np.cos(row[7] * times)) < 0
+    t_max, q_max = times[is_max], peaks[is_max]
+    # The reference: after 40 s, maxima 2 apart repeat to 1e-9 m (a period-2 orbit: the
+    # Poincare return of every second maximum), neighbours differ by far more than the band.
+    late = t_max > 40.0
+    assert np.ptp(q_max[late][::2]) < 1e-9 and np.ptp(q_max[late][1::2]) < 1e-9
+    assert abs(q_max[late][0] - q_max[late][1]) > 5 * tol * q_max.max()
+    period = np.mean(t_max[late][2::2] - t_max[late][:-2:2])
+    assert period == pytest.approx(2 * (2 * np.pi / row[7]), rel=1e-9)   # locked at W / 2
+    assert states[0] == km.STEADY
+    # response_period: two maxima spacings, over a whole number of periods of the tail.
+    tail = t_max[(t_max >= t_end / 2) & (t_max < t_end)]
+    whole = (tail.size - 1) // 2
+    assert reals[0, tk.PERIOD] == pytest.approx((tail[-1] - tail[-1 - 2 * whole]) / whole,
+                                                rel=1e-8)
+    assert reals[0, tk.PERIOD] == pytest.approx(period, rel=1e-6)   # the transient is gone
+    # Settling: the last extremum before t_end farther than tol * A from the final level of its
+    # own class (kind, and position from the end modulo 2).
+    amp = reals[0, tk.AMPLITUDE]
+    expected = 0.0
+    for kind in (True, False):
+        t_k, q_k = times[(is_max == kind) & (times < t_end)], peaks[(is_max == kind) & (times < t_end)]
+        level = np.where(np.arange(q_k.size)[::-1] % 2 == 0, q_k[-1], q_k[-2])
+        off = np.abs(q_k - level) > tol * amp
+        expected = max(expected, t_k[off][-1])
+    assert 0.5 < expected < t_end / 2
+    assert reals[0, tk.SETTLING] == pytest.approx(expected, rel=1e-6)
+
+
+def _buffer(times, values, kinds) -> tuple[np.ndarray, int]:
+    buf = np.column_stack([times, values, kinds]).astype(float)
+    return buf, buf.shape[0]
+
+
+def _extrema(levels_max, levels_min, n_periods, spacing=0.1):
+    """Alternating maxima and minima, the maxima cycling through levels_max, the minima through
+    levels_min; one extremum every spacing/2 s."""
+    values = []
+    for i in range(n_periods * len(levels_max)):
+        values += [levels_max[i % len(levels_max)], levels_min[i % len(levels_min)]]
+    times = 0.5 * spacing * np.arange(len(values))
+    kinds = np.tile([km.MAXIMUM, km.MINIMUM], len(values) // 2)
+    return times, np.array(values), kinds
+
+
+def test_three_level_orbit_is_period_three_and_settles_after_its_transient():
+    times, values, kinds = _extrema([1.0, 1.3, 1.15], [-1.1, -0.9, -1.2], 12)
+    values[:7] *= 1.5                      # a transient in the first 7 extrema
+    buf, n = _buffer(times, values, kinds)
+    t_end = times[-1] + 0.05
+    t_tail = t_end / 2
+    n_max, n_min, _ = km.tail_counts(buf, n, t_tail)
+    band = 0.02 * 1.3
+    assert km.last_envelope_violation(buf, n, band) >= t_tail      # k = 1 does not hold
+    k, t_settle = km.periodic_order(buf, n, t_tail, band, n_max, n_min)
+    assert k == 3                                                   # not 6: the smallest k
+    assert t_settle == times[6]
+    assert km.orbit_period(buf, n, t_tail, k) == pytest.approx(3 * 0.1, rel=1e-12)
+
+
+def test_quasi_periodic_and_drifting_extrema_are_not_periodic_orbits():
+    j = np.arange(96)
+    golden = (np.sqrt(5) - 1) / 2
+    t = 0.05 * np.arange(2 * j.size)
+    kinds = np.tile([km.MAXIMUM, km.MINIMUM], j.size)
+    band = 0.02
+    cases = {
+        "quasi-periodic": 1 + 0.2 * np.cos(2 * np.pi * golden * j),
+        # Decaying by 1.1 bands over the tail's 47 spacings: a class k = 8 apart spans only
+        # 39 of them (0.91 bands); the last 8 levels differ by far less than the band.
+        "drifting": 1.0 + 1.1 * band / 47 * (j[-1] - j),
+    }
+    for name, maxima in cases.items():
+        values = np.empty(2 * j.size)
+        values[0::2], values[1::2] = maxima, -maxima
+        buf, n = _buffer(t, values, kinds)
+        t_tail = t[-1] / 2
+        n_max, n_min, _ = km.tail_counts(buf, n, t_tail)
+        assert n_max >= km.MIN_PER_CLASS * km.MAX_ORDER               # enough extrema for every k
+        assert km.last_envelope_violation(buf, n, band) >= t_tail, name
+        assert km.periodic_order(buf, n, t_tail, band, n_max, n_min)[0] == 0, name
