@@ -7,9 +7,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from .errors import SceneError
 from .schema import BY_AXIS
-from .scene import Scene
+from .scene import Scene, default_inertia
 
 
 def coordinates(scene: Scene) -> dict[str, xr.DataArray]:
@@ -27,15 +26,13 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params: dict[str, Any] = {}
     for name, key in BY_AXIS.items():
         params[name] = coords[name] if name in coords else scene.get(key.dotted)
+    if params["inertia"] is None:                 # not given, area swept: follows the area
+        params["inertia"] = default_inertia(params["area"])
     params["coefficients"] = scene.get("model.coefficients")
     params["paper_parametric"] = scene.get("model.paper_parametric")
     params["load_type"] = scene.get("load.type")
     params["divergence_bound"] = scene.get("metrics.divergence_bound")
-    if params["load_type"] == "constant":
-        for name in ("frequency", "frequency_ratio"):
-            if name in coords:
-                raise SceneError(f"axis '{name}': load.type = 'constant' has no frequency "
-                                 "(remove the axis or use load.type = 'harmonic')")
+    if params["load_type"] == "constant":      # no frequency axis: refused by load_scene
         params["frequency"] = None
     return params
 

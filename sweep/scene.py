@@ -25,6 +25,9 @@ Resolution rules worth knowing:
   (``solver.t_end``, ``solver.transits``) removes the other, so ``--set`` can always
   replace what the scene file says.
 - ``solver.courant`` above 1 is refused whatever the model (the scheme is unstable there).
+- ``cable.inertia`` not given: `default_inertia` of the area, the bending moment of a solid
+  round section, A^2 / (4 pi). With ``area`` swept, ``values["cable.inertia"]`` is None and the
+  inertia follows the area point by point (`sweep.grid.parameters`).
 
 Transverse scenes (``model.kind = "transverse"``, the default):
 - ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
@@ -58,6 +61,7 @@ import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from fractions import Fraction
 from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
@@ -69,6 +73,17 @@ from .errors import SceneError
 
 PAPER_VELOCITY = 0.0321
 """initial.velocity (m/s) used by the paper preset when no initial condition is given."""
+
+def default_inertia(area: Any) -> Any:
+    """cable.inertia (m^4) of a scene that gives none: the bending second moment of area of a
+    solid round section of ``area`` (m^2), pi d^4 / 64 = A^2 / (4 pi); 2.865e-12 for 6e-6.
+
+    Element-wise on floats, arrays and DataArrays. The paper's 5.73e-12 is the polar moment
+    of its 6 mm^2 section (twice this), and a stranded cable bends more easily than a solid
+    one: give a measured inertia (EI / E) for it (see the cable.inertia key in README.md).
+    """
+    return area * area / (4.0 * math.pi)
+
 
 PAPER_FIXED_AXES: tuple[str, ...] = ("youngs_modulus", "density", "area", "inertia", "membrane")
 """Axes the paper preset cannot sweep: Eq.32 has these numbers baked in."""
@@ -87,6 +102,8 @@ LONGITUDINAL_AXES: tuple[str, ...] = ("length", "load_amplitude", "youngs_modulu
 """The axes a longitudinal scene can sweep (the parameters of the wave problem)."""
 LONGITUDINAL_LOAD = "constant"
 RANGE_KEYS: tuple[str, ...] = ("start", "stop", "num", "spacing")
+LOG_DIGITS = 15
+"""Significant digits of the values of a log-spaced range (its endpoints are kept exactly)."""
 MAX_AXIS_POINTS = 10_000_000
 MAX_SAMPLES = 10_000_000
 """Most time-series samples per point (solver.t_end / outputs.sample_interval)."""
@@ -107,7 +124,8 @@ _HINTS: dict[str, str] = {
     "cable.length": "give the span length in metres",
     "cable.density": "give the density in kg/m^3, e.g. 8900 for copper",
     "cable.area": "give the cross-sectional area in m^2, e.g. 6e-6 for 6 mm^2",
-    "cable.inertia": "give the bending second moment of area in m^4, e.g. 5.73e-12",
+    "cable.inertia": "give the bending second moment of area in m^4, e.g. 2.865e-12 (a solid "
+                     "round 6 mm^2 section), or leave it out for A^2/(4 pi)",
     "cable.youngs_modulus": "give Young's modulus in Pa, e.g. 1.1e11 for copper",
     "cable.damping_ratio": "give the damping ratio as a fraction of critical, e.g. 0.02 for 2 %",
     "model.membrane": "use 0.375 (the paper), 0.25 (classical stretching) or 0 (none)",
@@ -669,6 +687,8 @@ def _container_fix(key: schema.Key, raw: Any) -> str:
 def _example(key: schema.Key) -> str:
     """'write e.g. rtol = 1e-08', or a generic hint for keys without a default."""
     if key.default is None:
+        if key.dotted in _HINTS:
+            return _HINTS[key.dotted]
         return f"write e.g. {key.name} = 1.0" if key.kind == "float" else "give a single value"
     return f"write e.g. {key.name} = {_toml_value(key.default)}"
 
@@ -840,8 +860,53 @@ def _axis_range(where: str, raw: dict) -> np.ndarray:
         if start <= 0 or stop <= 0:
             _fail(where, f"log spacing needs start and stop > 0, got start = {start!r}, "
                          f"stop = {stop!r}", 'use positive limits or spacing = "linear"')
-        return np.geomspace(start, stop, num, dtype=np.float64)
-    return np.linspace(start, stop, num, dtype=np.float64)
+        return log_range(start, stop, num)
+    return linear_range(start, stop, num)
+
+
+def linear_range(start: float, stop: float, num: int) -> np.ndarray:
+    """``num`` evenly spaced values from start to stop, each the float nearest to its exact value.
+
+    start and stop are read as the decimals they print as (``repr``: what a user wrote, e.g.
+    0.3), and value i is the exact rational (start (num-1-i) + stop i) / (num-1) rounded once
+    to float64. So {start = 0.3, stop = 1.2, num = 10} gives 0.4, not linspace's
+    0.39999999999999997, and the endpoints are start and stop exactly.
+    """
+    if num == 1:
+        return np.array([start], dtype=np.float64)
+    first, last = Fraction(repr(start)), Fraction(repr(stop))
+    scale = math.lcm(first.denominator, last.denominator)
+    a, b = int(first * scale), int(last * scale)
+    steps = num - 1
+    denominator = scale * steps
+    if max(abs(a), abs(b)) * steps < 2**53 and denominator < 2**53:
+        # Every integer here is exact in float64, so one IEEE division rounds correctly.
+        i = np.arange(num, dtype=np.int64)
+        numerators = a * (steps - i) + b * i
+        return numerators.astype(np.float64) / float(denominator)
+    # Python's int / int is correctly rounded at any size.
+    return np.fromiter(((a * (steps - i) + b * i) / denominator for i in range(num)),
+                       dtype=np.float64, count=num)
+
+
+def log_range(start: float, stop: float, num: int) -> np.ndarray:
+    """``num`` log-spaced values from start to stop (both > 0), rounded to LOG_DIGITS
+    significant digits, endpoints exact.
+
+    A value that is a short decimal (1, 10, 100, 1000 for {start = 1, stop = 1000, num = 4})
+    is that decimal's float exactly; any other is within 5e-15 relative of start (stop /
+    start)^(i / (num - 1)) (plus float64 geomspace's few ulps where long double is double). If rounding would merge neighbours, the unrounded values are kept.
+    """
+    # In long double where the platform has it: within an ulp of the exact value before rounding.
+    values = np.geomspace(np.longdouble(start), np.longdouble(stop), num).astype(np.float64)
+    rounded = np.fromiter((float(f"{v:.{LOG_DIGITS}g}") for v in values), dtype=np.float64,
+                          count=num)
+    rounded[0], rounded[-1] = start, stop
+    steps = np.diff(rounded)
+    if np.all(steps > 0) or np.all(steps < 0):
+        return rounded
+    values[0], values[-1] = start, stop
+    return values
 
 
 def _check_monotonic(where: str, values: np.ndarray) -> None:
@@ -870,6 +935,11 @@ def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
         _fail("scene keys 'solver.method' and 'solver.controller'",
               "the PI controller is tuned for method 'rk45' only",
               "use solver.controller = 'scipy' with method 'dop853'")
+    if given.get("load.type") == "constant":
+        for axis in ("frequency_ratio", "frequency"):
+            if axis in axes:
+                _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
+                      f"remove the {axis} axis, or use load.type = 'harmonic'")
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:
@@ -914,6 +984,8 @@ def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray]) -> dict[str, An
 
     if not any(mentioned(d) for d in FREQUENCY_KEYS):
         values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    if not mentioned("cable.inertia") and values["cable.area"] is not None:
+        values["cable.inertia"] = default_inertia(values["cable.area"])
     if values["model.kind"] == "longitudinal":
         values["load.type"] = given.get("load.type", LONGITUDINAL_LOAD)
         if not any(mentioned(d) for d in END_TIME_KEYS):

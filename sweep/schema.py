@@ -67,8 +67,10 @@ KEYS: tuple[Key, ...] = (
         long_name="density", axis="density"),
     Key("cable", "area", "float", 6e-6, units="m2", minimum=0.0, exclusive_min=True,
         long_name="cross-sectional area", axis="area"),
-    Key("cable", "inertia", "float", 5.73e-12, units="m4", minimum=0.0, exclusive_min=True,
-        long_name="second moment of area used for bending", axis="inertia"),
+    # No fixed default: sweep.scene.default_inertia gives A^2/(4 pi) from the area.
+    Key("cable", "inertia", "float", None, units="m4", minimum=0.0, exclusive_min=True,
+        long_name="bending second moment of area, EI/E (default A^2/(4 pi), a solid round "
+                  "section; a stranded cable's is smaller: give a measured EI/E)", axis="inertia"),
     Key("cable", "damping_ratio", "float", 0.0, units="1", minimum=0.0,
         long_name="modal viscous damping ratio", axis="damping_ratio"),
     Key("cable", "length", "float", 1.0, units="m", minimum=0.0, exclusive_min=True,

@@ -93,8 +93,9 @@ def test_defaults_applied():
     scene = load_scene_text("")
     assert scene.name == "unnamed" and scene.description == ""
     for key in schema.KEYS:
-        if key.dotted not in ("load.frequency_ratio", "solver.t_end"):
+        if key.dotted not in ("load.frequency_ratio", "solver.t_end", "cable.inertia"):
             assert scene.get(key.dotted) == key.default
+    assert scene.get("cable.inertia") == scene.get("cable.area") ** 2 / (4 * np.pi)
     assert scene.get("load.frequency_ratio") == 1.0
     assert scene.get("solver.t_end") == DEFAULT_T_END == 5.0
     assert scene.get("solver.max_step") is None
@@ -663,3 +664,170 @@ def test_kind_override_switches_rules():
     back = load_scene_text(scene.to_toml(), overrides={"model.kind": "transverse",
                                                        "solver.t_end": 3.0})
     assert back.get("solver.t_end") == 3.0 and back.get("solver.transits") is None
+
+
+# --------------------------------------------------------------------------- range values as written
+
+
+def _decimal(units: int, places: int) -> str:
+    """units x 10^-places as a plain decimal string, e.g. (4, 1) -> '0.4'."""
+    from decimal import Decimal
+    return format(Decimal(units).scaleb(-places), "f")
+
+
+@pytest.mark.parametrize("start, stop, num, sel", [
+    ("0.3", "1.2", 10, "0.4"), ("0.3", "1.2", 10, "0.8"), ("0.1", "1.0", 10, "0.7"),
+    ("0.5", "3", 26, "2.3"), ("2", "0.2", 10, "0.6"), ("1e-3", "2e-3", 11, "0.0017"),
+])
+def test_linear_range_gives_the_values_as_written(start, stop, num, sel):
+    """Each value is the float of the decimal it is (0.4, not linspace's 0.39999999999999997),
+    so xarray's exact .sel with the written number finds it."""
+    import xarray as xr
+    scene = load_scene_text(f"[axes]\nlength = {{start = {start}, stop = {stop}, num = {num}}}")
+    axis = xr.DataArray(scene.axes["length"], dims="length", coords={"length": scene.axes["length"]})
+    assert float(axis.sel(length=float(sel))) == float(sel)
+    assert scene.axes["length"][0] == float(start) and scene.axes["length"][-1] == float(stop)
+    by_set = load_scene_text("", overrides=dict([parse_override(
+        f"axes.length={{start={start}, stop={stop}, num={num}}}")]))
+    np.testing.assert_array_equal(by_set.axes["length"], scene.axes["length"])
+
+
+def test_linear_range_of_written_decimals_matches_the_decimals():
+    """Hypothesis: start = a 10^-d, step = k 10^-d; value i must be float('<a + i k> e-d'),
+    the float Python reads from the decimal a user would type."""
+    from hypothesis import given, settings as hsettings, strategies as st
+
+    @hsettings(max_examples=300, deadline=None)
+    @given(st.integers(1, 10**6), st.integers(-10**4, 10**4).filter(bool),
+           st.integers(0, 12), st.integers(2, 60))
+    def check(a: int, k: int, places: int, num: int) -> None:
+        units = [a + i * k for i in range(num)]
+        if min(units) <= 0:
+            return                                    # lengths must stay positive
+        text = (f"[axes]\nlength = {{start = {_decimal(units[0], places)}, "
+                f"stop = {_decimal(units[-1], places)}, num = {num}}}")
+        values = load_scene_text(text).axes["length"]
+        expected = [float(_decimal(u, places)) for u in units]
+        assert values.tolist() == expected, text
+
+    check()
+
+
+def test_range_that_is_not_a_short_decimal_is_correctly_rounded():
+    from fractions import Fraction
+    values = load_scene_text("[axes]\nlength = {start = 0.1, stop = 1.0, num = 4}").axes["length"]
+    exact = [Fraction(1, 10) + i * Fraction(3, 10) for i in range(4)]
+    assert values.tolist() == [float(x) for x in exact]       # 0.4, 0.7 exactly
+    thirds = load_scene_text("[axes]\nload_amplitude = {start = 0, stop = 1, num = 4}")
+    assert thirds.axes["load_amplitude"].tolist() == [0.0, 1 / 3, 2 / 3, 1.0]
+
+
+@pytest.mark.parametrize("mantissa", [1, 2, 5, 7])
+@pytest.mark.parametrize("first, decades", [(0, 3), (-6, 4), (-3, 6), (2, 2)])
+def test_log_range_of_whole_decades_is_exact(mantissa, first, decades):
+    text = (f'[axes]\nlength = {{start = {mantissa}e{first}, stop = {mantissa}e{first + decades}, '
+            f'num = {decades + 1}, spacing = "log"}}')
+    values = load_scene_text(text).axes["length"]
+    assert values.tolist() == [float(f"{mantissa}e{first + i}") for i in range(decades + 1)]
+
+
+def test_log_range_close_to_the_geometric_values():
+    """Hypothesis: every log value within 1e-14 relative of start (stop/start)^(i/(num-1))
+    (computed in 40-digit decimal; rounding to 15 digits moves a value by up to 5e-15),
+    endpoints exact, strictly monotonic."""
+    from decimal import Decimal, localcontext
+    from hypothesis import given, settings as hsettings, strategies as st
+
+    @hsettings(max_examples=200, deadline=None)
+    @given(st.floats(1e-6, 1e6), st.floats(1e-6, 1e6), st.integers(2, 50))
+    def check(start: float, stop: float, num: int) -> None:
+        if abs(stop / start - 1) < 1e-6:
+            return
+        text = f'[axes]\nlength = {{start = {start!r}, stop = {stop!r}, num = {num}, spacing = "log"}}'
+        values = load_scene_text(text).axes["length"]
+        assert values[0] == start and values[-1] == stop
+        with localcontext() as ctx:
+            ctx.prec = 40
+            ratio = Decimal(stop) / Decimal(start)
+            exact = [Decimal(start) * ratio ** (Decimal(i) / (num - 1)) for i in range(num)]
+        np.testing.assert_allclose(values, [float(x) for x in exact], rtol=1e-14, atol=0)
+        assert np.all(np.diff(values) > 0) or np.all(np.diff(values) < 0)
+
+    check()
+
+
+def test_range_values_sel_through_the_netcdf_file(tmp_path):
+    """sweep.run(scene, output=...) then xr.open_dataset(...).sel(length=0.4)."""
+    import xarray as xr
+    import sweep
+    scene = load_scene_text("[axes]\nlength = {start = 0.3, stop = 1.2, num = 10}\n"
+                            "[solver]\nt_end = 0.02\n[initial]\ndisplacement = 1e-4")
+    sweep.run(scene, output=tmp_path / "r.nc", progress=False)
+    with xr.open_dataset(tmp_path / "r.nc") as ds:
+        for written in (0.4, 0.8, 0.9, 1.1):
+            assert float(ds["length"].sel(length=written)) == written
+        assert ds["state"].sel(length=0.4).size == 1
+
+
+# --------------------------------------------------------------------------- default inertia
+
+
+def test_default_inertia_is_the_bending_moment_of_the_solid_section():
+    """Not given: A^2/(4 pi) = pi d^4/64 of the round section of area A (2.865e-12 m^4 for
+    6 mm^2), not the paper's polar moment 5.73e-12 (twice it)."""
+    import math
+    assert load_scene_text("").get("cable.inertia") == pytest.approx(2.8648e-12, rel=1e-4)
+    for area in (6e-6, 1e-6, 3.3e-5):
+        d = math.sqrt(4 * area / math.pi)
+        inertia = load_scene_text(f"[cable]\narea = {area!r}").get("cable.inertia")
+        assert inertia == pytest.approx(math.pi * d ** 4 / 64, rel=1e-14)
+    assert load_scene_text("[cable]\ninertia = 1e-12").get("cable.inertia") == 1e-12
+    assert load_scene_text("", overrides={"cable.area": 1e-6}).get("cable.inertia") == \
+        pytest.approx(1e-12 / (4 * math.pi), rel=1e-14)
+    assert_round_trip(load_scene_text("[axes]\narea = [1e-6, 6e-6]"))
+
+
+def test_paper_scenes_keep_the_papers_inertia():
+    for name in ("paper-fig5", "paper-fig7"):
+        assert load_scene(name).get("cable.inertia") == 5.73e-12
+
+
+def _natural_frequency(scene: Scene):
+    from sweep import grid, models
+    coords = grid.coordinates(scene)
+    return models.oscillator(grid.parameters(scene, coords))["natural_frequency"]
+
+
+def test_natural_frequency_with_the_default_inertia_is_the_closed_form():
+    """f1 = pi sqrt(EI/(rho A)) / (2 l^2) with I = A^2/(4 pi), also when area is an axis (the
+    inertia then follows the area point by point)."""
+    import math
+    E, rho, length = 1.1e11, 8900.0, 0.7
+
+    def f1(area: float) -> float:
+        return math.pi * math.sqrt(E * area ** 2 / (4 * math.pi) / (rho * area)) / (2 * length ** 2)
+
+    base = f"[cable]\nyoungs_modulus = {E!r}\ndensity = {rho!r}\nlength = {length!r}\n"
+    assert float(_natural_frequency(load_scene_text(base))) == pytest.approx(f1(6e-6), rel=1e-13)
+    swept = load_scene_text(base + "[axes]\narea = [1e-6, 6e-6, 2e-5]")
+    assert swept.get("cable.inertia") is None
+    freq = _natural_frequency(swept)
+    assert freq.dims == ("area",)
+    np.testing.assert_allclose(freq.values, [f1(a) for a in (1e-6, 6e-6, 2e-5)], rtol=1e-13)
+    given = load_scene_text(base + "inertia = 5.73e-12\n[axes]\narea = [1e-6, 6e-6]")
+    np.testing.assert_allclose(
+        _natural_frequency(given).values,
+        [math.pi * math.sqrt(E * 5.73e-12 / (rho * a)) / (2 * length ** 2) for a in (1e-6, 6e-6)],
+        rtol=1e-13)
+
+
+# --------------------------------------------------------------------------- refused at load time
+
+
+@pytest.mark.parametrize("axis", ["frequency_ratio", "frequency"])
+def test_constant_load_with_a_frequency_axis_refused_by_load_scene(axis):
+    message = scene_error(f'[load]\ntype = "constant"\n[axes]\n{axis} = [1.0, 2.0]')
+    assert message == (f"axis '{axis}': load.type = 'constant' has no load frequency to sweep "
+                       f"(remove the {axis} axis, or use load.type = 'harmonic')")
+    with pytest.raises(SceneError, match="load.type = 'constant'"):
+        load_scene("harness-parametric", overrides={"load.type": "constant"})
