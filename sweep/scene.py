@@ -44,8 +44,9 @@ Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
   swept.
 - The end time is ``solver.t_end`` (s) or ``solver.transits`` (multiples of l/a), not both;
   with neither, ``solver.transits = 8.0``. Exactly one of the two values is not None.
-- With ``solver.t_end`` given, every ``outputs.snapshot_times`` entry must be <= it (with
-  transits the end time depends on the point, and is checked when the sweep runs, if at all),
+- With ``solver.t_end`` given, every ``outputs.snapshot_times`` entry must be <= it; with
+  transits the end time depends on the point, and an entry must be <= the longest one
+  (transits x max over the grid of l sqrt(rho/E); shorter spans give NaN snapshots there),
   and with ``outputs.histories`` t_end / sample_interval must be <= MAX_SAMPLES.
 - Transverse-only keys (tolerances, coefficients, frequencies, ``[initial]``, ``[metrics]``,
   the time-series outputs, ...) are accepted and ignored, so a resolved scene written by
@@ -509,7 +510,7 @@ def _build(text: str, source: str, default_name: str,
     _check_frequency_pair(given, axes)
     values = _resolve(given, axes)
     if values["model.kind"] == "longitudinal":
-        _check_snapshot_times(values)
+        _check_snapshot_times(values, axes)
         _check_sample_count(values, "outputs.histories")
     else:
         _check_times(values)
@@ -1023,16 +1024,35 @@ def _check_sample_count(values: dict[str, Any], wanted: str) -> None:
           "for t_end/1000")
 
 
-def _check_snapshot_times(values: dict[str, Any]) -> None:
-    """Longitudinal: with solver.t_end given, every snapshot time must be <= it."""
+def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Longitudinal: with solver.t_end given, every snapshot time must be <= it; with
+    solver.transits, <= the longest span's end time, transits x max(l sqrt(rho/E)) (a time
+    after every span's end would be NaN everywhere)."""
     t_end, times = values["solver.t_end"], values["outputs.snapshot_times"]
-    if t_end is None or not times:
+    if not times:
         return
+    if t_end is not None:
+        for number, time in enumerate(times, start=1):
+            if time > t_end:
+                _fail("scene key 'outputs.snapshot_times'",
+                      f"item {number} of the list, {time!r} s, is after solver.t_end "
+                      f"({t_end!r} s)", "use times <= solver.t_end or a longer solver.t_end")
+        return
+
+    def extreme(dotted: str, pick: Any) -> float:
+        axis = schema.BY_DOTTED[dotted].axis
+        return float(pick(axes[axis])) if axis in axes else values[dotted]
+
+    transits = values["solver.transits"]
+    # As sweep.longitudinal.wave_parameters computes it: transits x (l / a), a = sqrt(E/rho).
+    latest = transits * (extreme("cable.length", np.max) / math.sqrt(
+        extreme("cable.youngs_modulus", np.min) / extreme("cable.density", np.max)))
     for number, time in enumerate(times, start=1):
-        if time > t_end:
+        if time > latest:
             _fail("scene key 'outputs.snapshot_times'",
-                  f"item {number} of the list, {time!r} s, is after solver.t_end ({t_end!r} s)",
-                  "use times <= solver.t_end or a longer solver.t_end")
+                  f"item {number} of the list, {time!r} s, is after the end of every span "
+                  f"(solver.transits = {transits!r} x l/a is at most {latest:.6g} s)",
+                  f"use times <= {latest:.6g} s, or more solver.transits")
 
 
 # --------------------------------------------------------------------------- messages
