@@ -147,8 +147,9 @@ def combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def error_norm(K, h, y, y_new, rtol, atol):
-    """SciPy DOP853's error norm of the attempt in K (see `combined_error_norm`)."""
+def error_norm(K, h, y, y_new, rtol, atol_q, atol_v):
+    """SciPy DOP853's error norm of the attempt in K (see `combined_error_norm`); absolute
+    tolerances atol_q (m) for q and atol_v (m/s) for q'."""
     e5q = 0.0
     e5v = 0.0
     e3q = 0.0
@@ -158,8 +159,8 @@ def error_norm(K, h, y, y_new, rtol, atol):
         e5v += K[j, 1] * E5[j]
         e3q += K[j, 0] * E3[j]
         e3v += K[j, 1] * E3[j]
-    sq = atol + max(abs(y[0]), abs(y_new[0])) * rtol
-    sv = atol + max(abs(y[1]), abs(y_new[1])) * rtol
+    sq = atol_q + max(abs(y[0]), abs(y_new[0])) * rtol
+    sv = atol_v + max(abs(y[1]), abs(y_new[1])) * rtol
     return combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
 
 

@@ -97,8 +97,9 @@ def rk_step(t, y, h, p, K, y_new):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def error_norm(K, h, y, y_new, rtol, atol):
-    """SciPy's RMS norm of the embedded error estimate, scaled by atol + rtol max(|y|, |y_new|)."""
+def error_norm(K, h, y, y_new, rtol, atol_q, atol_v):
+    """SciPy's RMS norm of the embedded error estimate, scaled by atol + rtol max(|y|, |y_new|)
+    per component: atol_q (m) for q, atol_v (m/s) for q' (SciPy's atol as a 2-vector)."""
     eq = 0.0
     ev = 0.0
     for j in range(N_STAGES + 1):
@@ -106,8 +107,8 @@ def error_norm(K, h, y, y_new, rtol, atol):
         ev += K[j, 1] * E[j]
     eq *= h
     ev *= h
-    sq = atol + max(abs(y[0]), abs(y_new[0])) * rtol
-    sv = atol + max(abs(y[1]), abs(y_new[1])) * rtol
+    sq = atol_q + max(abs(y[0]), abs(y_new[0])) * rtol
+    sv = atol_v + max(abs(y[1]), abs(y_new[1])) * rtol
     rq = eq / sq
     rv = ev / sv
     return math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
@@ -169,14 +170,15 @@ def _rms2(a, b):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def initial_step(t0, y, f, t_bound, max_step, rtol, atol, p, order):
+def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, order):
     """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4) for a method whose
-    error estimator has order `order` (ERROR_ESTIMATOR_ORDER for RK45). One evaluation."""
+    error estimator has order `order` (ERROR_ESTIMATOR_ORDER for RK45); absolute tolerances
+    atol_q (m) and atol_v (m/s). One evaluation."""
     interval = abs(t_bound - t0)
     if interval == 0.0:
         return 0.0
-    sq = atol + abs(y[0]) * rtol
-    sv = atol + abs(y[1]) * rtol
+    sq = atol_q + abs(y[0]) * rtol
+    sv = atol_v + abs(y[1]) * rtol
     d0 = _rms2(y[0] / sq, y[1] / sv)
     d1 = _rms2(f[0] / sq, f[1] / sv)
     if d0 < 1e-5 or d1 < 1e-5:

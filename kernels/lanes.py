@@ -41,7 +41,7 @@ from . import metrics as mt
 from . import trajectory as tj
 from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
-from .layout import (ATOL, MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
+from .layout import (MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 from .transverse import classify, reject_point, valid
@@ -157,13 +157,14 @@ def _prepare(W, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt(W, rtol, atol, n_run):
+def _attempt(W, rtol, n_run):
     """One Dormand-Prince attempt in every lane of W.
 
     The stages are written out with scalar locals and the tableau's entries (dopri5.A, B, C,
     E), summed in the scalar step's order; one loop with a run-time trip count runs across the
     lanes with straight-line arithmetic, so LLVM vectorises it rather than unrolling it.
-    Lanes n_run and above are idle and skipped.
+    Each lane's absolute tolerances are its accumulator's (trajectory.point_atol, set by
+    trajectory.start). Lanes n_run and above are idle and skipped.
     """
     L = LANES
     for j in range(n_run):
@@ -199,8 +200,8 @@ def _attempt(W, rtol, atol, n_run):
               + k6q * _E[5] + k7q * _E[6]) * h
         ev = (k1v * _E[0] + k2v * _E[1] + k3v * _E[2] + k4v * _E[3] + k5v * _E[4]
               + k6v * _E[5] + k7v * _E[6]) * h
-        rq = eq / (atol + max(abs(q), abs(qn)) * rtol)
-        rv = ev / (atol + max(abs(v), abs(vn)) * rtol)
+        rq = eq / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
+        rv = ev / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
         W[(W_K + 2) * L + j] = k2q
         W[(W_K + 3) * L + j] = k2v
         W[(W_K + 4) * L + j] = k3q
@@ -219,7 +220,7 @@ def _attempt(W, rtol, atol, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt8(W, rtol, atol, n_run):
+def _attempt8(W, rtol, n_run):
     """One DOP853 attempt in every lane of W (as `_attempt`): the eighth-order solution
     (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage (W_K + 12, W_K + 13) and
     SciPy's DOP853 error norm (W_ERR). The other stages stay in registers: the DOP853 dense
@@ -292,8 +293,8 @@ def _attempt8(W, rtol, atol, n_run):
                + kq9 * _E3[9] + kq10 * _E3[10] + kq11 * _E3[11])
         e3v = (kv0 * _E3[0] + kv5 * _E3[5] + kv6 * _E3[6] + kv7 * _E3[7] + kv8 * _E3[8]
                + kv9 * _E3[9] + kv10 * _E3[10] + kv11 * _E3[11])
-        sq = atol + max(abs(q), abs(qn)) * rtol
-        sv = atol + max(abs(v), abs(vn)) * rtol
+        sq = W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol
+        sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
         W[(W_K + 12) * L + j] = vn
         W[(W_K + 13) * L + j] = fv_new
         W[W_QN * L + j] = qn
@@ -545,7 +546,6 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     """
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
-    atol = settings[ATOL]
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     n_samples = series.shape[1]
@@ -593,9 +593,9 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         if eighth is None:
-            _attempt(W, rtol, atol, n_run)
+            _attempt(W, rtol, n_run)
         else:
-            _attempt8(W, rtol, atol, n_run)
+            _attempt8(W, rtol, n_run)
         if pi is not None:
             _pi_factors(W, n_run)
         n_flagged, n_extrema = _finish(W, settings, n_samples, n_run, pi, eighth)

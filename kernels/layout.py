@@ -2,7 +2,7 @@
 
 # Entries of the `settings` vector.
 RTOL = 0            # relative tolerance
-ATOL = 1            # absolute tolerance (m and m/s)
+ATOL = 1            # absolute tolerance (m and m/s), added to ATOL_SCALE's (0 for none)
 T_END = 2           # end time (s)
 MAX_STEPS = 3       # bound on accepted steps
 MAX_STEP = 4        # largest step (s); inf for none
@@ -14,7 +14,9 @@ WANT_SETTLING = 9   # 1.0: compute settling times; 0.0: skip that work
 MIN_STEP = 10       # smallest step (s) before STEP_TOO_SMALL; SciPy's 10 ulps of t if larger
 CONTROLLER = 11     # step-size controller: 0.0 SciPy's (step for step as solve_ivp), 1.0 PI
 METHOD = 12         # integrator: 0.0 RK45 (Dormand-Prince 5(4)), 1.0 DOP853 (8(5,3))
-N_SETTINGS = 13
+ATOL_SCALE = 13     # c, 1: absolute tolerances c rtol q_scale (m) and c rtol v_scale (m/s)
+                    # from each point's own scales (oscillator.Q_SCALE); 0.0: ATOL alone
+N_SETTINGS = 14
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)

@@ -4,6 +4,11 @@
 
 q is the midspan deflection (m), t the time (s). A point's coefficients live in one row of a
 float64 parameter array; the column of each is named below.
+
+Q_SCALE and V_SCALE are the size of the point's response (sweep.models.state_scale): with
+settings[ATOL_SCALE] > 0 the absolute tolerances are that fraction of rtol times these scales
+(trajectory.point_atol), so a response and the same response scaled by any factor are
+integrated alike. They must be > 0 then; with ATOL_SCALE = 0 they are not read.
 """
 
 import math
@@ -22,9 +27,12 @@ OMEGA = 7       # W   load angular frequency                (rad/s)
 Q0 = 8          # q(0)                                      (m)
 V0 = 9          # q'(0)                                     (m/s)
 BOUND = 10      # |q| beyond which the point is diverged    (m)
-N_PARAMS = 11
+Q_SCALE = 11    # the point's displacement scale            (m)
+V_SCALE = 12    # the point's velocity scale                (m/s)
+N_PARAMS = 13
 
-PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound")
+PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound",
+               "q_scale", "v_scale")
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

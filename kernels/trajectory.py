@@ -3,7 +3,8 @@
 A trajectory's whole state lives in a float64 accumulator row (slots below) plus its extrema
 buffer, so a driver can advance many of them side by side:
 
-    start(...)                         initial state, f(0, y0), SciPy's initial step
+    start(...)                         initial state, f(0, y0), the point's absolute
+                                       tolerances (`point_atol`), SciPy's initial step
     h = next_attempt(settings, acc)    the step to try now (0.0: the trajectory has ended)
     ... the driver computes one attempt of size h (RK45 or DOP853) and its error norm ...
     buf = finish_attempt(...)          SciPy's accept/reject and step-size update (`control`);
@@ -26,9 +27,9 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR
                      RHS_PER_ATTEMPT,
                      dense_coefficients, dense_root, dense_value, initial_step, pi_log2_err,
                      pi_step_factor, step_factor)
-from .layout import (ATOL, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, RTOL,
-                     SAMPLE_DT, TAIL, T_END)
-from .oscillator import BOUND, Q0, V0, acceleration
+from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
+                     MIN_STEP, RTOL, SAMPLE_DT, TAIL, T_END)
+from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration
 from .vecmath import log2_fast
 
 # Slots of a trajectory's accumulator row.
@@ -53,7 +54,9 @@ LAST_ABOVE = 17     # last time |q - centre| > threshold (s)
 SAMPLE = 18         # next time-series sample index
 N_EXT = 19          # extrema recorded
 LOG2_ERR_PREV = 20  # log2 of the last accepted step's error norm (PI controller)
-N_SLOTS = 21
+ATOL_Q = 21         # absolute tolerance on q (m): `point_atol`
+ATOL_V = 22         # absolute tolerance on q' (m/s)
+N_SLOTS = 23
 
 # The PI controller's memory before the first accepted step: pi_log2_err(PI_MIN_ERR_PREV),
 # computed once here (the same arithmetic in Python) rather than compiled into `start`.
@@ -81,6 +84,17 @@ def with_room(buf, acc):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def point_atol(p, settings, rtol):
+    """The absolute tolerances (atol_q in m, atol_v in m/s) of the point with parameter row p:
+    settings[ATOL] plus settings[ATOL_SCALE] x rtol x the point's own scales (p[Q_SCALE],
+    p[V_SCALE]). With ATOL_SCALE = 0 that is settings[ATOL] for both, as SciPy's scalar atol;
+    with ATOL = 0 the error norm is relative to each point's own size, so a response scaled by
+    any factor takes the same steps. Both drivers read the tolerances from here (`start`)."""
+    c = settings[ATOL_SCALE] * rtol
+    return settings[ATOL] + c * p[Q_SCALE], settings[ATOL] + c * p[V_SCALE]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def start(p, settings, acc, series):
     """Set up a trajectory at t = 0 from its parameter row `p`; q(0) goes to series[0]."""
     rtol = max(settings[RTOL], MIN_RTOL)
@@ -94,6 +108,7 @@ def start(p, settings, acc, series):
     acc[FQ] = v
     acc[FV] = acceleration(0.0, q, v, p)
     acc[RHS_EVALS] = 1.0
+    acc[ATOL_Q], acc[ATOL_V] = point_atol(p, settings, rtol)
     if settings[FIRST_STEP] > 0.0:
         acc[H_ABS] = min(settings[FIRST_STEP], t_end)
     else:
@@ -102,8 +117,8 @@ def start(p, settings, acc, series):
         y[0], y[1] = q, v
         f[0], f[1] = acc[FQ], acc[FV]
         order = dop853.ERROR_ESTIMATOR_ORDER if settings[METHOD] != 0.0 else ERROR_ESTIMATOR_ORDER
-        acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, settings[ATOL], p,
-                                  order)
+        acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, acc[ATOL_Q],
+                                  acc[ATOL_V], p, order)
         acc[RHS_EVALS] += 1.0
     acc[T_NEW] = 0.0
     acc[REJECTED_NOW] = 0.0

@@ -26,7 +26,7 @@ from . import trajectory as tj
 from . import dop853
 from .dopri5 import MIN_RTOL, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
-from .layout import (AMPLITUDE, ATOL, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
+from .layout import (AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, MASS, N_PARAMS
@@ -41,7 +41,6 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
     """
     rtol = max(settings[RTOL], MIN_RTOL)
-    atol = settings[ATOL]
     acc = np.empty(tj.N_SLOTS)
     buf = tj.new_buffer()
     eighth = settings[METHOD] != 0.0
@@ -60,10 +59,10 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
         K[0, 1] = acc[tj.FV]
         if eighth:
             dop853.rk_step(acc[tj.T], y, h, p, K, y_new)
-            err = dop853.error_norm(K, h, y, y_new, rtol, atol)
+            err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
         else:
             rk_step(acc[tj.T], y, h, p, K, y_new)
-            err = error_norm(K, h, y, y_new, rtol, atol)
+            err = error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
         buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
                                 series, track, centre, thr_fixed, thr_rel)
     tj.end_series(acc, series)

@@ -96,14 +96,30 @@ def escape_barrier(k: Any, g: Any, h: Any) -> Any:
         return np.where(valid, np.sqrt(q2), np.nan)[()]
 
 
+def state_scale(q0: Any, v0: Any, omega: Any, bound: Any) -> tuple[Any, Any]:
+    """The size of a point's response: (displacement scale L in m, velocity scale in m/s).
+
+    L = max(|q0|, |v0| / omega) from the initial conditions q0 (m), v0 (m/s) and the span's
+    natural angular frequency omega (rad/s); the velocity scale is omega L. The oscillator has
+    no forcing, so a point started at rest at q = 0 stays there: it gets L = bound (m, the
+    divergence bound), any positive scale would do. The solver's default absolute tolerances
+    are a fixed fraction of rtol times these (sweep.run.settings_vector), so a response and
+    the same response 1e5 times smaller are integrated alike.
+    """
+    scale = np.maximum(np.abs(q0), np.abs(v0) / omega)
+    scale = xr.where(scale > 0, scale, bound) if isinstance(scale, xr.DataArray) \
+        else np.where(scale > 0, scale, bound)[()]
+    return scale, omega * scale
+
+
 def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     """Kernel coefficients and derived quantities for one model configuration.
 
     p holds the scene's parameters by axis name (scalars or arrays) plus "coefficients",
     "load_type" and "paper_parametric". Returns the oscillator coefficients under the names of
-    `kernels.oscillator.PARAM_NAMES` and the derived quantities natural_frequency (Hz),
-    buckling_load (N), load_ratio (1), escape_barrier (m, for the mean or constant load) and
-    load_frequency (Hz, harmonic load only).
+    `kernels.oscillator.PARAM_NAMES` (q_scale, v_scale: `state_scale`) and the derived
+    quantities natural_frequency (Hz), buckling_load (N), load_ratio (1), escape_barrier (m,
+    for the mean or constant load) and load_frequency (Hz, harmonic load only).
     """
     c = consistent(p) if p["coefficients"] == "consistent" else paper(p)
     out = {
@@ -129,4 +145,6 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
         out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
                    omega=0.0)
     out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"])
+    out["q_scale"], out["v_scale"] = state_scale(out["q0"], out["v0"], c["omega_1"],
+                                                 out["bound"])
     return out

@@ -93,8 +93,10 @@ KEYS: tuple[Key, ...] = (
     # [solver]
     Key("solver", "rtol", "float", 1e-8, units="1", minimum=1e-14, maximum=0.1,
         long_name="relative tolerance"),
-    Key("solver", "atol", "float", 1e-12, units="", minimum=0.0, exclusive_min=True,
-        maximum=1.0, long_name="absolute tolerance (m for q, m/s for q')"),
+    Key("solver", "atol", "float", None, units="", minimum=0.0, exclusive_min=True,
+        maximum=1.0, long_name="absolute tolerance (m for q, m/s for q'); default: each "
+                               "point's own, 0.01 x rtol x max(|q0|, |v0|/w1) (w1 x that for "
+                               "q'), so results do not depend on the response's size"),
     Key("solver", "t_end", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="end of the simulated time (default: 5 s transverse, 8 transits longitudinal)"),
     Key("solver", "transits", "float", None, units="1", minimum=0.0, exclusive_min=True,
