@@ -20,6 +20,8 @@ import math
 import numba as nb
 import numpy as np
 
+from . import metrics as mt
+
 # Columns of a parameter row.
 LENGTH = 0          # l (m)
 WAVE_SPEED = 1      # a = sqrt(E/rho) (m/s)
@@ -46,12 +48,12 @@ FAILURE_TIME = 4            # time at which a diverged point stopped (s) or NaN
 TIME_STEP = 5               # dt (s)
 N_REALS = 6
 
-# State flags.
-INVALID_INPUT = 0
-COMPLETED = 1
-DIVERGED = 2
-MAX_STEPS = 3
-STATE_MEANINGS = ("invalid_input", "completed", "diverged", "max_steps_reached")
+# State flags: the shared table of kernels/metrics.py (an integer means the same for every kind).
+INVALID_INPUT = mt.INVALID_INPUT
+COMPLETED = mt.COMPLETED
+DIVERGED = mt.DIVERGED
+MAX_STEPS = mt.MAX_STEPS
+STATES = mt.LONGITUDINAL_STATES           # the flags this kernel can produce
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -181,8 +183,14 @@ def solve_span(p, settings, snapshot_times, reals, hist_u, hist_f, snap_u, snap_
                 armed = False
             elif not armed and abs(f_fixed) < 0.5 * abs_load:
                 armed = True
-        while k < n_hist and k * dt_sample <= t_new:
-            w = (k * dt_sample - (t_new - dt)) / dt
+        # The last level stands for t_end, which level * dt may miss by rounding (n_needed
+        # allows 1e-9 dt): samples up to t_end (+1e-9 of a sample, as the sweep counts them)
+        # take its value rather than staying NaN.
+        t_reach = t_new
+        if level == n_needed:
+            t_reach = max(t_new, p[T_END] + 1e-9 * dt_sample)
+        while k < n_hist and k * dt_sample <= t_reach:
+            w = min((k * dt_sample - (t_new - dt)) / dt, 1.0)
             hist_u[k] = u_end_old + w * (u_end - u_end_old)
             hist_f[k] = f_old + w * (f_fixed - f_old)
             k += 1

@@ -98,9 +98,11 @@ def _parser() -> argparse.ArgumentParser:
 
 def _summary(ds, seconds: float) -> str:
     import numpy as np
-    meanings = ds["state"].attrs["flag_meanings"].split()
-    counts = np.bincount(ds["state"].values.ravel(), minlength=len(meanings))
-    states = ", ".join(f"{c} {m}" for c, m in zip(counts, meanings) if c)
+    flags = ds["state"].attrs          # CF flag_values / flag_meanings (not 0..n-1 for every kind)
+    values = ds["state"].values.ravel()
+    counts = [(int(np.count_nonzero(values == v)), m)
+              for v, m in zip(np.atleast_1d(flags["flag_values"]), flags["flag_meanings"].split())]
+    states = ", ".join(f"{c} {m}" for c, m in counts if c)
     n = int(ds.attrs["n_points"])
     return f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'} in {seconds:.2f} s ({states})"
 

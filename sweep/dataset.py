@@ -16,7 +16,7 @@ from .scene import Scene
 if TYPE_CHECKING:
     from .run import KernelResult
 
-CONVENTIONS = "CF-1.10"
+CONVENTIONS = "CF-1.11"
 
 # name -> (kernel column, units, long_name, scene output switch)
 _REALS = {
@@ -33,17 +33,24 @@ _REALS = {
                      None),
 }
 _COUNTS = {
-    "n_steps": (tk.STEPS, "accepted RK45 steps"),
-    "n_rejected": (tk.REJECTED, "rejected RK45 step attempts"),
+    "n_steps": (tk.STEPS, "accepted {method} steps"),
+    "n_rejected": (tk.REJECTED, "rejected {method} step attempts"),
     "n_rhs": (tk.RHS_EVALS, "right-hand-side evaluations"),
 }
+# solver.method -> how the source attribute and the counters name the integrator.
+METHODS = {"rk45": ("RK45", "Dormand-Prince 5(4) (RK45)"),
+           "dop853": ("DOP853", "Dormand-Prince 8(5,3) (DOP853)")}
+CONTROLLERS = {"scipy": "SciPy's step-size control", "pi": "PI (Gustafsson) step-size control"}
+_INT32 = np.iinfo(np.int32)
+TIME_DIM = "elapsed_time"       # the dimension (and coordinate) of stored histories
 _DERIVED = {
     "natural_frequency": ("Hz", "first linear natural frequency of the unloaded span"),
     "buckling_load": ("N", "Euler buckling load of the span (paper: implied by Eq.32)"),
     "load_ratio": ("1", "load amplitude over buckling load, P0/Pcr"),
     "load_frequency": ("Hz", "load frequency W/(2 pi)"),
     "escape_barrier": ("m", "|q| beyond which the softening quintic lets the span escape, "
-                            "for the mean (harmonic) or constant load; NaN: no barrier"),
+                            "for the mean (harmonic) or constant load; NaN: no barrier, or one "
+                            "beyond the model's range (mode slope pi q_b / l > 1)"),
 }
 
 
@@ -54,6 +61,25 @@ def package_version() -> str:
         return version("cable-sweep")
     except PackageNotFoundError:
         return "0+unknown"
+
+
+def counter(values: Any) -> Any:
+    """A count as int32 (what every netCDF reader takes) when every value fits, else int64."""
+    values = np.asarray(values)
+    if values.size == 0 or (values.min() >= _INT32.min and values.max() <= _INT32.max):
+        return values.astype(np.int32)
+    return values.astype(np.int64)
+
+
+def elapsed_time(values: np.ndarray) -> xr.DataArray:
+    """The coordinate TIME_DIM of stored histories: times since the start of the run (s).
+
+    Not CF's `time`: a CF time coordinate (standard_name time, and the name `time` to the IOOS
+    compliance checker) needs units "s since <date>", and these are durations from the
+    simulation's t = 0, which has no date.
+    """
+    return xr.DataArray(values, dims=TIME_DIM, attrs={
+        "units": "s", "long_name": "simulated time since t = 0 (the initial state)"})
 
 
 def derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
@@ -80,24 +106,28 @@ def global_attrs(scene: Scene, shape: tuple[int, ...], elapsed: float,
         "model_kind": scene.get("model.kind"),
         "coefficients": scene.get("model.coefficients"),
         "run_seconds": float(elapsed),
-        "n_points": int(np.prod(shape, dtype=np.int64)),
+        "n_points": counter(np.prod(shape, dtype=np.int64))[()],
     }
 
 
-def flag_attrs(meanings: tuple[str, ...]) -> dict[str, Any]:
-    """CF flag attributes of an int8 `state` variable with the given meanings."""
+def flag_attrs(flags: tuple[int, ...]) -> dict[str, Any]:
+    """CF flag attributes of an int8 `state` variable that can hold the given flags.
+
+    Every kind draws its flags from the one table of kernels/metrics.py (STATE_MEANINGS), so
+    the same integer has the same meaning in every dataset.
+    """
     return {
         "long_name": "state of the point",
         "units": "1",
-        "flag_values": np.arange(len(meanings), dtype=np.int8),
-        "flag_meanings": " ".join(meanings),
+        "flag_values": np.array(flags, dtype=np.int8),
+        "flag_meanings": " ".join(km.STATE_MEANINGS[f] for f in flags),
     }
 
 
 def state_attrs() -> dict[str, Any]:
     """CF flag attributes of the transverse `state` variable."""
     return {
-        **flag_attrs(km.STATE_MEANINGS),
+        **flag_attrs(km.TRANSVERSE_STATES),
         "long_name": "response state of the point",
         "comment": "decayed/steady have a settling time; modulated (beating, quasi-periodic), "
                    "unsettled (still drifting at t_end: lengthen solver.t_end) and the failure "
@@ -109,6 +139,7 @@ def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ..
              coeffs: dict[str, Any], result: "KernelResult", elapsed: float) -> xr.Dataset:
     """Build the result Dataset of the contract from the flat kernel result."""
     dims = tuple(coords)
+    short, method = METHODS[scene.get("solver.method")]
     data: dict[str, xr.DataArray] = {}
     data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims, attrs=state_attrs())
     for name, (col, units, long_name, switch) in _REALS.items():
@@ -117,20 +148,20 @@ def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ..
                                       attrs={"units": units, "long_name": long_name})
     if scene.get("outputs.solver_stats"):
         for name, (col, long_name) in _COUNTS.items():
-            data[name] = xr.DataArray(result.counts[:, col].reshape(shape), dims=dims,
-                                      attrs={"units": "1", "long_name": long_name})
+            data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
+                                      attrs={"units": "1",
+                                             "long_name": long_name.format(method=short)})
     for name, (units, long_name) in _DERIVED.items():
         if name in coeffs:
             data[name] = derived(coeffs[name], coords)
             data[name].attrs = {"units": units, "long_name": long_name}
     all_coords: dict[str, Any] = dict(coords)
     if result.series.shape[1] > 0:
-        all_coords["time"] = xr.DataArray(result.sample_times, dims="time",
-                                          attrs={"units": "s", "long_name": "time",
-                                                 "standard_name": "time"})
+        all_coords[TIME_DIM] = elapsed_time(result.sample_times)
         data["displacement"] = xr.DataArray(
-            result.series.reshape(shape + (result.series.shape[1],)), dims=dims + ("time",),
+            result.series.reshape(shape + (result.series.shape[1],)), dims=dims + (TIME_DIM,),
             attrs={"units": "m", "long_name": "midspan deflection q(t)"})
     attrs = global_attrs(scene, shape, elapsed,
-                         "transverse modal oscillator, Dormand-Prince RK45")
+                         f"transverse modal oscillator, {method}, "
+                         f"{CONTROLLERS[scene.get('solver.controller')]}")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)

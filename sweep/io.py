@@ -61,6 +61,8 @@ def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = Fals
     tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
     encoding = {name: {"zlib": True, "complevel": 4}
                 for name, var in ds.data_vars.items() if var.ndim >= 1 and var.dtype.kind == "f"}
+    # CF: coordinates have no missing values, so no _FillValue (xarray adds NaN to floats).
+    encoding.update({name: {"_FillValue": None} for name in ds.coords})
     try:
         ds.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
         with open(tmp, "rb") as fh:

@@ -19,7 +19,7 @@ import numpy as np
 import xarray as xr
 
 from . import grid
-from .dataset import derived, flag_attrs, global_attrs
+from .dataset import TIME_DIM, counter, derived, elapsed_time, flag_attrs, global_attrs
 from .errors import CableSweepWarning
 from .execute import longitudinal_chunk, longitudinal_outputs
 from .run import check_memory, solve_chunked
@@ -119,7 +119,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
 
     data: dict[str, xr.DataArray] = {}
     data["state"] = xr.DataArray(field(states), dims=dims, attrs={
-        **flag_attrs(lk.STATE_MEANINGS),
+        **flag_attrs(lk.STATES),
         "comment": "diverged: non-finite values or |u(l)| beyond metrics.divergence_bound; "
                    "max_steps_reached: the span needed more than solver.max_steps time levels "
                    "(its metrics cover the levels it took)"})
@@ -146,7 +146,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
     scalar("failure_time", r[:, lk.FAILURE_TIME], "s",
            "time at which a diverged or step-limited span stopped")
     scalar("time_step", r[:, lk.TIME_STEP], "s", "time step dt = C dx / a")
-    scalar("n_steps", steps, "1", "time steps taken")
+    scalar("n_steps", counter(steps), "1", "time steps taken")
     data["courant"] = xr.DataArray(courant, attrs={"units": "1",
                                                    "long_name": "Courant number a dt/dx"})
     for name, (units, long_name) in _DERIVED.items():
@@ -155,14 +155,12 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
 
     all_coords: dict[str, Any] = dict(coords)
     if n_hist:
-        all_coords["time"] = xr.DataArray(np.arange(n_hist) * dt_sample, dims="time",
-                                          attrs={"units": "s", "long_name": "time",
-                                                 "standard_name": "time"})
+        all_coords[TIME_DIM] = elapsed_time(np.arange(n_hist) * dt_sample)
         data["end_displacement"] = xr.DataArray(
-            field(hist_u), dims=dims + ("time",),
+            field(hist_u), dims=dims + (TIME_DIM,),
             attrs={"units": "m", "long_name": "displacement of the loaded end u(l, t)"})
         data["fixed_end_force"] = xr.DataArray(
-            field(hist_f), dims=dims + ("time",),
+            field(hist_f), dims=dims + (TIME_DIM,),
             attrs={"units": "N", "long_name": "axial force at the fixed end N(0, t), "
                                               "tension positive"})
     if n_snap:

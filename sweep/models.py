@@ -82,18 +82,28 @@ def paper(p: Mapping[str, Any]) -> dict[str, Any]:
     }
 
 
-def escape_barrier(k: Any, g: Any, h: Any) -> Any:
+# Largest mode slope pi q / l (rad) at which the one-mode cubic-quintic model still means
+# something: its cubic and quintic terms are the first terms of series in the squared slope
+# (the exact curvature w''/(1 + w'^2)^(3/2)) that diverge for slopes beyond 1 (docs/model.md
+# sec. 2).
+MAX_SLOPE = 1.0
+
+
+def escape_barrier(k: Any, g: Any, h: Any, length: Any) -> Any:
     """Positive root q_b (m) of k + g q^2 + h q^4 = 0 for a softening quintic (h < 0, k > 0).
 
-    Started at rest beyond q_b the span escapes (blows up in finite time); NaN where there is
-    no such barrier (h >= 0 or k <= 0).
+    Started at rest beyond q_b the span escapes (blows up in finite time). NaN where there is
+    no such barrier (h >= 0 or k <= 0) and where the barrier lies outside the model's range:
+    the mode's largest slope there, pi q_b / length (length in m), exceeds MAX_SLOPE (the
+    Table 1 cable's 1 m span would otherwise report 55 m).
     """
     with np.errstate(invalid="ignore", divide="ignore"):
         q2 = (-g - np.sqrt(g * g - 4.0 * h * k)) / (2.0 * h)
-        valid = (h < 0) & (k > 0)
-        if any(isinstance(v, xr.DataArray) for v in (k, g, h)):
-            return xr.where(valid, np.sqrt(q2), np.nan)
-        return np.where(valid, np.sqrt(q2), np.nan)[()]
+        q_b = np.sqrt(q2)
+        valid = (h < 0) & (k > 0) & (np.pi * q_b / length <= MAX_SLOPE)
+        if any(isinstance(v, xr.DataArray) for v in (k, g, h, length)):
+            return xr.where(valid, q_b, np.nan)
+        return np.where(valid, q_b, np.nan)[()]
 
 
 def state_scale(q0: Any, v0: Any, omega: Any, bound: Any) -> tuple[Any, Any]:
@@ -144,7 +154,7 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     else:
         out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
                    omega=0.0)
-    out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"])
+    out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"], p["length"])
     out["q_scale"], out["v_scale"] = state_scale(out["q0"], out["v0"], c["omega_1"],
                                                  out["bound"])
     return out

@@ -165,6 +165,7 @@ def test_transverse_constant_load_above_buckling_settles_or_diverges():
 membrane = 0.375
 [cable]
 damping_ratio = 0.05
+inertia = 5.73e-12              # m^4, the paper's value (EI below), whatever the default
 [load]
 type = "constant"
 amplitude = 8.0
@@ -186,3 +187,18 @@ t_end = 10.0
     q_s = np.sqrt(-k1 / K3)                                   # docs/model.md: sqrt(-k1/K3)
     assert float(ds["amplitude"][0]) == pytest.approx(q_s, rel=1e-3)
     assert 0 < float(ds["failure_time"][1]) < 10.0
+
+
+def test_last_history_sample_at_t_end_is_the_exact_value():
+    """8 transits of 0.3 m in 1000 intervals: 8000 dt rounds just below t_end = 1000 samples;
+    the sample at t_end must still hold d'Alembert's value, not NaN."""
+    scene = sweep.load_scene("paper-fig7", overrides={
+        "cable.length": 0.3, "outputs.snapshot_times": [], "outputs.normalised": False})
+    ds = sweep.run(scene, progress=False)
+    t = ds["elapsed_time"].values
+    assert t[-1] == pytest.approx(8 * 0.3 / WAVE, rel=1e-12)
+    u = ds["end_displacement"].values
+    assert np.isfinite(u).all()
+    np.testing.assert_allclose(u, exact_u(0.3, t, 0.3, 4.0), rtol=0, atol=1e-9 * 0.3 * 4.0 / EA)
+    f = ds["fixed_end_force"].values
+    assert np.isfinite(f).all() and f[-1] == pytest.approx(0.0, abs=1e-9)

@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import xarray as xr
 from scipy.integrate import quad
 
+import sweep
 from sweep import models
+from sweep.kernels import metrics as km
 
 
 def galerkin_by_quadrature(E, rho, A, I, l, P):
@@ -118,3 +121,83 @@ def test_oscillator_frequency_and_constant_load():
     assert c["k1"] == 0.0 and c["g1"] == 0.0 and c["omega"] == 0.0
     assert c["k0"] == pytest.approx(h["k0"] + h["k1"])
     assert c["g0"] == pytest.approx(h["g0"] + h["g1"])
+
+
+TABLE1 = dict(youngs_modulus=1.1e11, density=8900.0, area=6e-6, inertia=5.73e-12, length=1.0,
+              membrane=0.375, load_amplitude=0.0, damping_ratio=0.0, frequency_ratio=None,
+              frequency=None, initial_displacement=0.0, initial_velocity=0.0,
+              coefficients="consistent", load_type="constant", paper_parametric="printed",
+              divergence_bound=None)
+
+
+def barrier_by_roots(p):
+    """q_b from the modal equation's stiffness w1^2 (1 - P/Pcr) + K3 q^2 + K5 q^4 written out
+    (docs/model.md sec. 2), its smallest positive root in s = q^2 by numpy's polynomial roots."""
+    k = np.pi / p["length"]
+    ei_ra = p["youngs_modulus"] * p["inertia"] / (p["density"] * p["area"])
+    pcr = p["youngs_modulus"] * p["inertia"] * k ** 2
+    k1 = ei_ra * k ** 4 * (1 - p["load_amplitude"] / pcr)
+    k3 = (p["membrane"] * p["youngs_modulus"] / p["density"] * k ** 4
+          + p["load_amplitude"] * k ** 4 / (2 * p["density"] * p["area"]) - 1.25 * ei_ra * k ** 6)
+    k5 = -21 / 16 * ei_ra * k ** 8
+    s = np.polynomial.polynomial.polyroots([k1, k3, k5])
+    s = s.real[(abs(s.imag) < 1e-12 * abs(s)) & (s.real > 0)]
+    return float(np.sqrt(s.min()))
+
+
+@pytest.mark.parametrize("length, load", [(1.0, 0.0), (0.3, 0.0), (2.0, 0.0), (1.0, 3.0)])
+def test_escape_barrier_without_membrane_is_the_closed_form(length, load):
+    """membrane = 0: the barrier lies at slope pi q_b / l < 1, inside the model's range
+    (unloaded: (pi q_b / l)^2 = (-5/4 + sqrt(25/16 + 21/4)) / (21/8), whatever the cable)."""
+    p = {**TABLE1, "membrane": 0.0, "length": length, "load_amplitude": load}
+    qb = float(models.oscillator(p)["escape_barrier"])
+    assert qb == pytest.approx(barrier_by_roots(p), rel=1e-12)
+    if load == 0.0:
+        slope = np.sqrt((-1.25 + np.sqrt(25 / 16 + 21 / 4)) / (21 / 8))
+        assert qb == pytest.approx(slope * length / np.pi, rel=1e-12)
+
+
+def test_escape_barrier_beyond_the_model_range_is_nan():
+    """Table 1 with membrane 3/8: the quintic's root lies at 55 m for a 1 m span (slope 174), far
+    beyond slope 1, where the truncated slope series of the model diverge: NaN, not 55 m."""
+    assert barrier_by_roots(TABLE1) == pytest.approx(55.4, rel=0.01)
+    assert np.isnan(models.oscillator(TABLE1)["escape_barrier"])
+    # The cut is at slope 1: membrane alpha* = (25/16) I k^2 / A puts the root exactly there.
+    k = np.pi / TABLE1["length"]
+    alpha = 25 / 16 * TABLE1["inertia"] * k ** 2 / TABLE1["area"]
+    inside = {**TABLE1, "membrane": 0.999 * alpha}
+    qb = float(models.oscillator(inside)["escape_barrier"])
+    assert qb == pytest.approx(barrier_by_roots(inside), rel=1e-12) and qb * k < 1.0
+    beyond = {**TABLE1, "membrane": 1.001 * alpha}
+    assert barrier_by_roots(beyond) * k > 1.0
+    assert np.isnan(models.oscillator(beyond)["escape_barrier"])
+    lengths = xr.DataArray([0.3, 1.0], dims="length")
+    both = models.oscillator({**TABLE1, "membrane": 0.0, "length": lengths})["escape_barrier"]
+    assert both.dims == ("length",) and np.isfinite(both).all()
+
+
+def test_in_range_barrier_separates_bounded_from_escaping_motion():
+    """Started at rest 2 % inside the barrier the undamped span stays bounded at |q| = q0;
+    2 % outside it escapes (diverges) well before t_end."""
+    p = {**TABLE1, "membrane": 0.0}
+    qb = float(models.oscillator(p)["escape_barrier"])
+    ds = sweep.run(sweep.load_scene_text(f"""
+[model]
+membrane = 0.0
+[cable]
+length = 1.0
+[load]
+type = "constant"
+amplitude = 0.0
+[metrics]
+divergence_bound = 10.0
+[axes]
+initial_displacement = [{0.98 * qb!r}, {1.02 * qb!r}]
+[solver]
+t_end = 2.0
+"""), progress=False)
+    assert float(ds["escape_barrier"]) == pytest.approx(qb, rel=1e-12)
+    inside, outside = ds["state"].values
+    assert inside not in (km.DIVERGED, km.STEP_TOO_SMALL, km.MAX_STEPS)
+    assert float(ds["peak_amplitude"][0]) == pytest.approx(0.98 * qb, rel=1e-6)
+    assert outside == km.DIVERGED and 0 < float(ds["failure_time"][1]) < 2.0

@@ -44,8 +44,8 @@ def test_paper_fig5_amplitudes():
     amp_mm = ds["amplitude"].values * 1e3
     np.testing.assert_allclose(amp_mm, [4.1, 3.8, 3.4, 3.0], rtol=0.10)
     np.testing.assert_allclose(amp_mm, [4.10, 3.67, 3.42, 3.22], atol=0.006)
-    assert ds["displacement"].dims == ("length", "time")
-    assert ds["time"].values[-1] == pytest.approx(5.0)
+    assert ds["displacement"].dims == ("length", "elapsed_time")
+    assert ds["elapsed_time"].values[-1] == pytest.approx(5.0)
 
 
 def test_dataset_layout_units_and_netcdf_round_trip(tmp_path):
@@ -64,8 +64,9 @@ def test_dataset_layout_units_and_netcdf_round_trip(tmp_path):
         again = sweep.load_scene_text(back.attrs["scene"])
         assert again == scene
         flags = back["state"].attrs
-        assert list(flags["flag_values"]) == list(range(len(km.STATE_MEANINGS)))
-        assert flags["flag_meanings"].split() == list(km.STATE_MEANINGS)
+        assert list(flags["flag_values"]) == list(km.TRANSVERSE_STATES)
+        assert flags["flag_meanings"].split() == [km.STATE_MEANINGS[f]
+                                                  for f in km.TRANSVERSE_STATES]
         for name in ds.variables:
             np.testing.assert_array_equal(back[name].values, ds[name].values)
             assert back[name].attrs["units"] == ds[name].attrs["units"]
@@ -80,7 +81,7 @@ def test_only_what_is_asked_is_stored():
                                                     "outputs.amplitude": False})
     ds = sweep.run(scene, progress=False)
     assert "settling_time" not in ds and "n_steps" not in ds and "amplitude" not in ds
-    assert "displacement" not in ds and "time" not in ds.coords
+    assert "displacement" not in ds and "elapsed_time" not in ds.coords
     assert "state" in ds and "peak_amplitude" in ds
 
 
@@ -165,3 +166,11 @@ def test_cli_refuses_existing_output(tmp_path):
     r = cli("run", "paper-fig5", "-o", "o.nc", cwd=tmp_path)
     assert r.returncode == 2 and "--overwrite" in r.stderr
     assert (tmp_path / "o.nc").read_text() == "x"
+
+
+def test_summary_counts_states_by_their_flag_values():
+    """The one-line summary reads flag_values: longitudinal flags are not 0..n-1."""
+    from sweep.cli import _summary
+    ds = sweep.run(sweep.load_scene("paper-fig7", overrides={"solver.intervals": 50}),
+                   progress=False)
+    assert _summary(ds, 1.0).endswith("(1 completed)")

@@ -1,0 +1,125 @@
+"""Files other tools accept: the IOOS compliance checker finds no CF errors or warnings in the
+output of any built-in scene, and the file says truthfully what made it."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import sweep
+from sweep.dataset import CONVENTIONS, counter
+from sweep.kernels import metrics as km
+
+# Smaller grids and shorter runs than the scenes' own, with the same outputs and variables.
+REDUCED = {
+    "paper-fig5": {"solver.t_end": 0.5},
+    "harness-parametric": {"axes.length": [0.5, 1.0], "axes.frequency_ratio": [1.0, 2.0],
+                           "solver.t_end": 1.0},
+    "paper-fig7": {"solver.intervals": 50},
+}
+# The checker's priorities: high are its "errors", medium its "warnings", low its
+# "suggestions". A file fails on either of the first two.
+FAILING = ("high_priorities", "medium_priorities")
+
+
+def checker() -> str:
+    """The compliance-checker command of this environment (installed by the test extras)."""
+    beside = Path(sys.executable).with_name("compliance-checker")
+    found = str(beside) if beside.exists() else shutil.which("compliance-checker")
+    assert found, "compliance-checker is missing: pip install '.[test]'"
+    return found
+
+
+def cf_problems(path: Path) -> list[str]:
+    """Every failed error- or warning-level check of the CF version the file declares."""
+    test = "cf:" + CONVENTIONS.removeprefix("CF-")
+    done = subprocess.run([checker(), f"--test={test}", "-f", "json", "-o", "-", str(path)],
+                          capture_output=True, text=True, timeout=300)
+    report = json.loads(done.stdout)[test]
+    problems = [f"{priority} {check['name']}: {msg}"
+                for priority in FAILING for check in report[priority] for msg in check["msgs"]]
+    assert problems or report["high_count"] == report["medium_count"] == 0, report
+    return problems
+
+
+def scene_output(name: str, tmp_path: Path, **more) -> tuple[xr.Dataset, Path]:
+    scene = sweep.load_scene(name, overrides={**REDUCED.get(name, {}), **more})
+    out = tmp_path / f"{name}.nc"
+    return sweep.run(scene, output=out, progress=False), out
+
+
+@pytest.mark.parametrize("name", sorted(sweep.builtin_scenes()))
+def test_builtin_scene_output_passes_the_cf_checker_and_round_trips(name, tmp_path):
+    ds, out = scene_output(name, tmp_path)
+    assert cf_problems(out) == []
+    back = xr.open_dataset(out)
+    try:
+        for var in ds.variables:
+            np.testing.assert_array_equal(back[var].values, ds[var].values)
+            assert back[var].attrs["units"] == ds[var].attrs["units"], var
+        for coord in back.coords:
+            assert "_FillValue" not in back[coord].encoding or \
+                back[coord].encoding["_FillValue"] is None, coord
+    finally:
+        back.close()
+
+
+def test_the_checker_sees_what_was_wrong_before(tmp_path):
+    """The test above can fail: a coordinate with a _FillValue, a `time` coordinate without a
+    reference date and an int64 counter are what the files had before."""
+    ds, _ = scene_output("paper-fig5", tmp_path)
+    bad = ds.rename({"elapsed_time": "time"})
+    bad["time"].attrs["standard_name"] = "time"
+    path = tmp_path / "bad.nc"
+    bad.to_netcdf(path, engine="netcdf4")           # xarray's default: _FillValue on coords
+    problems = " ".join(cf_problems(path))
+    assert "_FillValue" in problems and "since" in problems
+
+
+@pytest.mark.parametrize("method, other", [("dop853", "RK45"), ("rk45", "DOP853")])
+def test_provenance_names_the_integrator_that_ran(method, other, tmp_path):
+    ds, out = scene_output("harness-parametric", tmp_path, **{"solver.method": method})
+    back = xr.open_dataset(out)
+    try:
+        name = method.upper()
+        assert name in back.attrs["source"] and other not in back.attrs["source"]
+        assert name in back["n_steps"].attrs["long_name"]
+        assert name in back["n_rejected"].attrs["long_name"]
+        assert back["n_steps"].dtype == np.int32 and back["n_rhs"].dtype == np.int32
+    finally:
+        back.close()
+
+
+def test_counters_are_int32_only_where_they_fit():
+    assert counter(np.array([0, 2**31 - 1])).dtype == np.int32
+    big = counter(np.array([1, 2**31]))
+    assert big.dtype == np.int64 and big[1] == 2**31     # kept exactly, never wrapped
+    assert counter(np.array([-2**31 - 1])).dtype == np.int64
+
+
+def test_one_state_table_across_kinds(tmp_path):
+    """The same integer never means two things: every dataset's flags are the shared table's."""
+    seen: dict[int, str] = {}
+    for name in ("harness-parametric", "paper-fig7"):
+        ds, out = scene_output(name, tmp_path)
+        back = xr.open_dataset(out)
+        try:
+            attrs = back["state"].attrs
+            values = [int(v) for v in np.atleast_1d(attrs["flag_values"])]
+            meanings = attrs["flag_meanings"].split()
+            assert len(values) == len(meanings) == len(set(values))
+            assert set(np.unique(back["state"].values)) <= set(values)
+        finally:
+            back.close()
+        for value, meaning in zip(values, meanings):
+            assert seen.setdefault(value, meaning) == meaning, (name, value)
+            assert km.STATE_MEANINGS[value] == meaning
+    assert len(set(seen.values())) == len(seen)            # no meaning under two integers
+    assert {"completed", "steady", "diverged"} <= set(seen.values())
