@@ -28,8 +28,10 @@ are needed, and none is forced on the caller.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
+import re
 import textwrap
 import tomllib
 from pathlib import Path
@@ -37,18 +39,21 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 import xarray as xr
+from matplotlib import colormaps as mpl_colormaps
 from matplotlib import colors as mcolors
 from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import ScalarFormatter
 
 from .errors import UserError
+from .schema import BY_AXIS
 
-__all__ = ["STATE_STYLES", "label", "load_result", "parse_select", "plot", "plot_histories",
+__all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label", "load_result", "parse_select", "plot", "plot_histories",
            "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
-           "save", "select_points", "state_styles", "swept_axes"]
+           "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]
 
 # A fixed colour and map marker per state meaning (CF flag_meanings); marker None: a good
 # state, not marked on maps. Meanings not listed here get a fallback colour and "*".
@@ -68,6 +73,20 @@ _NAN_COLOUR = "0.82"
 _OUTLINE = [patheffects.Stroke(linewidth=3.0, foreground="k"), patheffects.Normal()]
 _DECADES = 6          # a log colour scale spans at most this many decades below the maximum
 _MAX_LABEL = 60
+# Displacement maps: amplitudes below FLOOR x the map's largest one are drawn in one
+# "no response" colour, and the log colour scale spans only the three decades above it.
+FLOOR = 1e-3
+_NO_RESPONSE_COLOUR = "white"
+# Maps with more cells than this mark the states by hatched, outlined regions, not markers.
+_MARKER_CELLS = 100
+_HATCHES = {"modulated": "\\\\\\", "unsettled": "///", "diverged": "xxx",
+            "step_size_too_small": "...", "max_steps_reached": "+++", "invalid_input": "---"}
+# The paper's Fig 5 tail amplitudes [m] by span length [m] (P0 = 4 N, W/w0 = 1, Eq.32).
+PAPER_FIG5_AMPLITUDES: dict[float, float] = {0.5: 4.1e-3, 0.7: 3.8e-3, 0.85: 3.4e-3,
+                                             1.0: 3.0e-3}
+_FOOTER_PT = 7.0
+_TIME_DIMS = ("elapsed_time", "time")     # the dimension of stored histories (new, old name)
+_log = logging.getLogger(__name__)
 
 
 # ---------------------------------------------------------------------------------- reading
@@ -202,16 +221,29 @@ def _scaled(values: np.ndarray, units: str | None) -> tuple[float, str | None]:
     return 1.0 / factor, prefix + units
 
 
+def _is_displacement(da: xr.DataArray) -> bool:
+    """A displacement (units m, not the span length): always shown in mm."""
+    return da.attrs.get("units") == "m" and da.name != "length"
+
+
+def _unit(da: xr.DataArray, values: np.ndarray | None = None) -> tuple[float, str | None]:
+    """The factor and units a variable is shown in: displacements in mm, times and forces
+    with the prefix their largest value calls for (`_scaled`), anything else as stored."""
+    if _is_displacement(da):
+        return 1e3, "mm"
+    return _scaled(da.values if values is None else values, da.attrs.get("units"))
+
+
 def _fmt(value: float, units: str | None) -> str:
-    factor, scaled = _scaled(np.array([value]), units)
+    factor, scaled = (1e3, "mm") if units == "m" else _scaled(np.array([value]), units)
     text = f"{value * factor:.4g}"
     return f"{text} {scaled}" if scaled and scaled != "1" else text
 
 
 def _point_text(ds: xr.Dataset, dims: Iterable[str]) -> str:
     def one(d: str) -> str:
-        units = ds[d].attrs.get("units")
-        value = f"{float(ds[d].values):.4g}"
+        factor, units = (1e3, "mm") if _is_displacement(ds[d]) else (1.0, ds[d].attrs.get("units"))
+        value = f"{float(ds[d].values) * factor:.4g}"
         return f"{d} = {value} {units}" if units and units != "1" else f"{d} = {value}"
     return ", ".join(one(d) for d in dims)
 
@@ -230,7 +262,7 @@ def _title(ds: xr.Dataset, what: str = "") -> str:
 def _scene_axes(ds: xr.Dataset) -> list[str]:
     doc = _scene(ds)
     return list(doc.get("axes", {})) if doc else [c for c in ds.coords
-                                                 if c not in ("time", "snapshot_time",
+                                                 if c not in (*_TIME_DIMS, "snapshot_time",
                                                               "position")]
 
 
@@ -239,6 +271,118 @@ def _scene(ds: xr.Dataset) -> dict[str, Any]:
         return tomllib.loads(str(ds.attrs.get("scene", "")))
     except tomllib.TOMLDecodeError:
         return {}
+
+
+def _setting(ds: xr.Dataset, section: str, key: str) -> Any:
+    """A scene value as this (selected) result has it: a fixed axis's coordinate, None while
+    the axis is still swept (its values are on the figure's axes), else the scene's value."""
+    axis = next((a for a, k in BY_AXIS.items() if (k.section, k.name) == (section, key)), None)
+    if axis is not None and axis in ds.coords:
+        return float(ds[axis].values) if ds[axis].ndim == 0 else None
+    if axis is not None and axis in _scene(ds).get("axes", {}):
+        return None
+    return _scene(ds).get(section, {}).get(key)
+
+
+def footer(ds: xr.Dataset) -> str:
+    """The load case in one line, from the result's scene (its `scene` attribute) and fixed
+    axis values: model, end load, damping, initial state, span, end time, solver, metrics.
+    Swept quantities are left out (they are on the axes). Empty without a scene."""
+    doc = _scene(ds)
+    if not doc:
+        return ""
+
+    def get(section: str, key: str) -> Any:
+        return _setting(ds, section, key)
+
+    def num(value: Any) -> str:
+        return f"{float(value):.4g}"
+
+    parts = []
+    load = doc.get("load", {})
+    kind = doc.get("model", {}).get("kind", ds.attrs.get("model_kind", "transverse"))
+    p0 = get("load", "amplitude")
+    text = f"{load.get('type', 'harmonic')} end load" + ("" if p0 is None else
+                                                        f" P0 = {num(p0)} N")
+    if load.get("type", "harmonic") == "harmonic" and kind != "longitudinal":
+        ratio, freq = get("load", "frequency_ratio"), get("load", "frequency")
+        if ratio is not None:
+            text += f" at W/w1 = {num(ratio)}"
+        elif freq is not None:
+            text += f" at {num(freq)} Hz"
+    parts.append(text)
+    length = get("cable", "length")
+    if length is not None:
+        parts.append(f"l = {num(length)} m")
+    solver = doc.get("solver", {})
+    if kind == "longitudinal":
+        parts.append("longitudinal wave, central difference")
+        parts.append(f"{solver.get('intervals', '?')} intervals, C = {num(solver.get('courant', 1))}")
+        if solver.get("transits") is not None:
+            parts.append(f"{num(solver['transits'])} transits")
+        elif solver.get("t_end") is not None:
+            parts.append(f"t_end = {_fmt(float(solver['t_end']), 's')}")
+        return "Load case: " + "; ".join(parts)
+    model = doc.get("model", {})
+    coeff = model.get("coefficients", ds.attrs.get("coefficients", "?"))
+    text = f"{coeff} coefficients"
+    if coeff == "paper":
+        text += f" (cos terms {model.get('paper_parametric', 'printed')})"
+    elif get("model", "membrane") is not None:
+        text += f", membrane {num(get('model', 'membrane'))}"
+    parts.insert(0, text)
+    zeta = get("cable", "damping_ratio")
+    if zeta is not None:
+        parts.append(f"damping ratio {num(zeta)}")
+    q0, v0 = get("initial", "displacement"), get("initial", "velocity")
+    start = [t for t in ((None if q0 is None else f"q(0) = {_fmt(float(q0), 'm')}"),
+                         (None if v0 is None else f"q'(0) = {num(v0)} m/s")) if t]
+    if start:
+        parts.append(", ".join(start))
+    if solver.get("t_end") is not None:
+        parts.append(f"t_end = {num(solver['t_end'])} s")
+    parts.append(f"{solver.get('method', 'rk45')} rtol {num(solver.get('rtol', 1e-8))}")
+    metrics = doc.get("metrics", {})
+    if metrics:
+        parts.append(f"tail {num(metrics.get('tail', 0.5))}, "
+                     f"tolerance {num(metrics.get('tolerance', 0.02))}")
+    return "Load case: " + "; ".join(parts)
+
+
+def _add_footer(fig: Figure, ds: xr.Dataset) -> None:
+    """The footer under a constrained-layout figure, with room kept for it."""
+    text = footer(ds)
+    if not text:
+        return
+    width = fig.get_size_inches()[0]
+    chars = max(40, int(width * 72.0 / (0.62 * _FOOTER_PT)))
+    wrapped = _wrap(text, chars)
+    lines = wrapped.count("\n") + 1
+    height = (lines * 1.25 * _FOOTER_PT + 6.0) / 72.0 / fig.get_size_inches()[1]
+    fig.text(0.01, 0.004, wrapped, fontsize=_FOOTER_PT, color="0.3", ha="left", va="bottom")
+    engine = fig.get_layout_engine()
+    if engine is not None and hasattr(engine, "set"):
+        engine.set(rect=(0.0, height, 1.0, 1.0 - height))
+
+
+def _paper_fig5(ds: xr.Dataset) -> dict[float, float]:
+    """The paper's Fig 5 amplitudes [m] by span length for the points of this result, when it
+    is the paper's Fig 5 case (paper coefficients, harmonic P0 = 4 N at W/w0 = 1, spans among
+    0.5, 0.7, 0.85, 1 m); else empty."""
+    if ds.attrs.get("coefficients") != "paper" or "length" not in ds.coords:
+        return {}
+    if _scene(ds).get("load", {}).get("type", "harmonic") != "harmonic":
+        return {}
+    p0, ratio = _setting(ds, "load", "amplitude"), _setting(ds, "load", "frequency_ratio")
+    if p0 is None or ratio is None or not (math.isclose(float(p0), 4.0)
+                                           and math.isclose(float(ratio), 1.0)):
+        return {}
+    found = {}
+    for length in np.atleast_1d(ds["length"].values).astype(float):
+        for paper_length, amplitude in PAPER_FIG5_AMPLITUDES.items():
+            if math.isclose(length, paper_length, rel_tol=1e-6):
+                found[float(length)] = amplitude
+    return found
 
 
 # ---------------------------------------------------------------------------------- states
@@ -259,6 +403,50 @@ def state_styles(state: xr.DataArray) -> list[tuple[int, str, str, str | None]]:
 
 def _wrap(text: str, width: int) -> str:
     return textwrap.fill(text, width, break_long_words=False)
+
+
+def _plain_ticks(ax: Axes) -> None:
+    """Tick labels that are the numbers themselves: no offset ("1e-12+2") and no scientific
+    multiplier on any linear axis (log axes keep their own formatter)."""
+    for axis in (ax.xaxis, ax.yaxis):
+        formatter = axis.get_major_formatter()
+        if isinstance(formatter, ScalarFormatter):
+            formatter.set_useOffset(False)
+            formatter.set_scientific(False)
+
+
+def _padded_range(values: np.ndarray) -> tuple[float, float] | None:
+    """For near-constant data (spread below 1e-6 of its size): its mean +- 5 %, so that the
+    axis shows the value, not round-off; None otherwise."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return None
+    mean, spread = float(v.mean()), float(v.max() - v.min())
+    if spread > 1e-6 * abs(mean) or (mean == 0.0 and spread > 0.0):
+        return None
+    half = 0.05 * abs(mean) if mean else 1.0
+    return mean - half, mean + half
+
+
+def why_not_drawn(da: xr.DataArray) -> str | None:
+    """Why a figure of `da` would say nothing: every value NaN, or every finite value the same
+    (e.g. settling times all 0 s); None when it varies."""
+    v = np.asarray(da.values, dtype=float)
+    finite = v[np.isfinite(v)]
+    if not finite.size:
+        return "no point has a value (all NaN)"
+    if finite.min() == finite.max():
+        factor, units = _unit(da, finite)
+        value = f"{finite[0] * factor:.4g}" + (f" {units}" if units and units != "1" else "")
+        some = " with a value" if finite.size < v.size else ""
+        return f"every point{some} has the same value, {value}"
+    return None
+
+
+def _time_dim(da: xr.DataArray) -> str | None:
+    """The time dimension of a stored history, None when `da` has none."""
+    return next((d for d in _TIME_DIMS if d in da.dims), None)
 
 
 def _new_axes(figsize: tuple[float, float] = (6.4, 4.8)) -> Axes:
@@ -337,7 +525,10 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
     them). Points with no value (NaN, e.g. the settling time of a modulated point) are drawn
     hollow on the bottom edge in their state's colour. With length swept and P0/Pcr depending
     on it only, a dashed line marks the buckling length (P0 = Pcr) when it is in range.
-    Extra keyword arguments go to `Axes.scatter`. Returns the Axes."""
+    Displacements are in mm; near-constant data get a +-5 % range around their value (not a
+    range of round-off); no axis uses an offset. On the paper's Fig 5 case the paper's own
+    amplitudes are marked ("paper Fig 5"). Extra keyword arguments go to `Axes.scatter`.
+    Returns the Axes."""
     ds = select_points(ds, select)
     axes = swept_axes(ds)
     if len(axes) != 1:
@@ -348,12 +539,12 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
     if var not in ds:
         raise UserError(f"plot_line: the result has no variable '{var}'")
     ax = ax if ax is not None else _new_axes()
-    x = ds[dim].values.astype(float)
+    xfactor, xunits = _unit(ds[dim])
+    x = ds[dim].values.astype(float) * xfactor
     y = ds[var].values.astype(float)
     state = ds["state"].values
     log_y = _wide_range(y)
-    factor, units = (1.0, ds[var].attrs.get("units")) if log_y else \
-        _scaled(y, ds[var].attrs.get("units"))
+    factor, units = _unit(ds[var], y)
     ax.plot(x, y * factor, color="0.7", lw=1.0, zorder=1)
     handles = []
     nan_any = False
@@ -388,14 +579,27 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
             ax.axvline(l_cr, color="k", ls="--", lw=1.0, zorder=2)
             handles.append(Line2D([], [], color="k", ls="--", lw=1.0,
                                   label=f"P0 = Pcr, l = {l_cr:.3g} m"))
+        paper = _paper_fig5(ds) if var == "amplitude" else {}
+        if paper:
+            ax.scatter(list(paper), np.array(list(paper.values())) * factor, marker="D",
+                       s=kwargs["s"], facecolors="none", edgecolors="k", linewidths=1.2,
+                       zorder=4)
+            handles.append(Line2D([], [], ls="none", marker="D", markerfacecolor="none",
+                                  markeredgecolor="k", label="paper Fig 5: " + ", ".join(
+                                      f"{a * factor:g}" for a in paper.values()) + f" {units}"))
     if log_y:
         ax.set_yscale("log")
+    else:
+        padded = _padded_range(y * factor)
+        if padded is not None:
+            ax.set_ylim(*padded)
     if _is_log_spaced(x):
         ax.set_xscale("log")
-    ax.set_xlabel(label(ds[dim]))
+    ax.set_xlabel(label(ds[dim], xunits))
     ax.set_ylabel(label(ds[var], units))
     ax.set_title(_title(ds), fontsize="medium")
     ax.grid(True, color="0.92", zorder=0)
+    _plain_ticks(ax)
     if add_legend:
         _legend(ax, handles, "state")
     return ax
@@ -420,38 +624,74 @@ def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str) -> tuple[s
     return x, y
 
 
+def _coord(ds: xr.Dataset, dim: str) -> np.ndarray:
+    """An axis's values as drawn (displacement axes in mm)."""
+    return ds[dim].values.astype(float) * _unit(ds[dim])[0]
+
+
 def _mesh(ax: Axes, ds: xr.Dataset, x: str, y: str, values: np.ndarray, **kwargs: Any):
-    xv, yv = ds[x].values.astype(float), ds[y].values.astype(float)
+    xv, yv = _coord(ds, x), _coord(ds, y)
     mesh = ax.pcolormesh(_edges(xv), _edges(yv), values, shading="flat", **kwargs)
     if _is_log_spaced(xv):
         ax.set_xscale("log")
     if _is_log_spaced(yv):
         ax.set_yscale("log")
-    ax.set_xlabel(label(ds[x]))
-    ax.set_ylabel(label(ds[y]))
+    ax.set_xlabel(label(ds[x], _unit(ds[x])[1]))
+    ax.set_ylabel(label(ds[y], _unit(ds[y])[1]))
     return mesh
 
 
+def _state_label(meaning: str, count: int) -> str:
+    return f"{meaning} ({count})"
+
+
 def _mark_states(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
-    """Markers at the centres of the cells whose state is not a good one; legend handles."""
+    """Mark the cells whose state is not a good one; returns the legend handles. A small grid
+    (at most 100 cells) gets a marker per cell; a denser one gets each state's region hatched
+    and outlined in the state's colour along the cell edges, so the colour under it shows."""
     state = ds["state"].transpose(y, x).values
-    xx, yy = np.meshgrid(ds[x].values, ds[y].values)
+    styles = [s for s in state_styles(ds["state"]) if s[3] is not None and (state == s[0]).any()]
+    if state.size > _MARKER_CELLS:
+        return [_hatch_region(ax, ds, x, y, state == value, meaning, colour)
+                for value, meaning, colour, _marker in styles]
+    xx, yy = np.meshgrid(_coord(ds, x), _coord(ds, y))
     # Markers fit in their cells: at most 60 % of the smaller cell side (and 30 pt^2).
     box = ax.get_window_extent()
     cell = min(box.width / state.shape[1], box.height / state.shape[0]) * 72.0 / ax.figure.dpi
     size = float(np.clip((0.6 * cell) ** 2, 2.0, 30.0))
     edge = 0.6 if size >= 12.0 else 0.3
     handles = []
-    for value, meaning, colour, marker in state_styles(ds["state"]):
+    for value, meaning, colour, marker in styles:
         mask = state == value
-        if marker is None or not mask.any():
-            continue
         ax.scatter(xx[mask], yy[mask], marker=marker, s=size, color=colour, edgecolors="k",
                    linewidths=edge, zorder=4)
         handles.append(Line2D([], [], ls="none", marker=marker, color=colour,
                               markeredgecolor="k", markeredgewidth=0.6,
-                              label=f"{meaning} ({int(mask.sum())})"))
+                              label=_state_label(meaning, int(mask.sum()))))
     return handles
+
+
+def _hatch_region(ax: Axes, ds: xr.Dataset, x: str, y: str, mask: np.ndarray, meaning: str,
+                  colour: str) -> Patch:
+    """Hatch and outline the cells of `mask` (rows: y); its legend handle."""
+    def doubled(edges: np.ndarray) -> np.ndarray:
+        # Two samples per cell just inside its edges: contouring the 0/1 mask at 0.5 then
+        # crosses exactly on the cell edges (also on a log-spaced axis).
+        inset = 1e-3 * np.diff(edges)
+        return np.column_stack([edges[:-1] + inset, edges[1:] - inset]).ravel()
+
+    xs, ys = doubled(_edges(_coord(ds, x))), doubled(_edges(_coord(ds, y)))
+    fine = np.repeat(np.repeat(mask.astype(float), 2, axis=0), 2, axis=1)
+    hatch = _HATCHES.get(meaning, "ooo")
+    filled = ax.contourf(xs, ys, fine, levels=[0.5, 1.5], colors="none", hatches=[hatch],
+                         zorder=4)
+    filled.set_hatchcolor(colour)
+    filled.set_edgecolor("none")
+    ax.contour(xs, ys, fine, levels=[0.5], colors=[colour], linewidths=1.1, zorder=4,
+               path_effects=[patheffects.Stroke(linewidth=2.3, foreground="k"),
+                             patheffects.Normal()])
+    return Patch(facecolor="none", edgecolor=colour, hatch=hatch, linewidth=1.1,
+                 label=_state_label(meaning, int(mask.sum())))
 
 
 def _damping(ds: xr.Dataset) -> Any:
@@ -492,7 +732,7 @@ def _overlays(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
     parts = [ratio, base] + ([zeta] if isinstance(zeta, xr.DataArray) else [])
     if base is None or not all(_depends_only_on(p, [other]) for p in parts):
         return handles
-    pos = ds[other].values.astype(float)
+    pos = _coord(ds, other)
     dense = np.geomspace(pos[0], pos[-1], 200) if pos[0] > 0 else np.linspace(pos[0], pos[-1], 200)
 
     def along(da: Any) -> np.ndarray:
@@ -532,10 +772,14 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
              mark_states: bool = True, overlays: bool = True, **kwargs: Any) -> Axes:
     """A pcolormesh map of `var` over the two swept axes (x: the second, y: the first, as
     xarray draws a 2-D DataArray; or name them). A variable spanning more than two decades gets
-    a log colour scale; cells with no value (NaN) are grey. Points in a state that is not a
-    good one (modulated, unsettled, diverged, failures) are marked at the cell centres, and the
-    closed-form curves the axes allow are drawn in white (see the module docstring). Extra
-    keyword arguments go to `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
+    a log colour scale; cells with no value (NaN) are grey. Displacements are in mm; on a log
+    scale, a displacement below FLOOR (1e-3) times the map's largest is drawn white as "no
+    response" and the colours span only the three decades above it (other variables: at most
+    six decades, the rest in the lowest colour). Points in a state that is not a good one
+    (modulated, unsettled, diverged, failures) are marked: a marker per cell on small grids,
+    hatched and outlined regions on dense ones (`_MARKER_CELLS`). The closed-form curves the
+    axes allow are drawn in white (see the module docstring). Extra keyword arguments go to
+    `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
     """
     ds = select_points(ds, select)
     x, y = _map_axes(ds, x, y, "plot_map")
@@ -544,17 +788,32 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
     ax = ax if ax is not None else _new_axes((7.0, 6.0))
     da = ds[var].transpose(y, x) if ds[var].ndim == 2 else ds[var].broadcast_like(
         ds["state"]).transpose(y, x)
-    values = np.ma.masked_invalid(da.values.astype(float))
+    factor, units = _unit(ds[var], da.values)
+    values = np.ma.masked_invalid(da.values.astype(float) * factor)
     extend = "neither"
-    if "norm" not in kwargs and "vmin" not in kwargs and _wide_range(values.compressed()):
+    handles = []
+    cmap = kwargs.pop("cmap", "viridis")
+    user_scale = "norm" in kwargs or "vmin" in kwargs or "vmax" in kwargs
+    if not user_scale and _wide_range(values.compressed()):
         top, low = float(values.max()), float(values.min())
-        floor = top * 10.0 ** -_DECADES
+        if _is_displacement(ds[var]):
+            floor = FLOOR * top
+            cmap = mpl_colormaps[cmap] if isinstance(cmap, str) else cmap
+            cmap = cmap.with_extremes(under=_NO_RESPONSE_COLOUR)
+            below = int((values.compressed() < floor).sum())
+            if below:
+                handles.append(Patch(facecolor=_NO_RESPONSE_COLOUR, edgecolor="0.5",
+                                     label=f"no response, < {floor:.2g} {units} ({below})"))
+        else:
+            floor = top * 10.0 ** -_DECADES
         extend = "min" if low < floor else "neither"
         kwargs["norm"] = mcolors.LogNorm(vmin=max(low, floor), vmax=top, clip=False)
-    kwargs.setdefault("cmap", "viridis")
-    mesh = _mesh(ax, ds, x, y, values, **kwargs)
+    elif not user_scale:
+        padded = _padded_range(values.compressed())
+        if padded is not None:
+            kwargs["vmin"], kwargs["vmax"] = padded
+    mesh = _mesh(ax, ds, x, y, values, cmap=cmap, **kwargs)
     ax.set_facecolor(_NAN_COLOUR)
-    handles = []
     if values.mask.any():
         handles.append(Patch(facecolor=_NAN_COLOUR, edgecolor="0.5", label="no value (NaN)"))
     if mark_states:
@@ -565,8 +824,10 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
         ax.set_xlim(*lims[0])
         ax.set_ylim(*lims[1])
     if add_colorbar:
-        ax.figure.colorbar(mesh, ax=ax, label=label(ds[var]), extend=extend)
+        bar = ax.figure.colorbar(mesh, ax=ax, label=label(ds[var], units), extend=extend)
+        _plain_ticks(bar.ax)
     ax.set_title(_title(ds, str(var)), fontsize="medium")
+    _plain_ticks(ax)
     if add_legend:
         _legend(ax, handles)
     return ax
@@ -596,6 +857,7 @@ def plot_state_map(ds: xr.Dataset, *, x: str | None = None, y: str | None = None
         ax.set_xlim(*lims[0])
         ax.set_ylim(*lims[1])
     ax.set_title(_title(ds, "state"), fontsize="medium")
+    _plain_ticks(ax)
     if add_legend:
         _legend(ax, handles)
     return ax
@@ -630,10 +892,11 @@ def plot_time_series(ds: xr.Dataset, var: str = "displacement", *,
                      fig: Figure | None = None, **kwargs: Any) -> Figure:
     """The stored response against time, one panel per point (the paper's Fig 5 style), lines
     in the colour of the point's state; at most `max_panels` points, spread evenly over the
-    grid. Panels share the y scale when their peaks are within a factor 10. Extra keyword
-    arguments go to `Axes.plot`. Returns the Figure."""
+    grid. Panels share the y scale when their peaks are within a factor 10. Displacements are
+    in mm. On the paper's Fig 5 case, dashed lines mark the paper's amplitude +-A of each
+    span. Extra keyword arguments go to `Axes.plot`. Returns the Figure."""
     ds = select_points(ds, select)
-    if var not in ds or "time" not in ds[var].dims:
+    if var not in ds or _time_dim(ds[var]) is None:
         raise UserError(f"plot_time_series: the result stores no '{var}' time series (set "
                         "outputs.time_series = true in the scene)")
     points, total = _points(ds, max_panels)
@@ -641,19 +904,30 @@ def plot_time_series(ds: xr.Dataset, var: str = "displacement", *,
     data = ds[var]
     peaks = [float(np.nanmax(np.abs(data.isel(p).values), initial=0.0)) for p in points]
     share = bool(min(peaks) > 0 and max(peaks) < 10 * min(peaks))
-    factor, units = _scaled(np.array(peaks), data.attrs.get("units"))
-    tfactor, tunits = _scaled(ds["time"].values, ds["time"].attrs.get("units"))
+    factor, units = _unit(data, np.array(peaks))
+    paper = _paper_fig5(ds) if var == "displacement" else {}
+    time = ds[_time_dim(ds[var])]
+    tfactor, tunits = _scaled(time.values, time.attrs.get("units"))
     fig = fig if fig is not None else Figure(figsize=(7.0, 1.0 + 1.45 * n), layout="constrained")
     axs = fig.subplots(n, 1, sharex=True, sharey=share, squeeze=False)[:, 0]
     kwargs.setdefault("lw", 0.8)
     for ax, p in zip(axs, points):
         point = ds.isel(p)
-        ax.plot(ds["time"].values * tfactor, point[var].values * factor,
+        ax.plot(time.values * tfactor, point[var].values * factor,
                 color=_state_colour(point), **kwargs)
         text = _point_text(point, swept_axes(ds)) or "the point"
         ax.set_title(f"{text}: {_state_meaning(point)}", fontsize="small", loc="left")
         ax.grid(True, color="0.92")
-    axs[-1].set_xlabel(label(ds["time"], tunits))
+        length = float(point["length"].values) if "length" in point.coords else None
+        if length in paper:
+            amplitude = paper[length] * factor
+            for sign in (1.0, -1.0):
+                ax.axhline(sign * amplitude, color="k", ls="--", lw=0.9,
+                           label=f"paper Fig 5: \u00b1{amplitude:g} {units}" if sign > 0
+                           else None)
+            ax.legend(loc="upper right", fontsize="x-small", framealpha=0.9)
+        _plain_ticks(ax)
+    axs[-1].set_xlabel(label(time, tunits))
     fig.supylabel(label(data, units), fontsize="medium")
     shown = "" if n == total else f" ({n} of {total} points)"
     fig.suptitle(_title(ds, "response against time") + shown, fontsize="medium")
@@ -693,7 +967,7 @@ def plot_snapshots(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     x = ds["position"].values
     kwargs.setdefault("lw", 1.4)
     for j, name in enumerate(fields):
-        factor, units = _scaled(ds[name].values, ds[name].attrs.get("units"))
+        factor, units = _unit(ds[name])
         axs[0, j].set_title(_wrap(label(ds[name], units), 34), fontsize="small")
         axs[-1, j].set_xlabel(_wrap(label(ds["position"]), 34))
         for i, k in enumerate(rows):
@@ -705,6 +979,7 @@ def plot_snapshots(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
                         **kwargs)
             ax.axhline(0.0, color="0.6", lw=0.6, zorder=0)
             ax.grid(True, color="0.92")
+            _plain_ticks(ax)
     for i, k in enumerate(rows):
         t = float(ds["snapshot_time"].values[k])
         text = f"t = {_fmt(t, 's')}"
@@ -732,14 +1007,15 @@ def plot_histories(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     fig = fig if fig is not None else Figure(figsize=(7.0, 1.2 + 2.6 * len(names)),
                                              layout="constrained")
     axs = fig.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
-    tfactor, tunits = _scaled(ds["time"].values, ds["time"].attrs.get("units"))
+    time = ds[_time_dim(ds[names[0]])]
+    tfactor, tunits = _scaled(time.values, time.attrs.get("units"))
     kwargs.setdefault("lw", 1.2)
     for ax, name in zip(axs, names):
-        factor, units = _scaled(ds[name].values, ds[name].attrs.get("units"))
+        factor, units = _unit(ds[name])
         for p in points:
             point = ds.isel(p)
             text = _point_text(point, swept_axes(ds))
-            line, = ax.plot(ds["time"].values * tfactor, point[name].values * factor,
+            line, = ax.plot(time.values * tfactor, point[name].values * factor,
                             label=text or None, **kwargs)
             if len(points) == 1:
                 exact = _exact_peak(point, name)
@@ -751,9 +1027,10 @@ def plot_histories(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
         ax.axhline(0.0, color="0.6", lw=0.6)
         ax.set_ylabel(_wrap(label(ds[name], units), 26))
         ax.grid(True, color="0.92")
+        _plain_ticks(ax)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize="small", loc="best")
-    axs[-1].set_xlabel(label(ds["time"], tunits))
+    axs[-1].set_xlabel(label(time, tunits))
     shown = "" if len(points) == total else f" ({len(points)} of {total} points)"
     fig.suptitle(_title(ds, "end histories") + shown, fontsize="medium")
     return fig
@@ -778,44 +1055,95 @@ def _exact_peak(point: xr.Dataset, name: str) -> float | None:
 
 # ---------------------------------------------------------------------------------- choose
 
-def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> dict[str, Figure]:
+class Figures(dict):
+    """The figures `plot` drew, by name (a dict), with the selection they were drawn for
+    (`select`, written into the file names by `save`) and the figures left out with the
+    reason (`skipped`: name -> why)."""
+
+    def __init__(self, figures: Mapping[str, Figure] | None = None, *,
+                 select: Mapping[str, Any] | None = None,
+                 skipped: Mapping[str, str] | None = None) -> None:
+        super().__init__(figures or {})
+        self.select = dict(select or {})
+        self.skipped = dict(skipped or {})
+
+
+def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     """Every figure that fits the result, keyed by name (the file name `save` gives it).
 
     Transverse: 'amplitude' and 'settling_time' (lines over one swept axis, maps over two),
     'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
-    swept axes. An empty dict when nothing fits (no swept axis and nothing stored over time).
+    swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
+    settling times of an undamped run, all 0 s; a state map with one state) gets no figure:
+    the reason goes to `Figures.skipped` and the log (info here; `save` repeats it as a
+    warning, which reaches stderr by default).
+    Each figure has the load case in a footer (`footer`). An empty result when nothing fits.
     """
     ds = select_points(ds, select)
     axes = swept_axes(ds)
-    figures: dict[str, Figure] = {}
+    figures = Figures(select=select)
     if ds.attrs.get("model_kind") == "longitudinal":
         scalars = ["peak_end_displacement", "dynamic_amplification"]
     else:
         scalars = ["amplitude", "settling_time"]
-    for var in scalars:
-        if var not in ds:
-            continue
-        if len(axes) == 1:
-            figures[var] = plot_line(ds, var).figure
-        elif len(axes) == 2:
-            figures[var] = plot_map(ds, var).figure
     if len(axes) == 2:
-        figures["state"] = plot_state_map(ds).figure
-    if "displacement" in ds and "time" in ds["displacement"].dims:
+        scalars.append("state")
+    for var in scalars:
+        if var not in ds or len(axes) not in (1, 2):
+            continue
+        if var == "state":
+            reason = (f"every point is {_state_meaning(ds.isel({a: 0 for a in axes}))}"
+                      if np.unique(ds["state"].values).size == 1 else None)
+        else:
+            reason = why_not_drawn(ds[var])
+        if reason is not None:
+            figures.skipped[var] = reason
+            _log.info("%s: %s: no figure (%s)", ds.attrs.get("title", "result"), var, reason)
+        elif var == "state":
+            figures[var] = plot_state_map(ds).figure
+        elif len(axes) == 1:
+            figures[var] = plot_line(ds, var).figure
+        else:
+            figures[var] = plot_map(ds, var).figure
+    if "displacement" in ds and _time_dim(ds["displacement"]) is not None:
         figures["time_series"] = plot_time_series(ds)
     if _snapshot_fields(ds):
         figures["snapshots"] = plot_snapshots(ds)
     if "end_displacement" in ds or "fixed_end_force" in ds:
         figures["histories"] = plot_histories(ds)
+    for fig in figures.values():
+        for ax in fig.axes:
+            _plain_ticks(ax)
+        _add_footer(fig, ds)
     return figures
 
 
+def _select_tag(select: Mapping[str, Any]) -> str:
+    """'load_amplitude=4-length=0.5' for a selection, file-system safe (letters, digits and
+    . _ = + - only)."""
+    parts = []
+    for dim, value in select.items():
+        try:
+            shown = f"{float(value):g}"
+        except (TypeError, ValueError):
+            shown = str(value)
+        parts.append(re.sub(r"[^A-Za-z0-9._=+-]", "_", f"{dim}={shown}"))
+    return "-".join(parts)
+
+
 def save(figures: Mapping[str, Figure], directory: str | os.PathLike = ".",
-         formats: Iterable[str] = ("png",), *, prefix: str = "", dpi: float = 100) -> list[Path]:
+         formats: Iterable[str] = ("png",), *, prefix: str = "", dpi: float = 100,
+         select: Mapping[str, Any] | None = None) -> list[Path]:
     """Write each figure as DIRECTORY/PREFIX + key + .FORMAT (the directory is created);
-    returns the paths written. Raises UserError for an unknown format or an unwritable
-    directory."""
+    with a selection (`select`, else the one `plot` recorded on its `Figures`) the name is
+    PREFIX + 'DIM=VALUE-' ... + key, so that figures of different selections do not overwrite
+    each other (e.g. map-load_amplitude=4-amplitude.png). `dpi`: dots per inch of raster
+    formats. The figures `plot` left out (`Figures.skipped`) are logged as warnings, one line
+    each. Returns the paths written. Raises UserError for an unknown format or an
+    unwritable directory."""
+    select = getattr(figures, "select", None) if select is None else select
+    tag = _select_tag(select) + "-" if select else ""
     formats = [f.strip().lower().lstrip(".") for f in formats if f.strip()]
     supported = Figure().canvas.get_supported_filetypes()
     for fmt in formats:
@@ -828,10 +1156,12 @@ def save(figures: Mapping[str, Figure], directory: str | os.PathLike = ".",
     except OSError as exc:
         raise UserError(f"output directory '{out}': could not be created "
                         f"({exc.strerror or exc})") from exc
+    for key, reason in getattr(figures, "skipped", {}).items():
+        _log.warning("%s%s%s: no figure (%s)", prefix, tag, key, reason)
     written = []
     for key, fig in figures.items():
         for fmt in formats:
-            path = out / f"{prefix}{key}.{fmt}"
+            path = out / f"{prefix}{tag}{key}.{fmt}"
             try:
                 fig.savefig(path, format=fmt, dpi=dpi)
             except OSError as exc:

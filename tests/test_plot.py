@@ -43,6 +43,7 @@ name = "plot-map"
 coefficients = "consistent"
 [cable]
 damping_ratio = 0.02
+inertia = 5.73e-12              # m^4, the paper's number (the overlay test computes with it)
 [initial]
 displacement = 1e-4
 [axes]
@@ -116,7 +117,10 @@ def _check_png(path: Path, fig: Figure, dpi: float = 100) -> np.ndarray:
 def test_each_figure_is_drawn_and_saved_at_its_size(results, tmp_path, name, keys):
     ds, _ = results[name]
     figures = splot.plot(ds)
-    assert set(figures) == keys
+    # A variable with one value everywhere (or none) has no figure, and says why.
+    silent = {k for k in keys if k in ds and splot.why_not_drawn(ds[k]) is not None}
+    assert set(figures) == keys - silent and set(figures.skipped) == silent
+    keys = keys - silent
     paths = splot.save(figures, tmp_path, prefix=f"{name}-")
     assert sorted(p.name for p in paths) == sorted(f"{name}-{k}.png" for k in keys)
     for key, fig in figures.items():
@@ -180,9 +184,11 @@ def test_select_picks_values_and_names_what_is_wrong(results):
     three["state"] = three["state"].transpose("length", "frequency_ratio", "damping_ratio")
     with pytest.raises(sweep.UserError, match="3 swept axes .*--select damping_ratio=0.01"):
         splot.plot(three)
-    assert set(splot.plot(three, select={"damping_ratio": 0.02})) == \
+    def names(figures):          # drawn, or left out with a reason
+        return set(figures) | set(figures.skipped)
+    assert names(splot.plot(three, select={"damping_ratio": 0.02})) == \
         {"amplitude", "settling_time", "state"}
-    assert set(splot.plot(three, select={"damping_ratio": 0.02, "length": 0.7})) == \
+    assert names(splot.plot(three, select={"damping_ratio": 0.02, "length": 0.7})) == \
         {"amplitude", "settling_time"}
     with pytest.raises(sweep.UserError, match="'depth' is not a swept axis"):
         splot.plot(ds, select={"depth": 1.0})
@@ -197,10 +203,12 @@ def test_cli_plot_writes_png_and_svg(results, tmp_path):
     assert done.returncode == 0, done.stderr
     written = done.stdout.split()
     assert sorted(Path(p).name for p in written) == sorted(
-        f"map-{k}.{f}" for k in ("amplitude", "settling_time") for f in ("png", "svg"))
-    image = mpimg.imread(tmp_path / "figs" / "map-amplitude.png")
+        f"map-length=1-{k}.{f}" for k in ("amplitude",) for f in ("png", "svg"))
+    assert "settling_time: no figure" in done.stderr     # all NaN at t_end = 1 s
+    image = mpimg.imread(tmp_path / "figs" / "map-length=1-amplitude.png")
     assert image.shape[:2] == (480, 640)
-    assert (tmp_path / "figs" / "map-amplitude.svg").read_text().lstrip().startswith("<?xml")
+    assert (tmp_path / "figs" / "map-length=1-amplitude.svg").read_text().lstrip().startswith(
+        "<?xml")
 
 
 def test_cli_plot_defaults_to_the_current_directory_without_a_display(results, tmp_path):
@@ -271,4 +279,199 @@ def test_examples_run_on_a_reduced_grid(tmp_path, script, stem, keys):
     assert ds.attrs["cable_sweep_version"] and "state" in ds
     for key in keys:
         png = tmp_path / f"{stem}-{key}.png"
+        if key in ds and splot.why_not_drawn(ds[key]) is not None:
+            assert not png.exists() and f"{key}: no figure" in done.stderr, done.stderr
+            continue
         assert png.is_file() and png.stat().st_size > 1000, png
+
+
+# ------------------------------------------------------------- pictures that say something
+
+def _draw(fig: Figure) -> Figure:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    FigureCanvasAgg(fig).draw()
+    return fig
+
+
+def _map_ds(template: xr.Dataset, amplitude: np.ndarray, state: np.ndarray) -> xr.Dataset:
+    """A synthetic length x frequency_ratio result with the real state table and scene."""
+    ny, nx = amplitude.shape
+    dims = ("length", "frequency_ratio")
+    return xr.Dataset(
+        {"state": (dims, state.astype(np.int8), dict(template["state"].attrs)),
+         "amplitude": (dims, amplitude, dict(template["amplitude"].attrs))},
+        coords={"length": ("length", np.linspace(0.4, 1.4, ny), dict(template["length"].attrs)),
+                "frequency_ratio": ("frequency_ratio", np.linspace(0.5, 3.0, nx),
+                                    dict(template["frequency_ratio"].attrs))},
+        attrs={k: template.attrs[k] for k in ("title", "scene", "model_kind", "coefficients",
+                                              "cable_sweep_version")})
+
+
+def _flag(ds: xr.Dataset, meaning: str) -> int:
+    meanings = ds["state"].attrs["flag_meanings"].split()
+    return int(np.atleast_1d(ds["state"].attrs["flag_values"])[meanings.index(meaning)])
+
+
+def test_constant_or_all_nan_quantities_get_no_figure_and_say_why(results, caplog, tmp_path):
+    ds, _ = results["line"]
+    zero = ds.assign(settling_time=ds["settling_time"].copy(data=np.zeros(ds.sizes["length"])))
+    figures = splot.plot(zero)
+    assert "settling_time" not in figures and "amplitude" in figures
+    assert figures.skipped["settling_time"] == "every point has the same value, 0 s"
+    nan = ds.assign(amplitude=ds["amplitude"] * np.nan)
+    assert splot.plot(nan).skipped["amplitude"] == "no point has a value (all NaN)"
+    varying = ds.assign(settling_time=ds["settling_time"].copy(data=[0.1, 0.2, 0.3, 0.4]))
+    assert "settling_time" in splot.plot(varying)
+    # save() says it, one line per figure left out.
+    with caplog.at_level("WARNING", logger="sweep.plot"):
+        splot.save(figures, tmp_path, formats=())
+    assert any("settling_time: no figure (every point has the same value, 0 s)" in r.message
+               for r in caplog.records)
+    # A map where every point has one state: no state map.
+    mds, _ = results["map"]
+    one = mds.assign(state=mds["state"].copy(data=np.full(mds["state"].shape,
+                                                          _flag(mds, "decayed"))))
+    figures = splot.plot(one)
+    assert "state" not in figures and figures.skipped["state"] == "every point is decayed"
+
+
+def test_no_tick_label_has_an_offset_and_near_constant_data_get_a_sensible_range(results):
+    ds, _ = results["line"]
+    # A dynamic amplification of 2 up to round-off, as the longitudinal runs give it.
+    flat = ds.assign(amplitude=ds["amplitude"].copy(data=2e-3 + 1e-15 * np.arange(4)))
+    figures = splot.plot(flat)
+    for name, fig in figures.items():
+        _draw(fig)
+        for ax in fig.axes:
+            for axis in (ax.xaxis, ax.yaxis):
+                assert axis.get_offset_text().get_text() == "", (name, ax.get_ylabel())
+    ax = figures["amplitude"].axes[0]
+    low, high = ax.get_ylim()
+    assert low == pytest.approx(1.9) and high == pytest.approx(2.1)      # 2 mm +- 5 %
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert any(text and float(text) == 2.0 for text in labels), labels
+
+
+def test_dense_maps_mark_states_by_hatched_regions_outlined_on_cell_edges(results):
+    from matplotlib.collections import PathCollection
+    from matplotlib.contour import ContourSet
+    template, _ = results["map"]
+    ny, nx = 15, 20
+    state = np.full((ny, nx), _flag(template, "decayed"))
+    state[3:9, 4:12] = _flag(template, "unsettled")
+    state[10:, 15:] = _flag(template, "modulated")
+    amplitude = np.geomspace(1e-6, 1e-3, ny * nx).reshape(ny, nx)
+    ds = _map_ds(template, amplitude, state)
+    ax = splot.plot_map(ds, "amplitude")
+    assert not [c for c in ax.collections if isinstance(c, PathCollection)], "markers drawn"
+    contours = [c for c in ax.collections if isinstance(c, ContourSet)]
+    hatched = [c for c in contours if c.hatches[0]]
+    assert sorted(c.hatches[0] for c in hatched) == sorted(
+        [splot._HATCHES["unsettled"], splot._HATCHES["modulated"]])
+    handles = {t.get_text(): h for t, h in zip(ax.get_legend().get_texts(),
+                                               ax.get_legend().legend_handles)}
+    assert handles["unsettled (48)"].get_hatch() == splot._HATCHES["unsettled"]
+    # The outlines run along cell edges (midway between the centres), not through centres.
+    xe = splot._edges(ds["frequency_ratio"].values)
+    ye = splot._edges(ds["length"].values)
+    dx, dy = np.diff(xe).min(), np.diff(ye).min()
+    outlines = [c for c in contours if not c.hatches[0]]
+    assert len(outlines) == 2
+    for c in outlines:
+        for path in c.get_paths():
+            for vx, vy in path.vertices:
+                near_x = np.abs(xe - vx).min() < 0.01 * dx
+                near_y = np.abs(ye - vy).min() < 0.01 * dy
+                assert near_x or near_y, (vx, vy)
+    # A small grid keeps one marker per marked cell.
+    small = _map_ds(template, amplitude[:5, :5], state[3:8, 8:13])
+    ax = splot.plot_map(small, "amplitude")
+    marks = [c for c in ax.collections if isinstance(c, PathCollection)]
+    assert sum(len(c.get_offsets()) for c in marks) == int((state[3:8, 8:13] != state[0, 0]).sum())
+
+
+def test_a_noise_floor_is_one_no_response_colour_and_the_scale_spans_what_is_above(results):
+    template, _ = results["map"]
+    amplitude = np.geomspace(1e-12, 2e-3, 6 * 7).reshape(6, 7)        # m: nine decades
+    ds = _map_ds(template, amplitude, np.full((6, 7), _flag(template, "decayed")))
+    ax = splot.plot_map(ds, "amplitude")
+    mesh = ax.collections[0]
+    top_mm = 2.0
+    assert mesh.norm.vmax == pytest.approx(top_mm)
+    assert mesh.norm.vmin == pytest.approx(splot.FLOOR * top_mm)         # three decades
+    below = amplitude * 1e3 < splot.FLOOR * top_mm
+    colours = mesh.cmap(mesh.norm(amplitude.ravel() * 1e3))
+    white = np.array([1.0, 1.0, 1.0, 1.0])
+    assert np.all(colours[below.ravel()] == white)
+    assert not np.any(np.all(colours[~below.ravel()] == white, axis=1))
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert f"no response, < {splot.FLOOR * top_mm:.2g} mm ({int(below.sum())})" in labels
+
+
+def test_displacements_are_in_mm_everywhere(results):
+    line, _ = results["line"]
+    assert splot.plot_line(line, "amplitude").get_ylabel().endswith("[mm]")
+    mds, _ = results["map"]
+    fig = splot.plot_map(mds, "amplitude").figure
+    assert fig.axes[-1].get_ylabel().endswith("[mm]")                     # the colour bar
+    fig = splot.plot_time_series(line)
+    assert fig.get_supylabel().endswith("[mm]")
+    one, _ = results["longitudinal-one"]
+    fig = splot.plot_histories(one)
+    assert fig.axes[0].get_ylabel().replace("\n", " ").endswith("[mm]")
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any(t.startswith("exact peak 2 P0 l/EA = ") and t.endswith(" mm") for t in texts)
+    fig = splot.plot_snapshots(one)
+    assert fig.axes[0].get_title().endswith("[mm]")
+
+
+def test_every_figure_has_the_load_case_in_a_footer(results):
+    for name in ("line", "map", "longitudinal-one"):
+        ds, _ = results[name]
+        for key, fig in splot.plot(ds).items():
+            texts = " ".join(t.get_text() for t in fig.texts).replace("\n", " ")
+            assert "Load case:" in texts, (name, key)
+            assert "P0 = 4 N" in texts, texts
+            if name == "longitudinal-one":
+                assert "4 transits" in texts and "40 intervals" in texts, texts
+            else:
+                assert "damping ratio 0.02" in texts and "t_end = 1 s" in texts, texts
+                assert "q(0) = 0.1 mm" in texts, texts
+    # A selected axis value is the value in the footer; a swept one is left out.
+    mds, _ = results["map"]
+    text = splot.footer(splot.select_points(mds, {"frequency_ratio": 2.2}))
+    assert "W/w1 = 2.2" in text and "l = " not in text
+
+
+def test_the_paper_fig5_case_marks_the_papers_amplitudes(results):
+    ds, _ = results["line"]
+    paper = ds.assign_coords(length=[0.5, 0.7, 0.85, 1.0]).assign_attrs(
+        coefficients="paper", scene=ds.attrs["scene"].replace("frequency_ratio = 2.0",
+                                                              "frequency_ratio = 1.0"))
+    assert "frequency_ratio = 1.0" in paper.attrs["scene"]
+    ax = splot.plot_line(paper, "amplitude")
+    diamonds = [c for c in ax.collections if c.get_paths() and
+                len(c.get_offsets()) == 4 and not c.get_facecolor().size]
+    assert len(diamonds) == 1
+    np.testing.assert_allclose(diamonds[0].get_offsets(),
+                               [[0.5, 4.1], [0.7, 3.8], [0.85, 3.4], [1.0, 3.0]])
+    fig = splot.plot_time_series(paper)
+    assert [float(line.get_ydata()[0]) for line in fig.axes[0].lines[1:]] == \
+        pytest.approx([4.1, -4.1])
+    # Not the paper's case: no paper points.
+    for other in (ds.assign_coords(length=[0.5, 0.7, 0.85, 1.0]),        # consistent model
+                  paper.assign_attrs(scene=ds.attrs["scene"])):             # W/w1 = 2
+        ax = splot.plot_line(other, "amplitude")
+        assert not any("paper" in t.get_text() for t in ax.get_legend().get_texts())
+
+
+def test_a_selection_is_in_the_file_names(results, tmp_path):
+    mds, _ = results["map"]
+    first = splot.save(splot.plot(mds, select={"length": 0.7}), tmp_path, prefix="map-")
+    second = splot.save(splot.plot(mds, select={"length": 1.0}), tmp_path, prefix="map-")
+    assert {p.name for p in first} & {p.name for p in second} == set()
+    assert all(p.name.startswith("map-length=0.7-") for p in first)
+    assert splot._select_tag({"load_amplitude": 4.0, "weird key/x": -1.5}) == \
+        "load_amplitude=4-weird_key_x=-1.5"
+    assert [p.name for p in splot.save(splot.plot(mds), tmp_path, prefix="map-")][0] == \
+        "map-amplitude.png"
