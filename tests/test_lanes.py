@@ -245,8 +245,8 @@ def test_sweep_run_refuses_a_negative_thread_count():
 
 
 _VECTOR_LOOPS = [("_prepare", lambda W, s: (W, s, lanes.LANES)),
-                 ("_attempt", lambda W, s: (W, 1e-7, 1e-11, lanes.LANES)),
-                 ("_attempt8", lambda W, s: (W, 1e-7, 1e-11, lanes.LANES)),
+                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES)),
+                 ("_attempt8", lambda W, s: (W, 1e-7, lanes.LANES)),
                  ("_pi_factors", lambda W, s: (W, lanes.LANES)),
                  ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, None)),
                  ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, True)),

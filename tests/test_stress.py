@@ -42,6 +42,8 @@ def barrier_closed_form(length: float) -> float:
 def test_softening_quintic_escapes_just_past_its_barrier_only():
     qb = barrier_closed_form(1.0)
     ds = run(f"""
+[cable]
+inertia = 5.73e-12
 [load]
 amplitude = 0.0
 [metrics]
@@ -51,7 +53,9 @@ initial_displacement = [{0.98 * qb!r}, {1.02 * qb!r}]
 [solver]
 t_end = 2e-4        # s: about 35 periods at this huge amplitude (w ~ sqrt(K3) q ~ 1e6 rad/s)
 """)
-    assert float(ds["escape_barrier"]) == pytest.approx(qb, rel=1e-12)
+    # 55 m for a 1 m span: mode slope pi q_b / l = 174, beyond the model's range, so NaN; the
+    # dynamics still escape just past the closed-form root.
+    assert np.isnan(float(ds["escape_barrier"]))
     inside, outside = ds["state"].values
     assert inside == km.STEADY                      # undamped, periodic: bounded
     assert outside == km.DIVERGED
