@@ -18,12 +18,30 @@ What `plot` draws, by the result's content:
   histories (`plot_histories`); with swept axes also the peak end displacement and the
   dynamic amplification over them.
 
+What every figure keeps to, so that it says something:
+
+- a quantity that is NaN everywhere or has one value at every point (e.g. the settling times
+  of an undamped run, all 0 s) gets no figure; `plot` records why (`Figures.skipped`) and
+  `save` logs it;
+- displacements are in mm on every axis, colour bar and label (times and forces get the
+  prefix their size calls for); no axis uses an offset or a scientific multiplier, and
+  near-constant data get a +-5 % range around their value;
+- on a log-coloured displacement map, a cell below FLOOR (1e-3) times the map's largest
+  value is drawn white, "no response", and the colours span the three decades above it;
+- dense maps (more than 100 cells) mark the modulated, unsettled, diverged and failed points
+  by hatched regions outlined along the cell edges, so the colour under them still shows;
+- `plot` puts the load case (`footer`: model, P0, frequency, damping, initial state, t_end,
+  solver, metrics; from the result's `scene` attribute) under each figure;
+- on the paper's Fig 5 case (paper coefficients, P0 = 4 N, W/w0 = 1) the paper's amplitudes
+  4.1, 3.8, 3.4, 3.0 mm (l = 0.5, 0.7, 0.85, 1 m) are marked "paper Fig 5".
+
 More than two swept axes: `select={"dim": value, ...}` picks the values of the others (each
-value must be one of the axis's coordinates). Labels read `long_name` and `units` from the
-Dataset. Like xarray's plotting functions, the single-panel ones take `ax=None` and return the
-Axes, and pass extra keyword arguments to matplotlib. Figures are made with the
-object-oriented API (`matplotlib.figure.Figure`): no pyplot, no display and no backend choice
-are needed, and none is forced on the caller.
+value must be one of the axis's coordinates); `save` writes the selection into the file names
+(RESULT-DIM=VALUE-FIGURE.png), so that two selections do not overwrite each other. Labels read
+`long_name` and `units` from the Dataset. Like xarray's plotting functions, the single-panel
+ones take `ax=None` and return the Axes, and pass extra keyword arguments to matplotlib.
+Figures are made with the object-oriented API (`matplotlib.figure.Figure`): no pyplot, no
+display and no backend choice are needed, and none is forced on the caller.
 """
 
 from __future__ import annotations
@@ -51,7 +69,8 @@ from matplotlib.ticker import ScalarFormatter
 from .errors import UserError
 from .schema import BY_AXIS
 
-__all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label", "load_result", "parse_select", "plot", "plot_histories",
+__all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
+           "load_result", "parse_select", "plot", "plot_histories",
            "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
            "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]
 
@@ -317,7 +336,8 @@ def footer(ds: xr.Dataset) -> str:
     solver = doc.get("solver", {})
     if kind == "longitudinal":
         parts.append("longitudinal wave, central difference")
-        parts.append(f"{solver.get('intervals', '?')} intervals, C = {num(solver.get('courant', 1))}")
+        parts.append(f"{solver.get('intervals', '?')} intervals, "
+                     f"C = {num(solver.get('courant', 1))}")
         if solver.get("transits") is not None:
             parts.append(f"{num(solver['transits'])} transits")
         elif solver.get("t_end") is not None:
