@@ -8,6 +8,7 @@ States (integer flags, stored with CF flag_values / flag_meanings):
     INVALID_INPUT      the point's coefficients are not finite or its mass is not positive
     DECAYED            tail amplitude <= tol * peak amplitude
     STEADY             every envelope peak of the tail lies within +-tol*A of its final level
+                       (or of its class's in a period-k orbit: `periodic_order`)
     MODULATED          envelope varies in the tail without one-way drift (beating, quasi-periodic)
     UNSETTLED          envelope still drifting one way across the tail (a transient still decaying
                        or growing at t_end), or the tail holds too few oscillations to judge:
