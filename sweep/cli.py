@@ -13,6 +13,7 @@ to fix it; a sweep too large for memory counts as one), 1 on an internal error.
 from __future__ import annotations
 
 import argparse
+import shlex
 import sys
 import time
 import warnings
@@ -197,6 +198,28 @@ def _one_line_warnings() -> None:
     warnings.showwarning = show
 
 
+def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
+                 argv: Sequence[str] | None) -> str:
+    """The one line Ctrl-C leaves: what was kept, and the command that finishes the run."""
+    from pathlib import Path
+    from .execute import STORE_SUFFIX
+    output = getattr(args, "output", None)
+    if args.command != "run":
+        return "interrupted"
+    if output is None:
+        return ("interrupted: results were not kept (only a run with -o OUT.nc keeps its "
+                "finished chunks, in OUT.nc.chunks/, and 'sweep run ... -o OUT.nc --resume' "
+                "finishes it)")
+    store = Path(output).with_name(Path(output).name + STORE_SUFFIX)
+    if not store.exists():
+        return "interrupted before any point was solved; nothing kept, no output written"
+    words = list(sys.argv[1:] if argv is None else argv)
+    command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
+    kept = (f"{exc.kept:,} of {exc.total:,} points are kept" if hasattr(exc, "kept")
+            else "finished chunks are kept")
+    return f"interrupted: {kept} in {store}/; finish the run with: {command}"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `sweep` console script."""
     args = _parser().parse_args(argv)
@@ -217,8 +240,8 @@ def main(argv: Sequence[str] | None = None) -> int:
               "solver.intervals, fewer snapshot_times or a longer outputs.sample_interval)",
               file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("sweep: interrupted; no output written", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        print(f"sweep: {_interrupted(exc, args, argv)}", file=sys.stderr)
         return 130
 
 

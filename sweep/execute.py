@@ -2,8 +2,12 @@
 
 A chunk is a contiguous range of the grid's points in solve order (a fixed permutation, see
 run.point_order); one chunk is one kernel call, or one dask task. With a chunk store (next to
-the output file) every finished chunk is written to disk as soon as it is done, so a run that is
-killed can be resumed and computes only the chunks that are missing. Results never depend on
+the output file) finished work is written to disk as it is done, by time rather than by point
+count: the transverse kernel reports each block of points it finishes (sweep.threads), and the
+finished blocks are saved at least every FLUSH_SECONDS; a kernel that cannot report blocks (the
+longitudinal one) gets chunks sized from its measured speed to take about CHUNK_SECONDS each.
+A run that is killed can then be resumed and computes only the points that are missing, and
+Ctrl-C stops it after the blocks in hand, with every finished one kept. Results never depend on
 the backend, the chunking or the number of workers: each point depends on its own row only.
 """
 
@@ -11,11 +15,13 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import inspect
 import json
-import math
 import os
 import shutil
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Any, Callable, Iterator
@@ -26,6 +32,24 @@ from .errors import UserError
 
 STORE_SUFFIX = ".chunks"
 IN_FLIGHT = 2          # dask tasks submitted ahead per worker thread
+FLUSH_SECONDS = 1.0    # finished blocks reach the chunk store at least this often (s)
+CHUNK_SECONDS = 2.0    # a kernel call that cannot report its blocks takes about this long (s)
+FIRST_CHUNK = 4        # points per thread in such a kernel's first, timing call
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a run: `kept` of `total` points are in the chunk store `store` (None
+    when the run had no output file, so nothing was kept)."""
+
+    def __init__(self, kept: int, total: int, store: Path | None) -> None:
+        self.kept, self.total, self.store = kept, total, store
+        if store is None:
+            text = ("interrupted: results were not kept (a run with an output file keeps "
+                    "every finished chunk, and resume=True finishes it)")
+        else:
+            text = (f"interrupted: {kept:,} of {total:,} points are kept in '{store}' "
+                    "(run again with resume=True to compute only the rest)")
+        super().__init__(text)
 
 
 # --- chunk kernels (top-level functions: dask pickles them by name) -------------------------
@@ -57,12 +81,18 @@ def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
 
 
 def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, driver: str,
-                     threads: int = 0) -> dict[str, np.ndarray]:
-    """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series)."""
+                     threads: int = 0,
+                     on_block: Callable[[int, int, dict], None] | None = None,
+                     stop: threading.Event | None = None) -> dict[str, np.ndarray]:
+    """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series).
+
+    on_block(lo, hi, outputs) hears of each block of rows as soon as it is final; with `stop`
+    set the call returns early, with only the rows on_block reported solved."""
     from .threads import solve_transverse
     out = transverse_outputs(params.shape[0], n_samples)
+    report = None if on_block is None else (lambda lo, hi: on_block(lo, hi, out))
     solve_transverse(params, settings, out["states"], out["reals"], out["counts"], out["series"],
-                     driver=driver, threads=threads)
+                     driver=driver, threads=threads, on_block=report, stop=stop)
     return out
 
 
@@ -145,64 +175,88 @@ def fingerprint(*parts: Any) -> str:
 
 # --- progress ---------------------------------------------------------------------------------
 
-def progress_printer(total: int, enabled: bool) -> Callable[[int], None]:
-    """report(done) draws a one-line bar on stderr: points done, rate, time left."""
-    start = time.perf_counter()
-    first = [None]
+class Progress:
+    """A one-line tqdm bar on stderr of points done, their rate and the time left; does nothing
+    when not `enabled`. Safe to advance from several threads. The time Numba spends compiling
+    is taken off the bar's clock (`exclude`), so the rate and the time left are the kernel's."""
 
-    def report(done: int) -> None:
-        if not enabled:
-            return
-        if first[0] is None:
-            first[0] = done
-        elapsed = time.perf_counter() - start
-        rate = (done - first[0]) / elapsed if elapsed > 0 else 0.0
-        left = (total - done) / rate if rate > 0 else math.inf
-        width = 30
-        filled = int(width * done / total) if total else width
-        sys.stderr.write(f"\r[{'#' * filled}{'-' * (width - filled)}] {done:,}/{total:,} points"
-                         f"  {rate:,.0f}/s  {left:6.1f} s left ")
-        if done >= total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-    return report
+    def __init__(self, total: int, done: int, enabled: bool) -> None:
+        self.lock = threading.Lock()
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+            # smoothing=0: the rate is the average since the start (compiling excluded), the
+            # honest one for points solved in a random order
+            self.bar = tqdm(total=total, initial=done, unit=" points",
+                            dynamic_ncols=True, smoothing=0.0, mininterval=0.5,
+                            file=sys.stderr, leave=True)
+
+    def advance(self, points: int) -> None:
+        if self.bar is not None:
+            with self.lock:
+                self.bar.update(points)
+
+    def exclude(self, seconds: float) -> None:
+        """Take `seconds` (s) spent compiling off the bar's clock."""
+        if self.bar is not None:
+            with self.lock:
+                self.bar.start_t += seconds
+
+    def write(self, text: str) -> None:
+        """A line of text on stderr, above the bar when there is one."""
+        if self.bar is not None:
+            from tqdm import tqdm
+            tqdm.write(text, file=sys.stderr)
+        else:
+            sys.stderr.write(text + "\n")
+            sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+class CompileClock:
+    """Seconds Numba has spent compiling so far (s), and whether it has started once."""
+    seconds = 0.0
 
 
 @contextlib.contextmanager
-def announce_compilation(enabled: bool) -> Iterator[None]:
+def announce_compilation(enabled: bool,
+                         progress: Progress | None = None) -> Iterator[CompileClock]:
     """Within the block, say on stderr when Numba compiles a kernel (a cold start: seconds with
     nothing else on the screen; not when it loads one from its cache) and, at the end, how long
-    compiling took. Only in-process compiles are seen (not a dask worker's)."""
-    if not enabled:
-        yield
-        return
+    compiling took; the time is counted (the CompileClock yielded) and taken off `progress`'s
+    clock either way. Only in-process compiles are seen (not a dask worker's)."""
     from numba.core import event
+    out = progress or Progress(0, 0, False)
+    clock = CompileClock()
 
     class Notice(event.Listener):
         depth = 0
-        seconds = 0.0
         started = 0.0
+        announced = False
 
         def on_start(self, ev: event.Event) -> None:
             if self.depth == 0:
-                if self.seconds == 0.0:
-                    sys.stderr.write("compiling the Numba kernels this sweep needs (once: later "
-                                     "runs load them from Numba's cache) ...\n")
-                    sys.stderr.flush()
+                if enabled and not self.announced:
+                    out.write("compiling the Numba kernels this sweep needs (once: later runs "
+                              "load them from Numba's cache) ...")
+                    self.announced = True
                 self.started = time.perf_counter()
             self.depth += 1
 
         def on_end(self, ev: event.Event) -> None:
             self.depth -= 1
             if self.depth == 0:
-                self.seconds += time.perf_counter() - self.started
+                seconds = time.perf_counter() - self.started
+                clock.seconds += seconds
+                out.exclude(seconds)
 
-    notice = Notice()
-    with event.install_listener("numba:compile", notice):
-        yield
-    if notice.seconds > 0.0:
-        sys.stderr.write(f"compiled in {notice.seconds:.1f} s\n")
-        sys.stderr.flush()
+    with event.install_listener("numba:compile", Notice()):
+        yield clock
+    if enabled and clock.seconds > 0.0:
+        out.write(f"compiled in {clock.seconds:.1f} s")
 
 
 # --- execution ------------------------------------------------------------------------------
@@ -212,13 +266,107 @@ def chunk_ranges(n: int, chunk_size: int) -> list[tuple[int, int]]:
 
 
 def default_chunk_size(n: int, backend: str, workers: int) -> int:
-    """Points per chunk: for threads, enough for every thread's lanes and at most 100 chunks;
-    for dask, about 8 tasks per worker of at least 2 000 points (a task then runs long enough
-    to hide the scheduler's per-task overhead of a few ms)."""
+    """Points per chunk, at most: for threads, enough for every thread's lanes and at most 100
+    chunks (checkpoints and progress come from the blocks inside a chunk, by time); for dask,
+    about 8 tasks per worker of at least 2 000 points (a task then runs long enough to hide the
+    scheduler's per-task overhead of a few ms)."""
     import numba
     if backend == "dask":
         return max(2000, -(-n // (8 * max(workers, 1))))
     return max(4096 * numba.get_num_threads(), -(-n // 100))
+
+
+def missing_ranges(n: int, done: dict[tuple[int, int], dict],
+                   where: str = "chunk store") -> list[tuple[int, int]]:
+    """The ranges of points 0..n-1 that no chunk in `done` covers, in order. Chunks that
+    overlap, lie outside the grid or hold arrays of the wrong length are refused (UserError)."""
+    gaps = []
+    at = 0
+    for lo, hi in sorted(done):
+        lengths = {len(v) for v in done[(lo, hi)].values()}
+        if not at <= lo < hi <= n or lengths - {hi - lo}:
+            raise UserError(f"{where}: chunk {lo}-{hi} overlaps another, lies outside the "
+                            f"{n:,} points or holds the wrong number of them (remove the store, "
+                            "or use --overwrite to start again)")
+        if lo > at:
+            gaps.append((at, lo))
+        at = hi
+    if at < n:
+        gaps.append((at, n))
+    return gaps
+
+
+class _Keeper:
+    """The finished, not yet saved blocks of the chunk in hand: saved to the store at least
+    every FLUSH_SECONDS, and whatever is left when the chunk ends or the run stops."""
+
+    def __init__(self, store: ChunkStore | None, progress: Progress) -> None:
+        self.store, self.progress = store, progress
+        self.lock = threading.Lock()
+        self.base = 0
+        self.arrays: dict = {}
+        self.pending: list[tuple[int, int]] = []
+        self.saved = 0                   # points saved to the store by this run
+        self.flushed = time.perf_counter()
+
+    def begin(self, base: int) -> None:
+        self.base, self.arrays, self.pending = base, {}, []
+
+    def finished(self, lo: int, hi: int, arrays: dict) -> None:
+        """Rows lo..hi-1 of the chunk in hand are final (called from the solving thread)."""
+        with self.lock:
+            self.arrays = arrays
+            self.pending.append((lo, hi))
+            self.progress.advance(hi - lo)
+            if time.perf_counter() - self.flushed >= FLUSH_SECONDS:
+                self._flush()
+
+    def flush(self) -> None:
+        with self.lock:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self.store is not None:
+            for lo, hi in _merged(self.pending):
+                self.store.save(self.base + lo, self.base + hi,
+                                {k: v[lo:hi] for k, v in self.arrays.items()})
+                self.saved += hi - lo
+        self.pending = []
+        self.flushed = time.perf_counter()
+
+
+def _merged(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """Adjacent ranges joined: [(0, 5), (9, 12), (5, 9)] -> [(0, 12)]."""
+    out: list[list[int]] = []
+    for lo, hi in sorted(ranges):
+        if out and out[-1][1] == lo:
+            out[-1][1] = hi
+        else:
+            out.append([lo, hi])
+    return [(lo, hi) for lo, hi in out]
+
+
+@contextlib.contextmanager
+def _interrupt_sets(stop: threading.Event) -> Iterator[None]:
+    """Within the block, Ctrl-C (SIGINT) sets `stop` instead of raising at once, so the run
+    ends after the blocks in hand and keeps them; a second Ctrl-C raises KeyboardInterrupt.
+    Only in the main thread, and only over Python's own SIGINT handler (not over one a caller
+    installed, nor where SIGINT is ignored)."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        if stop.is_set():
+            raise KeyboardInterrupt
+        stop.set()
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.ndarray], n: int,
@@ -226,40 +374,83 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
             backend: str = "threads", threads: int = 0, scheduler: str | None = None,
             workers: int = 0, progress: bool = False, store: ChunkStore | None = None,
             done: dict | None = None) -> int:
-    """Solve points 0..n-1 (solve order) chunk by chunk; returns the number of chunks computed.
+    """Solve points 0..n-1 (solve order) chunk by chunk; returns the number of points computed.
 
     rows_for(lo, hi) builds the kernel's parameter rows of a chunk just before it runs, so the
     whole table never sits in memory; chunk_fn(rows, *args, threads=...) returns the chunk's
-    output arrays by name, and place(lo, hi, arrays) stores them. Chunks in `done` (from a
-    store) are placed, not computed; every computed chunk is also written to `store`.
+    output arrays by name, and place(lo, hi, arrays) stores them. A chunk_fn that takes
+    `on_block` and `stop` (transverse_chunk) reports its finished blocks and stops early when
+    asked. Chunks in `done` (from a store) are placed, not computed; finished work is also
+    written to `store`, at least every FLUSH_SECONDS. Chunks have at most chunk_size points.
+    On Ctrl-C the run stops after the work in hand, saves it and raises RunInterrupted.
     """
-    report = progress_printer(n, progress and n > chunk_size)
-    finished = 0
-    for (lo, hi), arrays in (done or {}).items():
+    done = done or {}
+    where = f"chunk store '{store.directory}'" if store is not None else "chunk store"
+    gaps = missing_ranges(n, done, where)
+    todo = sum(hi - lo for lo, hi in gaps)
+    for (lo, hi), arrays in done.items():
         place(lo, hi, arrays)
-        finished += hi - lo
-    todo = [r for r in chunk_ranges(n, chunk_size) if r not in (done or {})]
-    if finished:
-        report(finished)
-
-    def collect(lo: int, hi: int, arrays: dict) -> None:
-        nonlocal finished
-        place(lo, hi, arrays)
-        if store is not None:
-            store.save(lo, hi, arrays)
-        finished += hi - lo
-        report(finished)
-
-    if backend == "dask":
-        _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers)
-    else:
-        with announce_compilation(progress):
-            for lo, hi in todo:
-                collect(lo, hi, chunk_fn(rows_for(lo, hi), *args, threads=threads))
-    return len(todo)
+    bar = Progress(n, n - todo, progress)
+    keeper = _Keeper(store, bar)
+    stop = threading.Event()
+    try:
+        with _interrupt_sets(stop), announce_compilation(progress, bar) as clock:
+            if backend == "dask":
+                _execute_dask(chunk_fn, rows_for, args, _split(gaps, chunk_size), keeper,
+                              place, scheduler, workers, stop)
+            else:
+                _execute_threads(chunk_fn, rows_for, args, gaps, chunk_size, threads, keeper,
+                                 place, stop, clock)
+    finally:
+        keeper.flush()                   # what was finished when something went wrong
+        bar.close()
+    if stop.is_set():
+        raise RunInterrupted(n - todo + keeper.saved, n,
+                             store.directory if store is not None else None)
+    return todo
 
 
-def _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers) -> None:
+def _split(gaps: list[tuple[int, int]], size: int) -> list[tuple[int, int]]:
+    return [(a + lo, a + hi) for a, b in gaps for lo, hi in chunk_ranges(b - a, size)]
+
+
+def _execute_threads(chunk_fn, rows_for, args, gaps, chunk_size, threads, keeper, place, stop,
+                     clock) -> None:
+    """Chunks one after another in this process. A chunk_fn that reports blocks gets chunks of
+    chunk_size; another gets chunks sized from its measured speed (compiling excluded) to take
+    about CHUNK_SECONDS, growing at most fourfold from one chunk to the next."""
+    from .threads import thread_count
+    streams = "on_block" in inspect.signature(chunk_fn).parameters
+    size = chunk_size if streams else min(chunk_size, FIRST_CHUNK * thread_count(threads))
+    for a, b in gaps:
+        lo = a
+        while lo < b and not stop.is_set():
+            hi = min(b, lo + size)
+            rows = rows_for(lo, hi)
+            keeper.begin(lo)
+            if streams:
+                arrays = chunk_fn(rows, *args, threads=threads, on_block=keeper.finished,
+                                  stop=stop)
+                if stop.is_set():
+                    return                   # partly solved: the keeper has the finished rows
+                keeper.flush()
+                place(lo, hi, arrays)
+            else:
+                began, compiling = time.perf_counter(), clock.seconds
+                arrays = chunk_fn(rows, *args, threads=threads)
+                keeper.finished(0, hi - lo, arrays)
+                keeper.flush()
+                place(lo, hi, arrays)
+                seconds = time.perf_counter() - began - (clock.seconds - compiling)
+                grown = 4 * (hi - lo)
+                if seconds > 0.0:
+                    grown = min(grown, int((hi - lo) * CHUNK_SECONDS / seconds))
+                size = max(1, min(chunk_size, grown))
+            lo = hi
+
+
+def _execute_dask(chunk_fn, rows_for, args, todo, keeper, place, scheduler, workers,
+                  stop) -> None:
     """Each chunk a task on a dask.distributed cluster: the one at `scheduler` (an address), or
     a LocalCluster of `workers` single-threaded worker processes started for this run. At most
     IN_FLIGHT tasks per worker thread are submitted at a time, so memory stays bounded."""
@@ -300,7 +491,18 @@ def _execute_dask(chunk_fn, rows_for, args, todo, collect, scheduler, workers) -
             queue = as_completed(list(futures))
             for fut in queue:
                 lo, hi = futures.pop(fut)
-                collect(lo, hi, fut.result())
+                try:
+                    arrays = fut.result()
+                except Exception:
+                    if stop.is_set():        # Ctrl-C reached the workers too
+                        return
+                    raise
+                keeper.begin(lo)
+                keeper.finished(0, hi - lo, arrays)
+                keeper.flush()
+                place(lo, hi, arrays)
+                if stop.is_set():
+                    return
                 submit_next(queue)
     finally:
         if cluster is not None:

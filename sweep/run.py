@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import sys
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -66,22 +68,47 @@ def settings_vector(scene: Scene) -> np.ndarray:
     return s
 
 
-def check_memory(n_points: int, bytes_per_point: float, what: str) -> None:
-    """Refuse, before allocating, a sweep whose arrays would not fit in this machine's memory.
+def available_memory(root: str = "/") -> tuple[float, str] | None:
+    """The memory a new allocation can count on (bytes), and where that figure comes from: the
+    least of physical memory, the kernel's MemAvailable (/proc/meminfo) and what this process's
+    cgroup limit leaves (v2: memory.max - memory.current; v1: memory.limit_in_bytes -
+    memory.usage_in_bytes, under /sys/fs/cgroup). None when none of them can be read.
+    `root` is where /proc and /sys are looked for (a test's fake files)."""
+    base = Path(root)
+    found: list[tuple[float, str]] = []
+    with contextlib.suppress(ValueError, OSError, AttributeError):
+        found.append((os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"),
+                      "physical memory"))
+    with contextlib.suppress(OSError, ValueError):
+        for line in (base / "proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                found.append((float(line.split()[1]) * 1024, "available memory"))
+    for limit, usage in (("sys/fs/cgroup/memory.max", "sys/fs/cgroup/memory.current"),
+                         ("sys/fs/cgroup/memory/memory.limit_in_bytes",
+                          "sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        with contextlib.suppress(OSError, ValueError):
+            text = (base / limit).read_text().strip()
+            if text != "max":
+                left = float(text) - float((base / usage).read_text())
+                found.append((max(left, 0.0), "memory the cgroup limit leaves"))
+    return min(found) if found else None
+
+
+def check_memory(n_points: int, bytes_per_point: float, what: str, root: str = "/") -> None:
+    """Refuse, before allocating, a sweep whose arrays would not fit in the memory this process
+    can count on (available_memory: the least of physical memory, MemAvailable and the cgroup
+    limit's room; `root` as there).
 
     bytes_per_point counts every array a point needs, with its copies (solve order, grid
-    order, Dataset). Raises UserError when the total passes 80 % of physical memory.
+    order, Dataset). Raises UserError when the total passes 80 % of that memory.
     """
     need = n_points * bytes_per_point
-    try:
-        have = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return
-    if need > 0.8 * have:
+    have = available_memory(root)
+    if have is not None and need > 0.8 * have[0]:
         raise UserError(f"scene: {n_points:,} points x {bytes_per_point / 1024:,.1f} KiB "
-                        f"({what}) need about {need / 2**30:,.1f} GiB, more than this machine's "
-                        f"{have / 2**30:,.0f} GiB allow (use fewer axis values, or store fewer "
-                        "samples or snapshots)")
+                        f"({what}) need about {need / 2**30:,.1f} GiB, more than the "
+                        f"{have[0] / 2**30:,.1f} GiB of {have[1]} here allow (use fewer axis "
+                        "values, or store fewer samples or snapshots)")
 
 
 def point_order(n: int) -> np.ndarray:
@@ -161,8 +188,8 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
                        scheduler=scene.get("run.scheduler"), workers=workers,
                        progress=progress, store=store, done=done)
     if resume:
-        sys.stderr.write(f"resumed: {len(done)} chunks of {len(done) + computed} were already "
-                         f"done, {computed} computed\n")
+        sys.stderr.write(f"resumed: {n - computed:,} of {n:,} points were already done, "
+                         f"{computed:,} computed\n")
     return outputs
 
 

@@ -8,14 +8,22 @@ spans better than a static schedule. There is no Numba parallel region to compil
 took ~3 s on a cold cache), and a point's result never depends on the blocks or the number of
 threads.
 
+Blocks are also sized by time: once a thread has timed a block, its next one takes about
+BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points), so however slow the points, finished
+blocks come back every second or two. A caller's `on_block(lo, hi)` hears of each one as soon
+as its rows are final (a checkpoint, a progress bar), and a `stop` event ends the solve after
+the blocks in hand (an interrupt).
+
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
-`kernels.transverse.settle_second_pass`, compiled only when a sweep has one.
+`kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one.
 """
 
 from __future__ import annotations
 
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
+from typing import Callable
 
 import numpy as np
 
@@ -23,6 +31,9 @@ MIN_BLOCK = 128        # points per block, at least (smaller blocks leave lanes 
 MAX_BLOCK = 1024       # at most
 SHARE = 2              # a block is at most 1/SHARE of a thread's share of the points left
 LANES_PER_THREAD = 16  # a thread for every 16 points (one lanes group), at most
+BLOCK_SECONDS = 1.0    # a timed block takes about this long on one thread (s)
+MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
+                       # its end, which costs more the fewer points each lane gets)
 
 
 def thread_count(threads: int = 0) -> int:
@@ -33,24 +44,38 @@ def thread_count(threads: int = 0) -> int:
     return min(threads, limit) if threads > 0 else limit
 
 
-def next_block(lo: int, n: int, n_threads: int) -> int:
+def next_block(lo: int, n: int, n_threads: int, cap: int = MAX_BLOCK) -> int:
     """End of the block that starts at row `lo` of n, on n_threads threads: guided scheduling,
-    blocks shrinking with the points left, from MAX_BLOCK down to MIN_BLOCK (or to an equal
-    share of a small grid), so the threads finish together while blocks stay long enough to
-    keep the lanes full."""
-    floor = min(MIN_BLOCK, -(-n // n_threads))
+    blocks shrinking with the points left, from `cap` (at most MAX_BLOCK) down to MIN_BLOCK
+    (or to an equal share of a small grid, or to `cap`), so the threads finish together while
+    blocks stay long enough to keep the lanes full."""
+    cap = min(cap, MAX_BLOCK)
+    floor = min(MIN_BLOCK, cap, -(-n // n_threads))
     size = (n - lo) // (SHARE * n_threads)
-    return min(n, lo + max(floor, min(MAX_BLOCK, size)))
+    return min(n, lo + max(floor, min(cap, size)))
+
+
+def timed_cap(points: int, seconds: float) -> int:
+    """Points the next block of a thread gets so it takes about BLOCK_SECONDS, from the last
+    block's `points` in `seconds` (s): between MIN_TIMED_BLOCK and MAX_BLOCK."""
+    if seconds <= 0.0:
+        return MAX_BLOCK
+    return max(MIN_TIMED_BLOCK, min(MAX_BLOCK, int(points * BLOCK_SECONDS / seconds)))
 
 
 def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarray,
                      reals: np.ndarray, counts: np.ndarray, series: np.ndarray, *,
-                     driver: str = "lanes", threads: int = 0) -> None:
+                     driver: str = "lanes", threads: int = 0,
+                     on_block: Callable[[int, int], None] | None = None,
+                     stop: threading.Event | None = None) -> None:
     """Solve every row of `params` (n, N_PARAMS) into the preallocated outputs (first axis n):
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
-    trajectory after another); threads: 0 for all (see thread_count).
+    trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
+    called (from the thread that solved it) once rows lo..hi-1 are final; with `stop` set, no
+    new block starts and the call returns with the rows of the blocks it did not start unsolved
+    (on_block says which are solved).
     """
     from sweep.kernels import lanes
     from sweep.kernels import metrics as mt
@@ -58,40 +83,50 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     if driver not in ("lanes", "scalar"):
         raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
     if driver == "scalar":
-        def solve_block(lo: int, hi: int) -> None:
+        def kernel(lo: int, hi: int) -> None:
             tk.solve_block(params, settings, lo, hi, states, reals, counts, series)
     else:
         pi = True if settings[tk.CONTROLLER] != 0.0 else None   # see lanes.solve_block
         eighth = True if settings[tk.METHOD] != 0.0 else None
 
-        def solve_block(lo: int, hi: int) -> None:
+        def kernel(lo: int, hi: int) -> None:
             lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi,
                               eighth)
+
+    def solve_block(lo: int, hi: int) -> None:
+        kernel(lo, hi)
+        if np.any(states[lo:hi] == mt.SECOND_PASS):
+            tk.settle_second_pass(params[lo:hi], settings, states[lo:hi], reals[lo:hi],
+                                  counts[lo:hi])
+        if on_block is not None:
+            on_block(lo, hi)
+
     n = params.shape[0]
-    n_threads = min(thread_count(threads), -(-n // LANES_PER_THREAD))
-    if n_threads <= 1:
-        solve_block(0, n)
-    else:
-        start = 0
-        lock = threading.Lock()
-        stop = threading.Event()         # set on an interrupt: no new blocks are started
+    n_threads = max(1, min(thread_count(threads), -(-n // LANES_PER_THREAD)))
+    stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
+    start = 0
+    lock = threading.Lock()
 
-        def work() -> None:
-            nonlocal start
-            while not stop.is_set():
-                with lock:
-                    lo = start
-                    hi = start = next_block(lo, n, n_threads)
-                if lo >= n:
-                    return
-                solve_block(lo, hi)
+    def work() -> None:
+        nonlocal start
+        cap = MIN_TIMED_BLOCK            # the first block is short: it times the points
+        while not stop.is_set():
+            with lock:
+                lo = start
+                hi = start = next_block(lo, n, n_threads, cap)
+            if lo >= n:
+                return
+            began = time.perf_counter()
+            solve_block(lo, hi)
+            cap = timed_cap(hi - lo, time.perf_counter() - began)
 
-        with ThreadPoolExecutor(n_threads, thread_name_prefix="cable-sweep") as pool:
-            try:
-                for future in [pool.submit(work) for _ in range(n_threads)]:
-                    future.result()
-            except BaseException:
-                stop.set()
-                raise
-    if np.any(states == mt.SECOND_PASS):
-        tk.settle_second_pass(params, settings, states, reals, counts)
+    if n_threads == 1:
+        work()
+        return
+    with ThreadPoolExecutor(n_threads, thread_name_prefix="cable-sweep") as pool:
+        try:
+            for future in [pool.submit(work) for _ in range(n_threads)]:
+                future.result()
+        except BaseException:
+            stop.set()
+            raise

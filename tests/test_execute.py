@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import shlex
 import signal
 import subprocess
 import sys
@@ -14,6 +16,7 @@ import pytest
 import xarray as xr
 
 import sweep
+from sweep.cli import main as sweep_main
 
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
@@ -71,54 +74,110 @@ def _cli(args, cwd, **kwargs):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
 
 
-KILL_SCENE = """
+# A few hundred long runs in one default chunk: about 3 s of work on one thread of the
+# 2-core development machine, so finished blocks reach the store part-way only if they go by time.
+LONG_SCENE = """
 name = "kill-and-resume"
 [cable]
 damping_ratio = 0.02
 [initial]
 displacement = 1e-3
 [axes]
-length = {start = 0.2, stop = 1.0, num = 40}
-frequency_ratio = {start = 0.5, stop = 3.0, num = 40}
+length = {start = 0.2, stop = 1.0, num = 30}
+frequency_ratio = {start = 0.5, stop = 3.0, num = 30}
 [solver]
-t_end = 4.0
+t_end = 80.0
 rtol = 1e-10
 [run]
 threads = 1
-chunk_size = 40
 """
+LONG_POINTS = 900     # in blocks of 128 points or more, several of them after the first flush
 
 
-def test_a_killed_run_resumes_and_writes_the_same_file(tmp_path):
-    (tmp_path / "s.toml").write_text(KILL_SCENE)
+@pytest.fixture(scope="module")
+def long_whole(tmp_path_factory):
+    """The long sweep run without interruption, as a file."""
+    here = tmp_path_factory.mktemp("whole")
+    (here / "s.toml").write_text(LONG_SCENE)
+    with contextlib.chdir(here):          # the file names its scene file as the CLI runs do
+        sweep.run(sweep.load_scene("s.toml"), output="whole.nc", progress=False)
+    return here / "whole.nc"
+
+
+def _stored_points(store: Path) -> int:
+    """Points in a chunk store's finished chunk files (their names give each range)."""
+    ranges = [tuple(int(x) for x in p.stem.split("-")[1:3]) for p in store.glob("chunk-*.npz")]
+    return sum(hi - lo for lo, hi in ranges)
+
+
+def _start_and_wait_for_a_chunk(tmp_path, args):
+    """Start `sweep run` on the long scene; return it once the store holds a finished chunk."""
+    (tmp_path / "s.toml").write_text(LONG_SCENE)
     store = tmp_path / "out.nc.chunks"
-    proc = _cli(["run", "s.toml", "-o", "out.nc", "--quiet"], tmp_path)
+    # SIGINT as a terminal's Ctrl-C gives it (a test runner may have it ignored for children)
+    proc = _cli(["run", "s.toml", "-o", "out.nc", *args], tmp_path,
+                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 300
-    while time.monotonic() < deadline and len(list(store.glob("chunk-*.npz"))) < 3:
-        assert proc.poll() is None, proc.communicate()
-        time.sleep(0.05)
+    while not list(store.glob("chunk-*.npz")):
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.02)
+    return proc, store
+
+
+def test_a_killed_run_keeps_finished_blocks_and_resumes_to_the_same_file(tmp_path, long_whole,
+                                                                        capsys):
+    """Killed (SIGKILL) part-way through one default chunk, a run has its finished blocks in
+    the store; --resume computes only the rest and writes the uninterrupted run's file."""
+    proc, store = _start_and_wait_for_a_chunk(tmp_path, ["--quiet"])
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    done_at_kill = len(list(store.glob("chunk-*.npz")))
-    assert 3 <= done_at_kill < 40
+    kept = _stored_points(store)
+    assert 0 < kept < LONG_POINTS                         # saved part-way, by time
     assert not (tmp_path / "out.nc").exists()            # the file appears only when complete
 
-    refused = _cli(["run", "s.toml", "-o", "out.nc"], tmp_path)
-    _, err = refused.communicate(timeout=300)
-    assert refused.returncode == 2 and "--resume" in err
-
-    resumed = _cli(["run", "s.toml", "-o", "out.nc", "--resume", "--quiet"], tmp_path)
-    _, err = resumed.communicate(timeout=600)
-    assert resumed.returncode == 0, err
-    computed = int(err.split(" computed")[0].split(", ")[-1])
-    assert computed == 40 - done_at_kill                    # only the missing chunks
+    with contextlib.chdir(tmp_path):
+        scene = sweep.load_scene("s.toml")
+        with pytest.raises(sweep.UserError, match="--resume"):
+            sweep.run(scene, output="out.nc", progress=False)
+        sweep.run(scene, output="out.nc", resume=True, progress=False)
+    err = capsys.readouterr().err
+    assert f"{kept:,} of {LONG_POINTS:,} points were already done, " \
+           f"{LONG_POINTS - kept:,} computed" in err     # only the missing points
     assert not store.exists()                               # removed after success
-
-    whole = _cli(["run", "s.toml", "-o", "whole.nc", "--quiet"], tmp_path)
-    _, err = whole.communicate(timeout=600)
-    assert whole.returncode == 0, err
-    with xr.open_dataset(tmp_path / "out.nc") as a, xr.open_dataset(tmp_path / "whole.nc") as b:
+    with xr.open_dataset(tmp_path / "out.nc") as a, xr.open_dataset(long_whole) as b:
         assert_same_result(a, b)
+
+
+def test_ctrl_c_keeps_finished_blocks_says_how_to_resume_and_exits_130(tmp_path, long_whole,
+                                                                        capsys):
+    """SIGINT part-way: exit status 130, one line on stderr (no traceback, no progress bar:
+    stderr is not a terminal) naming what was kept and the command that finishes the run;
+    that command computes only the rest and writes the uninterrupted run's file."""
+    proc, store = _start_and_wait_for_a_chunk(tmp_path, ["--threads", "1"])
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    kept = _stored_points(store)
+    assert 0 < kept < LONG_POINTS
+    assert f"{kept:,} of {LONG_POINTS:,} points are kept in {store.name}" in lines[0], err
+    command = lines[0].split("finish the run with: ")[1]
+    assert command == "sweep run s.toml -o out.nc --threads 1 --resume"
+    with contextlib.chdir(tmp_path):
+        assert sweep_main(shlex.split(command)[1:] + ["--quiet"]) == 0
+    assert f"{LONG_POINTS - kept:,} computed" in capsys.readouterr().err
+    with xr.open_dataset(tmp_path / "out.nc") as a, xr.open_dataset(long_whole) as b:
+        assert_same_result(a, b)
+
+
+def test_ctrl_c_without_an_output_file_says_nothing_was_kept(capsys):
+    """Without -o nothing is kept: the line says so, and how to make a run resumable."""
+    from sweep.cli import _interrupted, _parser
+    from sweep.execute import RunInterrupted
+    args = _parser().parse_args(["run", "x.toml"])
+    line = _interrupted(RunInterrupted(0, 10, None), args, ["run", "x.toml"])
+    assert "not kept" in line and "-o OUT.nc" in line and "--resume" in line
 
 
 def _chunk_compiling_a_fresh_function(rows: np.ndarray, threads: int = 0) -> dict:
@@ -157,3 +216,179 @@ def test_progress_says_when_the_kernels_compile_and_only_then(capsys):
     sweep.run(scene, progress=False)                  # compiled (or loaded) here
     sweep.run(scene, progress=True)
     assert "compil" not in capsys.readouterr().err
+
+
+# --- blocks, checkpoints by time, resumable ranges -----------------------------------------
+
+def _rows(n: int, seed: int = 3) -> np.ndarray:
+    """Kernel rows of n random points of the execute-test scene, and the scene."""
+    from sweep import grid, models
+    from sweep.kernels.oscillator import PARAM_NAMES
+    scene = sweep.load_scene_text(SCENE)
+    coords = grid.coordinates(scene)
+    params = grid.parameters(scene, coords)
+    shape = tuple(c.size for c in coords.values())
+    points = np.random.default_rng(seed).integers(0, int(np.prod(shape)), n)
+    at = grid.point_values(params, tuple(coords), shape, points)
+    return grid.rows(models.oscillator(at), PARAM_NAMES, n), scene
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_blocks_are_reported_once_each_and_stop_ends_the_solve(threads):
+    """on_block hears of every row once, as results equal to a call without it; with `stop`
+    set from the first report, the call returns with exactly the reported rows solved."""
+    import threading
+
+    from sweep.run import settings_vector
+    from sweep.threads import MAX_BLOCK, solve_transverse
+    from sweep.execute import transverse_outputs
+    rows, scene = _rows(600)
+    s = settings_vector(scene)
+    whole = transverse_outputs(600, 0)
+    solve_transverse(rows, s, *whole.values(), threads=threads)
+    seen = []
+    got = transverse_outputs(600, 0)
+    solve_transverse(rows, s, *got.values(), threads=threads,
+                     on_block=lambda lo, hi: seen.append((lo, hi)))
+    assert sorted(seen)[0][0] == 0 and sorted(seen)[-1][1] == 600
+    assert sum(hi - lo for lo, hi in seen) == 600 and all(hi - lo <= MAX_BLOCK for lo, hi in seen)
+    for name in whole:
+        np.testing.assert_array_equal(got[name], whole[name], err_msg=name)
+
+    stop = threading.Event()
+    seen = []
+    part = transverse_outputs(600, 0)
+    part["states"][:] = -1
+    solve_transverse(rows, s, *part.values(), threads=threads, stop=stop,
+                     on_block=lambda lo, hi: (seen.append((lo, hi)), stop.set()))
+    solved = np.zeros(600, bool)
+    for lo, hi in seen:
+        solved[lo:hi] = True
+    assert 0 < solved.sum() < 600
+    np.testing.assert_array_equal(part["states"][solved], whole["states"][solved])
+    assert np.all(part["states"][~solved] == -1)
+
+
+def test_finished_blocks_reach_the_store_by_time_and_the_rest_is_computed_on_resume(tmp_path,
+                                                                                 monkeypatch):
+    """A chunk whose blocks come back one by one: with FLUSH_SECONDS = 0 every block is its
+    own file as soon as it is done; a store holding some ranges gets only the others computed,
+    and the whole equals one uninterrupted pass."""
+    from sweep import execute as ex
+    calls = []
+
+    def blocks(rows, threads=0, on_block=None, stop=None):
+        out = {"value": np.full(rows.size, np.nan)}
+        for lo in range(0, rows.size, 4):
+            hi = min(rows.size, lo + 4)
+            out["value"][lo:hi] = 2.0 * rows[lo:hi]
+            on_block(lo, hi, out)
+            calls.append(len(list(store.directory.glob("chunk-*.npz"))))
+        return out
+
+    monkeypatch.setattr(ex, "FLUSH_SECONDS", 0.0)
+    store = ex.ChunkStore(tmp_path / "o.nc", "fp")
+    done, _ = store.open(resume=False, overwrite=False, chunk_size=10)
+    values = np.zeros(30)
+    rows_for = lambda lo, hi: np.arange(lo, hi, dtype=float)           # noqa: E731
+    assert ex.execute(blocks, rows_for, 30, (), _place(values), chunk_size=10, store=store,
+                      done=done) == 30
+    np.testing.assert_array_equal(values, 2.0 * np.arange(30))
+    assert calls == list(range(1, 10))      # a file per block, written as the block ended
+    for path in sorted(store.directory.glob("chunk-*.npz"))[1::2]:                 # lose every other file
+        path.unlink()
+    done, _ = store.open(resume=True, overwrite=False, chunk_size=10)
+    values[:] = 0.0
+    computed = ex.execute(blocks, rows_for, 30, (), _place(values), chunk_size=10,
+                          store=store, done=done)
+    assert computed == 30 - sum(hi - lo for lo, hi in done)
+    np.testing.assert_array_equal(values, 2.0 * np.arange(30))
+
+    monkeypatch.setattr(ex, "FLUSH_SECONDS", 1e9)     # never by time: one file per chunk end
+    store.remove()
+    done, _ = store.open(resume=False, overwrite=False, chunk_size=10)
+    ex.execute(blocks, rows_for, 30, (), _place(values), chunk_size=10, store=store, done=done)
+    assert len(list(store.directory.glob("chunk-*.npz"))) == 3
+
+
+def _place(values):
+    def place(lo, hi, arrays):
+        values[lo:hi] = arrays["value"]
+    return place
+
+
+def test_overlapping_or_foreign_chunks_are_refused():
+    from sweep.execute import missing_ranges
+    a = {"v": np.zeros(3)}
+    assert missing_ranges(10, {(2, 5): a}) == [(0, 2), (5, 10)]
+    assert missing_ranges(3, {(0, 3): a}) == []
+    for done in ({(2, 5): a, (4, 7): {"v": np.zeros(3)}}, {(8, 11): a}, {(0, 4): a}):
+        with pytest.raises(sweep.UserError, match="chunk store"):
+            missing_ranges(10, done)
+
+
+def test_a_kernel_without_blocks_gets_chunks_sized_by_its_speed():
+    """The first call is short (it times the kernel), the next ones grow at most fourfold, up
+    to chunk_size, and together they cover every point once."""
+    from sweep.execute import FIRST_CHUNK, execute
+    sizes = []
+
+    def fast(rows, threads=0):
+        sizes.append(rows.size)
+        return {"value": 2.0 * rows}
+
+    values = np.zeros(3000)
+    execute(fast, lambda lo, hi: np.arange(lo, hi, dtype=float), 3000, (), _place(values),
+            chunk_size=500, threads=1)
+    np.testing.assert_array_equal(values, 2.0 * np.arange(3000))
+    assert sizes[:4] == [FIRST_CHUNK, 4 * FIRST_CHUNK, 16 * FIRST_CHUNK, 64 * FIRST_CHUNK]
+    assert max(sizes) == 500 and sum(sizes) == 3000
+
+
+# --- the memory guard -----------------------------------------------------------------------
+
+def _fake_system(root: Path, meminfo_kib: int | None = None, v2: tuple | None = None,
+                 v1: tuple | None = None) -> str:
+    if meminfo_kib is not None:
+        (root / "proc").mkdir(parents=True, exist_ok=True)
+        (root / "proc/meminfo").write_text(f"MemTotal:  99999999 kB\nMemFree: 1 kB\n"
+                                           f"MemAvailable:   {meminfo_kib} kB\n")
+    if v2 is not None:
+        (root / "sys/fs/cgroup").mkdir(parents=True, exist_ok=True)
+        (root / "sys/fs/cgroup/memory.max").write_text(f"{v2[0]}\n")
+        (root / "sys/fs/cgroup/memory.current").write_text(f"{v2[1]}\n")
+    if v1 is not None:
+        (root / "sys/fs/cgroup/memory").mkdir(parents=True, exist_ok=True)
+        (root / "sys/fs/cgroup/memory/memory.limit_in_bytes").write_text(f"{v1[0]}\n")
+        (root / "sys/fs/cgroup/memory/memory.usage_in_bytes").write_text(f"{v1[1]}\n")
+    return str(root)
+
+
+def test_the_memory_guard_counts_available_memory_and_the_cgroup_limit(tmp_path, monkeypatch):
+    """A sweep that fits in physical memory but not in what is available, or not in what a
+    cgroup limit leaves, is refused with the figure and where it comes from."""
+    from sweep.run import available_memory, check_memory
+    gib = 2**30
+    monkeypatch.setattr(os, "sysconf", lambda name: {"SC_PAGE_SIZE": 4096,
+                                                     "SC_PHYS_PAGES": 64 * gib // 4096}[name])
+    nothing = _fake_system(tmp_path / "none")
+    assert available_memory(nothing) == (64 * gib, "physical memory")
+    check_memory(10**6, 40 * 1024, "test", root=nothing)          # 38 GiB of 64: fine
+
+    low = _fake_system(tmp_path / "avail", meminfo_kib=8 * 2**20)  # 8 GiB available
+    assert available_memory(low) == (8 * gib, "available memory")
+    with pytest.raises(sweep.UserError, match=r"8\.0 GiB of available memory"):
+        check_memory(10**6, 40 * 1024, "test", root=low)
+    check_memory(10**5, 40 * 1024, "test", root=low)               # 3.8 GiB of 8: fine
+
+    v2 = _fake_system(tmp_path / "v2", meminfo_kib=32 * 2**20, v2=(6 * gib, 2 * gib))
+    assert available_memory(v2) == (4 * gib, "memory the cgroup limit leaves")
+    with pytest.raises(sweep.UserError, match=r"4\.0 GiB of memory the cgroup limit leaves"):
+        check_memory(10**5, 40 * 1024, "test", root=v2)
+    unlimited = _fake_system(tmp_path / "v2max", meminfo_kib=32 * 2**20, v2=("max", gib))
+    assert available_memory(unlimited) == (32 * gib, "available memory")
+
+    v1 = _fake_system(tmp_path / "v1", v1=(3 * gib, gib))
+    assert available_memory(v1) == (2 * gib, "memory the cgroup limit leaves")
+    with pytest.raises(sweep.UserError, match="cgroup"):
+        check_memory(10**5, 40 * 1024, "test", root=v1)
