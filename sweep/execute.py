@@ -3,9 +3,10 @@
 A chunk is a contiguous range of the grid's points in solve order (a fixed permutation, see
 run.point_order); one chunk is one kernel call, or one dask task. With a chunk store (next to
 the output file) finished work is written to disk as it is done, by time rather than by point
-count: the transverse kernel reports each block of points it finishes (sweep.threads), and the
-finished blocks are saved at least every FLUSH_SECONDS; a kernel that cannot report blocks (the
-longitudinal one) gets chunks sized from its measured speed to take about CHUNK_SECONDS each.
+count: the transverse kernel reports each block of points it finishes (sweep.threads: blocks of
+about 2 s on a thread), and the finished blocks are saved at the first block end FLUSH_SECONDS
+after the last save; a kernel that cannot report blocks (the longitudinal one) gets chunks
+sized from its measured speed to take about CHUNK_SECONDS each.
 A run that is killed can then be resumed and computes only the points that are missing, and
 Ctrl-C stops it after the blocks in hand, with every finished one kept. Results never depend on
 the backend, the chunking or the number of workers: each point depends on its own row only.
@@ -32,7 +33,7 @@ from .errors import UserError
 
 STORE_SUFFIX = ".chunks"
 IN_FLIGHT = 2          # dask tasks submitted ahead per worker thread
-FLUSH_SECONDS = 1.0    # finished blocks reach the chunk store at least this often (s)
+FLUSH_SECONDS = 1.0    # finished blocks are saved at a block end this long after the last save (s)
 CHUNK_SECONDS = 2.0    # a kernel call that cannot report its blocks takes about this long (s)
 FIRST_CHUNK = 4        # points per thread in such a kernel's first, timing call
 
@@ -297,8 +298,9 @@ def missing_ranges(n: int, done: dict[tuple[int, int], dict],
 
 
 class _Keeper:
-    """The finished, not yet saved blocks of the chunk in hand: saved to the store at least
-    every FLUSH_SECONDS, and whatever is left when the chunk ends or the run stops."""
+    """The finished, not yet saved blocks of the chunk in hand: saved to the store at the first
+    block end FLUSH_SECONDS after the last save, and whatever is left when the chunk ends or the
+    run stops."""
 
     def __init__(self, store: ChunkStore | None, progress: Progress) -> None:
         self.store, self.progress = store, progress
@@ -381,7 +383,7 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     output arrays by name, and place(lo, hi, arrays) stores them. A chunk_fn that takes
     `on_block` and `stop` (transverse_chunk) reports its finished blocks and stops early when
     asked. Chunks in `done` (from a store) are placed, not computed; finished work is also
-    written to `store`, at least every FLUSH_SECONDS. Chunks have at most chunk_size points.
+    written to `store` (see FLUSH_SECONDS). Chunks have at most chunk_size points.
     On Ctrl-C the run stops after the work in hand, saves it and raises RunInterrupted.
     """
     done = done or {}

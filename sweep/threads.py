@@ -10,9 +10,9 @@ threads.
 
 Blocks are also sized by time: once a thread has timed a block, its next one takes about
 BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points), so however slow the points, finished
-blocks come back every second or two. A caller's `on_block(lo, hi)` hears of each one as soon
-as its rows are final (a checkpoint, a progress bar), and a `stop` event ends the solve after
-the blocks in hand (an interrupt).
+blocks come back every two seconds or sooner. A caller's `on_block(lo, hi)` hears of each one
+as soon as its rows are final (a checkpoint, a progress bar), and a `stop` event ends the solve
+after the blocks in hand (an interrupt).
 
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
 `kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one.
@@ -31,7 +31,7 @@ MIN_BLOCK = 128        # points per block, at least (smaller blocks leave lanes 
 MAX_BLOCK = 1024       # at most
 SHARE = 2              # a block is at most 1/SHARE of a thread's share of the points left
 LANES_PER_THREAD = 16  # a thread for every 16 points (one lanes group), at most
-BLOCK_SECONDS = 1.0    # a timed block takes about this long on one thread (s)
+BLOCK_SECONDS = 2.0    # a timed block takes about this long on one thread (s)
 MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
                        # its end, which costs more the fewer points each lane gets)
 
@@ -48,8 +48,10 @@ def next_block(lo: int, n: int, n_threads: int, cap: int = MAX_BLOCK) -> int:
     """End of the block that starts at row `lo` of n, on n_threads threads: guided scheduling,
     blocks shrinking with the points left, from `cap` (at most MAX_BLOCK) down to MIN_BLOCK
     (or to an equal share of a small grid, or to `cap`), so the threads finish together while
-    blocks stay long enough to keep the lanes full."""
+    blocks stay long enough to keep the lanes full. One thread takes blocks of `cap`."""
     cap = min(cap, MAX_BLOCK)
+    if n_threads == 1:
+        return min(n, lo + cap)          # nothing to balance: fewer blocks, fewer lane drains
     floor = min(MIN_BLOCK, cap, -(-n // n_threads))
     size = (n - lo) // (SHARE * n_threads)
     return min(n, lo + max(floor, min(cap, size)))

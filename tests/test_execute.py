@@ -74,8 +74,10 @@ def _cli(args, cwd, **kwargs):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
 
 
-# A few hundred long runs in one default chunk: about 3 s of work on one thread of the
-# 2-core development machine, so finished blocks reach the store part-way only if they go by time.
+# A few hundred long runs in one default chunk (about 1.5 s of work on one thread of the 2-core
+# development machine): finished blocks reach the store part-way only if they go by time. The
+# child process times its blocks to 0.2 s (BLOCK_SECONDS, FLUSH_SECONDS) so that the test is
+# short and there are blocks left after the first one saved on any machine.
 LONG_SCENE = """
 name = "kill-and-resume"
 [cable]
@@ -83,15 +85,18 @@ damping_ratio = 0.02
 [initial]
 displacement = 1e-3
 [axes]
-length = {start = 0.2, stop = 1.0, num = 30}
-frequency_ratio = {start = 0.5, stop = 3.0, num = 30}
+length = {start = 0.2, stop = 1.0, num = 20}
+frequency_ratio = {start = 0.5, stop = 3.0, num = 20}
 [solver]
 t_end = 80.0
 rtol = 1e-10
 [run]
 threads = 1
 """
-LONG_POINTS = 900     # in blocks of 128 points or more, several of them after the first flush
+LONG_POINTS = 400
+SHORT_BLOCKS = ("import sys, sweep.execute as e, sweep.threads as t; "
+                "t.BLOCK_SECONDS = e.FLUSH_SECONDS = 0.2; "
+                "from sweep.cli import main; sys.exit(main(sys.argv[1:]))")
 
 
 @pytest.fixture(scope="module")
@@ -115,8 +120,11 @@ def _start_and_wait_for_a_chunk(tmp_path, args):
     (tmp_path / "s.toml").write_text(LONG_SCENE)
     store = tmp_path / "out.nc.chunks"
     # SIGINT as a terminal's Ctrl-C gives it (a test runner may have it ignored for children)
-    proc = _cli(["run", "s.toml", "-o", "out.nc", *args], tmp_path,
-                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    proc = subprocess.Popen([sys.executable, "-c", SHORT_BLOCKS, "run", "s.toml", "-o", "out.nc",
+                             *args], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 300
     while not list(store.glob("chunk-*.npz")):
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
@@ -295,7 +303,7 @@ def test_finished_blocks_reach_the_store_by_time_and_the_rest_is_computed_on_res
                       done=done) == 30
     np.testing.assert_array_equal(values, 2.0 * np.arange(30))
     assert calls == list(range(1, 10))      # a file per block, written as the block ended
-    for path in sorted(store.directory.glob("chunk-*.npz"))[1::2]:                 # lose every other file
+    for path in sorted(store.directory.glob("chunk-*.npz"))[1::2]:      # lose every other one
         path.unlink()
     done, _ = store.open(resume=True, overwrite=False, chunk_size=10)
     values[:] = 0.0
