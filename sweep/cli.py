@@ -20,19 +20,7 @@ import warnings
 from typing import Sequence
 
 from .errors import CableSweepWarning, UserError
-
-VERSION = "0.1.0"
-"""The version a source checkout reports when cable-sweep is not installed (keep it equal to
-pyproject.toml's; tests/test_keys.py checks)."""
-
-
-def package_version() -> str:
-    """The installed cable-sweep's version (package metadata), else `VERSION`."""
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("cable-sweep")
-    except PackageNotFoundError:
-        return VERSION
+from .version import VERSION, package_version  # noqa: F401  (VERSION: re-exported)
 
 
 class _Parser(argparse.ArgumentParser):

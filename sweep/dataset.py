@@ -12,6 +12,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import transverse as tk
 
 from .scene import Scene
+from .version import package_version  # noqa: F401  (re-exported: the version written into results)
 
 if TYPE_CHECKING:
     from .run import KernelResult
@@ -53,14 +54,6 @@ _DERIVED = {
                             "beyond the model's range (mode slope pi q_b / l > 1)"),
 }
 
-
-def package_version() -> str:
-    """The installed cable-sweep version, or '0+unknown' when run from a bare checkout."""
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("cable-sweep")
-    except PackageNotFoundError:
-        return "0+unknown"
 
 
 def counter(values: Any) -> Any:

@@ -93,7 +93,7 @@ KEYS: tuple[Key, ...] = (
     # [solver]
     Key("solver", "rtol", "float", 1e-8, units="1", minimum=1e-14, maximum=0.1,
         long_name="relative tolerance"),
-    Key("solver", "atol", "float", None, units="", minimum=0.0, exclusive_min=True,
+    Key("solver", "atol", "float", None, units="m", minimum=0.0, exclusive_min=True,
         maximum=1.0, long_name="absolute tolerance (m for q, m/s for q'); default: each "
                                "point's own, 0.01 x rtol x max(|q0|, |v0|/w1) (w1 x that for "
                                "q'), so results do not depend on the response's size"),

@@ -116,7 +116,7 @@ def test_version_from_a_source_checkout_falls_back_to_the_constant(monkeypatch, 
 def test_version_constant_matches_pyproject():
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
     assert cli.VERSION == project["version"], (
-        "sweep/cli.py VERSION must equal pyproject.toml's [project] version")
+        "sweep/version.py VERSION must equal pyproject.toml's [project] version")
 
 
 def test_version_from_the_command_line():
