@@ -34,6 +34,7 @@ LANES_PER_THREAD = 16  # a thread for every 16 points (one lanes group), at most
 BLOCK_SECONDS = 2.0    # a timed block takes about this long on one thread (s)
 MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
                        # its end, which costs more the fewer points each lane gets)
+SOLO_BLOCK = 8192      # at most, on one thread (nothing to balance: fewer drains)
 
 
 def thread_count(threads: int = 0) -> int:
@@ -48,21 +49,22 @@ def next_block(lo: int, n: int, n_threads: int, cap: int = MAX_BLOCK) -> int:
     """End of the block that starts at row `lo` of n, on n_threads threads: guided scheduling,
     blocks shrinking with the points left, from `cap` (at most MAX_BLOCK) down to MIN_BLOCK
     (or to an equal share of a small grid, or to `cap`), so the threads finish together while
-    blocks stay long enough to keep the lanes full. One thread takes blocks of `cap`."""
-    cap = min(cap, MAX_BLOCK)
+    blocks stay long enough to keep the lanes full. One thread takes blocks of `cap` (at most
+    SOLO_BLOCK)."""
     if n_threads == 1:
-        return min(n, lo + cap)          # nothing to balance: fewer blocks, fewer lane drains
+        return min(n, lo + min(cap, SOLO_BLOCK))    # nothing to balance: fewer lane drains
+    cap = min(cap, MAX_BLOCK)
     floor = min(MIN_BLOCK, cap, -(-n // n_threads))
     size = (n - lo) // (SHARE * n_threads)
     return min(n, lo + max(floor, min(cap, size)))
 
 
-def timed_cap(points: int, seconds: float) -> int:
+def timed_cap(points: int, seconds: float, most: int = MAX_BLOCK) -> int:
     """Points the next block of a thread gets so it takes about BLOCK_SECONDS, from the last
-    block's `points` in `seconds` (s): between MIN_TIMED_BLOCK and MAX_BLOCK."""
+    block's `points` in `seconds` (s): between MIN_TIMED_BLOCK and `most`."""
     if seconds <= 0.0:
-        return MAX_BLOCK
-    return max(MIN_TIMED_BLOCK, min(MAX_BLOCK, int(points * BLOCK_SECONDS / seconds)))
+        return most
+    return max(MIN_TIMED_BLOCK, min(most, int(points * BLOCK_SECONDS / seconds)))
 
 
 def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarray,
@@ -106,6 +108,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     n = params.shape[0]
     n_threads = max(1, min(thread_count(threads), -(-n // LANES_PER_THREAD)))
     stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
+    most = SOLO_BLOCK if n_threads == 1 else MAX_BLOCK
     start = 0
     lock = threading.Lock()
 
@@ -120,7 +123,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                 return
             began = time.perf_counter()
             solve_block(lo, hi)
-            cap = timed_cap(hi - lo, time.perf_counter() - began)
+            cap = timed_cap(hi - lo, time.perf_counter() - began, most)
 
     if n_threads == 1:
         work()
