@@ -1,7 +1,8 @@
 """Load-amplitude sweep: the damping threshold of the principal parametric resonance.
 
 One 0.8 m span, loaded at W = 2 w1 with amplitudes from 0.1 to 10 N (log spaced). Below
-mu = P0 / (2 Pcr) = 2 zeta (P0 of about 0.8 N with 2 % damping) the start decays; above it the
+mu = P0 / (2 Pcr) = 2 zeta (P0 of about 0.4 N with 2 % damping and the default
+bending inertia A^2/(4 pi): Pcr = 4.9 N) the start decays; above it the
 response grows to a steady nonlinear amplitude. The time series are stored to show both.
 
     python examples/load_amplitude_sweep.py [--small] [--out DIR]
