@@ -19,7 +19,7 @@ import time
 import warnings
 from typing import Sequence
 
-from .errors import CableSweepWarning, UserError
+from .errors import CableSweepWarning, UserError, one_line
 from .version import VERSION, package_version  # noqa: F401  (VERSION: re-exported)
 
 
@@ -31,8 +31,9 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"sweep: error: {_one_line(message)} ({usage}; see '{self.prog} --help')\n")
 
 
-def _one_line(text: str) -> str:
-    return " ".join(str(text).splitlines())
+def _one_line(text: object) -> str:
+    """Every line the CLI prints about a mistake goes through here: one line, escaped, short."""
+    return one_line(text)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -96,10 +97,28 @@ def _summary(ds, seconds: float) -> str:
     return f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'} in {seconds:.2f} s ({states})"
 
 
+def _check_output(path: str, overwrite: bool) -> None:
+    """`sweep.io.check_output_path`, plus what it leaves to the final write: a name netCDF
+    cannot store (it takes UTF-8 names only: undecodable bytes of an argument are refused here,
+    before the sweep runs), and OS errors of the checks (a name too long, a folder that cannot
+    be searched, a file where a folder should be) as one-line user errors."""
+    from .io import check_output_path
+    try:
+        path.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise UserError(f"output '{path}': the name is not UTF-8 text (character "
+                        f"{exc.start + 1}), which netCDF cannot store (give a UTF-8 file "
+                        "name, e.g. 'out.nc')") from None
+    try:
+        check_output_path(path, overwrite)
+    except OSError as exc:
+        raise UserError(f"output '{path}': cannot be checked: {exc.strerror or exc} (check "
+                        "the path and its permissions, or choose another -o path)") from None
+
+
 def _run(args: argparse.Namespace) -> int:
     from .scene import load_scene, parse_override
     from .run import run
-    from .io import check_output_path
 
     if args.threads is not None and args.threads < 1:
         raise UserError(f"--threads {args.threads}: must be a positive number of threads "
@@ -116,7 +135,7 @@ def _run(args: argparse.Namespace) -> int:
         raise UserError("--resume: needs -o OUT.nc, the file whose interrupted run to finish")
     scene = load_scene(args.scene, overrides=overrides)
     if args.output is not None:
-        check_output_path(args.output, args.overwrite)
+        _check_output(args.output, args.overwrite)
     started = time.perf_counter()
     ds = run(scene, output=args.output, overwrite=args.overwrite, resume=args.resume,
              threads=args.threads,

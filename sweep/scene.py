@@ -56,9 +56,11 @@ Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import os
 import re
+import stat
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -106,10 +108,13 @@ RANGE_KEYS: tuple[str, ...] = ("start", "stop", "num", "spacing")
 LOG_DIGITS = 15
 """Significant digits of the values of a log-spaced range (its endpoints are kept exactly)."""
 MAX_AXIS_POINTS = 10_000_000
+MAX_INT = 2**63 - 1
+"""Largest size of an integer key's value (int64; larger ones cannot even be compared as floats)."""
 MAX_SAMPLES = 10_000_000
 """Most time-series samples per point (solver.t_end / outputs.sample_interval)."""
-MAX_SCENE_BYTES = 256 * 2**20
-"""A scene file longer than this is refused (a device such as /dev/zero never ends)."""
+MAX_SCENE_BYTES = 8 * 2**20
+"""A scene file longer than this (bytes) is refused before it is read; 8 MiB holds an axis of
+400 000 values written out (parsed in about 1 s, 70 MB)."""
 
 _VALUE_SECTIONS: tuple[str, ...] = tuple(s for s in schema.SECTIONS if s != "axes")
 _COMMON_AXES = ("length", "load_amplitude", "frequency_ratio", "frequency", "damping_ratio")
@@ -285,37 +290,94 @@ def _builtin_file(name: str) -> Any | None:
 
 
 def _read_scene(scene: str | os.PathLike) -> tuple[str, str, str]:
-    """(source, text, default name) of a built-in name or a scene file path."""
+    """(source, text, default name) of a built-in name or a scene file path.
+
+    Only a regular file of at most MAX_SCENE_BYTES is read (a FIFO would block, a device
+    never ends); every OS error (permissions, a name too long, ...) is a one-line SceneError.
+    """
     if isinstance(scene, str):
         builtin = _builtin_file(scene)
         if builtin is not None:
             return scene, builtin.read_text("utf-8"), scene
     source = os.fspath(scene)
-    path = Path(source)
-    if not source or not path.exists():
+    if isinstance(source, bytes):
+        source = os.fsdecode(source)
+    where = f"scene file '{source}'"
+    info = _stat_scene(source, where)
+    if info is None:
         if _looks_like_path(source):
-            _fail(f"scene file '{source}'", "no such file",
-                  "check the path; 'sweep scenes' lists the built-in names")
+            _fail(where, "no such file", "check the path; 'sweep scenes' lists the built-in names")
         _fail(f"scene '{source}'", "no built-in scene of that name and no such file",
               "run 'sweep scenes' for the built-in names")
-    if path.is_dir():
-        _fail(f"scene file '{source}'", "is a directory, not a TOML file",
-              "give the path of a .toml scene file")
-    try:
-        with path.open("rb") as handle:
-            data = handle.read(MAX_SCENE_BYTES + 1)
-    except OSError as exc:
-        _fail(f"scene file '{source}'", f"cannot be read: {exc.strerror or exc}",
-              "check the path and its permissions")
-    if len(data) > MAX_SCENE_BYTES:
-        _fail(f"scene file '{source}'", f"is larger than {MAX_SCENE_BYTES // 2**20} MiB",
-              "give a TOML scene file; write long axes as range tables {start, stop, num}")
+    _check_text(where, source, "the file name", "rename the file (or a folder on its path)")
+    if stat.S_ISDIR(info.st_mode):
+        _fail(where, "is a directory, not a TOML file", "give the path of a .toml scene file")
+    data = _read_regular(source, where)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        _fail(f"scene file '{source}'", f"is not UTF-8 text (bad byte at offset {exc.start})",
+        _fail(where, f"is not UTF-8 text (bad byte at offset {exc.start})",
               "save the file as UTF-8")
-    return source, text, path.stem or "unnamed"
+    return source, text, Path(source).stem or "unnamed"
+
+
+def _stat_scene(source: str, where: str) -> os.stat_result | None:
+    """os.stat of a scene path (following links); None when nothing is there."""
+    if not source:
+        return None
+    try:
+        return os.stat(source)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError as exc:
+        _fail(where, f"cannot be read: {exc.strerror or exc}", "check the path and its permissions")
+    except ValueError as exc:                    # an embedded NUL character
+        _fail(where, f"is not a valid path ({exc})", "check the path")
+
+
+def _read_regular(source: str, where: str) -> bytes:
+    """The bytes of a regular file of at most MAX_SCENE_BYTES (opened without blocking, so a
+    FIFO put in its place is refused instead of waited on)."""
+    fix = "give a TOML scene file; write long axes as range tables {start, stop, num}"
+    too_large = f"is larger than {MAX_SCENE_BYTES // 2**20} MiB"
+    try:
+        fd = os.open(source, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        _fail(where, f"cannot be read: {exc.strerror or exc}", "check the path and its permissions")
+    with os.fdopen(fd, "rb") as handle:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            _fail(where, f"is not a regular file (a {_file_kind(info.st_mode)})",
+                  "give the path of a .toml scene file")
+        if info.st_size > MAX_SCENE_BYTES:
+            _fail(where, f"{too_large} ({info.st_size:,} bytes)", fix)
+        try:
+            data = handle.read(MAX_SCENE_BYTES + 1)
+        except OSError as exc:
+            _fail(where, f"cannot be read: {exc.strerror or exc}",
+                  "check the path and its permissions")
+    if len(data) > MAX_SCENE_BYTES:
+        _fail(where, too_large, fix)
+    return data
+
+
+def _file_kind(mode: int) -> str:
+    """'FIFO', 'character device', ... for a file mode that is not a regular file."""
+    kinds = ((stat.S_ISFIFO, "FIFO (named pipe)"), (stat.S_ISCHR, "character device"),
+             (stat.S_ISBLK, "block device"), (stat.S_ISSOCK, "socket"))
+    return next((name for test, name in kinds if test(mode)), "special file")
+
+
+def _check_text(where: str, text: str, what: str, fix: str) -> None:
+    """Refuse text that cannot be stored as a netCDF attribute: not encodable as UTF-8 (lone
+    surrogates, e.g. undecodable bytes of a command-line argument) or holding a NUL character
+    (netCDF would drop it silently)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        _fail(where, f"{what} is not valid UTF-8 text (character {exc.start + 1})", fix)
+    if "\x00" in text:
+        _fail(where, f"{what} holds a NUL character (character {text.index(chr(0)) + 1})", fix)
 
 
 def _looks_like_path(source: str) -> bool:
@@ -328,7 +390,7 @@ def _first_description_line(text: str) -> str:
     """The first line of a scene's ``description``, or "" if it has none."""
     try:
         description = tomllib.loads(text).get("description", "")
-    except tomllib.TOMLDecodeError:
+    except (ValueError, RecursionError):         # TOMLDecodeError is a ValueError
         return ""
     lines = description.strip().splitlines() if isinstance(description, str) else []
     return lines[0] if lines else ""
@@ -338,6 +400,9 @@ def _parse_toml(text: str, source: str) -> dict[str, Any]:
     """Parse scene text; a syntax error names the file, line and column."""
     try:
         return tomllib.loads(text)
+    except RecursionError:
+        _fail(f"scene file '{source}'", "arrays or tables are nested too deeply to parse",
+              "write at most a few levels of nested [...] and {...}")
     except tomllib.TOMLDecodeError as exc:
         message = str(exc)
         position = _TOML_POSITION.search(message)
@@ -351,6 +416,17 @@ def _parse_toml(text: str, source: str) -> dict[str, Any]:
             where = "somewhere"
         _fail(f"scene file '{source}'", f"TOML syntax error {where}: {message}",
               "fix the line and run again")
+    except ValueError as exc:                    # e.g. an integer of more than 4300 digits
+        _fail(f"scene file '{source}'", f"cannot be parsed: {_value_error_text(exc)}",
+              "fix the value and run again")
+
+
+def _value_error_text(exc: ValueError) -> str:
+    """What tomllib's plain ValueError (not a syntax error) means, in a few words."""
+    message = str(exc)
+    if "integer string conversion" in message:
+        return "an integer has more than 4300 digits"
+    return message
 
 
 # --------------------------------------------------------------------------- overrides
@@ -360,7 +436,7 @@ def _parse_value_text(text: str) -> Any:
     """A TOML value from text, or the stripped text itself if it is not one."""
     try:
         parsed = tomllib.loads("v = " + text)
-    except tomllib.TOMLDecodeError:
+    except (ValueError, RecursionError):         # TOMLDecodeError is a ValueError
         return text.strip()
     return parsed["v"] if list(parsed) == ["v"] else text.strip()
 
@@ -509,6 +585,7 @@ def _build(text: str, source: str, default_name: str,
     _check_model(given, axes)
     _check_frequency_pair(given, axes)
     values = _resolve(given, axes)
+    _check_coefficients(values, axes)
     if values["model.kind"] == "longitudinal":
         _check_snapshot_times(values, axes)
         _check_sample_count(values, "outputs.histories")
@@ -580,6 +657,7 @@ def _check_name(value: Any) -> str:
     if not isinstance(value, str) or not value.strip():
         _fail("scene key 'name'", f"must be a non-empty string, got {_show(value)}",
               'write e.g. name = "my-sweep"')
+    _check_text("scene key 'name'", value, "the name", 'write e.g. name = "my-sweep"')
     return value
 
 
@@ -587,6 +665,8 @@ def _check_description(value: Any) -> str:
     if not isinstance(value, str):
         _fail("scene key 'description'", f"must be a string, got {_show(value)}",
               'write e.g. description = "what the sweep is for"')
+    _check_text("scene key 'description'", value, "the description",
+                'write e.g. description = "what the sweep is for"')
     return value
 
 
@@ -714,6 +794,8 @@ def _as_int(where: str, raw: Any, fix: str) -> int:
         _fail(where, f"must be a whole number, got {_show(raw)}", fix)
     if isinstance(value, float) and not value.is_integer():
         _fail(where, f"must be a whole number, got {_show(raw)}", fix)
+    if abs(value) > MAX_INT:
+        _fail(where, f"must be at most {MAX_INT:,} in size, got {_show(raw)}", fix)
     return int(value)
 
 
@@ -728,6 +810,7 @@ def _as_choice(where: str, key: schema.Key, raw: Any) -> str:
     """A string, one of the key's choices if it has any."""
     if not isinstance(raw, str):
         _fail(where, f"must be a string, got {_show(raw)}", f'write {key.name} = "..." with quotes')
+    _check_text(where, raw, "the value", f'write {key.name} = "..." in UTF-8 text')
     if key.choices and raw not in key.choices:
         listed = ", ".join(f"'{c}'" for c in key.choices)
         _fail(where, f"must be one of {listed}, got {_show(raw)}",
@@ -1055,6 +1138,71 @@ def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -
                   f"use times <= {latest:.6g} s, or more solver.transits")
 
 
+_CHECKED_COEFFICIENTS: dict[str, tuple[str, ...]] = {
+    "transverse": ("k0", "k1", "g0", "g1", "h", "omega", "mass", "damping", "q_scale",
+                   "v_scale", "natural_frequency", "buckling_load", "load_ratio"),
+    "longitudinal": ("wave_speed", "axial_stiffness", "t_end", "transit_time",
+                     "static_end_displacement", "impedance"),
+}
+def _float64(value: Any) -> Any:
+    """A float as np.float64 (IEEE overflow and division by zero give inf, not exceptions)."""
+    return np.float64(value) if isinstance(value, float) else value
+
+
+_PLAUSIBLE = (1e-100, 1e100)
+"""Magnitudes outside this range are named first when derived coefficients are not finite."""
+
+
+def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Refuse cable data whose derived coefficients are not finite floats (e.g. density =
+    5e-324 makes w1^2 = EI k^4 / (rho A) infinite; E = 1e-300 with rho = 1e308 a zero wave
+    speed): computed with the run's own formulas (sweep.models.oscillator,
+    sweep.longitudinal.wave_parameters) at every corner of the grid (each axis at its first
+    and last value). Each coefficient is a product of powers of the parameters (or a sum of
+    same-signed ones), so its largest and smallest magnitudes lie at corners."""
+    kind = values["model.kind"]
+    corners = list(itertools.product(*([float(a[0]), float(a[-1])] for a in axes.values())))
+    columns = dict(zip(axes, np.array(corners, dtype=np.float64).T)) if axes else {}
+    params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
+                              for name, key in schema.BY_AXIS.items()}
+    if params["inertia"] is None:
+        params["inertia"] = default_inertia(params["area"])
+    params.update(coefficients=values["model.coefficients"], load_type=values["load.type"],
+                  paper_parametric=values["model.paper_parametric"],
+                  divergence_bound=values["metrics.divergence_bound"])
+    if params["load_type"] == "constant":
+        params["frequency"] = None
+    with np.errstate(all="ignore"):
+        if kind == "longitudinal":
+            from .longitudinal import wave_parameters
+            derived = wave_parameters(params, values["solver.t_end"], values["solver.transits"])
+        else:
+            from .models import oscillator
+            derived = oscillator(params)
+    bad = [(name, np.atleast_1d(np.asarray(derived[name], dtype=np.float64)))
+           for name in _CHECKED_COEFFICIENTS[kind]]
+    bad = [(name, v) for name, v in bad if not np.all(np.isfinite(v))]
+    if not bad:
+        return
+    name, coefficient = bad[0]
+    corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0
+    inputs = []
+    for axis, key in schema.BY_AXIS.items():
+        value = params[axis]
+        if value is None or key.section not in ("cable", "model", "load"):
+            continue
+        value = float(np.atleast_1d(value)[corner % np.size(value)])
+        where = (f"axis '{axis}' at {value!r}" if axis in axes
+                 else f"scene key '{key.dotted}' = {value!r}")
+        inputs.append((not (value == 0 or _PLAUSIBLE[0] <= abs(value) <= _PLAUSIBLE[1]), where))
+    named = [w for odd, w in inputs if odd] or [w for _, w in inputs]
+    _fail(", ".join(named),
+          f"give the derived coefficient {name} = {float(coefficient[corner])!r}, not a "
+          f"finite float64 (so are: {', '.join(n for n, _ in bad)})",
+          "give the cable data in SI units with physical magnitudes, e.g. cable.density = "
+          "8900 kg/m^3, cable.area = 6e-6 m^2, cable.youngs_modulus = 1.1e11 Pa")
+
+
 # --------------------------------------------------------------------------- messages
 
 
@@ -1076,7 +1224,10 @@ def _suggestion(guess: str | None, fallback: str) -> str:
 
 def _show(value: Any) -> str:
     """A short repr of a user's value for a message."""
-    text = repr(value)
+    try:
+        text = repr(value)
+    except (ValueError, RecursionError):         # an int of > 4300 digits, deep nesting
+        text = f"<a {type(value).__name__} too large to show>"
     return text if len(text) <= 60 else text[:57] + "..."
 
 
