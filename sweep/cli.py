@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import shlex
+import signal
 import sys
 import time
 import warnings
@@ -224,7 +225,9 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
     command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
     kept = (f"{exc.kept:,} of {exc.total:,} points are kept" if hasattr(exc, "kept")
             else "finished chunks are kept")
-    return f"interrupted: {kept} in {store}/; finish the run with: {command}"
+    how = ("interrupted" if getattr(exc, "signum", 2) == 2
+           else f"{signal.Signals(exc.signum).name} received")
+    return f"{how}: {kept} in {store}/; finish the run with: {command}"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -233,7 +236,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     _one_line_warnings()
     try:
         if args.command == "run":
-            return _run(args)
+            from .execute import terminate_raises
+            with terminate_raises():           # SIGTERM, SIGHUP: as Ctrl-C (one line, --resume)
+                return _run(args)
         if args.command == "plot":
             return _plot(args)
         if args.command == "keys":
@@ -249,7 +254,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt as exc:
         print(f"sweep: {_interrupted(exc, args, argv)}", file=sys.stderr)
-        return 130
+        return 128 + int(getattr(exc, "signum", 2))      # 130 for Ctrl-C, 143 SIGTERM, 129 SIGHUP
 
 
 if __name__ == "__main__":

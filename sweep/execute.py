@@ -36,11 +36,12 @@ FIRST_CHUNK = 4        # points per thread in such a kernel's first, timing call
 
 
 class RunInterrupted(KeyboardInterrupt):
-    """Ctrl-C stopped a run: `kept` of `total` points are in the chunk store `store` (None
-    when the run had no output file, so nothing was kept)."""
+    """Ctrl-C (or SIGTERM, SIGHUP: `signum`) stopped a run: `kept` of `total` points are in the
+    chunk store `store` (None when the run had no output file, so nothing was kept)."""
 
-    def __init__(self, kept: int, total: int, store: Path | None) -> None:
-        self.kept, self.total, self.store = kept, total, store
+    def __init__(self, kept: int, total: int, store: Path | None,
+                 signum: int = signal.SIGINT) -> None:
+        self.kept, self.total, self.store, self.signum = kept, total, store, signum
         if store is None:
             text = ("interrupted: results were not kept (a run with an output file keeps "
                     "every finished chunk, and resume=True finishes it)")
@@ -279,27 +280,68 @@ def _merged(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
     return [(lo, hi) for lo, hi in out]
 
 
+TERMINATING = (signal.SIGTERM, signal.SIGHUP)   # handled as Ctrl-C is (exit status 128 + signum)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (`signum`) arrived outside a chunked solve (see terminate_raises)."""
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+        super().__init__(f"terminated by {signal.Signals(signum).name}")
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    raise Terminated(signum)
+
+
 @contextlib.contextmanager
-def _interrupt_sets(stop: threading.Event) -> Iterator[None]:
-    """Within the block, Ctrl-C (SIGINT) sets `stop` instead of raising at once, so the run
-    ends after the blocks in hand and keeps them; a second Ctrl-C raises KeyboardInterrupt.
-    Only in the main thread, and only over Python's own SIGINT handler (not over one a caller
-    installed, nor where SIGINT is ignored)."""
-    if (threading.current_thread() is not threading.main_thread()
-            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+def terminate_raises() -> Iterator[None]:
+    """Within the block, SIGTERM and SIGHUP raise Terminated (a KeyboardInterrupt) as Ctrl-C
+    raises KeyboardInterrupt, instead of ending the process at once: temporary files are
+    removed and one line is printed. Only in the main thread, over the default handlers."""
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
+    previous = {s: signal.getsignal(s) for s in TERMINATING}
+    for s, handler in previous.items():
+        if handler is signal.SIG_DFL:
+            signal.signal(s, _raise_terminated)
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            if handler is signal.SIG_DFL:
+                signal.signal(s, handler)
+
+
+@contextlib.contextmanager
+def _interrupt_sets(stop: threading.Event) -> Iterator[list[int]]:
+    """Within the block, Ctrl-C (SIGINT), SIGTERM and SIGHUP set `stop` instead of ending the
+    run at once, so it ends after the blocks in hand and keeps them; the signal's number is
+    appended to the list yielded. A second one raises KeyboardInterrupt. Only in the main
+    thread, and only over Python's own SIGINT handler and the default (or terminate_raises's)
+    SIGTERM and SIGHUP handlers (not over one a caller installed, nor where one is ignored)."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+    ours = {signal.SIGINT: (signal.default_int_handler,)}
+    ours.update({s: (signal.SIG_DFL, _raise_terminated) for s in TERMINATING})
+    taken = [s for s, defaults in ours.items() if signal.getsignal(s) in defaults]
 
     def handler(signum: int, frame: Any) -> None:
         if stop.is_set():
             raise KeyboardInterrupt
+        received.append(signum)
         stop.set()
 
-    previous = signal.signal(signal.SIGINT, handler)
+    previous = {s: signal.signal(s, handler) for s in taken}
     try:
-        yield
+        yield received
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for s, before in previous.items():
+            signal.signal(s, before)
 
 
 def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.ndarray], n: int,
@@ -327,7 +369,8 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     keeper = _Keeper(store, bar)
     stop = threading.Event()
     try:
-        with _interrupt_sets(stop), announce_compilation(progress, bar) as clock:
+        with _interrupt_sets(stop) as received, \
+                announce_compilation(progress, bar) as clock:
             if backend == "dask":
                 _execute_dask(chunk_fn, rows_for, args, _split(gaps, chunk_size), keeper,
                               place, scheduler, workers, stop)
@@ -339,7 +382,8 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
         bar.close()
     if stop.is_set():
         raise RunInterrupted(n - todo + keeper.saved, n,
-                             store.directory if store is not None else None)
+                             store.directory if store is not None else None,
+                             received[0] if received else signal.SIGINT)
     return todo
 
 

@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import os
+import re
+import stat
 import tempfile
 from pathlib import Path
 
 import xarray as xr
 
 from .errors import UserError
+from .store import free_bytes, fsync_directory, mib, store_path
 
 
 def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
@@ -52,26 +57,117 @@ def _can_create_in(directory: Path) -> bool:
         return False
 
 
+def _temporary_pattern(out: Path) -> re.Pattern:
+    """The names write_netcdf gives its temporaries of `out`: .NAME.PID.RANDOM.tmp (and the
+    older .NAME.PID.tmp); the pid says which process made it."""
+    return re.compile(re.escape(f".{out.name}.") + r"(\d+)\.(?:[A-Za-z0-9_]+\.)?tmp")
+
+
+def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporaries a killed write of `path` left: only regular files (not links)
+    whose name is write_netcdf's, owned by this user, whose process is gone. Returns them."""
+    out = Path(path)
+    parent = out.parent if str(out.parent) else Path(".")
+    pattern = _temporary_pattern(out)
+    removed = []
+    try:
+        entries = list(os.scandir(parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        match = pattern.fullmatch(entry.name)
+        if not match:
+            continue
+        with contextlib.suppress(OSError):
+            st = entry.stat(follow_symlinks=False)
+            if (stat.S_ISREG(st.st_mode) and st.st_uid == os.getuid()
+                    and not _pid_alive(int(match[1]))):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+    return removed
+
+
+def _pid_alive(pid: int) -> bool:
+    """Whether process `pid` exists (one of another user's counts as alive)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def estimated_size(ds: xr.Dataset) -> int:
+    """Bytes the netCDF file of `ds` needs at most (its arrays uncompressed, and 1 MiB)."""
+    return int(sum(v.nbytes for v in ds.variables.values())) + 2**20
+
+
 def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = False) -> Path:
-    """Write `ds` to `path` atomically: a temporary file in the same directory, then a rename.
+    """Write `ds` to `path` atomically: a new temporary file in the same directory (made with
+    O_EXCL under an unpredictable name), fsync, then a rename over `path`.
 
     A failure leaves no partial file behind; an existing file is replaced only with `overwrite`.
+    A symbolic link at `path` is replaced by the file (its target is never written). A full
+    disk raises UserError naming the directory and the space the file needs.
     """
     out = check_output_path(path, overwrite)
-    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
+    parent = out.parent if str(out.parent) else Path(".")
     encoding = {name: {"zlib": True, "complevel": 4}
                 for name, var in ds.data_vars.items() if var.ndim >= 1 and var.dtype.kind == "f"}
     # CF: coordinates have no missing values, so no _FillValue (xarray adds NaN to floats).
     encoding.update({name: {"_FillValue": None} for name in ds.coords})
     try:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, out)
+        fd, name = tempfile.mkstemp(dir=parent, prefix=f".{out.name}.{os.getpid()}.",
+                                    suffix=".tmp")
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise UserError(f"output '{out}': could not be written ({exc.strerror or exc})") from exc
+        raise _write_error(out, parent, ds, exc) from exc
+    tmp = Path(name)
+    made = os.fstat(fd)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
+        now = os.stat(tmp, follow_symlinks=False)
+        if not stat.S_ISREG(now.st_mode) or (now.st_dev, now.st_ino) != (made.st_dev,
+                                                                         made.st_ino):
+            raise UserError(f"output '{out}': the temporary file '{tmp}' was replaced while "
+                            "it was written (someone else writes in this directory; choose "
+                            "another -o path)")
+        os.fsync(fd)
+        os.replace(tmp, out)
+        fsync_directory(parent)
+    except (OSError, RuntimeError) as exc:
+        _unlink_ours(tmp, made)
+        raise _write_error(out, parent, ds, exc) from exc
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        _unlink_ours(tmp, made)
         raise
+    finally:
+        os.close(fd)
     return out
+
+
+def _unlink_ours(tmp: Path, made: os.stat_result) -> None:
+    """Remove `tmp` if it is still the file this process made."""
+    with contextlib.suppress(OSError):
+        now = os.stat(tmp, follow_symlinks=False)
+        if (now.st_dev, now.st_ino) == (made.st_dev, made.st_ino):
+            os.unlink(tmp)
+
+
+def _write_error(out: Path, parent: Path, ds: xr.Dataset, exc: BaseException) -> UserError:
+    """The one line a failed write gives: a full disk says where and how much is needed."""
+    free = free_bytes(parent)
+    need = estimated_size(ds)
+    # netCDF/HDF5 report a full disk as they like (RuntimeError, even EACCES): the space says
+    full = (getattr(exc, "errno", None) in (errno.ENOSPC, errno.EDQUOT)
+            or (free is not None and free < need))
+    store = store_path(out)
+    kept = (f"; the finished chunks are kept in '{store}/': free space and run again with "
+            "--resume" if os.path.isdir(store) else "")
+    if full:
+        return UserError(f"output '{out}': no space left on the device in '{parent}' (the "
+                         f"file needs up to {mib(need)}, {mib(free or 0)} free){kept}")
+    reason = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
+    return UserError(f"output '{out}': could not be written ({reason}){kept}")

@@ -17,7 +17,7 @@ import xarray as xr
 from . import grid, models
 from .dataset import assemble, package_version
 from .errors import UserError
-from .io import check_output_path, write_netcdf
+from .io import check_output_path, remove_stale_temporaries, write_netcdf
 from .scene import Scene
 
 _PERMUTATION_SEED = 20261121   # fixed: the point order never changes any point's result
@@ -111,6 +111,29 @@ def check_memory(n_points: int, bytes_per_point: float, what: str, root: str = "
                         "values, or store fewer samples or snapshots)")
 
 
+def check_disk(store, bytes_per_point: float) -> None:
+    """Refuse, before solving, a run whose chunks do not fit on the chunk store's disk; warn
+    when the netCDF file (at most its arrays' size, `bytes_per_point` bytes a point) may not
+    fit beside them. `store`: an open store.ChunkStore."""
+    from .errors import CableSweepWarning
+    from .store import free_bytes, mib
+    import warnings
+    store.bytes_per_point = max(store.bytes_per_point, bytes_per_point)
+    chunks = store.space_needed()
+    free = free_bytes(store.directory)
+    if free is None:
+        return
+    if chunks > free:
+        raise UserError(f"chunk store '{store.directory}': not enough space on the device (the "
+                        f"run needs about {mib(chunks)} there, {mib(free)} free; free space, or "
+                        "choose another -o path)")
+    if chunks + bytes_per_point * store.points > free:
+        warnings.warn(f"'{store.directory.parent}': {mib(free)} free may not hold the chunks "
+                      f"({mib(chunks)}) and the output file (up to "
+                      f"{mib(bytes_per_point * store.points)}) together", CableSweepWarning,
+                      stacklevel=2)
+
+
 def point_order(n: int) -> np.ndarray:
     """The fixed pseudo-random order points are solved in: spreads costly points over threads.
 
@@ -170,7 +193,8 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
     first axis = points). rows_at(flat indices) gives the kernel's parameter rows of those
     points. With `output`, every finished chunk is persisted next to it and, when resuming,
     only the missing chunks are computed."""
-    from .execute import ChunkStore, default_chunk_size, execute
+    from .execute import default_chunk_size, execute
+    from .store import ChunkStore
     n = next(iter(outputs.values())).shape[0]
     order = point_order(n)
     backend = scene.get("run.backend")
@@ -181,7 +205,8 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
     done: dict = {}
     if output is not None:
         store = ChunkStore(output, run_fingerprint(scene))
-        done, chunk = store.open(resume, overwrite, chunk)
+        done, chunk = store.open(resume, overwrite, chunk, points=n)
+        check_disk(store, sum(v.nbytes for v in outputs.values()) / max(n, 1))
     computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args,
                        placer(outputs, order),
                        chunk_size=chunk, backend=backend, threads=threads,
@@ -216,15 +241,22 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         raise UserError(f"sweep.run: threads = {threads!r} is not a thread count (give an integer "
                         ">= 1, or 0 or None for every core)")
     persist = dict(output=output, resume=resume, overwrite=overwrite)
-    if scene.get("model.kind") == "longitudinal":
-        from .longitudinal import run_longitudinal
-        ds = run_longitudinal(scene, threads=threads, progress=progress, **persist)
-    else:
-        ds = run_transverse(scene, threads=threads, progress=progress, **persist)
     if output is not None:
-        from .execute import ChunkStore
-        write_netcdf(ds, output, overwrite)
-        ChunkStore(output, "").remove()
+        remove_stale_temporaries(output)            # of a write that was killed
+    from .store import ChunkStore
+    try:
+        if scene.get("model.kind") == "longitudinal":
+            from .longitudinal import run_longitudinal
+            ds = run_longitudinal(scene, threads=threads, progress=progress, **persist)
+        else:
+            ds = run_transverse(scene, threads=threads, progress=progress, **persist)
+        if output is not None:
+            write_netcdf(ds, output, overwrite)
+            ChunkStore(output, "").remove()
+    finally:
+        if output is not None:
+            # a run that failed before finishing a chunk leaves no store to block the next one
+            ChunkStore(output, "").release(discard_empty=True)
     return ds
 
 
