@@ -39,6 +39,11 @@ SAMPLE_DT = 2       # history sample interval (s); used only when histories have
 MAX_LEVELS = 3      # bound on time levels per span; a span that needs more stops there
 N_SETTINGS = 4
 
+LEVEL_LIMIT = 2.0 ** 62
+"""Most time levels a span can count (int64 with room): a larger MAX_LEVELS is capped here.
+A span whose level count t_end / dt is not finite (dt underflowed to 0, or the quotient
+overflowed) is INVALID_INPUT; one that needs more levels than the budget is MAX_STEPS."""
+
 # Columns of the `reals` output.
 PEAK_END_DISPLACEMENT = 0   # max |u(l, t)| (m)
 PEAK_FIXED_END_FORCE = 1    # max |N(0, t)| (N)
@@ -102,15 +107,28 @@ def solve_span(p, settings, snapshot_times, reals, hist_u, hist_f, snap_u, snap_
     dt = courant * dx / a
     c2 = courant * courant
     ghost = 2.0 * dx * load / ea          # u_{N+1} = u_{N-1} - ghost
-    n_needed = math.ceil(p[T_END] / dt - 1e-9)
-    n_levels = int(min(n_needed, settings[MAX_LEVELS]))
+    # The number of levels to t_end as a float first: a count beyond int64 (t_end / dt of
+    # 1e19 or more, or dt underflowed to 0) would wrap round in int() and run nothing.
+    levels = np.ceil(p[T_END] / dt - 1e-9) if dt > 0.0 else math.inf
+    if not math.isfinite(levels):
+        return INVALID_INPUT, 0
+    budget = min(settings[MAX_LEVELS], LEVEL_LIMIT)
+    if levels > budget:                    # runs `budget` levels, then MAX_STEPS
+        n_levels = int(budget)
+        n_needed = n_levels + 1
+    else:
+        n_levels = int(levels)
+        n_needed = n_levels
     reals[TIME_STEP] = dt
 
     n_snap = snapshot_times.shape[0]
     snap_level = np.empty(n_snap, np.int64)
     last_level = n_levels
     for s in range(n_snap):
-        snap_level[s] = int(round(snapshot_times[s] / dt))
+        ratio = snapshot_times[s] / dt
+        # A time past the levels this span takes is NaN (never reached); int() of a ratio
+        # beyond int64 would wrap round.
+        snap_level[s] = int(round(ratio)) if ratio <= n_levels else n_levels + 1
         if snap_level[s] <= n_levels:
             last_level = max(last_level, snap_level[s] + 1)   # centred velocity needs n + 1
 

@@ -29,7 +29,7 @@ from .layout import *  # noqa: F401,F403  (settings and output layouts, re-expor
 from .layout import (AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BOUND, MASS, N_PARAMS
+from .oscillator import BOUND, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -138,12 +138,37 @@ def classify(p, settings, acc, buf, reals, counts):
         if mt.tail_trend(buf, n_ext, t_tail, settings[T_END]):
             return mt.UNSETTLED
         return mt.MODULATED
-    if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band:
+    if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band and at_rest(p, acc, band):
         # At rest away from zero (e.g. post-buckled): its settling time (on the final value)
         # needs a second integration, left to settle_second_pass so that the drivers do not
         # compile the scalar integrator for a case most sweeps never meet.
         return mt.SECOND_PASS if want_settling else mt.STEADY
+    # Too few oscillations in the tail to judge, or a slow motion that has only begun (a run
+    # shorter than one period moves little and yet is not at rest).
     return mt.UNSETTLED
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def at_rest(p, acc, band):
+    """Whether the final state (acc's t, q, q') lies within `band` (m) of a stable equilibrium.
+
+    Linearised about the final q: stiffness k = d(force)/dq = k0 + k1 cos Wt + 3 (g0 + g1 cos Wt)
+    q^2 + 5 h q^4 (the load's value at t), natural angular frequency w = sqrt(k/m); the
+    equilibrium lies d = static force / k away, and the motion about it has amplitude
+    sqrt(d^2 + (q'/w)^2) (m). At rest when that is <= band. A tail that merely moved little
+    (a run shorter than one natural period 2 pi / w) is not at rest: d is then of the order
+    of q itself. k <= 0 (no stable equilibrium near q): not at rest.
+    """
+    t, q, v = acc[tj.T], acc[tj.Q], acc[tj.V]
+    cw = math.cos(p[OMEGA] * t)
+    q2 = q * q
+    stiffness = p[K0] + p[K1] * cw + 3.0 * (p[G0] + p[G1] * cw) * q2 + 5.0 * p[H] * q2 * q2
+    if not stiffness > 0.0:
+        return False
+    static = (p[K0] + p[K1] * cw) * q + (p[G0] + p[G1] * cw) * q * q2 + p[H] * q * q2 * q2
+    offset = static / stiffness
+    speed = v * math.sqrt(p[MASS] / stiffness)
+    return math.sqrt(offset * offset + speed * speed) <= band
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

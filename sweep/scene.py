@@ -33,10 +33,14 @@ Transverse scenes (``model.kind = "transverse"``, the default):
 - ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
 - ``outputs.sample_interval``, ``solver.max_step`` and ``solver.first_step`` must be
   <= ``solver.t_end``; with ``outputs.time_series``, t_end / sample_interval must be
-  <= MAX_SAMPLES (10 million samples per point).
+  <= MAX_SAMPLES (10 million samples per point). ``solver.min_step`` must be <= t_end and
+  <= ``solver.max_step``.
 - With ``model.coefficients = "paper"`` the cable data is baked into Eq.32, so its
-  parameters cannot be swept, and ``initial.velocity`` defaults to 0.0321 m/s when no
+  parameters cannot be swept, a cable key (and ``model.membrane``) other than Table 1's value
+  is refused (it would be ignored), and ``initial.velocity`` defaults to 0.0321 m/s when no
   initial condition is given (docs/model.md: that reproduces the paper's Fig 5 amplitudes).
+- Every point starting at q = q' = 0 (an empty scene, for one) gives q = 0 everywhere (the
+  model has no forcing term): load_scene warns (CableSweepWarning) and runs it.
 
 Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
 - ``load.type`` defaults to "constant", the only type allowed (a suddenly applied end load).
@@ -48,6 +52,9 @@ Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
   transits the end time depends on the point, and an entry must be <= the longest one
   (transits x max over the grid of l sqrt(rho/E); shorter spans give NaN snapshots there),
   and with ``outputs.histories`` t_end / sample_interval must be <= MAX_SAMPLES.
+- The most time levels a span needs, t_end / dt with dt = courant (l / intervals) / a over
+  the grid, must be <= LEVEL_LIMIT (2^62); more than ``solver.max_steps`` runs max_steps
+  levels and is flagged max_steps_reached.
 - Transverse-only keys (tolerances, coefficients, frequencies, ``[initial]``, ``[metrics]``,
   the time-series outputs, ...) are accepted and ignored, so a resolved scene written by
   `Scene.to_toml` loads back; the transverse time checks above are not applied.
@@ -69,10 +76,12 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
 
+import warnings
+
 import numpy as np
 
 from . import schema
-from .errors import SceneError
+from .errors import CableSweepWarning, SceneError
 
 PAPER_VELOCITY = 0.0321
 """initial.velocity (m/s) used by the paper preset when no initial condition is given."""
@@ -90,6 +99,15 @@ def default_inertia(area: Any) -> Any:
 
 PAPER_FIXED_AXES: tuple[str, ...] = ("youngs_modulus", "density", "area", "inertia", "membrane")
 """Axes the paper preset cannot sweep: Eq.32 has these numbers baked in."""
+PAPER_CABLE: dict[str, tuple[float, ...]] = {
+    "cable.youngs_modulus": (1.1e11,), "cable.density": (8900.0,), "cable.area": (6e-6,),
+    # Table 1's I, and the default A^2/(4 pi) of its area (what Scene.to_toml writes)
+    "cable.inertia": (5.73e-12, 6e-6 * 6e-6 / (4.0 * math.pi)), "model.membrane": (0.375,)}
+"""The cable data Eq.32 was derived from (Table 1, docs/model.md sec. 1): under
+``model.coefficients = "paper"`` a scalar key may only repeat one of these values."""
+
+LEVEL_LIMIT = 2.0 ** 62
+"""Most time levels a longitudinal span can count (kernels.longitudinal.LEVEL_LIMIT)."""
 
 FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
 DEFAULT_FREQUENCY_RATIO = 1.0
@@ -587,10 +605,12 @@ def _build(text: str, source: str, default_name: str,
     values = _resolve(given, axes)
     _check_coefficients(values, axes)
     if values["model.kind"] == "longitudinal":
+        _check_time_levels(values, axes)
         _check_snapshot_times(values, axes)
         _check_sample_count(values, "outputs.histories")
     else:
         _check_times(values)
+        _warn_zero_solution(values, axes, given)
     return Scene(name=name, description=description, values=values, axes=axes,
                  text=text, source=source, overrides=applied)
 
@@ -1030,6 +1050,22 @@ def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
                 _fail(f"axis '{axis}'", "model.coefficients = 'paper' has no such parameter",
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
+        _check_paper_cable(given)
+
+
+def _check_paper_cable(given: dict[str, Any]) -> None:
+    """Refuse cable data that Eq.32 would ignore: its coefficients are numbers for the Table 1
+    cable, so another modulus, density, area, inertia or membrane coefficient would not change
+    the result. A value equal to Table 1's (PAPER_CABLE) is accepted, so that resolved scenes
+    (every key written out) load back."""
+    for dotted, table in PAPER_CABLE.items():
+        value = given.get(dotted)
+        if value is None or any(math.isclose(value, v, rel_tol=1e-9) for v in table):
+            continue
+        _fail(f"scene key '{dotted}'",
+              f"model.coefficients = 'paper' ignores it: Eq.32 bakes in the Table 1 cable "
+              f"({dotted} = {table[0]:g}), got {value:g}",
+              "remove the key, or use model.coefficients = 'consistent' for another cable")
 
 
 def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
@@ -1086,11 +1122,17 @@ def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray]) -> dict[str, An
 def _check_times(values: dict[str, Any]) -> None:
     """Transverse: intervals and steps must fit inside the simulated time."""
     t_end = values["solver.t_end"]
-    for dotted in ("outputs.sample_interval", "solver.max_step", "solver.first_step"):
+    for dotted in ("outputs.sample_interval", "solver.max_step", "solver.first_step",
+                   "solver.min_step"):
         value = values[dotted]
         if value is not None and value > t_end:
             _fail(f"scene key '{dotted}'", f"must be <= solver.t_end ({t_end!r} s), got {value!r}",
                   "use a smaller value or a longer solver.t_end")
+    low, high = values["solver.min_step"], values["solver.max_step"]
+    if low is not None and high is not None and low > high:
+        _fail("scene key 'solver.min_step'",
+              f"must be <= solver.max_step ({high!r} s), got {low!r} (every step would be "
+              "below the smallest allowed)", "use a smaller min_step or a larger max_step")
     _check_sample_count(values, "outputs.time_series")
 
 
@@ -1105,6 +1147,60 @@ def _check_sample_count(values: dict[str, Any], wanted: str) -> None:
           f"solver.t_end = {t_end!r} s, more than {MAX_SAMPLES}",
           f"use outputs.sample_interval >= {t_end / MAX_SAMPLES:.3g} s, or leave it out "
           "for t_end/1000")
+
+
+def _extreme(values: dict[str, Any], axes: dict[str, np.ndarray], dotted: str,
+             pick: Any) -> float:
+    """`pick` (np.min or np.max) of a key over the grid: its axis, or its scalar value."""
+    axis = schema.BY_DOTTED[dotted].axis
+    return float(pick(axes[axis])) if axis in axes else float(values[dotted])
+
+
+def _check_time_levels(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Longitudinal: the most time levels a span needs, t_end / dt with dt = C (l/N) / a
+    (a = sqrt(E/rho)), must be a count the kernel can hold (<= LEVEL_LIMIT, about 4.6e18):
+    a larger one overflowed int64 and ran nothing. A count above solver.max_steps but within
+    the limit runs max_steps levels and is flagged max_steps_reached."""
+    courant, n_int = values["solver.courant"], values["solver.intervals"]
+    transits = values["solver.transits"]
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        if transits is not None:          # t_end = transits l/a: the count is the same for all
+            levels = np.float64(transits) * n_int / courant
+            keys = "solver.transits, solver.intervals and solver.courant"
+        else:
+            speed = np.sqrt(np.float64(_extreme(values, axes, "cable.youngs_modulus", np.max))
+                            / _extreme(values, axes, "cable.density", np.min))
+            levels = (np.float64(values["solver.t_end"]) * speed * n_int
+                      / (courant * _extreme(values, axes, "cable.length", np.min)))
+            keys = "solver.t_end, solver.intervals, solver.courant and the cable data"
+    if math.isfinite(levels) and levels <= LEVEL_LIMIT:
+        return
+    _fail(f"scene keys {keys}",
+          f"need {float(levels):.3g} time levels per span (t_end / dt, dt = courant l / "
+          f"(intervals a)), more than any run can count ({LEVEL_LIMIT:.3g}; solver.max_steps = "
+          f"{values['solver.max_steps']})",
+          "use fewer transits or a shorter t_end, fewer intervals, or a courant number "
+          "near 1")
+
+
+def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
+                        given: dict[str, Any]) -> None:
+    """Transverse: warn (CableSweepWarning) when every point starts at q = q' = 0. The
+    oscillator has no forcing term (the end load enters the stiffness only), so such a sweep
+    stays at q = 0 everywhere: it would look like a result and say nothing."""
+    for dotted in ("initial.displacement", "initial.velocity"):
+        if (_extreme(values, axes, dotted, np.min) != 0.0
+                or _extreme(values, axes, dotted, np.max) != 0.0):
+            return
+    what = ""
+    if not given and not axes:
+        what = (f"the scene sets no keys, so it runs one point of the defaults (a "
+                f"{values['cable.length']:g} m span, {values['load.amplitude']:g} N "
+                f"{values['load.type']} end load, {values['solver.t_end']:g} s): ")
+    warnings.warn(f"{what}initial.displacement = initial.velocity = 0 at every point, and the "
+                  "end load only changes the stiffness, so every point stays at q = 0 "
+                  "(state decayed, amplitude 0); give a start, e.g. initial.displacement = "
+                  "1e-4 (m)", CableSweepWarning, stacklevel=4)
 
 
 def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
