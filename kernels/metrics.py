@@ -8,11 +8,13 @@ States (integer flags, stored with CF flag_values / flag_meanings):
     INVALID_INPUT      the point's coefficients are not finite or its mass is not positive
     DECAYED            tail amplitude <= tol * peak amplitude
     STEADY             every envelope peak of the tail lies within +-tol*A of its final level
-                       (or of its class's in a period-k orbit: `periodic_order`)
+                       (or of its class's in a period-k orbit: `periodic_order`), or at rest
+                       away from zero: q within +-tol*A over the tail and the final state
+                       within that of a stable equilibrium (`transverse.at_rest`)
     MODULATED          envelope varies in the tail without one-way drift (beating, quasi-periodic)
     UNSETTLED          envelope still drifting one way across the tail (a transient still decaying
-                       or growing at t_end), or the tail holds too few oscillations to judge:
-                       lengthen t_end
+                       or growing at t_end), or the tail holds too few oscillations to judge
+                       and is not at rest (a run shorter than one period): lengthen t_end
     DIVERGED           non-finite state or |q| beyond the divergence bound
     STEP_TOO_SMALL     the step size fell below SciPy's minimum (10 ulps of t)
     MAX_STEPS          the bound on accepted steps was reached
