@@ -327,7 +327,7 @@ def _read_scene(scene: str | os.PathLike) -> tuple[str, str, str]:
             _fail(where, "no such file", "check the path; 'sweep scenes' lists the built-in names")
         _fail(f"scene '{source}'", "no built-in scene of that name and no such file",
               "run 'sweep scenes' for the built-in names")
-    _check_text(where, source, "the file name", "rename the file (or a folder on its path)")
+    _check_text(where, source, "the file name", "give the file (and its folders) a UTF-8 name")
     if stat.S_ISDIR(info.st_mode):
         _fail(where, "is a directory, not a TOML file", "give the path of a .toml scene file")
     data = _read_regular(source, where)

@@ -72,6 +72,8 @@ def snapshot(directory: Path) -> dict[str, bytes | None]:
         rel = str(path.relative_to(directory))
         if path.is_dir():
             entries[rel] = None
+        elif not path.is_file():        # a FIFO fixture: reading it would block
+            entries[rel] = b"<special>"
         else:
             try:
                 entries[rel] = path.read_bytes()
@@ -354,4 +356,136 @@ def test_scene_text_is_data_never_code(tmp_path, workdir, capsys):
 def test_process_exits_2_with_one_line_and_no_traceback(argv, workdir):
     r = run_process(argv, workdir)
     assert_user_error(r.returncode, r.stdout, r.stderr, [])
+    assert list(workdir.iterdir()) == []
+
+
+# --------------------------------------------------------------------------- hostile inputs
+
+
+def test_error_line_escapes_terminal_codes_and_shortens_long_keys(tmp_path, workdir, capsys):
+    """A key holding ESC [2J (clear screen) and a 1 MB key are printed escaped and cut short."""
+    escape = tmp_path / "escape.toml"
+    escape.write_text('[cable]\n"\\u001b[2Jx" = 1\n', encoding="utf-8")
+    line = run_in_process(["run", str(escape)], ["unknown key"], workdir, capsys)
+    assert "\x1b" not in line and "'cable.\\x1b[2Jx'" in line, line
+    huge = tmp_path / "huge-key.toml"
+    huge.write_text("[cable]\n" + "k" * 10**6 + " = 1\n", encoding="utf-8")
+    line = run_in_process(["run", str(huge)], ["unknown key", "1,000,006 characters"],
+                          workdir, capsys)
+    assert len(line) < 600, len(line)
+
+
+def test_override_value_with_control_characters_is_escaped(workdir, capsys):
+    line = run_in_process(["run", "paper-fig5", "--set", "solver.method=\x1b]0;pwned\x07"],
+                          ["solver.method"], workdir, capsys)
+    assert "\x1b" not in line and "\x07" not in line and "\\x1b]0;pwned\\x07" in line, line
+
+
+def _fifo(work: Path) -> None:
+    os.mkfifo(work / "pipe.toml")
+
+
+def _sparse_file(work: Path) -> None:
+    with open(work / "big.toml", "wb") as handle:       # 9 MiB of NULs, no disk blocks
+        handle.truncate(9 * 2**20)
+
+
+def _plain_file(work: Path) -> None:
+    (work / "afile").write_text("not a directory")
+
+
+def _unsearchable_dir(work: Path) -> None:
+    (work / "locked").mkdir()
+    (work / "locked" / "scene.toml").write_text('name = "x"\n')
+    (work / "locked").chmod(0)
+    try:
+        (work / "locked" / "scene.toml").stat()
+    except PermissionError:
+        return
+    pytest.skip("directory modes do not stop lookups here (root)")
+
+
+LONG_NAME = "n" * 300        # longer than NAME_MAX (255) on every common file system
+
+# (id, argv, expected fragments, setup): the OS refuses these paths; each is one line.
+PATH_CASES = [
+    ("scene-name-too-long", ["run", LONG_NAME + ".toml", "-o", "out.nc"],
+     ["scene file", "too long"], None),
+    ("scene-under-a-file", ["run", "afile/scene.toml", "-o", "out.nc"],
+     ["afile/scene.toml", "no such file"], _plain_file),
+    ("scene-fifo", ["run", "pipe.toml", "-o", "out.nc"], ["pipe.toml", "fifo"], _fifo),
+    ("scene-too-large", ["run", "big.toml", "-o", "out.nc"], ["big.toml", "larger than 8 mib"],
+     _sparse_file),
+    ("scene-unsearchable-dir", ["run", "locked/scene.toml", "-o", "out.nc"],
+     ["locked/scene.toml", "permission denied"], _unsearchable_dir),
+    ("output-name-too-long", ["run", "paper-fig5", "-o", LONG_NAME + ".nc"],
+     ["output", "too long"], None),
+]
+
+
+@pytest.mark.parametrize("argv, fragments, setup", [c[1:] for c in PATH_CASES],
+                         ids=[c[0] for c in PATH_CASES])
+def test_os_errors_of_paths_are_one_line(argv, fragments, setup, workdir, capsys):
+    try:
+        if setup is not None:
+            setup(workdir)
+        run_in_process(argv, fragments, workdir, capsys)
+    finally:
+        for path in [workdir, *workdir.iterdir()]:
+            if path.is_dir():
+                path.chmod(0o755)
+
+
+def test_fifo_scene_does_not_block_the_process(workdir):
+    """A FIFO nobody writes to used to block the read forever: a real process ends at once."""
+    os.mkfifo(workdir / "pipe.toml")
+    r = run_process(["run", "pipe.toml", "-o", "out.nc"], workdir)
+    assert_user_error(r.returncode, r.stdout, r.stderr, ["pipe.toml", "fifo"])
+    assert sorted(p.name for p in workdir.iterdir()) == ["pipe.toml"]
+
+
+def run_process_bytes(argv: list[bytes], cwd: Path) -> subprocess.CompletedProcess:
+    """run_process with raw bytes arguments (not valid UTF-8), output decoded leniently."""
+    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    r = subprocess.run([sys.executable.encode(), b"-m", b"sweep.cli", *argv],
+                       capture_output=True, cwd=cwd, env=env, timeout=300)
+    return subprocess.CompletedProcess(r.args, r.returncode, r.stdout.decode("utf-8", "replace"),
+                                       r.stderr.decode("utf-8", "replace"))
+
+
+@pytest.mark.parametrize("argv, fragments", [
+    ([b"run", b"paper-fig5", b"-o", b"out\xff.nc"], ["output 'out\\udcff.nc'", "utf-8"]),
+    ([b"run", b"paper-fig5", b"--set", b"name=caf\xe9", b"-o", b"out.nc"],
+     ["scene key 'name'", "utf-8"]),
+    ([b"run", b"paper-fig5", b"--set", b"description=\xff", b"-o", b"out.nc"],
+     ["scene key 'description'", "utf-8"]),
+], ids=["output-name", "scene-name", "description"])
+def test_names_netcdf_cannot_store_are_refused_before_the_run(argv, fragments, workdir):
+    """Undecodable bytes in -o or in text stored as an attribute used to fail in the netCDF
+    write after the whole sweep had run; now the run does not start."""
+    r = run_process_bytes(argv, workdir)
+    assert_user_error(r.returncode, r.stdout, r.stderr, fragments)
+    assert list(workdir.iterdir()) == []
+
+
+def test_scene_file_whose_name_is_not_utf8_is_refused(tmp_path, workdir):
+    name = os.fsencode(tmp_path) + b"/sc\xff.toml"
+    with open(name, "wb") as handle:
+        handle.write(b'[solver]\nt_end = 0.5\n')
+    r = run_process_bytes([b"run", name, b"-o", b"out.nc"], workdir)
+    assert_user_error(r.returncode, r.stdout, r.stderr, ["sc\\udcff.toml", "utf-8"])
+    assert list(workdir.iterdir()) == []
+
+
+@pytest.mark.parametrize("text, fragments", [
+    ("[cable]\nlength = " + "1" * 4301 + "\n", ["more than 4300 digits"]),
+    ("[cable]\nlength = " + "[" * 3000 + "]" * 3000 + "\n", ["nested too deeply"]),
+    ("[run]\nthreads = 1" + "0" * 400 + "\n", ["run.threads", "at most"]),
+    ("[cable]\ndensity = 5e-324\n", ["cable.density", "k0 = inf"]),
+], ids=["digits", "nesting", "int-overflow", "denormal-density"])
+def test_process_refuses_parser_classes_in_one_line(text, fragments, tmp_path, workdir):
+    path = tmp_path / "scene.toml"
+    path.write_text(text, encoding="utf-8")
+    r = run_process(["run", str(path), "-o", "out.nc"], workdir)
+    assert_user_error(r.returncode, r.stdout, r.stderr, fragments)
     assert list(workdir.iterdir()) == []
