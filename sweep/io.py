@@ -23,6 +23,24 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
     without `overwrite`, a directory in the way, or a name that is not .nc.
     """
     raw = os.fspath(path)
+    if isinstance(raw, bytes):
+        raw = os.fsdecode(raw)
+    try:
+        raw.encode("utf-8")
+    except UnicodeEncodeError:
+        raise UserError(f"output {ascii(raw)}: the name is not valid UTF-8 (netCDF stores names "
+                        "as UTF-8; choose a name in UTF-8)") from None
+    if "\0" in raw:
+        raise UserError(f"output {ascii(raw)}: the name holds a NUL character (choose another name)")
+    try:
+        return _check_output_path(raw, overwrite)
+    except OSError as exc:
+        raise UserError(f"output '{raw}': cannot be checked ({exc.strerror or exc}; choose "
+                        "another -o path)") from None
+
+
+def _check_output_path(raw: str, overwrite: bool) -> Path:
+    """check_output_path's checks on a name already known to be UTF-8 (may raise OSError)."""
     if not raw.strip():
         raise UserError(f"output '{raw}': empty file name (give a file name ending in .nc, "
                         "e.g. 'out.nc')")
@@ -36,6 +54,9 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
         suggestion = out.with_name((out.stem.rstrip('.') or 'out') + '.nc')
         raise UserError(f"output '{raw}': the name must end in .nc (give e.g. '{suggestion}')")
     parent = out.parent if str(out.parent) else Path(".")
+    if parent.exists() and not parent.is_dir():
+        raise UserError(f"output '{out}': '{parent}' is a file, not a directory (choose another "
+                        "-o path)")
     if not parent.is_dir():
         raise UserError(f"output '{out}': directory '{parent}' does not exist (create it first)")
     if not _can_create_in(parent):

@@ -489,3 +489,23 @@ def test_process_refuses_parser_classes_in_one_line(text, fragments, tmp_path, w
     r = run_process(["run", str(path), "-o", "out.nc"], workdir)
     assert_user_error(r.returncode, r.stdout, r.stderr, fragments)
     assert list(workdir.iterdir()) == []
+
+
+@pytest.mark.parametrize("name, expected", [
+    ("out\udcff.nc", "not valid UTF-8"),
+    ("x" * 5000 + ".nc", "cannot be checked"),
+    ("a\0b.nc", "NUL"),
+])
+def test_api_output_names_are_checked_before_the_run(tmp_path, name, expected):
+    """sweep.run(scene, output=...) refuses an unwritable name before computing, as the CLI
+    does (it used to fail in the netCDF write after the whole sweep had run)."""
+    from sweep.io import check_output_path
+    with pytest.raises(sweep.UserError, match=expected):
+        check_output_path(str(tmp_path / name) if "\0" not in name else name)
+
+
+def test_output_under_a_file_says_it_is_a_file(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    from sweep.io import check_output_path
+    with pytest.raises(sweep.UserError, match="is a file, not a directory"):
+        check_output_path(tmp_path / "afile" / "x.nc")
