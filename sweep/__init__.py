@@ -14,6 +14,10 @@ if not _os.path.isdir(_os.path.join(_os.path.dirname(__file__), "kernels")):
     # found as sweep.kernels through the package's search path.
     __path__.append(_os.path.dirname(_os.path.dirname(_os.path.abspath(__file__))))
 
+from .jitcache import drop_stale_cache as _drop_stale_cache  # noqa: E402
+
+_drop_stale_cache(__name__ + ".kernels")   # before any kernel is imported: see sweep/jitcache.py
+
 from .errors import CableSweepWarning, SceneError, UserError
 from .run import run
 from .scene import Scene, builtin_scenes, load_scene, load_scene_text
