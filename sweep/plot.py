@@ -664,7 +664,7 @@ def state_styles(state: xr.DataArray) -> list[tuple[int, str, str, str | None]]:
     for value, meaning in zip(values, meanings):
         colour, marker = STATE_STYLES.get(meaning, (next(spare), "*"))
         styles.append((int(value), meaning, colour, marker))
-    return styles
+    return sorted(styles)   # by flag value: colour boundaries must increase (longitudinal: 0 5 7 8)
 
 
 # ---------------------------------------------------------------------------------- helpers

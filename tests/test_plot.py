@@ -475,3 +475,30 @@ def test_a_selection_is_in_the_file_names(results, tmp_path):
         "load_amplitude=4-weird_key_x=-1.5"
     assert [p.name for p in splot.save(splot.plot(mds), tmp_path, prefix="map-")][0] == \
         "map-amplitude.png"
+
+
+def test_state_map_of_a_longitudinal_two_axis_result_with_mixed_states(tmp_path):
+    """Longitudinal flags are 0, 8, 5, 7 (one state table for every kind): the state map's
+    colour boundaries must still increase (the map raised 'bins must be monotonically
+    increasing' before the styles were sorted)."""
+    ds = _result("""
+name = "long-mixed"
+[model]
+kind = "longitudinal"
+[load]
+type = "constant"
+[solver]
+intervals = 20
+t_end = 0.0023          # s: 323 levels at 0.5 m, 162 at 1 m
+max_steps = 200         # the 0.5 m spans stop at max_steps_reached
+[axes]
+length = [0.5, 1.0]
+load_amplitude = [1.0, 2.0]
+""", tmp_path / "mixed.nc")
+    assert set(np.unique(ds["state"].values)) == {7, 8}
+    figures = splot.plot(ds)
+    state = figures["state"]
+    _draw(state)
+    labels = [t.get_text() for t in state.legends[0].get_texts()] if state.legends else [
+        t.get_text() for ax in state.axes for lg in [ax.get_legend()] if lg for t in lg.get_texts()]
+    assert any("max_steps_reached" in t for t in labels) and any("completed" in t for t in labels)
