@@ -60,7 +60,8 @@ def _parser() -> argparse.ArgumentParser:
                      help="run the chunks in-process (threads, the default) or on dask")
     run.add_argument("--scheduler", metavar="ADDRESS", default=None,
                      help="dask: an existing scheduler, e.g. tcp://HOST:8786 (implies --backend "
-                          "dask; default: a LocalCluster started for the run)")
+                          "dask; connect only to a cluster you control: it runs code in this "
+                          "process; default: a LocalCluster started for the run)")
     run.add_argument("--workers", type=int, default=None, metavar="N",
                      help="dask LocalCluster worker processes (default: one per core)")
     run.add_argument("--chunk-size", type=int, default=None, metavar="N",
@@ -126,7 +127,8 @@ def _run(args: argparse.Namespace) -> int:
                         "(give --threads 1 or more, or leave it out to use every core)")
     overrides = dict(parse_override(item) for item in args.overrides)
     if args.scheduler is not None:
-        overrides["run.scheduler"] = args.scheduler
+        from .execute import check_scheduler
+        check_scheduler(args.scheduler, "--scheduler")
         overrides.setdefault("run.backend", "dask")
     for key, value in (("run.backend", args.backend), ("run.workers", args.workers),
                        ("run.chunk_size", args.chunk_size)):
@@ -135,11 +137,12 @@ def _run(args: argparse.Namespace) -> int:
     if args.resume and not args.output:
         raise UserError("--resume: needs -o OUT.nc, the file whose interrupted run to finish")
     scene = load_scene(args.scene, overrides=overrides)
+    _check_dask_flags(args, scene.get("run.backend"))
     if args.output is not None:
         _check_output(args.output, args.overwrite)
     started = time.perf_counter()
     ds = run(scene, output=args.output, overwrite=args.overwrite, resume=args.resume,
-             threads=args.threads,
+             threads=args.threads, scheduler=args.scheduler,
              progress=False if args.quiet else None)
     if not args.quiet:
         line = _summary(ds, time.perf_counter() - started)
@@ -147,6 +150,23 @@ def _run(args: argparse.Namespace) -> int:
         if not args.output:
             print(ds)
     return 0
+
+
+def _check_dask_flags(args: argparse.Namespace, backend: str) -> None:
+    """Refuse dask options that would be ignored (an option that does nothing is a mistake
+    the user wants to hear of before the run, not after it): --scheduler with the threads
+    backend, --workers without dask or with --scheduler (an existing cluster has its own)."""
+    if args.scheduler is not None and backend != "dask":
+        raise UserError("--scheduler: runs the chunks on dask, and --backend threads (or "
+                        "run.backend = 'threads') asks for in-process threads (drop one of them)")
+    if args.workers is not None and args.scheduler is not None:
+        raise UserError(f"--workers {args.workers}: sizes a LocalCluster started for the run, and "
+                        "--scheduler names an existing cluster with its own workers (drop "
+                        "--workers)")
+    if args.workers is not None and backend != "dask":
+        raise UserError(f"--workers {args.workers}: sizes the dask backend's LocalCluster, and "
+                        "this run uses in-process threads (add --backend dask, or use --threads "
+                        "N for threads)")
 
 
 def _plot(args: argparse.Namespace) -> int:

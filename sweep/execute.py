@@ -14,6 +14,7 @@ the backend, the chunking or the number of workers: each point depends on its ow
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import inspect
 import os
@@ -358,6 +359,8 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     asked. Chunks in `done` (from a store) are placed, not computed; finished work is also
     written to `store` (see FLUSH_SECONDS). Chunks have at most chunk_size points.
     On Ctrl-C the run stops after the work in hand, saves it and raises RunInterrupted.
+    When the dask cluster fails (a worker that keeps dying, a lost scheduler, a malformed
+    result) the run stops with the finished chunks kept and raises one UserError line.
     """
     done = done or {}
     where = f"chunk store '{store.directory}'" if store is not None else "chunk store"
@@ -368,18 +371,24 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     bar = Progress(n, n - todo, progress)
     keeper = _Keeper(store, bar)
     stop = threading.Event()
+    failure = None
     try:
         with _interrupt_sets(stop) as received, \
                 announce_compilation(progress, bar) as clock:
             if backend == "dask":
-                _execute_dask(chunk_fn, rows_for, args, _split(gaps, chunk_size), keeper,
-                              place, scheduler, workers, stop)
+                try:
+                    _execute_dask(chunk_fn, rows_for, args, _split(gaps, chunk_size), keeper,
+                                  place, scheduler, workers, stop)
+                except ClusterFailed as exc:
+                    failure = exc
             else:
                 _execute_threads(chunk_fn, rows_for, args, gaps, chunk_size, threads, keeper,
                                  place, stop, clock)
     finally:
         keeper.flush()                   # what was finished when something went wrong
         bar.close()
+    if failure is not None:
+        raise UserError(_stopped_line(failure, n - todo + keeper.saved, n, store)) from None
     if stop.is_set():
         raise RunInterrupted(n - todo + keeper.saved, n,
                              store.directory if store is not None else None,
@@ -426,61 +435,298 @@ def _execute_threads(chunk_fn, rows_for, args, gaps, chunk_size, threads, keeper
             lo = hi
 
 
+# --- dask -------------------------------------------------------------------------------------
+# Connecting to a cluster trusts it: the client unpickles what the cluster sends back, and
+# unpickling can run code in this process. So the address comes only from the operator (the
+# --scheduler option or sweep.run's scheduler argument, never a scene file), and every result
+# is checked to be exactly the arrays its chunk makes before it is placed or stored.
+
+SCHEMES = ("tcp", "tls")   # dask scheduler address protocols accepted
+ALLOWED_FAILURES = 1       # a task whose worker dies is run once more, then the run stops
+CONNECT_SECONDS = 10.0     # to reach a scheduler (s)
+NO_WORKER_SECONDS = 60.0   # a cluster without any worker thread this long stops the run (s)
+POLL_SECONDS = 0.5         # the client looks at Ctrl-C and the cluster this often (s)
+
+
+class ClusterFailed(Exception):
+    """The dask cluster failed the run; the message says what happened, in one line."""
+
+
+def _shown(value: Any, limit: int = 60) -> str:
+    """A value for a one-line message: repr'd (control characters escaped) and shortened."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def check_scheduler(address: Any, where: str = "--scheduler") -> str:
+    """`address` when it is a dask scheduler address, PROTOCOL://HOST:PORT with PROTOCOL tcp or
+    tls and PORT 1..65535; otherwise a one-line UserError naming `where`. Contacts nothing."""
+    from urllib.parse import urlsplit
+    fix = "give the scheduler's address as tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786"
+    if not isinstance(address, str):
+        raise UserError(f"{where} {_shown(address)}: not an address ({fix})")
+    shown = _shown(address)
+    try:
+        parts = urlsplit(address)
+        port = parts.port
+    except ValueError:
+        raise UserError(f"{where} {shown}: the port must be a number from 1 to 65535 "
+                        f"({fix})") from None
+    if parts.scheme not in SCHEMES:
+        raise UserError(f"{where} {shown}: not a dask scheduler address ({fix}; the "
+                        f"protocol is one of {', '.join(s + '://' for s in SCHEMES)})")
+    if not parts.hostname or not port:
+        raise UserError(f"{where} {shown}: needs a host and a port from 1 to 65535 ({fix})")
+    if parts.path not in ("", "/") or parts.query or parts.fragment or "@" in parts.netloc:
+        raise UserError(f"{where} {shown}: has more than PROTOCOL://HOST:PORT ({fix})")
+    return address
+
+
+def chunk_template(chunk_fn: Callable[..., dict], args: tuple) -> dict[str, np.ndarray]:
+    """The arrays chunk_fn(rows, *args) makes for no rows: their names, dtypes and trailing
+    shapes. A chunk of points lo..hi-1 must return exactly these with hi - lo rows."""
+    if chunk_fn is transverse_chunk:
+        _, n_samples, _ = args
+        return transverse_outputs(0, n_samples)
+    if chunk_fn is longitudinal_chunk:
+        _, snapshot_times, n_hist, n_nodes = args
+        return longitudinal_outputs(0, n_hist, np.asarray(snapshot_times).size, n_nodes)
+    raise TypeError(f"{_shown(chunk_fn)}: not a chunk function of sweep.execute")
+
+
+def check_chunk(arrays: Any, lo: int, hi: int,
+                template: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """`arrays` when it is exactly what the chunk of points lo..hi-1 makes: a dict with the
+    names of `template`, each a numpy array of its dtype and of shape (hi - lo, *its trailing
+    shape). Otherwise ClusterFailed, saying what is wrong. Values are not judged."""
+    what = f"the result of chunk {lo}-{hi} from the cluster"
+    if type(arrays) is not dict:
+        raise ClusterFailed(f"{what} is a {_shown(type(arrays).__name__)}, not the kernel's "
+                            "arrays by name; refused")
+    missing = [k for k in template if k not in arrays]
+    extra = [k for k in arrays if k not in template]
+    if missing or extra:
+        raise ClusterFailed(f"{what} has the wrong arrays (missing {_shown(missing)}, "
+                            f"unexpected {_shown(extra)}); refused")
+    for name, want in template.items():
+        got = arrays[name]
+        shape = (hi - lo,) + want.shape[1:]
+        if type(got) is not np.ndarray:
+            raise ClusterFailed(f"{what}: '{name}' is a {_shown(type(got).__name__)}, not a "
+                                "numpy array; refused")
+        if got.dtype != want.dtype or got.shape != shape:
+            raise ClusterFailed(f"{what}: '{name}' is {got.dtype} {got.shape}, not "
+                                f"{want.dtype} {shape}; refused")
+    return arrays
+
+
+def _stopped_line(failure: Exception, kept: int, total: int, store: ChunkStore | None) -> str:
+    """The one line a failed dask run ends with: what happened, what is kept, how to go on."""
+    if store is None:
+        return (f"dask: {failure}; the run stopped and nothing was kept (a run with -o OUT.nc "
+                "keeps its finished chunks, and --resume then computes only the rest)")
+    if kept == 0:
+        return (f"dask: {failure}; the run stopped before any point was finished: nothing is "
+                "kept (run the same command again once the cluster is fixed)")
+    return (f"dask: {failure}; the run stopped: {kept:,} of {total:,} points are kept in "
+            f"'{store.directory}' (run the same command with --resume, or sweep.run with "
+            "resume=True, to compute only the rest)")
+
+
+@contextlib.contextmanager
+def _quiet_dask() -> Iterator[None]:
+    """Within the block: dask's retries and waits bounded (ALLOWED_FAILURES, CONNECT_SECONDS)
+    and its loggers in this process silenced, so that a failure is the run's one line and not
+    pages of dask's tracebacks. Restored afterwards."""
+    import logging
+
+    import dask
+    names = ["distributed", "tornado", "bokeh"] + [
+        name for name in list(logging.root.manager.loggerDict)
+        if name.startswith(("distributed.", "tornado.", "bokeh."))]
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [logger.level for logger in loggers]
+    settings = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
+                "distributed.comm.timeouts.connect": f"{CONNECT_SECONDS}s"}
+    # A LocalCluster's worker processes set up their logging from the environment they start
+    # with (one that dies is restarted during the run)
+    quiet = {"DASK_LOGGING__DISTRIBUTED": "critical", "DASK_LOGGING__TORNADO": "critical"}
+    saved = {name: os.environ.get(name) for name in quiet}
+    with dask.config.set(settings):
+        for logger in loggers:
+            logger.setLevel(logging.CRITICAL + 1)
+        os.environ.update(quiet)
+        try:
+            yield
+        finally:
+            for logger, level in zip(loggers, levels):
+                logger.setLevel(level)
+            for name, value in saved.items():
+                if value is None:
+                    os.environ.pop(name, None)
+                else:
+                    os.environ[name] = value
+
+
+def _connect(scheduler: str | None, workers: int) -> tuple[Any, Any]:
+    """A dask Client of the scheduler at `scheduler`, or of a LocalCluster of `workers`
+    single-threaded worker processes on this machine (0: one per core); and that cluster."""
+    import logging
+
+    from dask.distributed import Client, LocalCluster
+    if scheduler:
+        try:
+            _handshake(scheduler)
+            return Client(scheduler, timeout=CONNECT_SECONDS), None
+        except (Exception, asyncio.CancelledError) as exc:
+            raise UserError(f"dask scheduler {_shown(scheduler)}: none answers there within "
+                            f"{CONNECT_SECONDS:.0f} s ({type(exc).__name__}; check the address "
+                            "and that the scheduler runs, e.g. tcp://HOST:8786)") from None
+    cluster = None
+    try:
+        cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
+                               processes=True, dashboard_address=None, host="127.0.0.1",
+                               silence_logs=logging.CRITICAL + 1)
+        return Client(cluster, timeout=CONNECT_SECONDS), cluster
+    except (Exception, asyncio.CancelledError) as exc:
+        _close(None, cluster)
+        raise ClusterFailed(f"the LocalCluster did not start ({type(exc).__name__}: "
+                            f"{_shown(str(exc), 120)})") from None
+
+
+def _handshake(address: str) -> None:
+    """Raise TimeoutError unless a dask server at `address` completes dask's handshake within
+    CONNECT_SECONDS: dask's own connect waits for the handshake without bound, so a listener
+    that accepts and never answers would hang the Client forever. On a thread of its own, with
+    its own event loop (the caller may be running one, as in Jupyter)."""
+    from distributed.comm import connect
+    from distributed.security import Security
+    outcome: list = []
+
+    async def probe() -> None:
+        comm = await asyncio.wait_for(
+            connect(address, timeout=CONNECT_SECONDS,
+                    **Security().get_connection_args("client")), CONNECT_SECONDS)
+        await comm.close()
+
+    def run() -> None:
+        try:
+            asyncio.run(probe())
+            outcome.append(None)
+        except (Exception, asyncio.CancelledError) as exc:
+            outcome.append(exc)
+
+    thread = threading.Thread(target=run, name="sweep-dask-handshake", daemon=True)
+    thread.start()
+    thread.join(CONNECT_SECONDS + 2.0)
+    if not outcome:
+        raise TimeoutError(f"no dask handshake from {address}")
+    if outcome[0] is not None:
+        raise outcome[0]
+
+
+def _close(client: Any, cluster: Any) -> None:
+    """Close what _connect opened, whatever state the cluster is in, quietly."""
+    for thing in (client, cluster):
+        if thing is not None:
+            with contextlib.suppress(Exception, asyncio.CancelledError):
+                thing.close(timeout=CONNECT_SECONDS)
+
+
 def _execute_dask(chunk_fn, rows_for, args, todo, keeper, place, scheduler, workers,
                   stop) -> None:
     """Each chunk a task on a dask.distributed cluster: the one at `scheduler` (an address), or
     a LocalCluster of `workers` single-threaded worker processes started for this run. At most
-    IN_FLIGHT tasks per worker thread are submitted at a time, so memory stays bounded."""
+    IN_FLIGHT tasks per worker thread are submitted at a time, so memory stays bounded. Every
+    result is checked (check_chunk) before it is placed or stored. A cluster that fails (a
+    worker that keeps dying, a lost scheduler, a failed task, no workers) raises
+    ClusterFailed; the chunks finished before are kept."""
     try:
-        from dask.distributed import Client, LocalCluster, as_completed
+        import distributed  # noqa: F401
     except ImportError as exc:
         raise UserError("run.backend = 'dask': dask.distributed is not installed "
                         "(pip install distributed)") from exc
-    cluster = None
+    template = chunk_template(chunk_fn, args)
+    with _quiet_dask():
+        client, cluster = _connect(scheduler, workers)
+        try:
+            _run_tasks(client, chunk_fn, rows_for, args, todo, keeper, place, stop, template,
+                       f"the scheduler at {scheduler}" if scheduler else "the LocalCluster")
+        finally:
+            _close(client, cluster)
+
+
+def _run_tasks(client, chunk_fn, rows_for, args, todo, keeper, place, stop, template,
+               where: str) -> None:
+    """Submit the chunks `todo` to `client`'s cluster, and place and keep their checked
+    results as they come, watching for Ctrl-C (`stop`) and a failing cluster."""
+    from dask.distributed import wait
+    pending = iter(todo)
+    futures: dict = {}
+
+    def submit_next() -> None:
+        for lo, hi in pending:
+            # one kernel thread per task: one per dask worker thread, no oversubscription
+            futures[client.submit(chunk_fn, rows_for(lo, hi), *args, threads=1,
+                                  pure=False)] = (lo, hi)
+            return
+
+    for _ in range(IN_FLIGHT * max(1, _threads(client, where))):
+        submit_next()
+    idle_since = None
+    while futures:
+        try:
+            finished = wait(list(futures), timeout=POLL_SECONDS,
+                            return_when="FIRST_COMPLETED").done
+        except TimeoutError:
+            finished = set()
+        if stop.is_set():
+            return
+        if not finished:
+            if _threads(client, where) > 0:
+                idle_since = None
+            elif idle_since is None:
+                idle_since = time.perf_counter()
+            elif time.perf_counter() - idle_since > NO_WORKER_SECONDS:
+                raise ClusterFailed(f"{where} has had no worker for {NO_WORKER_SECONDS:.0f} s")
+            continue
+        for fut in sorted(finished, key=futures.get):      # in point order
+            lo, hi = futures.pop(fut)
+            arrays = _result(fut, lo, hi, where, stop)
+            if stop.is_set():
+                return
+            check_chunk(arrays, lo, hi, template)
+            keeper.begin(lo)
+            keeper.finished(0, hi - lo, arrays)
+            keeper.flush()
+            place(lo, hi, arrays)
+            submit_next()
+
+
+def _threads(client: Any, where: str) -> int:
+    """The number of worker threads `client`'s cluster has now."""
     try:
-        if scheduler:
-            try:
-                client = Client(scheduler, timeout="10s")
-            except (OSError, TimeoutError) as exc:
-                raise UserError(f"run.scheduler '{scheduler}': no dask scheduler answers there "
-                                "(check the address, e.g. tcp://HOST:8786)") from exc
-        else:
-            cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
-                                   threads_per_worker=1, processes=True,
-                                   dashboard_address=None, host="127.0.0.1")
-            client = Client(cluster)
-        with client:
-            slots = IN_FLIGHT * max(1, sum(client.nthreads().values()))
-            pending = iter(todo)
-            futures = {}
+        return sum(client.nthreads().values())
+    except (Exception, asyncio.CancelledError) as exc:
+        raise ClusterFailed(f"lost the connection to {where} ({type(exc).__name__})") from None
 
-            def submit_next(queue) -> None:
-                for lo, hi in pending:
-                    # one kernel thread per task: one per dask worker thread, no oversubscription
-                    fut = client.submit(chunk_fn, rows_for(lo, hi), *args, threads=1, pure=False)
-                    futures[fut] = (lo, hi)
-                    if queue is not None:
-                        queue.add(fut)
-                    return
 
-            for _ in range(slots):
-                submit_next(None)
-            queue = as_completed(list(futures))
-            for fut in queue:
-                lo, hi = futures.pop(fut)
-                try:
-                    arrays = fut.result()
-                except Exception:
-                    if stop.is_set():        # Ctrl-C reached the workers too
-                        return
-                    raise
-                keeper.begin(lo)
-                keeper.finished(0, hi - lo, arrays)
-                keeper.flush()
-                place(lo, hi, arrays)
-                if stop.is_set():
-                    return
-                submit_next(queue)
-    finally:
-        if cluster is not None:
-            cluster.close()
+def _result(fut: Any, lo: int, hi: int, where: str, stop: threading.Event) -> Any:
+    """A finished task's result, or ClusterFailed saying why there is none."""
+    from dask.distributed import KilledWorker
+    try:
+        return fut.result()
+    except KilledWorker as exc:
+        raise ClusterFailed(f"chunk {lo}-{hi}: the worker running it died "
+                            f"{exc.allowed_failures + 1} times on {where} (out of memory, "
+                            "killed, or crashed)") from None
+    except asyncio.CancelledError:
+        if stop.is_set():
+            return None
+        raise ClusterFailed(f"lost the connection to {where}") from None
+    except Exception as exc:
+        if stop.is_set():        # Ctrl-C reached the workers too
+            return None
+        text = str(exc).splitlines()[0] if str(exc) else ""
+        raise ClusterFailed(f"chunk {lo}-{hi} failed on a worker of {where} "
+                            f"({type(exc).__name__}: {_shown(text, 120)})") from None

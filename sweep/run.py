@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import math
 import os
 import sys
@@ -22,6 +23,10 @@ from .scene import Scene
 
 _PERMUTATION_SEED = 20261121   # fixed: the point order never changes any point's result
 ATOL_SCALE = 0.01              # default atol: this x rtol x each point's own scales (m, m/s)
+# The dask scheduler address of the sweep.run call in progress: the operator's choice, given to
+# run() (a scene cannot name one), and read where the chunks are handed out (solve_chunked).
+_SCHEDULER: contextvars.ContextVar[str | None] = contextvars.ContextVar("scheduler",
+                                                                        default=None)
 
 
 @dataclass
@@ -197,7 +202,8 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
     from .store import ChunkStore
     n = next(iter(outputs.values())).shape[0]
     order = point_order(n)
-    backend = scene.get("run.backend")
+    scheduler = _SCHEDULER.get()
+    backend = "dask" if scheduler else scene.get("run.backend")
     workers = scene.get("run.workers")
     chunk = scene.get("run.chunk_size") or default_chunk_size(n, backend, workers or
                                                               (os.cpu_count() or 1))
@@ -210,7 +216,7 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
     computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args,
                        placer(outputs, order),
                        chunk_size=chunk, backend=backend, threads=threads,
-                       scheduler=scene.get("run.scheduler"), workers=workers,
+                       scheduler=scheduler, workers=workers,
                        progress=progress, store=store, done=done)
     if resume:
         sys.stderr.write(f"resumed: {n - computed:,} of {n:,} points were already done, "
@@ -220,7 +226,7 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
 
 def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: bool = False,
         resume: bool = False, threads: int | None = None,
-        progress: bool | None = None) -> xr.Dataset:
+        progress: bool | None = None, scheduler: str | None = None) -> xr.Dataset:
     """Run every point of `scene` and return the result Dataset; with `output`, also write it
     as netCDF atomically (checked before any work: an existing file needs `overwrite=True`).
 
@@ -228,6 +234,10 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     a run that was killed is finished with `resume=True`, which computes only the missing chunks.
     threads: worker threads (default: the scene's run.threads, 0 = all cores).
     progress: a progress bar on stderr (default: only when stderr is a terminal).
+    scheduler: the address of a running dask scheduler (tcp://HOST:PORT) to run the chunks on,
+    whatever the scene's run.backend; only from the caller, never from a scene, because the
+    cluster runs code in this process (the client unpickles what it sends back): give only a
+    cluster you control. Default: the scene's run.backend (dask: a LocalCluster of run.workers).
     """
     if not isinstance(scene, Scene):
         raise UserError(f"sweep.run: expected a Scene from sweep.load_scene, got {type(scene).__name__}")
@@ -240,10 +250,13 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     if not isinstance(threads, (int, np.integer)) or isinstance(threads, bool) or threads < 0:
         raise UserError(f"sweep.run: threads = {threads!r} is not a thread count (give an integer "
                         ">= 1, or 0 or None for every core)")
+    if scheduler is not None:
+        _check_scheduler(scene, scheduler)
     persist = dict(output=output, resume=resume, overwrite=overwrite)
     if output is not None:
         remove_stale_temporaries(output)            # of a write that was killed
     from .store import ChunkStore
+    token = _SCHEDULER.set(scheduler)
     try:
         if scene.get("model.kind") == "longitudinal":
             from .longitudinal import run_longitudinal
@@ -254,10 +267,25 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
             write_netcdf(ds, output, overwrite)
             ChunkStore(output, "").remove()
     finally:
+        _SCHEDULER.reset(token)
         if output is not None:
             # a run that failed before finishing a chunk leaves no store to block the next one
             ChunkStore(output, "").release(discard_empty=True)
     return ds
+
+
+def _check_scheduler(scene: Scene, scheduler: str) -> None:
+    """Refuse a malformed scheduler address before any work; warn that the scene's run.workers
+    (a LocalCluster's size) is not used on an existing cluster."""
+    import warnings
+
+    from .errors import CableSweepWarning
+    from .execute import check_scheduler
+    check_scheduler(scheduler, "sweep.run: scheduler")
+    if scene.get("run.workers"):
+        warnings.warn(f"run.workers = {scene.get('run.workers')} (a LocalCluster's size) is not "
+                      f"used: the chunks run on the cluster at {scheduler}, on its own workers",
+                      CableSweepWarning, stacklevel=3)
 
 
 def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,

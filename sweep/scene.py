@@ -697,6 +697,11 @@ def _check_sections(doc: dict[str, Any]) -> dict[str, Any]:
         for name, raw in doc.get(section, {}).items():
             dotted = f"{section}.{name}"
             key = schema.BY_DOTTED.get(dotted)
+            if dotted == "run.scheduler":
+                _fail(f"scene key '{dotted}'", "a scene cannot choose the dask cluster it runs "
+                      "on (connecting lets the cluster run code in this process)",
+                      "remove it, and pass --scheduler tcp://HOST:8786 on the command line, "
+                      "or sweep.run(scene, scheduler=...)")
             if key is None:
                 _unknown_section_key(section, dotted)
             given[dotted] = _check_value(f"scene key '{dotted}'", key, raw)

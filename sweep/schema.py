@@ -150,10 +150,9 @@ KEYS: tuple[Key, ...] = (
     Key("run", "chunk_size", "int", None, units="1", minimum=1,
         long_name="grid points per kernel call or dask task (default: chosen from the grid)"),
     Key("run", "backend", "str", "threads", choices=("threads", "dask"),
-        long_name="where the chunks run: in-process threads, or dask.distributed"),
-    Key("run", "scheduler", "str", None,
-        long_name="dask: address of an existing scheduler, e.g. tcp://HOST:8786 "
-                  "(default: a LocalCluster started for the run)"),
+        long_name="where the chunks run: in-process threads, or dask.distributed (a "
+                  "LocalCluster started for the run; an existing cluster only from the command "
+                  "line, --scheduler)"),
     Key("run", "workers", "int", 0, units="1", minimum=0,
         long_name="dask LocalCluster worker processes (0 = one per core)"),
 )
