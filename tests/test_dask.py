@@ -236,3 +236,21 @@ def test_a_local_cluster_whose_workers_keep_dying_ends_in_one_line(tmp_path):
     assert "chunk 0-2: the worker running it died 2 times on the LocalCluster" in line
     assert "the run stopped" in line
     assert not (tmp_path / "out.nc").exists()
+
+
+def test_a_listener_that_never_answers_is_one_line_not_a_hang(tmp_path, capsys, monkeypatch):
+    """dask's own connect waits for the handshake without bound; the run must not."""
+    pytest.importorskip("dask.distributed")
+    monkeypatch.setattr(ex, "CONNECT_SECONDS", 1.0)
+    listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(8)
+    address = f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+    try:
+        scene = tmp_path / "s.toml"
+        scene.write_text(TINY)
+        assert sweep_main(["run", str(scene), "-q", "--scheduler", address]) == 2
+        line = _one_error_line(capsys.readouterr().err)
+        assert f"dask scheduler '{address}': none answers there" in line
+    finally:
+        listener.close()
