@@ -111,7 +111,9 @@ def test_failed_write_leaves_no_partial_file_and_keeps_the_results(tmp_path, mon
     def boom(self, *args, **kwargs):
         raise RuntimeError("disk on fire")
     monkeypatch.setattr(xr.Dataset, "to_netcdf", boom)
-    with pytest.raises(RuntimeError):
+    # netCDF4 reports its library's failures as RuntimeError: one UserError naming the file,
+    # the kept chunks and --resume.
+    with pytest.raises(sweep.UserError, match=r"could not be written \(disk on fire\).*--resume"):
         sweep.run(sweep.load_scene_text(SMALL), output=tmp_path / "y.nc", progress=False)
     # No partial netCDF, no temporary file: only the finished chunks, kept for a resume.
     assert sorted(p.name for p in tmp_path.iterdir()) == ["y.nc.chunks"]
