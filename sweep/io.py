@@ -106,18 +106,6 @@ def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
                 os.unlink(entry.path)
                 removed.append(Path(entry.path))
     return removed
-
-
-def _pid_alive(pid: int) -> bool:
-    """Whether process `pid` exists (one of another user's counts as alive)."""
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
     return True
 
 
@@ -192,3 +180,17 @@ def _write_error(out: Path, parent: Path, ds: xr.Dataset, exc: BaseException) ->
                          f"file needs up to {mib(need)}, {mib(free or 0)} free){kept}")
     reason = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
     return UserError(f"output '{out}': could not be written ({reason}){kept}")
+
+
+def _pid_alive(pid: int) -> bool:
+    """Whether process `pid` exists (a process of another user, or a pid beyond the OS's
+    range, counts as alive: never take over what might be in use)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True

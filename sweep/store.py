@@ -87,19 +87,6 @@ def fsync_directory(directory: str | os.PathLike) -> None:
             os.close(fd)
 
 
-def _pid_alive(pid: int) -> bool:
-    """Whether process `pid` exists (a process of another user counts as alive)."""
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
 def _is_link(path: Path) -> bool:
     try:
         return stat.S_ISLNK(os.lstat(path).st_mode)
