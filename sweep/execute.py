@@ -582,11 +582,14 @@ def _connect(scheduler: str | None, workers: int) -> tuple[Any, Any]:
             raise UserError(f"dask scheduler {_shown(scheduler)}: none answers there within "
                             f"{CONNECT_SECONDS:.0f} s ({type(exc).__name__}; check the address "
                             "and that the scheduler runs, e.g. tcp://HOST:8786)") from None
+    import dask
     cluster = None
     try:
-        cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                               processes=True, dashboard_address=None, host="127.0.0.1",
-                               silence_logs=logging.CRITICAL + 1)
+        with dask.config.set({"distributed.worker.preload": ["sweep.dask_worker"]}):
+            cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
+                                   threads_per_worker=1,
+                                   processes=True, dashboard_address=None, host="127.0.0.1",
+                                   silence_logs=logging.CRITICAL + 1)
         return Client(cluster, timeout=CONNECT_SECONDS), cluster
     except (Exception, asyncio.CancelledError) as exc:
         _close(None, cluster)

@@ -254,3 +254,21 @@ def test_a_listener_that_never_answers_is_one_line_not_a_hang(tmp_path, capsys, 
         assert f"dask scheduler '{address}': none answers there" in line
     finally:
         listener.close()
+
+
+def _stderr_target() -> str:
+    return os.readlink("/proc/self/fd/2")
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd/2").exists(), reason="needs /proc/self/fd")
+def test_the_run_s_own_local_cluster_workers_write_no_stderr():
+    """A dying worker and the one its nanny starts while the run stops print tracebacks to the
+    stderr they inherit, around the run's one line: the LocalCluster a run starts preloads
+    sweep.dask_worker, which points the workers' stderr at os.devnull."""
+    with ex._quiet_dask():
+        client, cluster = ex._connect(None, 1)
+        try:
+            target = client.submit(_stderr_target, pure=False).result(timeout=60)
+        finally:
+            ex._close(client, cluster)
+    assert target == os.devnull
