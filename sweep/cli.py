@@ -130,14 +130,15 @@ def _run(args: argparse.Namespace) -> int:
         from .execute import check_scheduler
         check_scheduler(args.scheduler, "--scheduler")
         overrides.setdefault("run.backend", "dask")
-    for key, value in (("run.backend", args.backend), ("run.workers", args.workers),
-                       ("run.chunk_size", args.chunk_size)):
+    for key, value in (("run.backend", args.backend), ("run.chunk_size", args.chunk_size)):
         if value is not None:
             overrides[key] = value
     if args.resume and not args.output:
         raise UserError("--resume: needs -o OUT.nc, the file whose interrupted run to finish")
     scene = load_scene(args.scene, overrides=overrides)
     _check_dask_flags(args, scene.get("run.backend"))
+    if args.workers is not None:     # checked against the backend first: its own line above
+        scene = load_scene(args.scene, overrides={**overrides, "run.workers": args.workers})
     if args.output is not None:
         _check_output(args.output, args.overwrite)
     started = time.perf_counter()

@@ -601,6 +601,7 @@ def _build(text: str, source: str, default_name: str,
     given = _check_sections(doc)
     axes = _check_axes(doc.get("axes", {}))
     _check_model(given, axes)
+    _check_run(given)
     _check_frequency_pair(given, axes)
     values = _resolve(given, axes)
     _check_coefficients(values, axes)
@@ -1040,6 +1041,13 @@ def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     if given.get("solver.transits") is not None:
         _fail("scene key 'solver.transits'", "only for model.kind = 'longitudinal'",
               "use solver.t_end in seconds")
+    for dotted, what in (("outputs.snapshot_times", "snapshots of the wave along the span"),
+                         ("outputs.histories", "the end histories u(l, t), N(0, t)"),
+                         ("outputs.normalised", "the N/P0 and v rho A a/P0 forms")):
+        if given.get(dotted) not in (None, False):
+            _fail(f"scene key '{dotted}'", f"only for model.kind = 'longitudinal' ({what}); a "
+                  "transverse scene would ignore it",
+                  "remove it, or use outputs.time_series = true for q(t)")
     if given.get("solver.method") == "dop853" and given.get("solver.controller") == "pi":
         _fail("scene keys 'solver.method' and 'solver.controller'",
               "the PI controller is tuned for method 'rk45' only",
@@ -1056,6 +1064,15 @@ def _check_model(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
         _check_paper_cable(given)
+
+
+def _check_run(given: dict[str, Any]) -> None:
+    """run.workers sizes the LocalCluster of the dask backend; with threads it would be
+    ignored (run.threads is the threads backend's count)."""
+    if given.get("run.workers", 0) and given.get("run.backend", "threads") != "dask":
+        _fail("scene key 'run.workers'", "only for run.backend = 'dask' (the LocalCluster's "
+              "worker processes); the threads backend would ignore it",
+              "use run.threads for the threads backend, or set run.backend = 'dask'")
 
 
 def _check_paper_cable(given: dict[str, Any]) -> None:

@@ -243,3 +243,23 @@ def test_cli_says_in_one_line_what_an_empty_scene_ran(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("sweep: warning: the scene sets no keys")
     assert "1 m span" in lines[0] and "stays at q = 0" in lines[0]
     assert "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize("text, key", [
+    ("[outputs]\nsnapshot_times = [0.1]", "outputs.snapshot_times"),
+    ("[outputs]\nhistories = true", "outputs.histories"),
+    ("[outputs]\nnormalised = true", "outputs.normalised"),
+    ("[run]\nworkers = 2", "run.workers"),
+    ('[run]\nbackend = "threads"\nworkers = 2', "run.workers"),
+])
+def test_keys_a_transverse_threads_run_would_ignore_are_refused(text, key):
+    with pytest.raises(sweep.UserError, match=f"scene key '{key}'.*would ignore it"):
+        sweep.load_scene_text(text + "\n[initial]\ndisplacement = 1e-4")
+
+
+def test_workers_with_the_dask_backend_and_resolved_scenes_still_load():
+    scene = sweep.load_scene_text('[run]\nbackend = "dask"\nworkers = 2\n'
+                                  "[initial]\ndisplacement = 1e-4")
+    assert scene.get("run.workers") == 2
+    for name in sweep.builtin_scenes():          # resolved scenes write every key out
+        sweep.load_scene_text(sweep.load_scene(name).to_toml())
