@@ -683,6 +683,10 @@ def _run_tasks(client, chunk_fn, rows_for, args, todo, keeper, place, stop, temp
                             return_when="FIRST_COMPLETED").done
         except TimeoutError:
             finished = set()
+        except (Exception, asyncio.CancelledError) as exc:
+            # e.g. FuturesCancelledError: the scheduler was lost (killed, network down)
+            raise ClusterFailed(f"lost the connection to {where} while waiting for results "
+                                f"({type(exc).__name__})") from None
         if stop.is_set():
             return
         if not finished:

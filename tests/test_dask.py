@@ -9,6 +9,7 @@ import select
 import socket
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -204,6 +205,7 @@ def test_a_malformed_result_stops_the_run_and_nothing_of_it_is_placed(monkeypatc
 DYING = """
 import os
 import sys
+import threading
 
 import sweep.execute
 from sweep.cli import main
@@ -272,3 +274,28 @@ def test_the_run_s_own_local_cluster_workers_write_no_stderr():
         finally:
             ex._close(client, cluster)
     assert target == os.devnull
+
+
+def test_a_lost_scheduler_while_waiting_is_one_line_naming_resume(monkeypatch):
+    """A killed external scheduler cancels every future: dask's wait() raises
+    FuturesCancelledError (seen as a 47-line traceback with a real `dask scheduler` killed
+    mid-run). It must end as the run's one line, with the finished chunks kept."""
+    distributed = pytest.importorskip("dask.distributed")
+    from distributed.client import FuturesCancelledError
+
+    class Client:                       # stands for a connected client: one worker thread
+        def submit(self, fn, *args, **kwargs):
+            return object()
+
+        def nthreads(self):
+            return {"tcp://127.0.0.1:1": 1}
+
+    def lost(futures, timeout=None, return_when=None):
+        raise FuturesCancelledError({"scheduler-connection-lost": list(futures)})
+
+    monkeypatch.setattr(distributed, "wait", lost)
+    with pytest.raises(ex.ClusterFailed, match="lost the connection to the scheduler at X "
+                                                "while waiting for results"):
+        ex._run_tasks(Client(), ex.transverse_chunk, lambda lo, hi: None, TRANSVERSE_ARGS,
+                      [(0, 2), (2, 4)], None, None, threading.Event(), None,
+                      "the scheduler at X")
