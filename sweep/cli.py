@@ -269,9 +269,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except MemoryError:
-        print("sweep: error: the sweep does not fit in memory (use fewer axis points, fewer "
-              "solver.intervals, fewer snapshot_times or a longer outputs.sample_interval)",
-              file=sys.stderr)
+        if args.command == "plot":
+            print(f"sweep: error: {_one_line(args.result)}: the result does not fit in memory "
+                  "(plot a smaller result, or select fewer values with --select)",
+                  file=sys.stderr)
+        else:
+            print("sweep: error: the sweep does not fit in memory (use fewer axis points, fewer "
+                  "solver.intervals, fewer snapshot_times or a longer outputs.sample_interval)",
+                  file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
         print(f"sweep: {_interrupted(exc, args, argv)}", file=sys.stderr)

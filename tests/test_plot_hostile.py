@@ -300,3 +300,15 @@ def test_figures_are_written_with_ordinary_permissions_and_no_temporaries(result
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in paths)
     for p in paths:
         assert p.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+def test_a_result_too_large_for_memory_is_one_plot_line(monkeypatch, capsys, tmp_path):
+    """MemoryError while plotting says the result does not fit (not the sweep's advice)."""
+    from sweep import cli
+
+    def no_memory(*args, **kwargs):
+        raise MemoryError
+    monkeypatch.setattr(cli, "_plot", no_memory, raising=True)
+    assert cli.main(["plot", str(tmp_path / "big.nc"), "-o", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "the result does not fit in memory" in err[0]
