@@ -43,3 +43,13 @@ def acceleration(t, q, v, p):
     force = (p[DAMPING] * v + (p[K0] + p[K1] * cw) * q
              + (p[G0] + p[G1] * cw) * q * q2 + p[H] * q * q2 * q2)
     return -force / p[MASS]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def stiffness(t, q, p):
+    """d(restoring force)/dq (N/m per unit modal mass m) at time t (s) and deflection q (m):
+    k0 + k1 cos Wt + 3 (g0 + g1 cos Wt) q^2 + 5 h q^4, the derivative of `acceleration`'s
+    force at zero velocity."""
+    cw = math.cos(p[OMEGA] * t)
+    q2 = q * q
+    return p[K0] + p[K1] * cw + 3.0 * (p[G0] + p[G1] * cw) * q2 + 5.0 * p[H] * q2 * q2

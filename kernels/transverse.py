@@ -29,7 +29,7 @@ from .layout import *  # noqa: F401,F403  (settings and output layouts, re-expor
 from .layout import (AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BOUND, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
+from .oscillator import BOUND, MASS, N_PARAMS, acceleration, stiffness
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -152,22 +152,20 @@ def classify(p, settings, acc, buf, reals, counts):
 def at_rest(p, acc, band):
     """Whether the final state (acc's t, q, q') lies within `band` (m) of a stable equilibrium.
 
-    Linearised about the final q: stiffness k = d(force)/dq = k0 + k1 cos Wt + 3 (g0 + g1 cos Wt)
-    q^2 + 5 h q^4 (the load's value at t), natural angular frequency w = sqrt(k/m); the
+    Linearised about the final q: stiffness k = d(force)/dq (`oscillator.stiffness`, at the
+    load's value at t), natural angular frequency w = sqrt(k/m); the
     equilibrium lies d = static force / k away, and the motion about it has amplitude
     sqrt(d^2 + (q'/w)^2) (m). At rest when that is <= band. A tail that merely moved little
     (a run shorter than one natural period 2 pi / w) is not at rest: d is then of the order
     of q itself. k <= 0 (no stable equilibrium near q): not at rest.
     """
     t, q, v = acc[tj.T], acc[tj.Q], acc[tj.V]
-    cw = math.cos(p[OMEGA] * t)
-    q2 = q * q
-    stiffness = p[K0] + p[K1] * cw + 3.0 * (p[G0] + p[G1] * cw) * q2 + 5.0 * p[H] * q2 * q2
-    if not stiffness > 0.0:
+    k = stiffness(t, q, p)
+    if not k > 0.0:
         return False
-    static = (p[K0] + p[K1] * cw) * q + (p[G0] + p[G1] * cw) * q * q2 + p[H] * q * q2 * q2
-    offset = static / stiffness
-    speed = v * math.sqrt(p[MASS] / stiffness)
+    static = -p[MASS] * acceleration(t, q, 0.0, p)      # the restoring force at q, at rest
+    offset = static / k
+    speed = v * math.sqrt(p[MASS] / k)
     return math.sqrt(offset * offset + speed * speed) <= band
 
 
