@@ -70,7 +70,7 @@ def _warn_courant(courant: float) -> None:
 
 def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
                      output: str | os.PathLike | None = None, resume: bool = False,
-                     overwrite: bool = False) -> xr.Dataset:
+                     overwrite: bool = False, scheduler: str | None = None) -> xr.Dataset:
     """The longitudinal (central-difference) sweep of `scene` as a Dataset."""
     from sweep.kernels import longitudinal as lk
 
@@ -108,7 +108,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
                         (settings, snap_times, n_hist, n_nodes),
                         longitudinal_outputs(n, n_hist, n_snap, n_nodes),
                         output=output, resume=resume, overwrite=overwrite, threads=threads,
-                        progress=progress)
+                        progress=progress, scheduler=scheduler)
     elapsed = time.perf_counter() - started
     states, reals, steps, hist_u, hist_f = (out[k] for k in ("states", "reals", "steps",
                                                               "hist_u", "hist_f"))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import contextvars
 import math
 import os
 import sys
@@ -23,10 +22,6 @@ from .scene import Scene
 
 _PERMUTATION_SEED = 20261121   # fixed: the point order never changes any point's result
 ATOL_SCALE = 0.01              # default atol: this x rtol x each point's own scales (m, m/s)
-# The dask scheduler address of the sweep.run call in progress: the operator's choice, given to
-# run() (a scene cannot name one), and read where the chunks are handed out (solve_chunked).
-_SCHEDULER: contextvars.ContextVar[str | None] = contextvars.ContextVar("scheduler",
-                                                                        default=None)
 
 
 @dataclass
@@ -193,16 +188,17 @@ def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
                   rows_at: Callable[[np.ndarray], np.ndarray], args: tuple,
                   outputs: dict[str, np.ndarray], *, output: str | os.PathLike | None = None,
                   resume: bool = False, overwrite: bool = False, threads: int = 0,
-                  progress: bool = False) -> dict[str, np.ndarray]:
-    """Solve every grid point in chunks on the scene's backend, filling `outputs` (grid order,
-    first axis = points). rows_at(flat indices) gives the kernel's parameter rows of those
-    points. With `output`, every finished chunk is persisted next to it and, when resuming,
-    only the missing chunks are computed."""
+                  progress: bool = False,
+                  scheduler: str | None = None) -> dict[str, np.ndarray]:
+    """Solve every grid point in chunks on the scene's backend (on the dask cluster at
+    `scheduler` when the caller gives one), filling `outputs` (grid order, first axis =
+    points). rows_at(flat indices) gives the kernel's parameter rows of those points. With
+    `output`, every finished chunk is persisted next to it and, when resuming, only the missing
+    chunks are computed."""
     from .execute import default_chunk_size, execute
     from .store import ChunkStore
     n = next(iter(outputs.values())).shape[0]
     order = point_order(n)
-    scheduler = _SCHEDULER.get()
     backend = "dask" if scheduler else scene.get("run.backend")
     workers = scene.get("run.workers")
     chunk = scene.get("run.chunk_size") or default_chunk_size(n, backend, workers or
@@ -252,11 +248,10 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
                         ">= 1, or 0 or None for every core)")
     if scheduler is not None:
         _check_scheduler(scene, scheduler)
-    persist = dict(output=output, resume=resume, overwrite=overwrite)
+    persist = dict(output=output, resume=resume, overwrite=overwrite, scheduler=scheduler)
     if output is not None:
         remove_stale_temporaries(output)            # of a write that was killed
     from .store import ChunkStore
-    token = _SCHEDULER.set(scheduler)
     try:
         if scene.get("model.kind") == "longitudinal":
             from .longitudinal import run_longitudinal
@@ -267,7 +262,6 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
             write_netcdf(ds, output, overwrite)
             ChunkStore(output, "").remove()
     finally:
-        _SCHEDULER.reset(token)
         if output is not None:
             # a run that failed before finishing a chunk leaves no store to block the next one
             ChunkStore(output, "").release(discard_empty=True)
@@ -290,7 +284,7 @@ def _check_scheduler(scene: Scene, scheduler: str) -> None:
 
 def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
                    output: str | os.PathLike | None = None, resume: bool = False,
-                   overwrite: bool = False) -> xr.Dataset:
+                   overwrite: bool = False, scheduler: str | None = None) -> xr.Dataset:
     """The transverse (RK45) sweep of `scene` as a Dataset."""
     from sweep.kernels import transverse as tk
     from sweep.kernels.oscillator import PARAM_NAMES
@@ -319,6 +313,6 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
                         (settings, times.size, scene.get("solver.driver")),
                         transverse_outputs(n_points, times.size),
                         output=output, resume=resume, overwrite=overwrite, threads=threads,
-                        progress=progress)
+                        progress=progress, scheduler=scheduler)
     result = KernelResult(out["states"], out["reals"], out["counts"], out["series"], times)
     return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)
