@@ -13,7 +13,8 @@ from pathlib import Path
 import xarray as xr
 
 from .errors import UserError
-from .store import free_bytes, fsync_directory, mib, store_path
+from .files import free_bytes, fsync_directory, mib
+from .store import store_path
 
 
 def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:

@@ -54,7 +54,6 @@ import math
 import os
 import re
 import stat
-import tempfile
 import textwrap
 import tomllib
 from pathlib import Path
@@ -72,6 +71,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import ScalarFormatter
 
 from .errors import UserError
+from .files import write_temporary
 from .schema import BY_AXIS
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
@@ -1465,13 +1465,7 @@ def _write_all(rendered: list[tuple[Path, bytes]]) -> list[Path]:
     path = None
     try:
         for path, data in rendered:
-            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-            temps.append(tmp)
-            with os.fdopen(fd, "wb") as f:
-                os.fchmod(f.fileno(), 0o666 & ~mask)
-                f.write(data)
-                f.flush()
-                os.fsync(f.fileno())
+            temps.append(write_temporary(path.parent, f".{path.name}.", data, 0o666 & ~mask))
         for (path, _data), tmp in zip(rendered, temps):
             os.replace(tmp, path)
             done.append(path)

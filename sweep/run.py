@@ -116,7 +116,7 @@ def check_disk(store, bytes_per_point: float) -> None:
     when the netCDF file (at most its arrays' size, `bytes_per_point` bytes a point) may not
     fit beside them. `store`: an open store.ChunkStore."""
     from .errors import CableSweepWarning
-    from .store import free_bytes, mib
+    from .files import free_bytes, mib
     import warnings
     store.bytes_per_point = max(store.bytes_per_point, bytes_per_point)
     chunks = store.space_needed()

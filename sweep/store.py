@@ -29,7 +29,6 @@ import re
 import shutil
 import stat
 import sys
-import tempfile
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -37,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from .errors import UserError
+from .files import free_bytes, fsync_directory, mib, write_temporary
 
 STORE_SUFFIX = ".chunks"
 _META = "__chunk__"                      # the array in each chunk file that says what it is
@@ -53,20 +53,6 @@ def store_path(output: str | os.PathLike) -> Path:
     return out.with_name(out.name + STORE_SUFFIX)
 
 
-def mib(n_bytes: float) -> str:
-    """`n_bytes` (bytes) as text in MiB, e.g. '12.3 MiB'."""
-    return f"{n_bytes / 2**20:,.1f} MiB"
-
-
-def free_bytes(directory: str | os.PathLike) -> int | None:
-    """Bytes an unprivileged writer can still use on the file system of `directory`, or None."""
-    try:
-        st = os.statvfs(directory)
-    except OSError:
-        return None
-    return st.f_bavail * st.f_frsize
-
-
 def checksum(arrays: dict[str, np.ndarray]) -> str:
     """SHA-256 of arrays by name: their names, dtypes, shapes and bytes, in name order."""
     h = hashlib.sha256()
@@ -75,16 +61,6 @@ def checksum(arrays: dict[str, np.ndarray]) -> str:
         h.update(json.dumps([name, a.dtype.str, list(a.shape)]).encode())
         h.update(a.tobytes())
     return h.hexdigest()
-
-
-def fsync_directory(directory: str | os.PathLike) -> None:
-    """Make a rename in `directory` durable (where the file system allows it)."""
-    with contextlib.suppress(OSError):
-        fd = os.open(directory, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
 
 
 def _is_link(path: Path) -> bool:
@@ -328,12 +304,8 @@ class ChunkStore:
 
     def _write_atomic(self, path: Path, data: bytes) -> None:
         """`data` as file `path`: a new temporary (O_EXCL), fsync, rename, fsync of the store."""
-        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=".chunk-", suffix=".tmp")
+        tmp = write_temporary(self.directory, ".chunk-", data)
         try:
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
             os.replace(tmp, path)
         except BaseException:
             with contextlib.suppress(OSError):

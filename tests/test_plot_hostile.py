@@ -15,6 +15,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 import sweep
+import sweep.files
 from sweep import cli
 from sweep import plot as splot
 
@@ -277,7 +278,8 @@ def test_a_failure_while_writing_removes_what_the_call_wrote(result, tmp_path, m
     out.mkdir()
     (out / "keep.txt").write_text("not ours")
     calls = {"n": 0}
-    target = (splot.tempfile, "mkstemp") if stage == "temporary" else (splot.os, "replace")
+    target = ((sweep.files.tempfile, "mkstemp") if stage == "temporary"
+              else (splot.os, "replace"))
     real = getattr(*target)
 
     def failing(*args, **kwargs):
