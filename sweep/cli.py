@@ -99,26 +99,8 @@ def _summary(ds, seconds: float) -> str:
     return f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'} in {seconds:.2f} s ({states})"
 
 
-def _check_output(path: str, overwrite: bool) -> None:
-    """`sweep.io.check_output_path`, plus what it leaves to the final write: a name netCDF
-    cannot store (it takes UTF-8 names only: undecodable bytes of an argument are refused here,
-    before the sweep runs), and OS errors of the checks (a name too long, a folder that cannot
-    be searched, a file where a folder should be) as one-line user errors."""
-    from .io import check_output_path
-    try:
-        path.encode("utf-8")
-    except UnicodeEncodeError as exc:
-        raise UserError(f"output '{path}': the name is not UTF-8 text (character "
-                        f"{exc.start + 1}), which netCDF cannot store (give a UTF-8 file "
-                        "name, e.g. 'out.nc')") from None
-    try:
-        check_output_path(path, overwrite)
-    except OSError as exc:
-        raise UserError(f"output '{path}': cannot be checked: {exc.strerror or exc} (check "
-                        "the path and its permissions, or choose another -o path)") from None
-
-
 def _run(args: argparse.Namespace) -> int:
+    from .io import check_output_path
     from .scene import load_scene, parse_override
     from .run import run
 
@@ -140,7 +122,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.workers is not None:     # checked against the backend first: its own line above
         scene = load_scene(args.scene, overrides={**overrides, "run.workers": args.workers})
     if args.output is not None:
-        _check_output(args.output, args.overwrite)
+        check_output_path(args.output, args.overwrite)   # before any work, in one line
     started = time.perf_counter()
     ds = run(scene, output=args.output, overwrite=args.overwrite, resume=args.resume,
              threads=args.threads, scheduler=args.scheduler,
@@ -230,8 +212,7 @@ def _one_line_warnings() -> None:
 def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                  argv: Sequence[str] | None) -> str:
     """The one line Ctrl-C leaves: what was kept, and the command that finishes the run."""
-    from pathlib import Path
-    from .execute import STORE_SUFFIX
+    from .store import store_path
     output = getattr(args, "output", None)
     if args.command != "run":
         return "interrupted"
@@ -239,7 +220,7 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
         return ("interrupted: results were not kept (only a run with -o OUT.nc keeps its "
                 "finished chunks, in OUT.nc.chunks/, and 'sweep run ... -o OUT.nc --resume' "
                 "finishes it)")
-    store = Path(output).with_name(Path(output).name + STORE_SUFFIX)
+    store = store_path(output)
     if not store.exists():
         return "interrupted before any point was solved; nothing kept, no output written"
     words = list(sys.argv[1:] if argv is None else argv)

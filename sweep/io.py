@@ -28,9 +28,10 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
         raw = os.fsdecode(raw)
     try:
         raw.encode("utf-8")
-    except UnicodeEncodeError:
-        raise UserError(f"output {ascii(raw)}: the name is not valid UTF-8 (netCDF stores names "
-                        "as UTF-8; choose a name in UTF-8)") from None
+    except UnicodeEncodeError as exc:
+        raise UserError(f"output {ascii(raw)}: the name is not valid UTF-8 text (character "
+                        f"{exc.start + 1}), which netCDF cannot store (give a UTF-8 file name, "
+                        "e.g. 'out.nc')") from None
     if "\0" in raw:
         raise UserError(f"output {ascii(raw)}: the name holds a NUL character (choose another name)")
     try:
