@@ -69,14 +69,13 @@ import os
 import re
 import stat
 import tomllib
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
 from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
-
-import warnings
 
 import numpy as np
 
