@@ -12,6 +12,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import transverse as tk
 
 from .scene import Scene
+from .schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
 from .version import package_version  # noqa: F401  (re-exported: the version written into results)
 
 if TYPE_CHECKING:
@@ -53,6 +54,19 @@ _DERIVED = {
                             "for the mean (harmonic) or constant load; NaN: no barrier, or one "
                             "beyond the model's range (mode slope pi q_b / l > 1)"),
 }
+# Scenes with [base] (docs/model.md sec. 5): the excitation in both spellings (each stored
+# only where it is not an axis: then the axis is its coordinate) and closed forms.
+_BASE_DERIVED = {
+    **{axis: (BY_AXIS[axis].units, BY_AXIS[axis].long_name)
+       for axis in ("base_acceleration", "base_acceleration_g", "base_frequency",
+                    "base_frequency_ratio")},
+    "linear_amplitude": ("m", "steady midspan amplitude of the linearised span (no load, "
+                              "K3 = K5 = 0), (4/pi) A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2); "
+                              "NaN: unbounded (undamped at resonance)"),
+    "resonance_amplification": ("1", "linear resonance amplification Q = 1/(2 zeta): peak "
+                                     "amplitude over the quasi-static (4/pi) A / w1^2; NaN: "
+                                     "undamped"),
+}
 
 
 
@@ -81,6 +95,28 @@ def derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
         dims = [d for d in coords if d in values.dims]
         return values.transpose(*dims).drop_vars(list(values.coords), errors="ignore")
     return xr.DataArray(float(values))
+
+
+def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
+                 level: xr.DataArray) -> dict[str, xr.DataArray]:
+    """The outputs of base excitation: the kernel's absolute midspan acceleration amplitude
+    max |q'' + a_b| over the tail window (m s-2, over `dims`), the same in g, and the
+    transmissibility, that over the base level A (`level`, m s-2, over some of `dims`; NaN
+    where A = 0). Like `amplitude`, NaN where the point failed."""
+    absolute = xr.DataArray(acceleration, dims=dims, attrs={
+        "units": "m s-2",
+        "long_name": "absolute midspan acceleration amplitude, max |q'' + a_b| over the tail "
+                     "window"})
+    in_g = xr.DataArray(acceleration / STANDARD_GRAVITY, dims=dims, attrs={
+        "units": G_UNITS,
+        "long_name": f"absolute midspan acceleration amplitude in g ({STANDARD_GRAVITY:g} "
+                     "m s-2)"})
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = xr.where(level > 0, absolute / level, np.nan).transpose(*dims)
+    ratio.attrs = {"units": "1", "long_name": "transmissibility: absolute midspan "
+                                               "acceleration amplitude over the base level A"}
+    return {"absolute_acceleration": absolute, "absolute_acceleration_g": in_g,
+            "transmissibility": ratio}
 
 
 def global_attrs(scene: Scene, shape: tuple[int, ...], elapsed: float,
@@ -144,10 +180,14 @@ def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ..
             data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
                                       attrs={"units": "1",
                                              "long_name": long_name.format(method=short)})
-    for name, (units, long_name) in _DERIVED.items():
-        if name in coeffs:
+    for name, (units, long_name) in (_DERIVED | (_BASE_DERIVED if scene.has_base else {})
+                                     ).items():
+        if name in coeffs and name not in coords:
             data[name] = derived(coeffs[name], coords)
             data[name].attrs = {"units": units, "long_name": long_name}
+    if scene.has_base and scene.get("outputs.absolute_acceleration"):
+        data.update(base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
+                                 derived(coeffs["base_accel"], coords)))
     all_coords: dict[str, Any] = dict(coords)
     if result.series.shape[1] > 0:
         all_coords[TIME_DIM] = elapsed_time(result.sample_times)

@@ -1,6 +1,10 @@
 """Physical models: cable data and load -> coefficients of the kernel's modal oscillator.
 
-    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = 0
+    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = -m Gamma A sin(w_b t)
+
+The right-hand side is base excitation of the clamps (docs/model.md sec. 5): both clamps move
+transversely with acceleration A sin(w_b t), q is the deflection relative to them and Gamma =
+4/pi the participation factor of sin(pi x / l); A = 0 without a [base] table.
 
 Every function here works element-wise on floats, NumPy arrays or xarray DataArrays, so the
 derived quantities keep exactly the dimensions of the axes they depend on.
@@ -22,11 +26,17 @@ from typing import Any, Mapping
 import numpy as np
 import xarray as xr
 
+from .schema import STANDARD_GRAVITY
+
 # Eq.32 as printed (SI, P0 = 4 N).
 PAPER_LOAD = 4.0                      # N, the load Eq.32 was printed for
 PAPER_OMEGA0 = 1.86 * np.pi           # rad/s, "w0 = 1.86 pi / l^4" with the l^4 dropped
 PAPER_COS_LINEAR = {"printed": 1.08, "corrected": 37.5 / 1.86 ** 2}   # x l^5
 PAPER_COS_CUBIC = {"printed": 0.54, "corrected": 18.7 / 1.86 ** 2}    # x pi^2 l^3
+
+PARTICIPATION = 4.0 / np.pi
+"""Gamma (1), the participation factor of sin(pi x / l) under uniform base motion:
+int phi dx / int phi^2 dx over the span (docs/model.md sec. 5)."""
 
 
 def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
@@ -106,17 +116,22 @@ def escape_barrier(k: Any, g: Any, h: Any, length: Any) -> Any:
         return np.where(valid, q_b, np.nan)[()]
 
 
-def state_scale(q0: Any, v0: Any, omega: Any, bound: Any) -> tuple[Any, Any]:
+def state_scale(q0: Any, v0: Any, omega: Any, bound: Any, forcing: Any = 0.0,
+                base_omega: Any = 0.0) -> tuple[Any, Any]:
     """The size of a point's response: (displacement scale L in m, velocity scale in m/s).
 
-    L = max(|q0|, |v0| / omega) from the initial conditions q0 (m), v0 (m/s) and the span's
-    natural angular frequency omega (rad/s); the velocity scale is omega L. The oscillator has
-    no forcing, so a point started at rest at q = 0 stays there: it gets L = bound (m, the
-    divergence bound), any positive scale would do. The solver's default absolute tolerances
-    are a fixed fraction of rtol times these (sweep.run.settings_vector), so a response and
-    the same response 1e5 times smaller are integrated alike.
+    L = max(|q0|, |v0| / omega, |forcing| / max(omega^2, base_omega^2)) from the initial
+    conditions q0 (m), v0 (m/s), the span's natural angular frequency omega (rad/s) and the
+    base forcing Gamma A (m/s^2) at base_omega (rad/s): the last is the quasi-static (below
+    resonance) or mass-line (above) response of the linear span. The velocity scale is
+    omega L. Without forcing a point started at rest at q = 0 stays there: it gets L = bound
+    (m, the divergence bound), any positive scale would do. The solver's default absolute
+    tolerances are a fixed fraction of rtol times these (sweep.run.settings_vector), so a
+    response and the same response 1e5 times smaller are integrated alike.
     """
-    scale = np.maximum(np.abs(q0), np.abs(v0) / omega)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        driven = np.abs(forcing) / np.maximum(omega * omega, base_omega * base_omega)
+    scale = np.maximum(np.maximum(np.abs(q0), np.abs(v0) / omega), driven)
     scale = xr.where(scale > 0, scale, bound) if isinstance(scale, xr.DataArray) \
         else np.where(scale > 0, scale, bound)[()]
     return scale, omega * scale
@@ -130,6 +145,11 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     `kernels.oscillator.PARAM_NAMES` (q_scale, v_scale: `state_scale`) and the derived
     quantities natural_frequency (Hz), buckling_load (N), load_ratio (1), escape_barrier (m,
     for the mean or constant load) and load_frequency (Hz, harmonic load only).
+
+    Base excitation (p's base_acceleration (m/s^2) or base_acceleration_g (g), and
+    base_frequency (Hz) or base_frequency_ratio (f/f1, f1 of the unloaded span); all None
+    without a [base] table): the columns base_accel = A (m/s^2), base_omega = 2 pi f (rad/s),
+    participation = 4/pi, zeros without base; and `base_response`'s derived quantities.
     """
     c = consistent(p) if p["coefficients"] == "consistent" else paper(p)
     out = {
@@ -155,6 +175,66 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
         out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
                    omega=0.0)
     out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"], p["length"])
-    out["q_scale"], out["v_scale"] = state_scale(out["q0"], out["v0"], c["omega_1"],
-                                                 out["bound"])
+    base = base_excitation(p, c["omega_1"])
+    out.update(base)
+    if base["participation"] != 0.0:
+        out.update(base_response(base["base_accel"], base["base_omega"], c["omega_1"],
+                                 p["damping_ratio"]))
+    out["q_scale"], out["v_scale"] = state_scale(
+        out["q0"], out["v0"], c["omega_1"], out["bound"],
+        base["participation"] * base["base_accel"], base["base_omega"])
     return out
+
+
+def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
+    """The kernel's base-excitation columns from p's base keys (by axis name, None if absent).
+
+    base_accel: A (m/s^2), from base_acceleration (m/s^2) or base_acceleration_g times
+    STANDARD_GRAVITY; base_omega: 2 pi f (rad/s), from base_frequency (Hz) or
+    base_frequency_ratio times omega_1 (rad/s, the unloaded span's w1); participation: Gamma =
+    4/pi. All three 0.0 when p has no base level (no [base] table).
+    """
+    if p.get("base_acceleration") is not None:
+        accel = p["base_acceleration"]
+    elif p.get("base_acceleration_g") is not None:
+        accel = p["base_acceleration_g"] * STANDARD_GRAVITY
+    else:
+        return {"base_accel": 0.0, "base_omega": 0.0, "participation": 0.0}
+    if p.get("base_frequency") is not None:
+        omega = 2.0 * np.pi * p["base_frequency"]
+    else:
+        omega = p["base_frequency_ratio"] * omega_1
+    return {"base_accel": accel, "base_omega": omega, "participation": PARTICIPATION}
+
+
+def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> dict[str, Any]:
+    """Derived quantities of base excitation A sin(w t) (docs/model.md sec. 5), element-wise.
+
+    accel: A (m/s^2); omega: w (rad/s); omega_1: the unloaded w1 (rad/s); damping_ratio: zeta.
+    Returns base_acceleration (m/s^2), base_acceleration_g (g), base_frequency (Hz),
+    base_frequency_ratio (f/f1), linear_amplitude (m): the steady midspan amplitude of the
+    linearised span (K3 = K5 = 0, P = 0), Gamma A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2)
+    (NaN where that is unbounded: undamped at resonance), and resonance_amplification (1):
+    Q = 1/(2 zeta), its peak over the quasi-static Gamma A / w1^2 (NaN undamped).
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        denominator = np.sqrt((omega_1 ** 2 - omega ** 2) ** 2
+                              + (2.0 * damping_ratio * omega_1 * omega) ** 2)
+        linear = PARTICIPATION * accel / denominator
+        q_factor = 0.5 / (np.float64(damping_ratio) if isinstance(damping_ratio, (int, float))
+                          else damping_ratio)
+    return {
+        "base_acceleration": accel,
+        "base_acceleration_g": accel / STANDARD_GRAVITY,
+        "base_frequency": omega / (2.0 * np.pi),
+        "base_frequency_ratio": omega / omega_1,
+        "linear_amplitude": _finite_or_nan(linear),
+        "resonance_amplification": _finite_or_nan(q_factor),
+    }
+
+
+def _finite_or_nan(value: Any) -> Any:
+    """value with its infinities (and NaNs) as NaN: a float, array or DataArray."""
+    if isinstance(value, xr.DataArray):
+        return value.where(np.isfinite(value))
+    return np.where(np.isfinite(value), value, np.nan)[()]

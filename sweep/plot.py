@@ -12,7 +12,9 @@ What `plot` draws, by the result's content:
   modulated, unsettled, diverged and failed points marked, and a map of `state`
   (`plot_state_map`); closed-form overlays where the axes allow: the principal parametric
   resonance zone W = 2 w1 sqrt(1 +- mu), mu = P0/(2 Pcr) (docs/model.md sec. 2; dotted where
-  damping suppresses it, mu < 2 zeta) and the buckling length where P0 = Pcr;
+  damping suppresses it, mu < 2 zeta) and the buckling length where P0 = Pcr; under base
+  excitation also a map of the absolute midspan acceleration in g and the linear resonance
+  f = f1 (docs/model.md sec. 5);
 - stored time series: q(t), one panel per point (`plot_time_series`, the paper's Fig 5);
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
   histories (`plot_histories`); with swept axes also the peak end displacement and the
@@ -72,7 +74,7 @@ from matplotlib.ticker import ScalarFormatter
 
 from .errors import UserError
 from .files import write_temporary
-from .schema import BY_AXIS
+from .schema import BY_AXIS, G_UNITS
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
            "check_result", "load_result", "parse_select", "plot", "plot_histories",
@@ -132,14 +134,17 @@ _SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
 # Variables the figures read: over the swept axes only, or a history / snapshots over them.
 _OVER_AXES = ("amplitude", "settling_time", "peak_end_displacement", "dynamic_amplification",
               "load_ratio", "natural_frequency", "transit_time", "static_end_displacement",
-              "peak_fixed_end_force", "force_amplification", "damping_ratio")
+              "peak_fixed_end_force", "force_amplification", "damping_ratio",
+              "absolute_acceleration_g", "transmissibility")
 _HISTORIES = ("displacement", "end_displacement", "fixed_end_force")
 _SNAPSHOTS = tuple(f"snapshot_{f}{s}" for f in ("displacement", "force", "velocity")
                    for s in ("", "_ratio"))
 # Scene values the footer and overlays read: tables, numbers, short strings.
-_SCENE_TABLES = ("model", "cable", "load", "initial", "solver", "metrics", "outputs", "run",
-                 "axes")
+_SCENE_TABLES = ("model", "cable", "load", "base", "initial", "solver", "metrics", "outputs",
+                 "run", "axes")
 _SCENE_NUMBERS = (("load", "amplitude"), ("load", "frequency_ratio"), ("load", "frequency"),
+                  ("base", "acceleration"), ("base", "acceleration_g"), ("base", "frequency"),
+                  ("base", "frequency_ratio"),
                   ("cable", "length"), ("cable", "damping_ratio"), ("model", "membrane"),
                   ("initial", "displacement"), ("initial", "velocity"), ("solver", "t_end"),
                   ("solver", "intervals"), ("solver", "courant"), ("solver", "transits"),
@@ -498,6 +503,8 @@ def _unit(da: xr.DataArray, values: np.ndarray | None = None) -> tuple[float, st
     with the prefix their largest value calls for (`_scaled`), anything else as stored."""
     if _is_displacement(da):
         return 1e3, "mm"
+    if da.attrs.get("units") == G_UNITS:          # a level in g: "9.80665 m s-2" reads as g
+        return 1.0, "g"
     return _scaled(da.values if values is None else values, da.attrs.get("units"))
 
 
@@ -571,13 +578,18 @@ def footer(ds: xr.Dataset) -> str:
     p0 = get("load", "amplitude")
     text = f"{load.get('type', 'harmonic')} end load" + ("" if p0 is None else
                                                         f" P0 = {num(p0)} N")
-    if load.get("type", "harmonic") == "harmonic" and kind != "longitudinal":
+    if p0 is not None and float(p0) == 0.0 and kind != "longitudinal":
+        text = "no end load"
+    elif load.get("type", "harmonic") == "harmonic" and kind != "longitudinal":
         ratio, freq = get("load", "frequency_ratio"), get("load", "frequency")
         if ratio is not None:
             text += f" at W/w1 = {num(ratio)}"
         elif freq is not None:
             text += f" at {num(freq)} Hz"
     parts.append(text)
+    if "absolute_acceleration_g" in ds or "base" in doc or any(
+            str(a).startswith("base_") for a in doc.get("axes", {})):
+        parts.append(_base_text(get))
     length = get("cable", "length")
     if length is not None:
         parts.append(f"l = {num(length)} m")
@@ -615,6 +627,42 @@ def footer(ds: xr.Dataset) -> str:
         parts.append(f"tail {num(metrics.get('tail', 0.5))}, "
                      f"tolerance {num(metrics.get('tolerance', 0.02))}")
     return "Load case: " + "; ".join(parts)
+
+
+def _base_text(get: Any) -> str:
+    """'base sine 1 g at 20 Hz' for the footer; swept parts left out (they are on the axes)."""
+    level_g, level = get("base", "acceleration_g"), get("base", "acceleration")
+    freq, ratio = get("base", "frequency"), get("base", "frequency_ratio")
+    text = "base sine"
+    if level_g is not None:
+        text += f" {float(level_g):.4g} g"
+    elif level is not None:
+        text += f" {float(level):.4g} m/s^2"
+    if freq is not None:
+        text += f" at {float(freq):.4g} Hz"
+    elif ratio is not None:
+        text += f" at f/f1 = {float(ratio):.4g}"
+    return text
+
+
+def _base_overlay(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
+    """The linear resonance of a base-excited map: f = f1 over the other axis (a
+    base_frequency axis, when f1 depends on that axis alone) or f/f1 = 1; its legend handle."""
+    style = dict(color="w", lw=1.4, ls=(0, (1, 1.5)), zorder=3, path_effects=_OUTLINE)
+    if "base_frequency_ratio" in (x, y):
+        (ax.axvline if x == "base_frequency_ratio" else ax.axhline)(1.0, **style)
+    elif "base_frequency" in (x, y) and "natural_frequency" in ds:
+        other = y if x == "base_frequency" else x
+        f1 = ds["natural_frequency"]
+        if not _depends_only_on(f1, [other]) or other not in f1.dims:
+            return []
+        pos = _coord(ds, other)
+        values = np.asarray(f1.transpose(other).values, float)
+        px, py = (values, pos) if x == "base_frequency" else (pos, values)
+        ax.plot(px, py, **style)
+    else:
+        return []
+    return [Line2D([], [], label="linear resonance f = f1", **style)]
 
 
 def _add_footer(fig: Figure, ds: xr.Dataset) -> None:
@@ -976,6 +1024,9 @@ def _overlays(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
     handles: list = []
     if ds.attrs.get("model_kind") == "longitudinal":
         return handles
+    if "absolute_acceleration_g" in ds or "base_frequency" in (x, y) \
+            or "base_frequency_ratio" in (x, y):
+        handles += _base_overlay(ax, ds, x, y)
 
     def draw(along: str, pos: np.ndarray, val: np.ndarray, **style: Any) -> None:
         # `pos` runs along the `along` axis; `val` is the other map coordinate.
@@ -1340,6 +1391,7 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     """Every figure that fits the result, keyed by name (the file name `save` gives it).
 
     Transverse: 'amplitude' and 'settling_time' (lines over one swept axis, maps over two),
+    and 'absolute_acceleration_g' under base excitation,
     'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
     swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
@@ -1358,6 +1410,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
         scalars = ["peak_end_displacement", "dynamic_amplification"]
     else:
         scalars = ["amplitude", "settling_time"]
+        if "absolute_acceleration_g" in ds:        # base excitation (docs/model.md sec. 5)
+            scalars.insert(1, "absolute_acceleration_g")
     if len(axes) == 2:
         scalars.append("state")
     for var in scalars:

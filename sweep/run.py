@@ -47,6 +47,8 @@ def settings_vector(scene: Scene) -> np.ndarray:
     solver.atol given: that absolute tolerance for q (m) and q' (m/s), as SciPy's scalar atol.
     Not given: each point's own, ATOL_SCALE x rtol x its displacement and velocity scales
     (sweep.models.state_scale), so results do not depend on the response's size.
+    BASE is 1.0 for a scene with base excitation ([base]): the kernel then adds the forcing
+    term and computes the absolute acceleration.
     """
     from sweep.kernels import transverse as tk
     s = np.zeros(tk.N_SETTINGS)
@@ -65,6 +67,8 @@ def settings_vector(scene: Scene) -> np.ndarray:
     s[tk.MIN_STEP] = scene.get("solver.min_step") or 0.0
     s[tk.CONTROLLER] = 1.0 if scene.get("solver.controller") == "pi" else 0.0
     s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
+    if scene.has_base:                  # else 0.0: no forcing term compiled
+        s[tk.BASE] = 1.0
     return s
 
 

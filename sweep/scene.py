@@ -40,7 +40,18 @@ Transverse scenes (``model.kind = "transverse"``, the default):
   is refused (it would be ignored), and ``initial.velocity`` defaults to 0.0321 m/s when no
   initial condition is given (docs/model.md: that reproduces the paper's Fig 5 amplitudes).
 - Every point starting at q = q' = 0 (an empty scene, for one) gives q = 0 everywhere (the
-  model has no forcing term): load_scene warns (CableSweepWarning) and runs it.
+  end load only changes the stiffness): load_scene warns (CableSweepWarning) and runs it,
+  unless base excitation of a non-zero level drives the span.
+
+Base excitation (``[base]``, docs/model.md sec. 5; `has_base`):
+- A ``[base]`` table or a base axis (``base_acceleration``, ``base_acceleration_g``,
+  ``base_frequency``, ``base_frequency_ratio``; an axis counts as the table's key, as the load
+  axes do) needs a level, ``base.acceleration`` (m/s^2) or ``base.acceleration_g`` (g), and a
+  frequency, ``base.frequency`` (Hz) or ``base.frequency_ratio`` (f/f1), each as a key or an
+  axis, and one spelling of each only. No defaults: a scene without them has no base motion.
+- Refused with ``model.kind = "longitudinal"`` and with ``model.coefficients = "paper"``
+  (Eq.32 as printed has no forcing term).
+- An override of one spelling removes the other, as for the load frequency.
 
 Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
 - ``load.type`` defaults to "constant", the only type allowed (a suddenly applied end load).
@@ -111,6 +122,21 @@ LEVEL_LIMIT = 2.0 ** 62
 FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
 DEFAULT_FREQUENCY_RATIO = 1.0
 
+BASE_LEVEL_KEYS: tuple[str, str] = ("base.acceleration", "base.acceleration_g")
+BASE_FREQUENCY_KEYS: tuple[str, str] = ("base.frequency", "base.frequency_ratio")
+BASE_KEYS: tuple[str, ...] = BASE_LEVEL_KEYS + BASE_FREQUENCY_KEYS
+BASE_FIX = ("add a [base] table with acceleration or acceleration_g and frequency or "
+            "frequency_ratio")
+"""How to fix a base key or axis given without the rest of the base excitation."""
+PAIRS: tuple[tuple[str, str], ...] = (FREQUENCY_KEYS, BASE_LEVEL_KEYS, BASE_FREQUENCY_KEYS)
+"""Either-or keys: two spellings of one quantity (as scalars or axes), never both."""
+_PAIR_UNITS: dict[str, str] = {
+    "load.frequency": "load.frequency is in Hz, load.frequency_ratio in multiples of w1",
+    "base.acceleration": "acceleration is in m/s^2, acceleration_g in g = "
+                         f"{schema.STANDARD_GRAVITY:g} m/s^2",
+    "base.frequency": "frequency is in Hz, frequency_ratio in multiples of f1 of the unloaded "
+                      "span"}
+
 END_TIME_KEYS: tuple[str, str] = ("solver.t_end", "solver.transits")
 DEFAULT_T_END = 5.0
 """solver.t_end (s) of a transverse scene that gives none."""
@@ -154,6 +180,11 @@ _HINTS: dict[str, str] = {
     "model.membrane": "use 0.375 (the paper), 0.25 (classical stretching) or 0 (none)",
     "load.frequency_ratio": "give the load frequency as a multiple of w1, e.g. 2.0",
     "load.frequency": "give the load frequency in Hz",
+    "base.acceleration": "give the peak base acceleration in m/s^2, e.g. 4.9, or use "
+                         "base.acceleration_g",
+    "base.acceleration_g": "give the peak base acceleration in g, e.g. 0.5",
+    "base.frequency": "give the base excitation frequency in Hz, e.g. 20.0",
+    "base.frequency_ratio": "give the base excitation frequency as a multiple of f1, e.g. 1.0",
     "solver.t_end": "give the simulated time in seconds, e.g. 5.0",
     "solver.transits": "give the end time in wave transits l/a, e.g. 8.0",
     "solver.intervals": "give the number of spatial intervals per span, e.g. 1000",
@@ -194,6 +225,11 @@ class Scene:
     text: str = field(repr=False)
     source: str
     overrides: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def has_base(self) -> bool:
+        """Whether the scene has base excitation of the clamps (a [base] level and frequency)."""
+        return has_base(self.values, self.axes)
 
     def get(self, dotted: str) -> Any:
         """The resolved value of a dotted key, e.g. ``scene.get("solver.rtol")``.
@@ -496,23 +532,23 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
                   "write KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
         key = key.strip()
         parsed[key] = _override_value(key, value)
-    frequencies = {_frequency_target(k) for k in parsed} - {None}
-    if len(frequencies) == 2:
-        _fail("overrides 'load.frequency' and 'load.frequency_ratio'", "give one, not both",
-              "remove one of the two overrides")
+    for pair in PAIRS:
+        if len({_pair_target(k, pair) for k in parsed} - {None}) == 2:
+            _fail(f"overrides '{pair[0]}' and '{pair[1]}'", "give one, not both",
+                  "remove one of the two overrides")
     if all(k in parsed for k in END_TIME_KEYS):
         _fail("overrides 'solver.t_end' and 'solver.transits'", "give one, not both",
               "remove one of the two overrides")
     return parsed
 
 
-def _frequency_target(dotted: str) -> str | None:
-    """The load frequency key an override sets (as scalar or axis), or None."""
-    if dotted in FREQUENCY_KEYS:
+def _pair_target(dotted: str, pair: tuple[str, str]) -> str | None:
+    """The key of an either-or `pair` an override sets (as scalar or axis), or None."""
+    if dotted in pair:
         return dotted
     if dotted.startswith("axes."):
         axis = _axis_or_none(dotted[len("axes."):])
-        if axis is not None and schema.BY_AXIS[axis].dotted in FREQUENCY_KEYS:
+        if axis is not None and schema.BY_AXIS[axis].dotted in pair:
             return schema.BY_AXIS[axis].dotted
     return None
 
@@ -538,7 +574,8 @@ def _override_table(doc: dict[str, Any], section: str) -> dict[str, Any]:
 
 
 def _override_axis(doc: dict[str, Any], name: str, value: Any) -> None:
-    """Set or replace an axis (keeping its place); drop the other load frequency key."""
+    """Set or replace an axis (keeping its place); drop the other key of its either-or pair
+    (load or base frequency, base level)."""
     axes = _override_table(doc, "axes")
     axis = _axis_or_none(name)
     if axis is None:
@@ -573,13 +610,15 @@ def _drop_axis(doc: dict[str, Any], axis: str) -> None:
 
 
 def _drop_frequency_partner(doc: dict[str, Any], dotted: str) -> None:
-    """When one load frequency key is set, remove the other (scalar and axis)."""
-    if dotted not in FREQUENCY_KEYS:
+    """When one key of an either-or pair (PAIRS: the load frequency, the base level, the base
+    frequency) is set, remove the other (scalar and axis)."""
+    pair = next((p for p in PAIRS if dotted in p), None)
+    if pair is None:
         return
-    partner = schema.BY_DOTTED[FREQUENCY_KEYS[1 - FREQUENCY_KEYS.index(dotted)]]
-    load = doc.get("load")
-    if isinstance(load, dict):
-        load.pop(partner.name, None)
+    partner = schema.BY_DOTTED[pair[1 - pair.index(dotted)]]
+    table = doc.get(partner.section)
+    if isinstance(table, dict):
+        table.pop(partner.name, None)
     _drop_axis(doc, partner.axis or "")
 
 
@@ -592,6 +631,7 @@ def _build(text: str, source: str, default_name: str,
     doc = _parse_toml(text, source)
     if isinstance(doc.get("axes"), dict):
         doc["axes"] = _flatten_axes(doc["axes"])
+    file_has_base = "base" in doc
     applied = _parse_overrides(overrides)
     _apply_overrides(doc, applied)
     _check_top_level(doc)
@@ -599,6 +639,7 @@ def _build(text: str, source: str, default_name: str,
     description = _check_description(doc.get("description", ""))
     given = _check_sections(doc)
     axes = _check_axes(doc.get("axes", {}))
+    _check_base(doc, given, axes, file_has_base)
     _check_model(given, axes)
     _check_run(given)
     _check_frequency_pair(given, axes)
@@ -869,6 +910,8 @@ def _within(key: schema.Key, array: np.ndarray) -> np.ndarray:
 def _bounds_text(key: schema.Key) -> str:
     """E.g. '> 0 m' or '>= 1e-14 and <= 0.1'."""
     units = f" {key.units}" if key.units not in ("", "1") else ""
+    if key.units == schema.G_UNITS:
+        units = " g"
     parts = []
     if key.minimum is not None:
         parts.append(f"{'>' if key.exclusive_min else '>='} {key.minimum:g}{units}")
@@ -1107,11 +1150,51 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
 
 
 def _check_frequency_pair(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
-    present = [d for d in FREQUENCY_KEYS
-               if d in given or schema.BY_DOTTED[d].axis in axes]
-    if len(present) == 2:
-        raise SceneError("scene keys 'load.frequency' and 'load.frequency_ratio': "
-                         "give one, not both (remove one of them)")
+    """Refuse both keys of an either-or pair (PAIRS), as scalars or axes."""
+    for pair in PAIRS:
+        present = [d for d in pair if d in given or schema.BY_DOTTED[d].axis in axes]
+        if len(present) == 2:
+            _fail(f"scene keys '{pair[0]}' and '{pair[1]}'", "give one, not both (as keys or "
+                  f"axes {', '.join(schema.BY_DOTTED[d].axis or d for d in pair)})",
+                  f"remove one of them: {_PAIR_UNITS[pair[0]]}")
+
+
+def has_base(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
+    """Whether a resolved scene (its values and axes) has base excitation: a base level is
+    given, as a [base] key or an axis (a validated scene then has a base frequency too)."""
+    return any(values.get(d) is not None or schema.BY_DOTTED[d].axis in axes
+               for d in BASE_LEVEL_KEYS)
+
+
+
+def _check_base(doc: dict[str, Any], given: dict[str, Any], axes: dict[str, np.ndarray],
+                file_has_base: bool) -> None:
+    """Rules of base excitation (docs/model.md sec. 5): a [base] table or base axis needs a
+    level and a frequency (each as a key or an axis), a transverse scene and the consistent
+    coefficients. `file_has_base`: the scene file itself (before overrides) has a [base]
+    table; if not (a lone base axis, an override), the fix says to add the table."""
+    named = [(f"axis '{schema.BY_DOTTED[d].axis}'" if schema.BY_DOTTED[d].axis in axes
+              else f"scene key '{d}'")
+             for d in BASE_KEYS if d in given or schema.BY_DOTTED[d].axis in axes]
+    if not named and "base" not in doc:
+        return
+    where = named[0] if named else "scene section '[base]'"
+    if _model_kind(given) == "longitudinal":
+        _fail(where, "model.kind = 'longitudinal' has no base excitation (the clamps' "
+              "transverse motion drives the transverse modal equation only)",
+              "remove the [base] table and the base axes, or use model.kind = 'transverse'")
+    if given.get("model.coefficients") == "paper":
+        _fail(where, "model.coefficients = 'paper' has no base excitation (Eq.32 as printed "
+              "has no forcing term)", "use model.coefficients = 'consistent'")
+    for pair, what, example in ((BASE_LEVEL_KEYS, "a level", "acceleration_g = 0.5 (g) or "
+                                 "acceleration = 4.9 (m/s^2)"),
+                                (BASE_FREQUENCY_KEYS, "a frequency", "frequency = 20.0 (Hz) or "
+                                 "frequency_ratio = 1.0 (f/f1)")):
+        if any(d in given or schema.BY_DOTTED[d].axis in axes for d in pair):
+            continue
+        _fail(where, f"base excitation needs {what}: the scene gives neither "
+              f"{pair[0]} nor {pair[1]} (as a key or axis)",
+              BASE_FIX if not file_has_base else f"add {example} to the [base] table")
 
 
 def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray]) -> dict[str, Any]:
@@ -1208,7 +1291,12 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
                         given: dict[str, Any]) -> None:
     """Transverse: warn (CableSweepWarning) when every point starts at q = q' = 0. The
     oscillator has no forcing term (the end load enters the stiffness only), so such a sweep
-    stays at q = 0 everywhere: it would look like a result and say nothing."""
+    stays at q = 0 everywhere: it would look like a result and say nothing. Base excitation
+    with a level above zero somewhere drives the span from rest: no warning then."""
+    if has_base(values, axes) and any(
+            _extreme(values, axes, d, np.max) > 0.0 for d in BASE_LEVEL_KEYS
+            if values[d] is not None or schema.BY_DOTTED[d].axis in axes):
+        return
     for dotted in ("initial.displacement", "initial.velocity"):
         if (_extreme(values, axes, dotted, np.min) != 0.0
                 or _extreme(values, axes, dotted, np.max) != 0.0):
@@ -1257,7 +1345,8 @@ def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -
 
 _CHECKED_COEFFICIENTS: dict[str, tuple[str, ...]] = {
     "transverse": ("k0", "k1", "g0", "g1", "h", "omega", "mass", "damping", "q_scale",
-                   "v_scale", "natural_frequency", "buckling_load", "load_ratio"),
+                   "v_scale", "natural_frequency", "buckling_load", "load_ratio", "base_accel",
+                   "base_omega"),
     "longitudinal": ("wave_speed", "axial_stiffness", "t_end", "transit_time",
                      "static_end_displacement", "impedance"),
 }
@@ -1306,7 +1395,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     inputs = []
     for axis, key in schema.BY_AXIS.items():
         value = params[axis]
-        if value is None or key.section not in ("cable", "model", "load"):
+        if value is None or key.section not in ("cable", "model", "load", "base"):
             continue
         value = float(np.atleast_1d(value)[corner % np.size(value)])
         where = (f"axis '{axis}' at {value!r}" if axis in axes

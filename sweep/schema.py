@@ -17,6 +17,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+STANDARD_GRAVITY = 9.80665
+"""g (m s-2), the standard acceleration of gravity: what a level in g (``base.acceleration_g``,
+the ``absolute_acceleration_g`` output) is a multiple of. The one place this number is written."""
+G_UNITS = f"{STANDARD_GRAVITY:g} m s-2"
+"""UDUNITS units of a value given in g: "9.80665 m s-2" (a scaled unit that converts to m s-2
+in any UDUNITS tool; "g" would mean grams, "1" dimensionless)."""
+
 
 @dataclass(frozen=True)
 class Key:
@@ -85,6 +92,18 @@ KEYS: tuple[Key, ...] = (
         axis="frequency_ratio"),
     Key("load", "frequency", "float", None, units="Hz", minimum=0.0,
         long_name="load frequency W/(2 pi)", axis="frequency"),
+    # [base]: both clamps move transversely, a_b(t) = A sin(2 pi f t) (docs/model.md sec. 5)
+    Key("base", "acceleration", "float", None, units="m s-2", minimum=0.0,
+        long_name="base (clamp) acceleration amplitude A, peak",
+        axis="base_acceleration"),
+    Key("base", "acceleration_g", "float", None, units=G_UNITS, minimum=0.0,
+        long_name=f"base (clamp) acceleration amplitude A, peak, in g ({STANDARD_GRAVITY:g} "
+                  "m s-2)", axis="base_acceleration_g"),
+    Key("base", "frequency", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
+        long_name="base excitation frequency f", axis="base_frequency"),
+    Key("base", "frequency_ratio", "float", None, units="1", minimum=0.0, exclusive_min=True,
+        long_name="base excitation frequency over the unloaded span's first natural frequency, "
+                  "f/f1", axis="base_frequency_ratio"),
     # [initial]
     Key("initial", "displacement", "float", 0.0, units="m",
         long_name="initial midspan deflection q(0)", axis="initial_displacement"),
@@ -95,8 +114,9 @@ KEYS: tuple[Key, ...] = (
         long_name="relative tolerance"),
     Key("solver", "atol", "float", None, units="m", minimum=0.0, exclusive_min=True,
         maximum=1.0, long_name="absolute tolerance (m for q, m/s for q'); default: each "
-                               "point's own, 0.01 x rtol x max(|q0|, |v0|/w1) (w1 x that for "
-                               "q'), so results do not depend on the response's size"),
+                               "point's own, 0.01 x rtol x max(|q0|, |v0|/w1, (4/pi) A / "
+                               "max(w1^2, w_b^2)) (w1 x that for q'; A, w_b: the [base] "
+                               "excitation), so results do not depend on the response's size"),
     Key("solver", "t_end", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="end of the simulated time (default: 5 s transverse, 8 transits longitudinal)"),
     Key("solver", "transits", "float", None, units="1", minimum=0.0, exclusive_min=True,
@@ -135,6 +155,9 @@ KEYS: tuple[Key, ...] = (
     Key("outputs", "settling_time", "bool", True, long_name="compute and store the settling time"),
     Key("outputs", "response_period", "bool", True, long_name="store the response period"),
     Key("outputs", "solver_stats", "bool", True, long_name="store step and evaluation counts"),
+    Key("outputs", "absolute_acceleration", "bool", True,
+        long_name="scenes with [base]: store the absolute midspan acceleration amplitude (m s-2 "
+                  "and g) and the transmissibility"),
     Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
     Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="time-series sample interval (default t_end/1000)"),
