@@ -43,9 +43,9 @@ from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
 from .layout import (MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BOUND, DAMPING, G0, G1, H, K0, K1, MASS, N_PARAMS, OMEGA
+from .oscillator import BASE_TERM, BOUND, N_PARAMS, acceleration, prepare
 from .transverse import classify, reject_point, valid
-from .vecmath import fast_cos, inv_fifth_root
+from .vecmath import inv_fifth_root
 
 # The vector loops may fuse a * b + c into one fused multiply-add (one rounding instead of two;
 # no reordering): about half the floating-point instructions of the stage sums, the cosine's
@@ -117,17 +117,10 @@ def _step_factor(err, rejected_before, eighth):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _accel(W, j, t, q, v):
-    """q'' (m/s^2) of lane j's oscillator at (t, q, v), from the lane's coefficients divided by
-    -m (`_load_lane`): no division in the stage chain, and the velocity term added last, so each
-    stage waits on the previous one for two fused multiply-adds rather than for a division."""
-    L = LANES
-    cw = fast_cos(W[(W_P + OMEGA) * L + j] * t)
-    q2 = q * q
-    a = ((W[(W_P + K0) * L + j] + W[(W_P + K1) * L + j] * cw) * q
-         + (W[(W_P + G0) * L + j] + W[(W_P + G1) * L + j] * cw) * q * q2
-         + W[(W_P + H) * L + j] * q * q2 * q2)
-    return a + W[(W_P + DAMPING) * L + j] * v
+def _accel(W, j, t, q, v, terms):
+    """q'' (m/s^2) of lane j at (t, q, v): the System's one right-hand side
+    (oscillator.acceleration) on the lane's prepared row, with vecmath's cos and sin."""
+    return acceleration(t, q, v, W, W_P * LANES + j, LANES, True, terms)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -157,7 +150,7 @@ def _prepare(W, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt(W, rtol, n_run):
+def _attempt(W, rtol, n_run, terms):
     """One Dormand-Prince attempt in every lane of W.
 
     The stages are written out with scalar locals and the tableau's entries (dopri5.A, B, C,
@@ -175,27 +168,27 @@ def _attempt(W, rtol, n_run):
         k1q = W[tj.FQ * L + j]
         k1v = W[tj.FV * L + j]
         k2q = v + (k1v * _A[1][0]) * h
-        k2v = _accel(W, j, t + _C[1] * h, q + (k1q * _A[1][0]) * h, k2q)
+        k2v = _accel(W, j, t + _C[1] * h, q + (k1q * _A[1][0]) * h, k2q, terms)
         q3 = q + (k1q * _A[2][0] + k2q * _A[2][1]) * h
         k3q = v + (k1v * _A[2][0] + k2v * _A[2][1]) * h
-        k3v = _accel(W, j, t + _C[2] * h, q3, k3q)
+        k3v = _accel(W, j, t + _C[2] * h, q3, k3q, terms)
         q4 = q + (k1q * _A[3][0] + k2q * _A[3][1] + k3q * _A[3][2]) * h
         k4q = v + (k1v * _A[3][0] + k2v * _A[3][1] + k3v * _A[3][2]) * h
-        k4v = _accel(W, j, t + _C[3] * h, q4, k4q)
+        k4v = _accel(W, j, t + _C[3] * h, q4, k4q, terms)
         q5 = q + (k1q * _A[4][0] + k2q * _A[4][1] + k3q * _A[4][2] + k4q * _A[4][3]) * h
         k5q = v + (k1v * _A[4][0] + k2v * _A[4][1] + k3v * _A[4][2] + k4v * _A[4][3]) * h
-        k5v = _accel(W, j, t + _C[4] * h, q5, k5q)
+        k5v = _accel(W, j, t + _C[4] * h, q5, k5q, terms)
         q6 = q + (k1q * _A[5][0] + k2q * _A[5][1] + k3q * _A[5][2] + k4q * _A[5][3]
                   + k5q * _A[5][4]) * h
         k6q = v + (k1v * _A[5][0] + k2v * _A[5][1] + k3v * _A[5][2] + k4v * _A[5][3]
                    + k5v * _A[5][4]) * h
-        k6v = _accel(W, j, t + _C[5] * h, q6, k6q)
+        k6v = _accel(W, j, t + _C[5] * h, q6, k6q, terms)
         qn = q + h * (k1q * _B[0] + k2q * _B[1] + k3q * _B[2] + k4q * _B[3] + k5q * _B[4]
                       + k6q * _B[5])
         vn = v + h * (k1v * _B[0] + k2v * _B[1] + k3v * _B[2] + k4v * _B[3] + k5v * _B[4]
                       + k6v * _B[5])
         k7q = vn
-        k7v = _accel(W, j, t + h, qn, vn)
+        k7v = _accel(W, j, t + h, qn, vn, terms)
         eq = (k1q * _E[0] + k2q * _E[1] + k3q * _E[2] + k4q * _E[3] + k5q * _E[4]
               + k6q * _E[5] + k7q * _E[6]) * h
         ev = (k1v * _E[0] + k2v * _E[1] + k3v * _E[2] + k4v * _E[3] + k5v * _E[4]
@@ -220,7 +213,7 @@ def _attempt(W, rtol, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt8(W, rtol, n_run):
+def _attempt8(W, rtol, n_run, terms):
     """One DOP853 attempt in every lane of W (as `_attempt`): the eighth-order solution
     (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage (W_K + 12, W_K + 13) and
     SciPy's DOP853 error norm (W_ERR). The other stages stay in registers: the DOP853 dense
@@ -236,55 +229,55 @@ def _attempt8(W, rtol, n_run):
         kv0 = W[tj.FV * L + j]
         q1 = q + (kq0 * _A8[1][0]) * h
         kq1 = v + (kv0 * _A8[1][0]) * h
-        kv1 = _accel(W, j, t + _C8[1] * h, q1, kq1)
+        kv1 = _accel(W, j, t + _C8[1] * h, q1, kq1, terms)
         q2 = q + (kq0 * _A8[2][0] + kq1 * _A8[2][1]) * h
         kq2 = v + (kv0 * _A8[2][0] + kv1 * _A8[2][1]) * h
-        kv2 = _accel(W, j, t + _C8[2] * h, q2, kq2)
+        kv2 = _accel(W, j, t + _C8[2] * h, q2, kq2, terms)
         q3 = q + (kq0 * _A8[3][0] + kq2 * _A8[3][2]) * h
         kq3 = v + (kv0 * _A8[3][0] + kv2 * _A8[3][2]) * h
-        kv3 = _accel(W, j, t + _C8[3] * h, q3, kq3)
+        kv3 = _accel(W, j, t + _C8[3] * h, q3, kq3, terms)
         q4 = q + (kq0 * _A8[4][0] + kq2 * _A8[4][2] + kq3 * _A8[4][3]) * h
         kq4 = v + (kv0 * _A8[4][0] + kv2 * _A8[4][2] + kv3 * _A8[4][3]) * h
-        kv4 = _accel(W, j, t + _C8[4] * h, q4, kq4)
+        kv4 = _accel(W, j, t + _C8[4] * h, q4, kq4, terms)
         q5 = q + (kq0 * _A8[5][0] + kq3 * _A8[5][3] + kq4 * _A8[5][4]) * h
         kq5 = v + (kv0 * _A8[5][0] + kv3 * _A8[5][3] + kv4 * _A8[5][4]) * h
-        kv5 = _accel(W, j, t + _C8[5] * h, q5, kq5)
+        kv5 = _accel(W, j, t + _C8[5] * h, q5, kq5, terms)
         q6 = q + (kq0 * _A8[6][0] + kq3 * _A8[6][3] + kq4 * _A8[6][4] + kq5 * _A8[6][5]) * h
         kq6 = v + (kv0 * _A8[6][0] + kv3 * _A8[6][3] + kv4 * _A8[6][4] + kv5 * _A8[6][5]) * h
-        kv6 = _accel(W, j, t + _C8[6] * h, q6, kq6)
+        kv6 = _accel(W, j, t + _C8[6] * h, q6, kq6, terms)
         q7 = q + (kq0 * _A8[7][0] + kq3 * _A8[7][3] + kq4 * _A8[7][4] + kq5 * _A8[7][5]
                   + kq6 * _A8[7][6]) * h
         kq7 = v + (kv0 * _A8[7][0] + kv3 * _A8[7][3] + kv4 * _A8[7][4] + kv5 * _A8[7][5]
                     + kv6 * _A8[7][6]) * h
-        kv7 = _accel(W, j, t + _C8[7] * h, q7, kq7)
+        kv7 = _accel(W, j, t + _C8[7] * h, q7, kq7, terms)
         q8 = q + (kq0 * _A8[8][0] + kq3 * _A8[8][3] + kq4 * _A8[8][4] + kq5 * _A8[8][5]
                   + kq6 * _A8[8][6] + kq7 * _A8[8][7]) * h
         kq8 = v + (kv0 * _A8[8][0] + kv3 * _A8[8][3] + kv4 * _A8[8][4] + kv5 * _A8[8][5]
                     + kv6 * _A8[8][6] + kv7 * _A8[8][7]) * h
-        kv8 = _accel(W, j, t + _C8[8] * h, q8, kq8)
+        kv8 = _accel(W, j, t + _C8[8] * h, q8, kq8, terms)
         q9 = q + (kq0 * _A8[9][0] + kq3 * _A8[9][3] + kq4 * _A8[9][4] + kq5 * _A8[9][5]
                   + kq6 * _A8[9][6] + kq7 * _A8[9][7] + kq8 * _A8[9][8]) * h
         kq9 = v + (kv0 * _A8[9][0] + kv3 * _A8[9][3] + kv4 * _A8[9][4] + kv5 * _A8[9][5]
                     + kv6 * _A8[9][6] + kv7 * _A8[9][7] + kv8 * _A8[9][8]) * h
-        kv9 = _accel(W, j, t + _C8[9] * h, q9, kq9)
+        kv9 = _accel(W, j, t + _C8[9] * h, q9, kq9, terms)
         q10 = q + (kq0 * _A8[10][0] + kq3 * _A8[10][3] + kq4 * _A8[10][4] + kq5 * _A8[10][5]
                   + kq6 * _A8[10][6] + kq7 * _A8[10][7] + kq8 * _A8[10][8] + kq9 * _A8[10][9]) * h
         kq10 = v + (kv0 * _A8[10][0] + kv3 * _A8[10][3] + kv4 * _A8[10][4] + kv5 * _A8[10][5]
                      + kv6 * _A8[10][6] + kv7 * _A8[10][7] + kv8 * _A8[10][8]
                      + kv9 * _A8[10][9]) * h
-        kv10 = _accel(W, j, t + _C8[10] * h, q10, kq10)
+        kv10 = _accel(W, j, t + _C8[10] * h, q10, kq10, terms)
         q11 = q + (kq0 * _A8[11][0] + kq3 * _A8[11][3] + kq4 * _A8[11][4] + kq5 * _A8[11][5]
                   + kq6 * _A8[11][6] + kq7 * _A8[11][7] + kq8 * _A8[11][8] + kq9 * _A8[11][9]
                   + kq10 * _A8[11][10]) * h
         kq11 = v + (kv0 * _A8[11][0] + kv3 * _A8[11][3] + kv4 * _A8[11][4] + kv5 * _A8[11][5]
                      + kv6 * _A8[11][6] + kv7 * _A8[11][7] + kv8 * _A8[11][8]
                      + kv9 * _A8[11][9] + kv10 * _A8[11][10]) * h
-        kv11 = _accel(W, j, t + _C8[11] * h, q11, kq11)
+        kv11 = _accel(W, j, t + _C8[11] * h, q11, kq11, terms)
         qn = q + h * (kq0 * _B8[0] + kq5 * _B8[5] + kq6 * _B8[6] + kq7 * _B8[7] + kq8 * _B8[8]
                       + kq9 * _B8[9] + kq10 * _B8[10] + kq11 * _B8[11])
         vn = v + h * (kv0 * _B8[0] + kv5 * _B8[5] + kv6 * _B8[6] + kv7 * _B8[7] + kv8 * _B8[8]
                       + kv9 * _B8[9] + kv10 * _B8[10] + kv11 * _B8[11])
-        fv_new = _accel(W, j, t + h, qn, vn)
+        fv_new = _accel(W, j, t + h, qn, vn, terms)
         e5q = (kq0 * _E5[0] + kq5 * _E5[5] + kq6 * _E5[6] + kq7 * _E5[7] + kq8 * _E5[8]
                + kq9 * _E5[9] + kq10 * _E5[10] + kq11 * _E5[11])
         e5v = (kv0 * _E5[0] + kv5 * _E5[5] + kv6 * _E5[6] + kv7 * _E5[7] + kv8 * _E5[8]
@@ -316,18 +309,25 @@ def _pi_factors(W, n_run):
         W[tj.LOG2_ERR_PREV * L + j] = pi_log2_err(err) if remember else memory
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _finish(W, settings, n_samples, n_run, pi, eighth):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
-    ordinary accepted step the first metrics pass (threshold tol * peak around 0) and the move
+    ordinary accepted step the first metrics pass (threshold tol * peak around 0; the
+    base-excitation metric is `_observe_acceleration`'s) and the move
     to the step's end. An accepted step with anything to locate on the dense output, or a
     divergence, is left for trajectory.record_step: W_FLAG = NEEDS_SCALAR, or HAS_EXTREMUM
-    when it holds an extremum of q (`_locate_extrema` finds it first).
+    when it holds an extremum of q (`_locate_extrema` finds it first). The metrics of an
+    ordinary step are the Observer's (trajectory.observe_step_end), as in the scalar driver.
 
     SciPy's controller is computed here when `pi` is None (RK45's, or DOP853's when `eighth` is
     True); otherwise the PI controller's factor comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
-    vectorising the loop. Returns how many lanes it flagged, and how many of those HAS_EXTREMUM.
+    vectorising the loop. Returns how many lanes it flagged, how many of those HAS_EXTREMUM,
+    and how many ordinary steps end within two steps of the tail window or in it (the
+    base-excitation metric needs those: `_observe_acceleration`).
+    Compiled without reference counting (`_nrt=False`; nothing here allocates): W passed to the
+    Observer as its arrays would otherwise cost atomic counter updates in the loop, which stop
+    LLVM vectorising it.
     """
     L = LANES
     t_tail = settings[T_END] * (1.0 - settings[TAIL])
@@ -337,6 +337,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
     rhs_per_attempt = float(RHS_PER_ATTEMPT if eighth is None else dop853.RHS_PER_ATTEMPT)
     n_flagged = 0
     n_extrema = 0
+    n_near = 0
     for j in range(n_run):
         h = W[W_H * L + j]
         active = h > 0.0
@@ -368,28 +369,36 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
         W[W_FLAG * L + j] = (HAS_EXTREMUM if locate else NEEDS_SCALAR) if event else ORDINARY
         n_flagged += 1 if event else 0
         n_extrema += 1 if event & locate else 0
+        n_near += 1 if done & (t_new + 2.0 * h >= t_tail) else 0
         W[tj.RHS_EVALS * L + j] += rhs_per_attempt if active else 0.0
         W[tj.H_ABS * L + j] *= factor if active else 1.0
         W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if active else (
             1.0 if rejected_before else 0.0)
         W[tj.REJECTED * L + j] += 1.0 if active & (not accepted) else 0.0
         W[tj.STEPS * L + j] += 1.0 if active & accepted else 0.0
-        W[tj.PEAK * L + j] = peak_new if done else peak
-        in_tail = done & (t_new >= t_tail)
-        W[tj.TAIL_AMP * L + j] = max(W[tj.TAIL_AMP * L + j], abs(qn)) if in_tail else \
-            W[tj.TAIL_AMP * L + j]
-        W[tj.TAIL_QMIN * L + j] = min(W[tj.TAIL_QMIN * L + j], qn) if in_tail else \
-            W[tj.TAIL_QMIN * L + j]
-        W[tj.TAIL_QMAX * L + j] = max(W[tj.TAIL_QMAX * L + j], qn) if in_tail else \
-            W[tj.TAIL_QMAX * L + j]
-        above = done & track & (abs(qn) > thr)
-        W[tj.LAST_ABOVE * L + j] = W[tj.T * L + j] + h if above else W[tj.LAST_ABOVE * L + j]
+        tj.observe_step_end(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], h, t_new, qn, fv_new,
+                            t_tail, track, 0.0, 0.0, thr_rel, done, True, (None, None))
         W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
         W[tj.Q * L + j] = qn if done else q_old
         W[tj.V * L + j] = vn if done else v_old
         W[tj.FQ * L + j] = vn if done else W[tj.FQ * L + j]
         W[tj.FV * L + j] = fv_new if done else W[tj.FV * L + j]
-    return n_flagged, n_extrema
+    return n_flagged, n_extrema, n_near
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+def _observe_acceleration(W, settings, n_run):
+    """trajectory.observe_acceleration for every lane whose attempt `_finish` accepted as an
+    ordinary step (the flagged ones get it from record_step): the base-excitation metric, in
+    a loop of its own so that `_finish` stays vectorised and scenes without base excitation
+    do not pay for it."""
+    L = LANES
+    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    for j in range(n_run):
+        done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
+                & (W[W_FLAG * L + j] == ORDINARY))
+        tj.observe_acceleration(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], W[tj.FV * L + j],
+                                t_tail, done, True)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -504,7 +513,7 @@ def _locate_extrema8(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
+def _load_lane(params, settings, point, lane, W, states, reals, counts, series, terms):
     """Give `lane` the trajectory of row `point`; an invalid row is answered at once.
     Returns False when the row needs no integration."""
     p = params[point]
@@ -512,29 +521,25 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series):
         reject_point(reals[point], counts[point], series[point])
         states[point] = mt.INVALID_INPUT
         return False
-    for c in range(N_PARAMS):
-        W[(W_P + c) * LANES + lane] = p[c]
-    minus_inv_m = -1.0 / p[MASS]            # _accel's coefficients: per unit mass, negated
-    for c in (DAMPING, K0, K1, G0, G1, H):
-        W[(W_P + c) * LANES + lane] = p[c] * minus_inv_m
-    tj.start(p, settings, W[lane::LANES], series[point])
+    prepare(p, W, W_P * LANES + lane, LANES)
+    tj.start(W, W_P * LANES + lane, LANES, settings, W[lane::LANES], series[point], terms)
     return True
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe):
+def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, terms):
     """trajectory.record_step for lane j (point i) after an accepted attempt. The lane's views of
     W and of the point's time-series row are taken here, where Numba keeps no reference counts
     (`_nrt=False`; nothing here allocates): taken in solve_block, each view cost two atomic
     counter updates per flagged lane."""
     L = LANES
-    tj.record_step(W[(W_P + BOUND) * L + j], settings, W[j::L], K, W[W_QN * L + j],
+    tj.record_step(W, W_P * L + j, L, settings, W[j::L], K, W[W_QN * L + j],
                    W[W_VN * L + j], W[W_H * L + j], Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j])
+                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], terms)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth, terms):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
 
@@ -542,7 +547,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     True for the PI controller; `eighth` the method, matching settings[METHOD]: None for RK45,
     True for DOP853 (SciPy's controller only). None is a type of its own to Numba, which
     prunes the branches on `pi is None` at compile time: each combination is its own
-    specialisation, compiled without the others' code.
+    specialisation, compiled without the others' code. `base` likewise: None, or True when
+    settings[BASE] is 1 (oscillator's base-excitation switch).
     """
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
@@ -575,13 +581,13 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                             break
                         i = point[j]
                         tj.end_series(acc, series[i])
-                        states[i] = classify(params[i], settings, acc, bufs[j], reals[i],
-                                             counts[i])
+                        states[i] = classify(W, W_P * L + j, L, settings, acc, bufs[j],
+                                             reals[i], counts[i], terms)
                         point[j] = -1
                     if next_point >= hi:
                         break
                     if _load_lane(params, settings, next_point, j, W, states, reals, counts,
-                                  series):
+                                  series, terms):
                         point[j] = next_point
                         bufs[j] = tj.new_buffer()
                         capacity[j] = bufs[j].shape[0]
@@ -593,12 +599,14 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         if eighth is None:
-            _attempt(W, rtol, n_run)
+            _attempt(W, rtol, n_run, terms)
         else:
-            _attempt8(W, rtol, n_run)
+            _attempt8(W, rtol, n_run, terms)
         if pi is not None:
             _pi_factors(W, n_run)
-        n_flagged, n_extrema = _finish(W, settings, n_samples, n_run, pi, eighth)
+        n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth)
+        if terms[BASE_TERM] is not None and n_near > 0:
+            _observe_acceleration(W, settings, n_run)
         if n_flagged == 0:
             continue
         if n_extrema > 0:
@@ -624,4 +632,4 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             if W[tj.N_EXT * L + j] >= capacity[j]:
                 bufs[j] = tj.with_room(bufs[j], W[j::L])
                 capacity[j] = bufs[j].shape[0]
-            _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe)
+            _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe, terms)

@@ -16,7 +16,12 @@ CONTROLLER = 11     # step-size controller: 0.0 SciPy's (step for step as solve_
 METHOD = 12         # integrator: 0.0 RK45 (Dormand-Prince 5(4)), 1.0 DOP853 (8(5,3))
 ATOL_SCALE = 13     # c, 1: absolute tolerances c rtol q_scale (m) and c rtol v_scale (m/s)
                     # from each point's own scales (oscillator.Q_SCALE); 0.0: ATOL alone
-N_SETTINGS = 14
+BASE = 14           # 1.0: the scene has base excitation (the forcing term and the absolute
+                    # acceleration are compiled in: oscillator.BASE_TERM); 0.0: none
+CONSTANT_STIFFNESS = 15  # 1.0: no row has a time-varying stiffness (k1 = g1 = 0 everywhere: a
+                    # constant or zero end load), so cos(W t) is compiled out
+                    # (oscillator.PARAMETRIC_TERM); 0.0, the default: rows may have one
+N_SETTINGS = 16
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)
@@ -24,7 +29,9 @@ PEAK = 1            # max |q| over the whole run (m)
 SETTLING = 2        # settling time (s) or NaN
 PERIOD = 3          # mean time between maxima of q in the tail (s) or NaN
 FAILURE_TIME = 4    # time at which a diverged or failed point stopped (s) or NaN
-N_REALS = 5
+ACCELERATION = 5    # max |q'' + a_b| over the tail window (m/s^2): the absolute midspan
+                    # acceleration amplitude under base excitation; NaN without (BASE = 0)
+N_REALS = 6
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -1,9 +1,31 @@
-"""The modal oscillator of docs/model.md in general form (SI units).
+"""The transverse System: the modal oscillator of docs/model.md, written once (SI units).
 
-    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = 0
+    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = -m G a_b(t),
+    a_b(t) = A sin(w_b t)
 
-q is the midspan deflection (m), t the time (s). A point's coefficients live in one row of a
-float64 parameter array; the column of each is named below.
+q is the midspan deflection relative to the clamps (m), t the time (s), a_b the transverse
+acceleration of both clamps (base excitation, m/s^2) and G its participation factor (4/pi for
+the first mode). A point's coefficients live in one row of a float64 parameter array; the
+column of each is named below.
+
+Every driver reads a row through the same accessor, p[o + column * s]: a row of its own
+(o = 0, s = 1: the scalar driver), or one lane of the lock-step driver's working memory (o the
+lane's first parameter slot, s the number of lanes). Before integrating, `prepare` writes the
+row in the form `acceleration` reads: the force coefficients divided by -m, so the right-hand
+side is a sum of products with no division. Both drivers, the initial step, the metrics
+(`kernels.observer`) and the at-rest test call `acceleration`; the SciPy references of the
+benchmarks call its pure-Python form (`acceleration.py_func`). There is no other copy.
+
+Compile-time switches (None or True: Numba compiles one specialisation per choice, and the
+branches not taken are not in it):
+    fast   None: libm's cos and sin (the scalar driver, SciPy's arithmetic);
+           True: vecmath's vectorisable fast_cos and fast_sin (the lanes driver)
+    terms  a tuple: which optional terms of the equation a scene has (`terms_of`)
+           terms[PARAMETRIC_TERM]  the load's cos(W t) parts k1, g1 (None: every row of the
+                                   scene has k1 = g1 = 0, a constant or zero load, and cos is
+                                   not evaluated; the result is the same to the last bit)
+           terms[BASE_TERM]        the base excitation -G a_b(t), and the absolute
+                                   acceleration metric (kernels.trajectory.observe_acceleration)
 
 Q_SCALE and V_SCALE are the size of the point's response (sweep.models.state_scale): with
 settings[ATOL_SCALE] > 0 the absolute tolerances are that fraction of rtol times these scales
@@ -14,6 +36,8 @@ integrated alike. They must be > 0 then; with ATOL_SCALE = 0 they are not read.
 import math
 
 import numba as nb
+
+from .vecmath import fast_cos, fast_sin
 
 # Columns of a parameter row.
 MASS = 0        # m   (kg-like: any consistent scaling of the equation; must be > 0)
@@ -29,27 +53,81 @@ V0 = 9          # q'(0)                                     (m/s)
 BOUND = 10      # |q| beyond which the point is diverged    (m)
 Q_SCALE = 11    # the point's displacement scale            (m)
 V_SCALE = 12    # the point's velocity scale                (m/s)
-N_PARAMS = 13
+BASE_ACCEL = 13     # A    base acceleration amplitude      (m/s^2 peak)
+BASE_OMEGA = 14     # w_b  base angular frequency           (rad/s)
+PARTICIPATION = 15  # G    participation factor of the mode (1)
+N_PARAMS = 16
 
 PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound",
-               "q_scale", "v_scale")
+               "q_scale", "v_scale", "base_accel", "base_omega", "participation")
+
+# The columns `prepare` divides by -m.
+FORCE_COLUMNS = (DAMPING, K0, K1, G0, G1, H)
+
+# Indices into `terms`, the tuple of the equation's optional terms (module docstring).
+PARAMETRIC_TERM = 0
+BASE_TERM = 1
+ALL_TERMS = (True, True)
+
+
+def terms_of(parametric: bool, base: bool) -> tuple:
+    """The `terms` switches of a scene: whether any row has a time-varying stiffness (k1 or
+    g1 not 0) and whether the scene has base excitation (settings[layout.BASE])."""
+    return (True if parametric else None, True if base else None)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def acceleration(t, q, v, p):
-    """q'' (m/s^2) at time t (s) for deflection q (m), velocity v (m/s), parameter row p."""
-    cw = math.cos(p[OMEGA] * t)
-    q2 = q * q
-    force = (p[DAMPING] * v + (p[K0] + p[K1] * cw) * q
-             + (p[G0] + p[G1] * cw) * q * q2 + p[H] * q * q2 * q2)
-    return -force / p[MASS]
+def prepare(row, p, o, s):
+    """Write parameter row `row` (a point's raw row, columns above) to p[o + column * s] in the
+    form `acceleration` reads: the columns of FORCE_COLUMNS divided by -m (one division per
+    point), the others as they are. The row must be valid (m > 0)."""
+    for c in range(N_PARAMS):
+        p[o + c * s] = row[c]
+    minus_inv_m = -1.0 / row[MASS]
+    for c in FORCE_COLUMNS:
+        p[o + c * s] = row[c] * minus_inv_m
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def stiffness(t, q, p):
-    """d(restoring force)/dq (N/m per unit modal mass m) at time t (s) and deflection q (m):
-    k0 + k1 cos Wt + 3 (g0 + g1 cos Wt) q^2 + 5 h q^4, the derivative of `acceleration`'s
-    force at zero velocity."""
-    cw = math.cos(p[OMEGA] * t)
+def base_acceleration(t, p, o, s, fast):
+    """a_b(t) = A sin(w_b t) (m/s^2): the clamps' acceleration at time t (s)."""
+    x = p[o + BASE_OMEGA * s] * t
+    if fast is None:
+        return p[o + BASE_ACCEL * s] * math.sin(x)
+    return p[o + BASE_ACCEL * s] * fast_sin(x)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def acceleration(t, q, v, p, o, s, fast, terms):
+    """q'' (m/s^2) at time t (s) for deflection q (m) and velocity v (m/s), from a prepared
+    row (`prepare`) at p[o + column * s]; `fast`, `terms`: the module's switches.
+
+    The velocity term is added after the stiffness terms, so in a chain of stages each waits
+    on the previous one for two fused multiply-adds rather than for the whole sum."""
     q2 = q * q
-    return p[K0] + p[K1] * cw + 3.0 * (p[G0] + p[G1] * cw) * q2 + 5.0 * p[H] * q2 * q2
+    if terms[PARAMETRIC_TERM] is not None:
+        x = p[o + OMEGA * s] * t
+        if fast is None:
+            cw = math.cos(x)
+        else:
+            cw = fast_cos(x)
+        a = ((p[o + K0 * s] + p[o + K1 * s] * cw) * q
+             + (p[o + G0 * s] + p[o + G1 * s] * cw) * q * q2
+             + p[o + H * s] * q * q2 * q2)
+    else:
+        a = p[o + K0 * s] * q + p[o + G0 * s] * q * q2 + p[o + H * s] * q * q2 * q2
+    a = a + p[o + DAMPING * s] * v
+    if terms[BASE_TERM] is not None:
+        a = a - p[o + PARTICIPATION * s] * base_acceleration(t, p, o, s, fast)
+    return a
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def stiffness(t, q, p, o, s):
+    """d(restoring force)/dq per unit mass m (1/s^2) at time t (s) and deflection q (m), from a
+    prepared row: (k0 + k1 cos Wt + 3 (g0 + g1 cos Wt) q^2 + 5 h q^4) / m, the derivative of
+    -`acceleration` with respect to q."""
+    cw = math.cos(p[o + OMEGA * s] * t)
+    q2 = q * q
+    return -(p[o + K0 * s] + p[o + K1 * s] * cw + 3.0 * (p[o + G0 * s] + p[o + G1 * s] * cw) * q2
+             + 5.0 * p[o + H * s] * q2 * q2)

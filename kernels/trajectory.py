@@ -29,7 +29,7 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR
                      pi_step_factor, step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      MIN_STEP, RTOL, SAMPLE_DT, TAIL, T_END)
-from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration
+from .oscillator import BASE_TERM, BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
 from .vecmath import log2_fast
 
 # Slots of a trajectory's accumulator row.
@@ -56,7 +56,14 @@ N_EXT = 19          # extrema recorded
 LOG2_ERR_PREV = 20  # log2 of the last accepted step's error norm (PI controller)
 ATOL_Q = 21         # absolute tolerance on q (m): `point_atol`
 ATOL_V = 22         # absolute tolerance on q' (m/s)
-N_SLOTS = 23
+ACC_AMP = 23        # max |q'' + a_b| over the tail window so far (m/s^2; base excitation only)
+ACC_1 = 24          # q'' + a_b at the last accepted step's end (m/s^2)
+T_1 = 25            # ... its time (s)
+ACC_2 = 26          # q'' + a_b at the end of the step before (m/s^2; NaN before the first)
+T_2 = 27            # ... its time (s)
+ACC_STEP = 28       # the accepted-step count when ACC_1 was sampled (its samples are consecutive
+                    # steps' ends only if the next sample comes one step later)
+N_SLOTS = 29
 
 # The PI controller's memory before the first accepted step: pi_log2_err(PI_MIN_ERR_PREV),
 # computed once here (the same arithmetic in Python) rather than compiled into `start`.
@@ -84,31 +91,33 @@ def with_room(buf, acc):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def point_atol(p, settings, rtol):
+def point_atol(p, o, s, settings, rtol):
     """The absolute tolerances (atol_q in m, atol_v in m/s) of the point with parameter row p:
     settings[ATOL] plus settings[ATOL_SCALE] x rtol x the point's own scales (p[Q_SCALE],
     p[V_SCALE]). With ATOL_SCALE = 0 that is settings[ATOL] for both, as SciPy's scalar atol;
     with ATOL = 0 the error norm is relative to each point's own size, so a response scaled by
-    any factor takes the same steps. Both drivers read the tolerances from here (`start`)."""
+    any factor takes the same steps. Both drivers read the tolerances from here (`start`).
+    The row is read at p[o + column * s] (oscillator's accessor)."""
     c = settings[ATOL_SCALE] * rtol
-    return settings[ATOL] + c * p[Q_SCALE], settings[ATOL] + c * p[V_SCALE]
+    return settings[ATOL] + c * p[o + Q_SCALE * s], settings[ATOL] + c * p[o + V_SCALE * s]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def start(p, settings, acc, series):
-    """Set up a trajectory at t = 0 from its parameter row `p`; q(0) goes to series[0]."""
+def start(p, o, s, settings, acc, series, terms):
+    """Set up a trajectory at t = 0 from its prepared parameter row at p[o + column * s]
+    (oscillator.prepare); q(0) goes to series[0]. base: oscillator's switch."""
     rtol = max(settings[RTOL], MIN_RTOL)
     t_end = settings[T_END]
     t_tail = t_end * (1.0 - settings[TAIL])
-    q = p[Q0]
-    v = p[V0]
+    q = p[o + Q0 * s]
+    v = p[o + V0 * s]
     acc[T] = 0.0
     acc[Q] = q
     acc[V] = v
     acc[FQ] = v
-    acc[FV] = acceleration(0.0, q, v, p)
+    acc[FV] = acceleration(0.0, q, v, p, o, s, None, terms)
     acc[RHS_EVALS] = 1.0
-    acc[ATOL_Q], acc[ATOL_V] = point_atol(p, settings, rtol)
+    acc[ATOL_Q], acc[ATOL_V] = point_atol(p, o, s, settings, rtol)
     if settings[FIRST_STEP] > 0.0:
         acc[H_ABS] = min(settings[FIRST_STEP], t_end)
     else:
@@ -118,7 +127,7 @@ def start(p, settings, acc, series):
         f[0], f[1] = acc[FQ], acc[FV]
         order = dop853.ERROR_ESTIMATOR_ORDER if settings[METHOD] != 0.0 else ERROR_ESTIMATOR_ORDER
         acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, acc[ATOL_Q],
-                                  acc[ATOL_V], p, order)
+                                  acc[ATOL_V], p, o, s, order, terms)
         acc[RHS_EVALS] += 1.0
     acc[T_NEW] = 0.0
     acc[REJECTED_NOW] = 0.0
@@ -137,7 +146,16 @@ def start(p, settings, acc, series):
         acc[SAMPLE] = 1.0
     acc[N_EXT] = 0.0
     acc[LOG2_ERR_PREV] = _LOG2_ERR_PREV_START
-    if not abs(q) <= p[BOUND]:
+    a0 = acc[FV]
+    if terms[BASE_TERM] is not None:
+        a0 += base_acceleration(0.0, p, o, s, None)
+    acc[ACC_AMP] = abs(a0) if t_tail <= 0.0 else 0.0
+    acc[ACC_1] = a0
+    acc[T_1] = 0.0
+    acc[ACC_2] = math.nan
+    acc[T_2] = math.nan
+    acc[ACC_STEP] = 0.0
+    if not abs(q) <= p[o + BOUND * s]:
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = 0.0
 
@@ -219,17 +237,18 @@ def control(settings, acc, err):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
-                   track, centre, thr_fixed, thr_rel):
+                   track, centre, thr_fixed, thr_rel, terms):
     """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
     y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
     SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
     the extrema buffer (regrown when full). Qc is scratch for the interpolant, shape (2, 5).
+    p: the point's prepared row (oscillator.prepare).
     """
     if control(settings, acc, err):
         if acc[N_EXT] >= buf.shape[0]:
             buf = with_room(buf, acc)
-        record_step(p[BOUND], settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
-                    centre, thr_fixed, thr_rel, -1.0, 0.0)
+        record_step(p, 0, 1, settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
+                    centre, thr_fixed, thr_rel, -1.0, 0.0, terms)
     return buf
 
 
@@ -245,22 +264,94 @@ def interpolant(settings, acc, K, q_new, v_new, h, Qc):
         dense_coefficients(K, Qc)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def observe_acceleration(acc, a, sa, p, o, s, t_new, fv_new, t_tail, take, fast):
+    """The Observer's base-excitation metric at an accepted step's end (t_new, s; q'' there
+    fv_new, m/s^2), accessors as `observe_step_end`: the tail's peak absolute midspan
+    acceleration |q'' + a_b| (m/s^2), from the step-end samples, each local extremum of them
+    refined by the parabola through the last three. Only where `take`; straight-line selects
+    (the lanes driver runs it in a loop of its own, `lanes._observe_acceleration`, which keeps
+    `_finish` vectorised, and only near and in the tail window: samples that are not the ends
+    of consecutive steps are never joined by a parabola, ACC_STEP)."""
+    a3 = fv_new + base_acceleration(t_new, p, o, s, fast)
+    a1 = acc[a + ACC_1 * sa]
+    t1 = acc[a + T_1 * sa]
+    a2 = acc[a + ACC_2 * sa]
+    t2 = acc[a + T_2 * sa]
+    steps = acc[a + STEPS * sa]                # this step counted
+    consecutive = acc[a + ACC_STEP * sa] == steps - 1.0
+    turn = consecutive & ((a1 - a2) * (a3 - a1) < 0.0)   # the middle sample is an extremum
+    d21 = (a1 - a2) / (t1 - t2)
+    d321 = ((a3 - a1) / (t_new - t1) - d21) / (t_new - t2)
+    tv = 0.5 * (t1 + t2) - 0.5 * d21 / d321   # the parabola's vertex
+    vertex = a2 + (tv - t2) * (d21 + d321 * (tv - t1))
+    refined = abs(vertex) if turn & (tv >= t_tail) & (tv <= t_new) & (tv >= t2) else 0.0
+    amp = acc[a + ACC_AMP * sa]
+    new_amp = max(amp, max(refined, abs(a3) if t_new >= t_tail else 0.0))
+    acc[a + ACC_AMP * sa] = new_amp if take else amp
+    acc[a + ACC_2 * sa] = (a1 if consecutive else math.nan) if take else a2
+    acc[a + T_2 * sa] = t1 if take else t2
+    acc[a + ACC_STEP * sa] = steps if take else acc[a + ACC_STEP * sa]
+    acc[a + ACC_1 * sa] = a3 if take else a1
+    acc[a + T_1 * sa] = t_new if take else t1
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, track, centre,
+                     thr_fixed, thr_rel, take, fast, terms):
+    """The Observer: what every accepted step's end adds to the metrics, for both drivers
+    (`record_step`, and `kernels.lanes._finish` for the lanes' ordinary steps).
+
+    The accumulator is read at acc[a + slot * sa], the prepared parameter row at
+    p[o + column * s] (a trajectory's own arrays: a = o = 0, sa = s = 1; a lane of the lock-step
+    driver: its offsets and the number of lanes). The step of size h (s) from t ends at t_new
+    (the attempt's end as next_attempt set it) with q_new (m) and q'' = fv_new (m/s^2). Updates, only where `take` (straight-line selects, so
+    the lanes' loop vectorises): the running peak |q|; the tail window's max |q| and range
+    (from t_tail, s); with `track`, the last time |q - centre| was above the threshold
+    thr_fixed + thr_rel * peak (m); with base excitation (`base` True),
+    `observe_acceleration` (`fast`: oscillator's switch for a_b).
+    Returns (threshold, whether q_new is above it): record_step finds a crossing inside the
+    step itself.
+    """
+    peak = acc[a + PEAK * sa]
+    peak_new = max(peak, abs(q_new))
+    in_tail = take & (t_new >= t_tail)
+    acc[a + PEAK * sa] = peak_new if take else peak
+    tail_amp = acc[a + TAIL_AMP * sa]
+    tail_qmin = acc[a + TAIL_QMIN * sa]
+    tail_qmax = acc[a + TAIL_QMAX * sa]
+    acc[a + TAIL_AMP * sa] = max(tail_amp, abs(q_new)) if in_tail else tail_amp
+    acc[a + TAIL_QMIN * sa] = min(tail_qmin, q_new) if in_tail else tail_qmin
+    acc[a + TAIL_QMAX * sa] = max(tail_qmax, q_new) if in_tail else tail_qmax
+    thr = thr_fixed + thr_rel * peak_new
+    above = abs(q_new - centre) > thr
+    last_above = acc[a + LAST_ABOVE * sa]
+    acc[a + LAST_ABOVE * sa] = t + h if take & track & above else last_above
+    if terms[BASE_TERM] is not None:
+        observe_acceleration(acc, a, sa, p, o, s, t_new, fv_new, t_tail, take, fast)
+    return thr, above
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
-                thr_fixed, thr_rel, xe_known, qe_known):
+def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
+                thr_fixed, thr_rel, xe_known, qe_known, terms):
     """Reduce the metrics of an accepted step [acc[T], acc[T_NEW]] on its dense output and
-    advance the trajectory to its end. `bound`: the divergence bound on |q| (m); `buf` must
-    have room for one more extremum (`with_room`).
+    advance the trajectory to its end. p[o + column * s]: the point's prepared row (its
+    divergence bound on |q|, m, and base excitation); `buf` must have room for one more
+    extremum (`with_room`).
 
     If the driver has already located the step's extremum of q, xe_known in [0, 1] is its
     x = (t - t_old)/h and qe_known q there; xe_known < 0 means: locate it here. The interpolant
-    (Qc, `interpolant`) is built only when something needs it.
+    (Qc, `interpolant`) is built only when something needs it. What the step's end adds is
+    `observe_step_end`'s; here are the events inside the step (an extremum, the tail's start,
+    a threshold crossing, time-series samples).
     """
     t = acc[T]
     t_new = acc[T_NEW]
     q_old = acc[Q]
     v_old = acc[V]
     t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    bound = p[o + BOUND * s]
 
     if not (abs(q_new) <= bound and math.isfinite(v_new)):
         acc[STATUS] = mt.DIVERGED
@@ -274,7 +365,6 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
     n_samples = series.shape[0]
     k = int(acc[SAMPLE])
     dt_sample = settings[SAMPLE_DT]
-    peak = acc[PEAK]
     has_ext = (v_old > 0.0 and v_new <= 0.0) or (v_old < 0.0 and v_new >= 0.0)
     have_qc = False
     xe = 0.0
@@ -295,34 +385,28 @@ def record_step(bound, settings, acc, K, q_new, v_new, h, Qc, buf, series, track
         buf[n_ext, mt.EXT_Q] = qe
         buf[n_ext, mt.EXT_KIND] = kind
         acc[N_EXT] = n_ext + 1
-        peak = max(peak, abs(qe))
+        acc[PEAK] = max(acc[PEAK], abs(qe))
         if te >= t_tail:
             acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qe))
             acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qe)
             acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qe)
-    peak = max(peak, abs(q_new))
 
-    if t_new >= t_tail:
-        if t < t_tail:
-            if not have_qc:
-                interpolant(settings, acc, K, q_new, v_new, h, Qc)
-                have_qc = True
-            qt = dense_value(q_old, h, Qc[0], (t_tail - t) / h)
-            peak = max(peak, abs(qt))
-            acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qt))
-            acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qt)
-            acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qt)
-        acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(q_new))
-        acc[TAIL_QMIN] = min(acc[TAIL_QMIN], q_new)
-        acc[TAIL_QMAX] = max(acc[TAIL_QMAX], q_new)
-    acc[PEAK] = peak
+    if t < t_tail <= t_new:
+        if not have_qc:
+            interpolant(settings, acc, K, q_new, v_new, h, Qc)
+            have_qc = True
+        qt = dense_value(q_old, h, Qc[0], (t_tail - t) / h)
+        acc[PEAK] = max(acc[PEAK], abs(qt))
+        acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qt))
+        acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qt)
+        acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qt)
 
-    if track:
-        thr = thr_fixed + thr_rel * peak
+    thr, above = observe_step_end(acc, 0, 1, p, o, s, t, h, t_new, q_new, K[K.shape[0] - 1, 1],
+                                  t_tail, track, centre, thr_fixed, thr_rel, True, None, terms)
+
+    if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
-        if xa > 1.0:
-            acc[LAST_ABOVE] = t + h
-        elif xa >= 0.0:
+        if xa >= 0.0:
             if not have_qc:
                 interpolant(settings, acc, K, q_new, v_new, h, Qc)
                 have_qc = True

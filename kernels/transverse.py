@@ -26,16 +26,17 @@ from . import trajectory as tj
 from . import dop853
 from .dopri5 import MIN_RTOL, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
-from .layout import (AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
+from .layout import (ACCELERATION, AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BOUND, MASS, N_PARAMS, acceleration, stiffness
+from .oscillator import BASE_TERM, BOUND, MASS, N_PARAMS, acceleration, prepare, stiffness
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
-    """Integrate one point from t = 0 to t_end with SciPy's RK45 or DOP853 (settings[METHOD]),
-    reducing metrics on the fly.
+def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, terms):
+    """Integrate one point (p: its prepared row, oscillator.prepare) from t = 0 to t_end with
+    SciPy's RK45 or DOP853 (settings[METHOD]), reducing metrics on the fly. base: oscillator's
+    base-excitation switch (None or True).
 
     When `track`, the accumulator's LAST_ABOVE is the last time |q - centre| exceeded
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
@@ -48,7 +49,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
     Qc = np.empty((2, 5))
     y = np.empty(2)
     y_new = np.empty(2)
-    tj.start(p, settings, acc, series)
+    tj.start(p, 0, 1, settings, acc, series, terms)
     while True:
         h = tj.next_attempt(settings, acc)
         if h == 0.0:
@@ -58,13 +59,13 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series):
         K[0, 0] = acc[tj.FQ]
         K[0, 1] = acc[tj.FV]
         if eighth:
-            dop853.rk_step(acc[tj.T], y, h, p, K, y_new)
+            dop853.rk_step(acc[tj.T], y, h, p, K, y_new, terms)
             err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
         else:
-            rk_step(acc[tj.T], y, h, p, K, y_new)
+            rk_step(acc[tj.T], y, h, p, K, y_new, terms)
             err = error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
         buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
-                                series, track, centre, thr_fixed, thr_rel)
+                                series, track, centre, thr_fixed, thr_rel, terms)
     tj.end_series(acc, series)
     return acc, buf
 
@@ -90,8 +91,9 @@ def reject_point(reals, counts, series):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def classify(p, settings, acc, buf, reals, counts):
+def classify(p, o, s, settings, acc, buf, reals, counts, terms):
     """State flag and metrics of a finished trajectory (metrics module); fills reals, counts.
+    p[o + column * s]: the point's prepared row (oscillator.prepare).
 
     A trajectory that came to rest away from zero without oscillating is integrated a second
     time to find when it settled on its final value.
@@ -114,6 +116,8 @@ def classify(p, settings, acc, buf, reals, counts):
     n_ext = int(acc[tj.N_EXT])
     reals[AMPLITUDE] = tail_amp
     reals[PEAK] = peak
+    if terms[BASE_TERM] is not None:
+        reals[ACCELERATION] = acc[tj.ACC_AMP]
     n_max, n_min, period = mt.tail_counts(buf, n_ext, t_tail)
     reals[PERIOD] = period
     band = tol * tail_amp
@@ -138,7 +142,7 @@ def classify(p, settings, acc, buf, reals, counts):
         if mt.tail_trend(buf, n_ext, t_tail, settings[T_END]):
             return mt.UNSETTLED
         return mt.MODULATED
-    if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band and at_rest(p, acc, band):
+    if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band and at_rest(p, o, s, acc, band, terms):
         # At rest away from zero (e.g. post-buckled): its settling time (on the final value)
         # needs a second integration, left to settle_second_pass so that the drivers do not
         # compile the scalar integrator for a case most sweeps never meet.
@@ -149,28 +153,29 @@ def classify(p, settings, acc, buf, reals, counts):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def at_rest(p, acc, band):
+def at_rest(p, o, s, acc, band, terms):
     """Whether the final state (acc's t, q, q') lies within `band` (m) of a stable equilibrium.
 
-    Linearised about the final q: stiffness k = d(force)/dq (`oscillator.stiffness`, at the
-    load's value at t), natural angular frequency w = sqrt(k/m); the
-    equilibrium lies d = static force / k away, and the motion about it has amplitude
-    sqrt(d^2 + (q'/w)^2) (m). At rest when that is <= band. A tail that merely moved little
-    (a run shorter than one natural period 2 pi / w) is not at rest: d is then of the order
-    of q itself. k <= 0 (no stable equilibrium near q): not at rest.
+    Linearised about the final q: stiffness per unit mass k = d(force)/dq / m
+    (`oscillator.stiffness`, at the load's value at t), natural angular frequency
+    w = sqrt(k); the equilibrium lies d = (force / m) / k away, and the motion about it has
+    amplitude sqrt(d^2 + (q'/w)^2) (m). At rest when that is <= band. A tail that merely moved
+    little (a run shorter than one natural period 2 pi / w) is not at rest: d is then of the
+    order of q itself. k <= 0 (no stable equilibrium near q): not at rest. p[o + column * s]:
+    the prepared row.
     """
     t, q, v = acc[tj.T], acc[tj.Q], acc[tj.V]
-    k = stiffness(t, q, p)
+    k = stiffness(t, q, p, o, s)
     if not k > 0.0:
         return False
-    static = -p[MASS] * acceleration(t, q, 0.0, p)      # the restoring force at q, at rest
+    static = -acceleration(t, q, 0.0, p, o, s, None, terms)   # the restoring force at q per mass
     offset = static / k
-    speed = v * math.sqrt(p[MASS] / k)
+    speed = v / math.sqrt(k)
     return math.sqrt(offset * offset + speed * speed) <= band
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, settings, states, reals, counts):
+def settle_second_pass(params, settings, states, reals, counts, terms):
     """Finish the points a driver left as SECOND_PASS (at rest away from zero): integrate
     again to find the final value, then a second time tracking |q - q_final| against the band
     tol * amplitude; the settling time is the last time q was outside it. The state becomes
@@ -180,10 +185,11 @@ def settle_second_pass(params, settings, states, reals, counts):
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
-        p = params[i]
-        first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0))
+        p = np.empty(N_PARAMS)
+        prepare(params[i], p, 0, 1)
+        first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0), terms)
         band = settings[TOL] * first[tj.TAIL_AMP]
-        second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0))
+        second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), terms)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -192,26 +198,29 @@ def settle_second_pass(params, settings, states, reals, counts):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(p, settings, reals, counts, series):
-    """Integrate one point and classify it. Never raises for bad parameters: they give
-    INVALID_INPUT."""
-    if not valid(p):
+def solve_point(row, settings, reals, counts, series, terms):
+    """Integrate the point of parameter row `row` and classify it. Never raises for bad
+    parameters: they give INVALID_INPUT."""
+    if not valid(row):
         reject_point(reals, counts, series)
         return mt.INVALID_INPUT
+    p = np.empty(N_PARAMS)
+    prepare(row, p, 0, 1)
     acc, buf = integrate(p, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                         settings[TOL], series)
-    return classify(p, settings, acc, buf, reals, counts)
+                         settings[TOL], series, terms)
+    return classify(p, 0, 1, settings, acc, buf, reals, counts, terms)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, terms):
     """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
     counts (n, N_COUNTS) int64, series (n, n_samples) q samples at k * SAMPLE_DT (n_samples may
     be 0). Each point's result depends only on its own row. Releases the GIL: the sweep layer
     runs blocks on several threads (sweep.threads). Points left SECOND_PASS are finished by
-    settle_second_pass.
+    settle_second_pass. base: oscillator's base-excitation switch, None or True (True when
+    settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one).
     """
     for i in range(lo, hi):
-        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i])
+        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], terms)

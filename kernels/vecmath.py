@@ -5,7 +5,8 @@ A libm call inside a loop stops LLVM vectorising it; these are straight-line ari
 round with `np.floor`, which stays a float (`math.floor` returns an integer: two vector
 conversions per call, with no single instruction for them before AVX-512):
 
-- `fast_cos(x)`: cos x for |x| < 1e5 (Cody-Waite reduction, fdlibm's kernels);
+- `fast_cos(x)`, `fast_sin(x)`: cos x and sin x for |x| < 1e5 (Cody-Waite reduction, fdlibm's
+  kernels);
 - `inv_fifth_root(x)`: x^(-1/5) for 2^-31 <= x < 2^32 (power-of-two reduction, Newton);
 - `log2_fast(x)`, `exp2_fast(y)`: to about 1e-9, for the step-size controller.
 """
@@ -25,16 +26,31 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def fast_cos(x):
-    """cos(x) without a libm call, to about an ulp for |x| < 1e5 (vectorisable)."""
+def _reduced(x):
+    """(sin r, cos r, quadrant k mod 4 as a float) with x = k pi/2 + r, |r| <= pi/4 (Cody-Waite
+    reduction, fdlibm's kernels); accurate to about an ulp for |x| < 1e5."""
     k = np.floor(x * _TWO_OVER_PI + 0.5)
     r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_2T
     z = r * r
     s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
     c = 1.0 - 0.5 * z + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-    quadrant = k - 4.0 * np.floor(0.25 * k)       # 0, 1, 2, 3 as floats: vectorisable
+    return s, c, k - 4.0 * np.floor(0.25 * k)       # 0, 1, 2, 3 as floats: vectorisable
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def fast_cos(x):
+    """cos(x) without a libm call, to about an ulp for |x| < 1e5 (vectorisable)."""
+    s, c, quadrant = _reduced(x)
     v = s if (quadrant == 1.0) | (quadrant == 3.0) else c
     return -v if (quadrant == 1.0) | (quadrant == 2.0) else v
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def fast_sin(x):
+    """sin(x) without a libm call, to about an ulp for |x| < 1e5 (vectorisable)."""
+    s, c, quadrant = _reduced(x)
+    v = c if (quadrant == 1.0) | (quadrant == 3.0) else s
+    return -v if (quadrant == 2.0) | (quadrant == 3.0) else v
 
 
 # Newton's start for m^(-1/5) on [1, 2) (least squares, |error| < 2e-5).

@@ -86,22 +86,28 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     from sweep.kernels import transverse as tk
     if driver not in ("lanes", "scalar"):
         raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
+    from sweep.kernels import oscillator as osc
+    # Compile-time switches (None or True: one specialisation each, see lanes.solve_block)
+    constant = settings[tk.CONSTANT_STIFFNESS] != 0.0
+    if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
+        raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
+    terms = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
     if driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
-            tk.solve_block(params, settings, lo, hi, states, reals, counts, series)
+            tk.solve_block(params, settings, lo, hi, states, reals, counts, series, terms)
     else:
-        pi = True if settings[tk.CONTROLLER] != 0.0 else None   # see lanes.solve_block
+        pi = True if settings[tk.CONTROLLER] != 0.0 else None
         eighth = True if settings[tk.METHOD] != 0.0 else None
 
         def kernel(lo: int, hi: int) -> None:
             lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi,
-                              eighth)
+                              eighth, terms)
 
     def solve_block(lo: int, hi: int) -> None:
         kernel(lo, hi)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             tk.settle_second_pass(params[lo:hi], settings, states[lo:hi], reals[lo:hi],
-                                  counts[lo:hi])
+                                  counts[lo:hi], terms)
         if on_block is not None:
             on_block(lo, hi)
 
