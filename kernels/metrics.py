@@ -26,28 +26,11 @@ import math
 import numba as nb
 import numpy as np
 
-# One state table for every model kind: an integer never means two things. The longitudinal
-# kernel (kernels/longitudinal.py) imports its flags from here.
-INVALID_INPUT = 0
-DECAYED = 1
-STEADY = 2
-MODULATED = 3
-UNSETTLED = 4
-DIVERGED = 5
-STEP_TOO_SMALL = 6
-MAX_STEPS = 7
-COMPLETED = 8         # longitudinal only: the span reached t_end (it has no settling to judge)
-RUNNING = -1
-SECOND_PASS = -2      # internal: STEADY at rest away from zero, its settling time still to be found
-                      # by transverse.settle_second_pass; never left in a result
-
-# STATE_MEANINGS[flag] is the CF flag_meaning of `flag`.
-STATE_MEANINGS = ("invalid_input", "decayed", "steady", "modulated", "unsettled", "diverged",
-                  "step_size_too_small", "max_steps_reached", "completed")
-# The flags each model kind can produce (its dataset's `state` flag_values).
-TRANSVERSE_STATES = (INVALID_INPUT, DECAYED, STEADY, MODULATED, UNSETTLED, DIVERGED,
-                     STEP_TOO_SMALL, MAX_STEPS)
-LONGITUDINAL_STATES = (INVALID_INPUT, COMPLETED, DIVERGED, MAX_STEPS)
+# The state table lives in kernels/states.py (no Numba: the sweep layer reads it); the kernels
+# import it from here.
+from .states import (COMPLETED, DECAYED, DIVERGED, INVALID_INPUT, LONGITUDINAL_STATES,  # noqa: F401
+                     MAX_STEPS, MODULATED, RUNNING, SECOND_PASS, STATE_MEANINGS, STEADY,
+                     STEP_TOO_SMALL, TRANSVERSE_STATES, UNSETTLED)
 
 # Extremum kinds in the extrema buffer.
 MAXIMUM = 1.0

@@ -65,7 +65,7 @@ def _set_threads(threads: int) -> None:
 
 def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:
     """Empty transverse outputs of n points, by name (the kernel's output arrays)."""
-    from sweep.kernels import transverse as tk
+    from sweep.kernels import layout as tk
     return {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
             "counts": np.empty((n, tk.N_COUNTS), np.int64), "series": np.empty((n, n_samples))}
 
@@ -73,7 +73,7 @@ def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:
 def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
                          n_nodes: int) -> dict[str, np.ndarray]:
     """Empty longitudinal outputs of n spans, by name (the kernel's output arrays)."""
-    from sweep.kernels import longitudinal as lk
+    from sweep.kernels import wave_layout as lk
     return {"states": np.empty(n, np.int8), "reals": np.empty((n, lk.N_REALS)),
             "steps": np.empty(n, np.int64), "hist_u": np.empty((n, n_hist)),
             "hist_f": np.empty((n, n_hist)), "snap_u": np.empty((n, n_snap, n_nodes)),

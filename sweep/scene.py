@@ -116,8 +116,7 @@ PAPER_CABLE: dict[str, tuple[float, ...]] = {
 """The cable data Eq.32 was derived from (Table 1, docs/model.md sec. 1): under
 ``model.coefficients = "paper"`` a scalar key may only repeat one of these values."""
 
-LEVEL_LIMIT = 2.0 ** 62
-"""Most time levels a longitudinal span can count (kernels.longitudinal.LEVEL_LIMIT)."""
+from sweep.kernels.wave_layout import LEVEL_LIMIT  # noqa: E402  (most time levels a span counts)
 
 FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
 DEFAULT_FREQUENCY_RATIO = 1.0
@@ -1332,7 +1331,7 @@ def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -
         return float(pick(axes[axis])) if axis in axes else values[dotted]
 
     transits = values["solver.transits"]
-    # As sweep.longitudinal.wave_parameters computes it: transits x (l / a), a = sqrt(E/rho).
+    # As sweep.models.wave.wave_parameters computes it: transits x (l / a), a = sqrt(E/rho).
     latest = transits * (extreme("cable.length", np.max) / math.sqrt(
         extreme("cable.youngs_modulus", np.min) / extreme("cable.density", np.max)))
     for number, time in enumerate(times, start=1):
@@ -1363,7 +1362,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     """Refuse cable data whose derived coefficients are not finite floats (e.g. density =
     5e-324 makes w1^2 = EI k^4 / (rho A) infinite; E = 1e-300 with rho = 1e308 a zero wave
     speed): computed with the run's own formulas (sweep.models.oscillator,
-    sweep.longitudinal.wave_parameters) at every corner of the grid (each axis at its first
+    sweep.models.wave.wave_parameters) at every corner of the grid (each axis at its first
     and last value). Each coefficient is a product of powers of the parameters (or a sum of
     same-signed ones), so its largest and smallest magnitudes lie at corners."""
     kind = values["model.kind"]
@@ -1380,10 +1379,10 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
         params["frequency"] = None
     with np.errstate(all="ignore"):
         if kind == "longitudinal":
-            from .longitudinal import wave_parameters
+            from .models.wave import wave_parameters
             derived = wave_parameters(params, values["solver.t_end"], values["solver.transits"])
         else:
-            from .models import oscillator
+            from .models.modal import oscillator
             derived = oscillator(params)
     bad = [(name, np.atleast_1d(np.asarray(derived[name], dtype=np.float64)))
            for name in _CHECKED_COEFFICIENTS[kind]]

@@ -176,3 +176,4 @@ def test_summary_counts_states_by_their_flag_values():
     ds = sweep.run(sweep.load_scene("paper-fig7", overrides={"solver.intervals": 50}),
                    progress=False)
     assert _summary(ds, 1.0).endswith("(1 completed)")
+

@@ -1,4 +1,4 @@
-"""Longitudinal sweeps: cable data -> central-difference kernel over every span -> Dataset.
+"""The longitudinal model: cable data -> central-difference kernel over every span -> Dataset.
 
 The span is fixed at x = 0 and loaded by a constant compressive force P0 at x = l from t = 0
 (docs/model.md sec. 4). Exact facts the outputs can be read against: the front travels at
@@ -18,35 +18,16 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from . import grid
-from .dataset import TIME_DIM, counter, derived, elapsed_time, flag_attrs, global_attrs
-from .errors import CableSweepWarning
-from .execute import longitudinal_chunk, longitudinal_outputs
-from .run import check_memory, solve_chunked
-from .scene import Scene
+from .. import grid
+from ..dataset import TIME_DIM, counter, derived, elapsed_time, flag_attrs, global_attrs
+from ..errors import CableSweepWarning
+from ..execute import longitudinal_chunk, longitudinal_outputs
+from ..runner import check_memory, solve_chunked
+from ..scene import Scene
+from .wave import wave_parameters
 
+KIND = "longitudinal"
 
-def wave_parameters(p: dict[str, Any], t_end: float | None, transits: float | None) -> dict:
-    """Per-span kernel parameters and closed-form references (float, array or DataArray).
-
-    p: youngs_modulus (Pa), density (kg/m^3), area (m^2), length (m), load_amplitude (N),
-    divergence_bound (m or None). The end time is t_end (s) or `transits` x l/a.
-    """
-    a = np.sqrt(p["youngs_modulus"] / p["density"])
-    ea = p["youngs_modulus"] * p["area"]
-    transit = p["length"] / a
-    return {
-        "length": p["length"],
-        "wave_speed": a,
-        "axial_stiffness": ea,
-        "load": p["load_amplitude"],
-        "t_end": transits * transit if transits is not None else t_end,
-        "bound": p["divergence_bound"] if p.get("divergence_bound") is not None
-        else p["length"],
-        "transit_time": transit,
-        "static_end_displacement": p["load_amplitude"] * p["length"] / ea,
-        "impedance": p["density"] * p["area"] * a,
-    }
 
 
 _DERIVED = {
@@ -72,7 +53,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
                      output: str | os.PathLike | None = None, resume: bool = False,
                      overwrite: bool = False, scheduler: str | None = None) -> xr.Dataset:
     """The longitudinal (central-difference) sweep of `scene` as a Dataset."""
-    from sweep.kernels import longitudinal as lk
+    from sweep.kernels import wave_layout as lk
 
     coords = grid.coordinates(scene)
     dims = tuple(coords)
@@ -190,3 +171,11 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
     attrs = global_attrs(scene, shape, elapsed, "longitudinal wave, explicit central "
                                                 "difference (Eq.38) with a ghost-node force end")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)
+
+
+def run(scene: Scene, *, threads: int = 0, progress: bool = False,
+        output: str | os.PathLike | None = None, resume: bool = False, overwrite: bool = False,
+        scheduler: str | None = None) -> xr.Dataset:
+    """The model's entry point (sweep.models.model_for): `run_longitudinal`."""
+    return run_longitudinal(scene, threads=threads, progress=progress, output=output,
+                            resume=resume, overwrite=overwrite, scheduler=scheduler)

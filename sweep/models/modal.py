@@ -26,7 +26,7 @@ from typing import Any, Mapping
 import numpy as np
 import xarray as xr
 
-from .schema import STANDARD_GRAVITY
+from ..schema import STANDARD_GRAVITY
 
 # Eq.32 as printed (SI, P0 = 4 N).
 PAPER_LOAD = 4.0                      # N, the load Eq.32 was printed for

@@ -1,0 +1,26 @@
+"""The state table: the integer flag of every grid point's outcome, one table for every model
+kind (an integer never means two things). Plain constants, no Numba: the sweep layer reads
+them (dataset flags, scene rules) without compiling or importing a kernel. Their meanings are
+in kernels/metrics.py's docstring and docs/architecture.md.
+"""
+
+INVALID_INPUT = 0
+DECAYED = 1
+STEADY = 2
+MODULATED = 3
+UNSETTLED = 4
+DIVERGED = 5
+STEP_TOO_SMALL = 6
+MAX_STEPS = 7
+COMPLETED = 8         # longitudinal only: the span reached t_end (it has no settling to judge)
+RUNNING = -1
+SECOND_PASS = -2      # internal: STEADY at rest away from zero, its settling time still to be found
+                      # by transverse.settle_second_pass; never left in a result
+
+# STATE_MEANINGS[flag] is the CF flag_meaning of `flag`.
+STATE_MEANINGS = ("invalid_input", "decayed", "steady", "modulated", "unsettled", "diverged",
+                  "step_size_too_small", "max_steps_reached", "completed")
+# The flags each model kind can produce (its dataset's `state` flag_values).
+TRANSVERSE_STATES = (INVALID_INPUT, DECAYED, STEADY, MODULATED, UNSETTLED, DIVERGED,
+                     STEP_TOO_SMALL, MAX_STEPS)
+LONGITUDINAL_STATES = (INVALID_INPUT, COMPLETED, DIVERGED, MAX_STEPS)

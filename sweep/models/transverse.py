@@ -1,0 +1,257 @@
+"""The transverse model: the modal oscillator of the span (RK45 or DOP853 kernels).
+
+Its pieces, in the order a run uses them: the kernel settings of a scene (`settings_vector`),
+the parameter rows of any set of grid points (coefficients from sweep/models/modal.py), the
+kernel over chunks of points through the generic runner (sweep/runner.py), and the result
+Dataset (`assemble`): the output variables with their units and long names, the derived
+closed forms, the state flags. docs/model.md secs. 2, 3 and 5 are its mathematics.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from sweep.kernels import layout as tk        # plain constants: no Numba is imported
+from sweep.kernels import states as km
+
+from .. import grid
+from ..dataset import TIME_DIM, counter, derived, elapsed_time, flag_attrs, global_attrs
+from ..runner import check_memory, placer, point_order, solve_chunked
+from ..scene import Scene
+from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
+from . import modal
+
+KIND = "transverse"
+ATOL_SCALE = 0.01              # default atol: this x rtol x each point's own scales (m, m/s)
+
+# name -> (kernel column, units, long_name, scene output switch)
+_REALS = {
+    "amplitude": (tk.AMPLITUDE, "m", "max |q| over the tail window (midspan deflection)",
+                  "outputs.amplitude"),
+    "peak_amplitude": (tk.PEAK, "m", "max |q| over the whole run (overshoot)",
+                       "outputs.peak_amplitude"),
+    "settling_time": (tk.SETTLING, "s", "time after which every envelope peak stays within "
+                      "+-tolerance of its final level (decayed: last time |q| > tolerance * peak)",
+                      "outputs.settling_time"),
+    "response_period": (tk.PERIOD, "s", "mean time between maxima of q in the tail window",
+                        "outputs.response_period"),
+    "failure_time": (tk.FAILURE_TIME, "s", "time at which a diverged or failed point stopped",
+                     None),
+}
+_COUNTS = {
+    "n_steps": (tk.STEPS, "accepted {method} steps"),
+    "n_rejected": (tk.REJECTED, "rejected {method} step attempts"),
+    "n_rhs": (tk.RHS_EVALS, "right-hand-side evaluations"),
+}
+# solver.method -> how the source attribute and the counters name the integrator.
+METHODS = {"rk45": ("RK45", "Dormand-Prince 5(4) (RK45)"),
+           "dop853": ("DOP853", "Dormand-Prince 8(5,3) (DOP853)")}
+CONTROLLERS = {"scipy": "SciPy's step-size control", "pi": "PI (Gustafsson) step-size control"}
+_DERIVED = {
+    "natural_frequency": ("Hz", "first linear natural frequency of the unloaded span"),
+    "buckling_load": ("N", "Euler buckling load of the span (paper: implied by Eq.32)"),
+    "load_ratio": ("1", "load amplitude over buckling load, P0/Pcr"),
+    "load_frequency": ("Hz", "load frequency W/(2 pi)"),
+    "escape_barrier": ("m", "|q| beyond which the softening quintic lets the span escape, "
+                            "for the mean (harmonic) or constant load; NaN: no barrier, or one "
+                            "beyond the model's range (mode slope pi q_b / l > 1)"),
+}
+# Scenes with [base] (docs/model.md sec. 5): the excitation in both spellings (each stored
+# only where it is not an axis: then the axis is its coordinate) and closed forms.
+_BASE_DERIVED = {
+    **{axis: (BY_AXIS[axis].units, BY_AXIS[axis].long_name)
+       for axis in ("base_acceleration", "base_acceleration_g", "base_frequency",
+                    "base_frequency_ratio")},
+    "linear_amplitude": ("m", "steady midspan amplitude of the linearised span (no load, "
+                              "K3 = K5 = 0), (4/pi) A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2); "
+                              "NaN: unbounded (undamped at resonance)"),
+    "resonance_amplification": ("1", "linear resonance amplification Q = 1/(2 zeta): peak "
+                                     "amplitude over the quasi-static (4/pi) A / w1^2; NaN: "
+                                     "undamped"),
+}
+
+
+@dataclass
+class KernelResult:
+    """Flat per-point kernel outputs, in grid (C) order."""
+    states: np.ndarray      # int8 state flags
+    reals: np.ndarray       # (n, kernels.transverse.N_REALS)
+    counts: np.ndarray      # (n, kernels.transverse.N_COUNTS) int64
+    series: np.ndarray      # (n, n_samples) q samples (m); n_samples may be 0
+    sample_times: np.ndarray
+
+
+def sample_times(t_end: float, dt: float) -> np.ndarray:
+    """k * dt for every k with k * dt <= t_end (s); computed as the kernel computes them."""
+    n = int(math.floor(t_end / dt)) + 1
+    k = np.arange(max(n - 2, 0), n + 2)
+    return np.arange(int(k[k * dt <= t_end][-1]) + 1) * dt
+
+
+def settings_vector(scene: Scene) -> np.ndarray:
+    """The kernel's settings vector (kernels.transverse) from the scene's solver/metrics keys.
+
+    solver.atol given: that absolute tolerance for q (m) and q' (m/s), as SciPy's scalar atol.
+    Not given: each point's own, ATOL_SCALE x rtol x its displacement and velocity scales
+    (sweep.models.state_scale), so results do not depend on the response's size.
+    BASE is 1.0 for a scene with base excitation ([base]): the kernel then adds the forcing
+    term and computes the absolute acceleration.
+    """
+    s = np.zeros(tk.N_SETTINGS)
+    s[tk.RTOL] = scene.get("solver.rtol")
+    atol = scene.get("solver.atol")
+    s[tk.ATOL] = 0.0 if atol is None else atol
+    s[tk.ATOL_SCALE] = ATOL_SCALE if atol is None else 0.0
+    s[tk.T_END] = scene.get("solver.t_end")
+    s[tk.MAX_STEPS] = scene.get("solver.max_steps")
+    s[tk.MAX_STEP] = scene.get("solver.max_step") or math.inf
+    s[tk.FIRST_STEP] = scene.get("solver.first_step") or 0.0
+    s[tk.TAIL] = scene.get("metrics.tail")
+    s[tk.TOL] = scene.get("metrics.tolerance")
+    s[tk.SAMPLE_DT] = scene.get("outputs.sample_interval") or scene.get("solver.t_end") / 1000.0
+    s[tk.WANT_SETTLING] = 1.0 if scene.get("outputs.settling_time") else 0.0
+    s[tk.MIN_STEP] = scene.get("solver.min_step") or 0.0
+    s[tk.CONTROLLER] = 1.0 if scene.get("solver.controller") == "pi" else 0.0
+    s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
+    if scene.has_base:                  # else 0.0: no forcing term compiled
+        s[tk.BASE] = 1.0
+    return s
+
+
+def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
+                 threads: int = 0, progress: bool = False,
+                 chunk_size: int | None = None, driver: str = "lanes") -> KernelResult:
+    """Run the transverse kernel over the rows of `params` in-process (grid order in, grid
+    order out). driver: "lanes" (kernels.lanes, lock-step SIMD) or "scalar"
+    (kernels.transverse, one trajectory per iteration); the two agree to round-off."""
+    from ..execute import default_chunk_size, execute, transverse_chunk, transverse_outputs
+    n = params.shape[0]
+    order = point_order(n)
+    outputs = transverse_outputs(n, n_samples)
+    execute(transverse_chunk, lambda lo, hi: np.ascontiguousarray(params[order[lo:hi]]), n,
+            (settings, n_samples, driver), placer(outputs, order),
+            chunk_size=chunk_size or default_chunk_size(n, "threads", 0),
+            threads=threads, progress=progress)
+    return KernelResult(outputs["states"], outputs["reals"], outputs["counts"],
+                        outputs["series"], np.empty(0))
+
+
+def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
+                   output: str | os.PathLike | None = None, resume: bool = False,
+                   overwrite: bool = False, scheduler: str | None = None) -> xr.Dataset:
+    """The transverse (RK45) sweep of `scene` as a Dataset."""
+    from sweep.kernels.oscillator import PARAM_NAMES
+
+    coords = grid.coordinates(scene)
+    dims = tuple(coords)
+    shape = tuple(coords[d].size for d in dims)
+    settings = settings_vector(scene)
+    times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
+             if scene.get("outputs.time_series") else np.empty(0))
+    n_points = int(np.prod(shape, dtype=np.int64))
+    # Outputs (and their Dataset copies), the solve order and a few derived quantities: the
+    # parameter rows are built chunk by chunk and never held for the whole grid.
+    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + times.size)) + 40,
+                 "metrics and time series")
+    params = grid.parameters(scene, coords)
+    coeffs = modal.oscillator(params)          # derived quantities, on the axes they need
+    # No time-varying stiffness anywhere (a constant or zero end load): the kernels leave the
+    # cos(W t) terms out (the same results, bit for bit, and a cheaper right-hand side).
+    varying = any(bool(np.any(np.asarray(coeffs[c]) != 0.0)) for c in ("k1", "g1"))
+    settings[tk.CONSTANT_STIFFNESS] = 0.0 if varying else 1.0
+
+    def rows_at(points: np.ndarray) -> np.ndarray:
+        at = grid.point_values(params, dims, shape, points)
+        return grid.rows(modal.oscillator(at), PARAM_NAMES, points.size)
+
+    started = time.perf_counter()
+    from ..execute import transverse_chunk, transverse_outputs
+    out = solve_chunked(scene, transverse_chunk, rows_at,
+                        (settings, times.size, scene.get("solver.driver")),
+                        transverse_outputs(n_points, times.size),
+                        output=output, resume=resume, overwrite=overwrite, threads=threads,
+                        progress=progress, scheduler=scheduler)
+    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"], times)
+    return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)
+def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
+                 level: xr.DataArray) -> dict[str, xr.DataArray]:
+    """The outputs of base excitation: the kernel's absolute midspan acceleration amplitude
+    max |q'' + a_b| over the tail window (m s-2, over `dims`), the same in g, and the
+    transmissibility, that over the base level A (`level`, m s-2, over some of `dims`; NaN
+    where A = 0). Like `amplitude`, NaN where the point failed."""
+    absolute = xr.DataArray(acceleration, dims=dims, attrs={
+        "units": "m s-2",
+        "long_name": "absolute midspan acceleration amplitude, max |q'' + a_b| over the tail "
+                     "window"})
+    in_g = xr.DataArray(acceleration / STANDARD_GRAVITY, dims=dims, attrs={
+        "units": G_UNITS,
+        "long_name": f"absolute midspan acceleration amplitude in g ({STANDARD_GRAVITY:g} "
+                     "m s-2)"})
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = xr.where(level > 0, absolute / level, np.nan).transpose(*dims)
+    ratio.attrs = {"units": "1", "long_name": "transmissibility: absolute midspan "
+                                               "acceleration amplitude over the base level A"}
+    return {"absolute_acceleration": absolute, "absolute_acceleration_g": in_g,
+            "transmissibility": ratio}
+
+
+def state_attrs() -> dict[str, Any]:
+    """CF flag attributes of the transverse `state` variable."""
+    return {
+        **flag_attrs(km.TRANSVERSE_STATES),
+        "long_name": "response state of the point",
+        "comment": "decayed/steady have a settling time; modulated (beating, quasi-periodic), "
+                   "unsettled (still drifting at t_end: lengthen solver.t_end) and the failure "
+                   "states have NaN",
+    }
+
+
+def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ...],
+             coeffs: dict[str, Any], result: "KernelResult", elapsed: float) -> xr.Dataset:
+    """Build the result Dataset of the contract from the flat kernel result."""
+    dims = tuple(coords)
+    short, method = METHODS[scene.get("solver.method")]
+    data: dict[str, xr.DataArray] = {}
+    data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims, attrs=state_attrs())
+    for name, (col, units, long_name, switch) in _REALS.items():
+        if switch is None or scene.get(switch):
+            data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
+                                      attrs={"units": units, "long_name": long_name})
+    if scene.get("outputs.solver_stats"):
+        for name, (col, long_name) in _COUNTS.items():
+            data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
+                                      attrs={"units": "1",
+                                             "long_name": long_name.format(method=short)})
+    for name, (units, long_name) in (_DERIVED | (_BASE_DERIVED if scene.has_base else {})
+                                     ).items():
+        if name in coeffs and name not in coords:
+            data[name] = derived(coeffs[name], coords)
+            data[name].attrs = {"units": units, "long_name": long_name}
+    if scene.has_base and scene.get("outputs.absolute_acceleration"):
+        data.update(base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
+                                 derived(coeffs["base_accel"], coords)))
+    all_coords: dict[str, Any] = dict(coords)
+    if result.series.shape[1] > 0:
+        all_coords[TIME_DIM] = elapsed_time(result.sample_times)
+        data["displacement"] = xr.DataArray(
+            result.series.reshape(shape + (result.series.shape[1],)), dims=dims + (TIME_DIM,),
+            attrs={"units": "m", "long_name": "midspan deflection q(t)"})
+    attrs = global_attrs(scene, shape, elapsed,
+                         f"transverse modal oscillator, {method}, "
+                         f"{CONTROLLERS[scene.get('solver.controller')]}")
+    return xr.Dataset(data, coords=all_coords, attrs=attrs)
+
+
+def run(scene: Scene, *, threads: int = 0, progress: bool = False,
+        output: str | os.PathLike | None = None, resume: bool = False, overwrite: bool = False,
+        scheduler: str | None = None) -> xr.Dataset:
+    """The model's entry point (sweep.models.model_for): `run_transverse`."""
+    return run_transverse(scene, threads=threads, progress=progress, output=output,
+                          resume=resume, overwrite=overwrite, scheduler=scheduler)

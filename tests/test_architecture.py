@@ -1,0 +1,98 @@
+"""The layering the architecture promises (docs/architecture.md): no import cycles among the
+sweep modules, kernels/ free of the sweep layer and of I/O, and `import sweep` free of Numba."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _modules(folder: Path, package: str) -> dict[str, Path]:
+    found = {}
+    for path in sorted(folder.rglob("*.py")):
+        parts = path.relative_to(folder).with_suffix("").parts
+        name = ".".join((package,) + parts).removesuffix(".__init__")
+        found[name] = path
+    return found
+
+
+def _imports(name: str, path: Path, known: dict[str, Path]) -> set[str]:
+    """Every module of `known` that `name` imports, at module level or inside a function (a
+    lazy import is still a dependency). `from . import x` counts as importing the submodule x,
+    not the package being initialised."""
+    package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            subs = [f"{target}.{a.name}" for a in node.names if f"{target}.{a.name}" in known]
+            names = subs if len(subs) == len(node.names) else [target, *subs]
+        elif isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            continue
+        out |= {n for n in names if n in known and n != name}
+    return out
+
+
+def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One import cycle of `graph`, or None."""
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def visit(v: str) -> list[str] | None:
+        state[v] = 1
+        path.append(v)
+        for w in sorted(graph[v]):
+            if state.get(w) == 1:
+                return path[path.index(w):] + [w]
+            if w not in state and (found := visit(w)):
+                return found
+        state[v] = 2
+        path.pop()
+        return None
+
+    for v in sorted(graph):
+        if v not in state and (found := visit(v)):
+            return found
+    return None
+
+
+def test_the_sweep_modules_import_each_other_without_cycles():
+    known = _modules(ROOT / "sweep", "sweep")
+    graph = {name: _imports(name, path, known) for name, path in known.items()}
+    assert _cycle(graph) is None, " -> ".join(_cycle(graph))
+    # and the test can see a cycle: one added edge closes run -> models.transverse -> run
+    graph["sweep.models.transverse"].add("sweep.run")
+    assert _cycle(graph) is not None
+
+
+def test_kernels_import_neither_the_sweep_layer_nor_io():
+    for path in sorted((ROOT / "kernels").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level
+                     else [])
+            for n in names:
+                top = n.split(".")[0]
+                assert top not in ("sweep", "xarray", "dask", "netCDF4", "matplotlib", "os",
+                                   "pathlib", "io"), f"{path.name} imports {n}"
+
+
+def test_importing_sweep_does_not_import_numba():
+    """`import sweep` (and so `import sweep.errors`, the scene, dataset and model layers)
+    imports no Numba: the kernels' layouts and state table are plain constants
+    (kernels/layout.py, states.py, wave_layout.py); Numba is imported when a kernel runs."""
+    code = ("import sys, sweep.errors, sweep, sweep.scene, sweep.dataset, sweep.models, "
+            "sweep.models.transverse, sweep.models.longitudinal; "
+            "print(sorted(m for m in sys.modules if m == 'numba' or m.startswith('numba.')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout
