@@ -6,6 +6,7 @@ with these."""
 from __future__ import annotations
 
 import datetime as _dt
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -50,21 +51,40 @@ def derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
     return xr.DataArray(float(values))
 
 
-def global_attrs(scene: Scene, shape: tuple[int, ...], elapsed: float,
+@dataclass(frozen=True)
+class Provenance:
+    """What a result says about where it came from, resolved once from its scene
+    (`provenance`): its name, description and source, the resolved scene text, the model kind
+    and coefficient set."""
+    title: str
+    description: str
+    source: str
+    scene_text: str
+    kind: str
+    coefficients: str
+
+
+def provenance(scene: Scene) -> Provenance:
+    """The Provenance of a result of `scene`."""
+    return Provenance(scene.name, scene.description, scene.source, scene.to_toml(),
+                      scene.get("model.kind"), scene.get("model.coefficients"))
+
+
+def global_attrs(origin: Provenance, shape: tuple[int, ...], elapsed: float,
                  method: str) -> dict[str, Any]:
     """The dataset's global attributes: CF conventions, provenance and the resolved scene."""
     version = package_version()
     now = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     return {
-        "title": scene.name,
-        "description": scene.description,
+        "title": origin.title,
+        "description": origin.description,
         "Conventions": CONVENTIONS,
         "source": f"cable-sweep {version}: {method}",
-        "history": f"{now} created by cable-sweep {version} from scene '{scene.source}'",
+        "history": f"{now} created by cable-sweep {version} from scene '{origin.source}'",
         "cable_sweep_version": version,
-        "scene": scene.to_toml(),
-        "model_kind": scene.get("model.kind"),
-        "coefficients": scene.get("model.coefficients"),
+        "scene": origin.scene_text,
+        "model_kind": origin.kind,
+        "coefficients": origin.coefficients,
         "run_seconds": float(elapsed),
         "n_points": counter(np.prod(shape, dtype=np.int64))[()],
     }

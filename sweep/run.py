@@ -23,7 +23,7 @@ from .scene import Scene
 from .models.transverse import (ATOL_SCALE, KernelResult, sample_times,  # noqa: F401,E402
                                 settings_vector, solve_points)
 from .runner import (available_memory, check_disk, check_memory, grid_order,  # noqa: F401,E402
-                     point_order)
+                     point_order, run_options)
 
 
 def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: bool = False,
@@ -59,8 +59,8 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         remove_stale_temporaries(output)            # of a write that was killed
     from .store import ChunkStore
     try:
-        model = models.model_for(scene.get("model.kind"))
-        ds = model.run(scene, threads=threads, progress=progress, **persist)
+        options = run_options(scene, threads=threads, progress=progress, **persist)
+        ds = models.model_for(scene.get("model.kind")).run(scene, options)
         if output is not None:
             write_netcdf(ds, output, overwrite)
             ChunkStore(output, "").remove()

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -22,6 +23,41 @@ from .scene import Scene
 from .version import package_version
 
 _PERMUTATION_SEED = 20261121   # fixed: the point order never changes any point's result
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How a run executes, resolved once (`run_options`) from the scene's run.* keys and the
+    caller's arguments: nothing here changes a result.
+
+    backend "threads" | "dask"; workers: dask LocalCluster processes (0: one per core);
+    chunk_size: points per kernel call or task (None: chosen from the grid); threads: worker
+    threads (0: all cores); progress: a bar on stderr; scheduler: an existing dask scheduler's
+    address (the caller's, never a scene's); output: the netCDF path whose chunk store keeps
+    finished chunks (None: no store); resume, overwrite: as sweep.run's; fingerprint: what
+    decides the results (`run_fingerprint`), which a chunk store must match.
+    """
+    backend: str = "threads"
+    workers: int = 0
+    chunk_size: int | None = None
+    threads: int = 0
+    progress: bool = False
+    scheduler: str | None = None
+    output: str | os.PathLike | None = None
+    resume: bool = False
+    overwrite: bool = False
+    fingerprint: str = ""
+
+
+def run_options(scene: Scene, *, threads: int = 0, progress: bool = False,
+                output: str | os.PathLike | None = None, resume: bool = False,
+                overwrite: bool = False, scheduler: str | None = None) -> RunOptions:
+    """The RunOptions of running `scene` with sweep.run's arguments (a scheduler forces the
+    dask backend)."""
+    return RunOptions(backend="dask" if scheduler else scene.get("run.backend"),
+                      workers=scene.get("run.workers"), chunk_size=scene.get("run.chunk_size"),
+                      threads=threads, progress=progress, scheduler=scheduler, output=output,
+                      resume=resume, overwrite=overwrite, fingerprint=run_fingerprint(scene))
 
 
 def available_memory(root: str = "/") -> tuple[float, str] | None:
@@ -122,37 +158,32 @@ def run_fingerprint(scene: Scene) -> str:
     return fingerprint(sorted(values.items()), sorted(axes.items()), package_version())
 
 
-def solve_chunked(scene: Scene, chunk_fn: Callable[..., dict],
+def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
                   rows_at: Callable[[np.ndarray], np.ndarray], args: tuple,
-                  outputs: dict[str, np.ndarray], *, output: str | os.PathLike | None = None,
-                  resume: bool = False, overwrite: bool = False, threads: int = 0,
-                  progress: bool = False,
-                  scheduler: str | None = None) -> dict[str, np.ndarray]:
-    """Solve every grid point in chunks on the scene's backend (on the dask cluster at
-    `scheduler` when the caller gives one), filling `outputs` (grid order, first axis =
-    points). rows_at(flat indices) gives the kernel's parameter rows of those points. With
-    `output`, every finished chunk is persisted next to it and, when resuming, only the missing
-    chunks are computed."""
+                  outputs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Solve every grid point in chunks as `options` say (backend, threads, chunk store),
+    filling `outputs` (grid order, first axis = points): chunk_fn(rows, *args) is the model's
+    kernel call, rows_at(flat indices) the model's parameter rows of those points. With an
+    output path every finished chunk is persisted next to it and, when resuming, only the
+    missing chunks are computed."""
     from .execute import default_chunk_size, execute
     from .store import ChunkStore
     n = next(iter(outputs.values())).shape[0]
     order = point_order(n)
-    backend = "dask" if scheduler else scene.get("run.backend")
-    workers = scene.get("run.workers")
-    chunk = scene.get("run.chunk_size") or default_chunk_size(n, backend, workers or
-                                                              (os.cpu_count() or 1))
+    chunk = options.chunk_size or default_chunk_size(n, options.backend, options.workers or
+                                                     (os.cpu_count() or 1))
     store = None
     done: dict = {}
-    if output is not None:
-        store = ChunkStore(output, run_fingerprint(scene))
-        done, chunk = store.open(resume, overwrite, chunk, points=n)
+    if options.output is not None:
+        store = ChunkStore(options.output, options.fingerprint)
+        done, chunk = store.open(options.resume, options.overwrite, chunk, points=n)
         check_disk(store, sum(v.nbytes for v in outputs.values()) / max(n, 1))
     computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args,
                        placer(outputs, order),
-                       chunk_size=chunk, backend=backend, threads=threads,
-                       scheduler=scheduler, workers=workers,
-                       progress=progress, store=store, done=done)
-    if resume:
+                       chunk_size=chunk, backend=options.backend, threads=options.threads,
+                       scheduler=options.scheduler, workers=options.workers,
+                       progress=options.progress, store=store, done=done)
+    if options.resume:
         sys.stderr.write(f"resumed: {n - computed:,} of {n:,} points were already done, "
                          f"{computed:,} computed\n")
     return outputs

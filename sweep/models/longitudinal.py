@@ -10,19 +10,20 @@ Sign convention: tension positive, so the compressive forces here are negative.
 from __future__ import annotations
 
 import math
-import os
 import time
 import warnings
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from .. import grid
-from ..dataset import TIME_DIM, counter, derived, elapsed_time, flag_attrs, global_attrs
+from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, flag_attrs,
+                       global_attrs, provenance)
 from ..errors import CableSweepWarning
 from ..execute import longitudinal_chunk, longitudinal_outputs
-from ..runner import check_memory, solve_chunked
+from ..runner import RunOptions, check_memory, solve_chunked
 from ..scene import Scene
 from .wave import wave_parameters
 
@@ -37,9 +38,47 @@ _DERIVED = {
 }
 
 
-def _snapshot_times(scene: Scene) -> np.ndarray:
+@dataclass(frozen=True)
+class Inputs:
+    """A longitudinal scene resolved once (`resolve`); nothing after it reads the scene.
+
+    coords, dims, shape, params: the grid and its parameters (grid.coordinates, .parameters);
+    intervals, courant: solver.intervals, solver.courant; t_end (s) or transits (in l/a):
+    the end time; max_levels: solver.max_steps; snapshot_times (s); histories, normalised:
+    the outputs.* switches; sample_interval (s, or None: t_end/1000); origin: provenance.
+    """
+    coords: dict[str, xr.DataArray]
+    dims: tuple[str, ...]
+    shape: tuple[int, ...]
+    params: dict[str, Any]
+    intervals: int
+    courant: float
+    t_end: float | None
+    transits: float | None
+    max_levels: int
+    snapshot_times: np.ndarray
+    histories: bool
+    normalised: bool
+    sample_interval: float | None
+    origin: Provenance
+
+
+def resolve(scene: Scene) -> Inputs:
+    """The Inputs of a longitudinal scene: the only place this model reads it."""
+    coords = grid.coordinates(scene)
+    dims = tuple(coords)
     times = scene.get("outputs.snapshot_times")
-    return np.asarray(times if times is not None else (), dtype=float)
+    return Inputs(coords=coords, dims=dims, shape=tuple(coords[d].size for d in dims),
+                  params=grid.parameters(scene, coords),
+                  intervals=int(scene.get("solver.intervals")),
+                  courant=float(scene.get("solver.courant")), t_end=scene.get("solver.t_end"),
+                  transits=scene.get("solver.transits"),
+                  max_levels=scene.get("solver.max_steps"),
+                  snapshot_times=np.asarray(times if times is not None else (), dtype=float),
+                  histories=bool(scene.get("outputs.histories")),
+                  normalised=bool(scene.get("outputs.normalised")),
+                  sample_interval=scene.get("outputs.sample_interval"),
+                  origin=provenance(scene))
 
 
 def _warn_courant(courant: float) -> None:
@@ -49,31 +88,28 @@ def _warn_courant(courant: float) -> None:
                       CableSweepWarning, stacklevel=3)
 
 
-def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
-                     output: str | os.PathLike | None = None, resume: bool = False,
-                     overwrite: bool = False, scheduler: str | None = None) -> xr.Dataset:
-    """The longitudinal (central-difference) sweep of `scene` as a Dataset."""
+def run(scene: Scene, options: RunOptions) -> xr.Dataset:
+    """The longitudinal (central-difference) sweep of `scene` as a Dataset, run as `options`
+    say: the model's entry point (sweep.models.model_for)."""
     from sweep.kernels import wave_layout as lk
 
-    coords = grid.coordinates(scene)
-    dims = tuple(coords)
-    shape = tuple(coords[d].size for d in dims)
+    inputs = resolve(scene)
+    coords, dims, shape = inputs.coords, inputs.dims, inputs.shape
     n = int(np.prod(shape, dtype=np.int64))
-    n_int = int(scene.get("solver.intervals"))
-    courant = float(scene.get("solver.courant"))
-    snap_times = _snapshot_times(scene)
+    n_int = inputs.intervals
+    courant = inputs.courant
+    snap_times = inputs.snapshot_times
     n_snap = snap_times.size
-    fields = 5 if scene.get("outputs.normalised") else 3
+    fields = 5 if inputs.normalised else 3
     # Histories need the longest end time; check the snapshots' size before that.
     check_memory(n, 3.0 * 8 * (lk.N_PARAMS + lk.N_REALS + 1 + fields * n_snap * (n_int + 1)),
                  "parameters, metrics and snapshots")
-    params = grid.parameters(scene, coords)
-    waves = wave_parameters(params, scene.get("solver.t_end"), scene.get("solver.transits"))
+    waves = wave_parameters(inputs.params, inputs.t_end, inputs.transits)
     table = grid.flatten(waves, lk.PARAM_NAMES, dims, shape)
     _warn_courant(courant)
     t_max = float(np.max(table[:, lk.T_END])) if n else 0.0
-    dt_sample = scene.get("outputs.sample_interval") or t_max / 1000.0
-    n_hist = int(math.floor(t_max / dt_sample + 1e-9)) + 1 if scene.get("outputs.histories") else 0
+    dt_sample = inputs.sample_interval or t_max / 1000.0
+    n_hist = int(math.floor(t_max / dt_sample + 1e-9)) + 1 if inputs.histories else 0
     check_memory(n, 3.0 * 8 * (lk.N_PARAMS + lk.N_REALS + 1 + 2 * n_hist
                                + fields * n_snap * (n_int + 1)),
                  "parameters, metrics, histories and snapshots")
@@ -81,15 +117,13 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
     settings[lk.INTERVALS] = n_int
     settings[lk.COURANT] = courant
     settings[lk.SAMPLE_DT] = dt_sample
-    settings[lk.MAX_LEVELS] = scene.get("solver.max_steps")
+    settings[lk.MAX_LEVELS] = inputs.max_levels
 
     started = time.perf_counter()
     n_nodes = n_int + 1
-    out = solve_chunked(scene, longitudinal_chunk, lambda points: table[points],
+    out = solve_chunked(options, longitudinal_chunk, lambda points: table[points],
                         (settings, snap_times, n_hist, n_nodes),
-                        longitudinal_outputs(n, n_hist, n_snap, n_nodes),
-                        output=output, resume=resume, overwrite=overwrite, threads=threads,
-                        progress=progress, scheduler=scheduler)
+                        longitudinal_outputs(n, n_hist, n_snap, n_nodes))
     elapsed = time.perf_counter() - started
     states, reals, steps, hist_u, hist_f = (out[k] for k in ("states", "reals", "steps",
                                                               "hist_u", "hist_f"))
@@ -159,7 +193,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
         for (name, units, long_name), values in zip(names, snaps):
             data[name] = xr.DataArray(field(values), dims=sdims,
                                       attrs={"units": units, "long_name": long_name})
-        if scene.get("outputs.normalised"):
+        if inputs.normalised:
             load = xr.DataArray(field(table[:, lk.LOAD]), dims=dims)
             impedance = grid.flatten(waves, ("impedance",), dims, shape)[:, 0]
             impedance = xr.DataArray(field(impedance), dims=dims)
@@ -168,14 +202,7 @@ def run_longitudinal(scene: Scene, threads: int = 0, progress: bool = False,
             data["snapshot_velocity_ratio"] = (
                 data["snapshot_velocity"] * impedance / load).assign_attrs(
                 units="1", long_name="velocity in units of P0/(rho A a), v rho A a / P0")
-    attrs = global_attrs(scene, shape, elapsed, "longitudinal wave, explicit central "
+    attrs = global_attrs(inputs.origin, shape, elapsed, "longitudinal wave, explicit central "
                                                 "difference (Eq.38) with a ghost-node force end")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)
 
-
-def run(scene: Scene, *, threads: int = 0, progress: bool = False,
-        output: str | os.PathLike | None = None, resume: bool = False, overwrite: bool = False,
-        scheduler: str | None = None) -> xr.Dataset:
-    """The model's entry point (sweep.models.model_for): `run_longitudinal`."""
-    return run_longitudinal(scene, threads=threads, progress=progress, output=output,
-                            resume=resume, overwrite=overwrite, scheduler=scheduler)

@@ -10,7 +10,6 @@ closed forms, the state flags. docs/model.md secs. 2, 3 and 5 are its mathematic
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -22,8 +21,9 @@ from sweep.kernels import layout as tk        # plain constants: no Numba is imp
 from sweep.kernels import states as km
 
 from .. import grid
-from ..dataset import TIME_DIM, counter, derived, elapsed_time, flag_attrs, global_attrs
-from ..runner import check_memory, placer, point_order, solve_chunked
+from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, flag_attrs,
+                       global_attrs, provenance)
+from ..runner import RunOptions, check_memory, placer, point_order, solve_chunked
 from ..scene import Scene
 from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
 from . import modal
@@ -143,24 +143,61 @@ def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
                         outputs["series"], np.empty(0))
 
 
-def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
-                   output: str | os.PathLike | None = None, resume: bool = False,
-                   overwrite: bool = False, scheduler: str | None = None) -> xr.Dataset:
-    """The transverse (RK45) sweep of `scene` as a Dataset."""
-    from sweep.kernels.oscillator import PARAM_NAMES
+@dataclass(frozen=True)
+class Inputs:
+    """A transverse scene resolved once (`resolve`) into what the model's steps need; nothing
+    after `resolve` reads the scene.
 
+    coords, dims, shape: the grid (one coordinate per axis, scene order); params: the
+    parameters by axis name (scalars, or DataArrays over their own axes; grid.parameters);
+    settings: the kernel settings vector (`settings_vector`); sample_times: the time-series
+    sample times (s; empty when none are stored); driver, method, controller: solver.driver,
+    solver.method, solver.controller; wanted: the outputs.* switches that are on (dotted
+    keys); has_base: the scene has base excitation; origin: its provenance.
+    """
+    coords: dict[str, xr.DataArray]
+    dims: tuple[str, ...]
+    shape: tuple[int, ...]
+    params: dict[str, Any]
+    settings: np.ndarray
+    sample_times: np.ndarray
+    driver: str
+    method: str
+    controller: str
+    wanted: frozenset[str]
+    has_base: bool
+    origin: Provenance
+
+
+def resolve(scene: Scene) -> Inputs:
+    """The Inputs of a transverse scene: the only place this model reads it."""
     coords = grid.coordinates(scene)
     dims = tuple(coords)
-    shape = tuple(coords[d].size for d in dims)
     settings = settings_vector(scene)
+    wanted = frozenset(k for k in scene.values if k.startswith("outputs.") and scene.get(k) is True)
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
-             if scene.get("outputs.time_series") else np.empty(0))
+             if "outputs.time_series" in wanted else np.empty(0))
+    return Inputs(coords=coords, dims=dims, shape=tuple(coords[d].size for d in dims),
+                  params=grid.parameters(scene, coords), settings=settings, sample_times=times,
+                  driver=scene.get("solver.driver"), method=scene.get("solver.method"),
+                  controller=scene.get("solver.controller"), wanted=wanted,
+                  has_base=scene.has_base, origin=provenance(scene))
+
+
+def run(scene: Scene, options: RunOptions) -> xr.Dataset:
+    """The transverse sweep of `scene` as a Dataset, run as `options` say: the model's entry
+    point (sweep.models.model_for)."""
+    from sweep.kernels.oscillator import PARAM_NAMES
+
+    from ..execute import transverse_chunk, transverse_outputs
+    inputs = resolve(scene)
+    dims, shape, params = inputs.dims, inputs.shape, inputs.params
+    settings = inputs.settings.copy()
     n_points = int(np.prod(shape, dtype=np.int64))
     # Outputs (and their Dataset copies), the solve order and a few derived quantities: the
     # parameter rows are built chunk by chunk and never held for the whole grid.
-    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + times.size)) + 40,
-                 "metrics and time series")
-    params = grid.parameters(scene, coords)
+    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size))
+                 + 40, "metrics and time series")
     coeffs = modal.oscillator(params)          # derived quantities, on the axes they need
     # No time-varying stiffness anywhere (a constant or zero end load): the kernels leave the
     # cos(W t) terms out (the same results, bit for bit, and a cheaper right-hand side).
@@ -172,14 +209,14 @@ def run_transverse(scene: Scene, threads: int = 0, progress: bool = False,
         return grid.rows(modal.oscillator(at), PARAM_NAMES, points.size)
 
     started = time.perf_counter()
-    from ..execute import transverse_chunk, transverse_outputs
-    out = solve_chunked(scene, transverse_chunk, rows_at,
-                        (settings, times.size, scene.get("solver.driver")),
-                        transverse_outputs(n_points, times.size),
-                        output=output, resume=resume, overwrite=overwrite, threads=threads,
-                        progress=progress, scheduler=scheduler)
-    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"], times)
-    return assemble(scene, coords, shape, coeffs, result, time.perf_counter() - started)
+    n_samples = inputs.sample_times.size
+    out = solve_chunked(options, transverse_chunk, rows_at, (settings, n_samples, inputs.driver),
+                        transverse_outputs(n_points, n_samples))
+    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"],
+                          inputs.sample_times)
+    return assemble(inputs, coeffs, result, time.perf_counter() - started)
+
+
 def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
                  level: xr.DataArray) -> dict[str, xr.DataArray]:
     """The outputs of base excitation: the kernel's absolute midspan acceleration amplitude
@@ -213,28 +250,30 @@ def state_attrs() -> dict[str, Any]:
     }
 
 
-def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ...],
-             coeffs: dict[str, Any], result: "KernelResult", elapsed: float) -> xr.Dataset:
-    """Build the result Dataset of the contract from the flat kernel result."""
-    dims = tuple(coords)
-    short, method = METHODS[scene.get("solver.method")]
+def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
+             elapsed: float) -> xr.Dataset:
+    """Build the result Dataset of the contract from the flat kernel result: the variables the
+    scene asked for (inputs.wanted), with units and long names; the derived closed forms
+    (`coeffs`, sweep/models/modal.py) on their own axes; elapsed: the solve's wall time (s)."""
+    coords, dims, shape = inputs.coords, inputs.dims, inputs.shape
+    short, method = METHODS[inputs.method]
     data: dict[str, xr.DataArray] = {}
     data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims, attrs=state_attrs())
     for name, (col, units, long_name, switch) in _REALS.items():
-        if switch is None or scene.get(switch):
+        if switch is None or switch in inputs.wanted:
             data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
                                       attrs={"units": units, "long_name": long_name})
-    if scene.get("outputs.solver_stats"):
+    if "outputs.solver_stats" in inputs.wanted:
         for name, (col, long_name) in _COUNTS.items():
             data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
                                       attrs={"units": "1",
                                              "long_name": long_name.format(method=short)})
-    for name, (units, long_name) in (_DERIVED | (_BASE_DERIVED if scene.has_base else {})
+    for name, (units, long_name) in (_DERIVED | (_BASE_DERIVED if inputs.has_base else {})
                                      ).items():
         if name in coeffs and name not in coords:
             data[name] = derived(coeffs[name], coords)
             data[name].attrs = {"units": units, "long_name": long_name}
-    if scene.has_base and scene.get("outputs.absolute_acceleration"):
+    if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         data.update(base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                  derived(coeffs["base_accel"], coords)))
     all_coords: dict[str, Any] = dict(coords)
@@ -243,15 +282,6 @@ def assemble(scene: Scene, coords: dict[str, xr.DataArray], shape: tuple[int, ..
         data["displacement"] = xr.DataArray(
             result.series.reshape(shape + (result.series.shape[1],)), dims=dims + (TIME_DIM,),
             attrs={"units": "m", "long_name": "midspan deflection q(t)"})
-    attrs = global_attrs(scene, shape, elapsed,
-                         f"transverse modal oscillator, {method}, "
-                         f"{CONTROLLERS[scene.get('solver.controller')]}")
+    attrs = global_attrs(inputs.origin, shape, elapsed,
+                         f"transverse modal oscillator, {method}, {CONTROLLERS[inputs.controller]}")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)
-
-
-def run(scene: Scene, *, threads: int = 0, progress: bool = False,
-        output: str | os.PathLike | None = None, resume: bool = False, overwrite: bool = False,
-        scheduler: str | None = None) -> xr.Dataset:
-    """The model's entry point (sweep.models.model_for): `run_transverse`."""
-    return run_transverse(scene, threads=threads, progress=progress, output=output,
-                          resume=resume, overwrite=overwrite, scheduler=scheduler)
