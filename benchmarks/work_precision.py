@@ -36,27 +36,29 @@ tolerance govern until |q| falls ~10x below q0.
     time come from `reference_metrics` on their own dense output (not timed).
   - numbalsoda (optional extra: `pip install numbalsoda`; skipped with a message if it is not
     importable) `dop853` and `lsoda`: a Numba `cfunc` right-hand side with numbalsoda's
-    signature, the 8 oscillator coefficients (m, c, k0, k1, g0, g1, h, W) passed through the data
-    pointer (one more slot of the padded row counts right-hand-side calls: no measurable
-    cost), called from an `@njit(parallel=True)` prange loop over all points, in the same
-    shuffled order as cable-sweep's (`sweep.run.point_order`, which spreads the costly points
-    over the threads); each call returns q, q' on --ns-samples (20001) evenly spaced
-    times on [0, 5] s (numbalsoda has no dense-output object; its 0.3.4 `dop853` integrates
-    [0, 5] s once and fills the output times from DOP853's dense output, `lsoda` interpolates
-    to each output time). Timed like cable-sweep (the prange loop, best of repeats, after a
-    compile warm-up) on 1 and on 2 Numba threads. The timed loop includes filling the output
-    times, which a user needs to read amplitude and settling time: about a quarter of dop853's
-    time at rtol 1e-8 with 20001 samples (measured during development against 2001 samples);
-    --ns-samples 5001 costs less, with an interpolation floor of ~3e-11 on the amplitude.
-    The metrics are then taken from the samples (not timed): q'' at each sample from the
-    right-hand side, a piecewise quintic Hermite interpolant through (q, q', q'')
-    (`reference_metrics.HermiteSamples`) and `reference_metrics` on it, with the sample times
-    as the bracketing grid: the same definitions applied to the sampled signal. Its
-    interpolation error is ~(w dt)^6/46080 of the amplitude: applied to the reference solution
-    sampled the same way it changes the amplitudes by <= 1.1e-13 relative (non-decayed points),
-    settling times by ~1e-13 t_end, and no state. The plain max of the samples would
-    underestimate the amplitude by up to (w dt)^2/8 (2.5e-5 measured at 20001 samples), far
-    above the errors compared here. numbalsoda reports no step counts: "mean steps" is empty.
+    signature that calls the System's own right-hand side (`kernels.oscillator.acceleration`,
+    njit, libm's cos) on the point's parameter row prepared by `kernels.oscillator.prepare`,
+    passed through the data pointer (one more slot of the padded row counts right-hand-side
+    calls: no measurable cost), called from an `@njit(parallel=True)` prange loop over all
+    points, in the same shuffled order as cable-sweep's (`sweep.run.point_order`, which spreads
+    the costly points over the threads); each call returns q, q' on --ns-samples (20001) evenly
+    spaced times on [0, 5] s (numbalsoda has no dense-output object; its 0.3.4 `dop853`
+    integrates [0, 5] s once and fills the output times from DOP853's dense output, `lsoda`
+    interpolates to each output time). Timed like cable-sweep (the prange loop, best of repeats,
+    after a compile warm-up) on 1 and on 2 Numba threads. The timed loop includes filling the
+    output times, which a user needs to read amplitude and settling time: about a quarter of
+    dop853's time at rtol 1e-8 with 20001 samples (measured during development against 2001
+    samples); --ns-samples 5001 costs less, with an interpolation floor of ~3e-11 on the
+    amplitude. The metrics are then taken from the samples (not timed): q'' at each sample from
+    the right-hand side (`kernels.oscillator.acceleration.py_func`), a piecewise quintic Hermite
+    interpolant through (q, q', q'') (`reference_metrics.HermiteSamples`) and
+    `reference_metrics` on it, with the sample times as the bracketing grid: the same
+    definitions applied to the sampled signal. Its interpolation error is ~(w dt)^6/46080 of the
+    amplitude: applied to the reference solution sampled the same way it changes the amplitudes
+    by <= 1.1e-13 relative (non-decayed points), settling times by ~1e-13 t_end, and no state.
+    The plain max of the samples would underestimate the amplitude by up to (w dt)^2/8 (2.5e-5
+    measured at 20001 samples), far above the errors compared here. numbalsoda reports no step
+    counts: "mean steps" is empty.
 Reported per method and rtol: wall time for the set (1 thread; 2 threads for cable-sweep and
 numbalsoda), mean accepted steps, mean right-hand-side evaluations, max relative amplitude
 error |A - A_ref| / A_ref, the settling-time error max |Ts - Ts_ref| / t_end over the points
@@ -123,8 +125,10 @@ CABLE = "cable-sweep"
 CABLE_PI = "cable-sweep (PI)"      # solver.controller = "pi"
 CABLE_DOP853 = "cable-sweep (DOP853)"   # solver.method = "dop853"
 NS_MAX_STEPS = 2_000_000_000        # numbalsoda mxstep (a C int): no practical bound
-N_COEFFS = 8                        # m, c, k0, k1, g0, g1, h, W: the first 8 parameter columns
-NS_COUNTER = 12                     # slot of the RHS-call counter in a numbalsoda data row
+NS_COUNTER = osc.N_PARAMS           # slot of the RHS-call counter in a numbalsoda data row,
+                                    # after the prepared parameter row
+NS_TERMS = (True, None)             # the oscillator's `terms` in the numbalsoda rhs: the
+                                    # cos(W t) load terms, no base excitation (this scene has none)
 NS_ROW = 24                         # data row length: 192 bytes, so that one point's counter
                                     # never shares a cache line with another point's row
 TIE = 1.01                          # equal-error: an error within 1 % of the target reaches it
@@ -246,12 +250,17 @@ def build_scene(lengths: list[float], ratios: list[float]) -> Scene:
 
 
 def acceleration(row: np.ndarray, t: np.ndarray, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """q'' of the oscillator at samples (t, q, q'), vectorised; coefficients from `row`."""
-    m, c, k0, k1, g0, g1, h, w = (float(row[j]) for j in (
-        osc.MASS, osc.DAMPING, osc.K0, osc.K1, osc.G0, osc.G1, osc.H, osc.OMEGA))
-    cw = np.cos(w * t)
-    q2 = q * q
-    return -(c * v + (k0 + k1 * cw) * q + (g0 + g1 * cw) * q * q2 + h * q * q2 * q2) / m
+    """q'' (m/s^2) of the oscillator at samples (t (s), q (m), q' (m/s)) of one point, from its
+    raw parameter row `row`: the System's own right-hand side (`kernels.oscillator.acceleration`,
+    its pure-Python form, libm's cos and sin) on the row prepared as the kernels prepare it,
+    looped over the samples."""
+    prepared = np.empty(osc.N_PARAMS)
+    osc.prepare.py_func(row, prepared, 0, 1)
+    p = [float(x) for x in prepared]                  # list indexing: Python floats
+    terms = osc.terms_of(parametric=True, base=bool(row[osc.BASE_ACCEL] != 0.0))
+    rhs = osc.acceleration.py_func
+    return np.array([rhs(ti, qi, vi, p, 0, 1, None, terms)
+                     for ti, qi, vi in zip(t.tolist(), q.tolist(), v.tolist())])
 
 
 def reference_solution(table: np.ndarray, rtol: float, atol: float, cfg: Settings) -> Reference:
@@ -332,9 +341,11 @@ def max_threads() -> int:
 class Numbalsoda:
     """numbalsoda's dop853 and lsoda over all points from a Numba prange loop.
 
-    The right-hand side is a `cfunc` with numbalsoda's signature rhs(t, u, du, p); p points to
-    one row of `data`: the 8 coefficients m, c, k0, k1, g0, g1, h, W, and at NS_COUNTER a
-    counter of calls (rows padded to NS_ROW doubles: no false sharing between threads).
+    The right-hand side is a `cfunc` with numbalsoda's signature rhs(t, u, du, p) that calls the
+    System's own `kernels.oscillator.acceleration` (njit, inlined; libm's cos: fast=None;
+    terms NS_TERMS). p points to one row of `data`: the point's parameter row prepared by
+    `kernels.oscillator.prepare` (columns 0 .. N_PARAMS - 1), and at NS_COUNTER a counter of
+    calls (rows padded to NS_ROW doubles: no false sharing between threads).
     """
 
     SOLVERS = ("dop853", "lsoda")
@@ -343,19 +354,15 @@ class Numbalsoda:
         import numba as nb
         from numbalsoda import dop853, lsoda, lsoda_sig
 
-        assert (osc.MASS, osc.DAMPING, osc.K0, osc.K1, osc.G0, osc.G1, osc.H, osc.OMEGA) \
-            == tuple(range(N_COEFFS))
+        assert NS_COUNTER < NS_ROW
+        acceleration = osc.acceleration
 
         @nb.cfunc(lsoda_sig)
         def rhs(t, u, du, p):
             q = u[0]
             v = u[1]
-            cw = math.cos(p[7] * t)
-            q2 = q * q
-            force = (p[1] * v + (p[2] + p[3] * cw) * q + (p[4] + p[5] * cw) * q * q2
-                     + p[6] * q * q2 * q2)
             du[0] = v
-            du[1] = -force / p[0]
+            du[1] = acceleration(t, q, v, p, 0, 1, None, NS_TERMS)
             p[NS_COUNTER] += 1.0
 
         def make_loop(solver):
@@ -387,8 +394,12 @@ class Numbalsoda:
         import numba
         n = len(table)
         order = point_order(n)
+        if np.any(table[:, osc.BASE_ACCEL] != 0.0):
+            raise ValueError("Numbalsoda: the rhs is compiled without base excitation "
+                             "(NS_TERMS) but a row has base_accel != 0")
         data = np.zeros((n, NS_ROW))
-        data[:, :N_COEFFS] = table[order, :N_COEFFS]
+        for i, row in enumerate(table[order]):
+            osc.prepare.py_func(row, data[i], 0, 1)
         u0 = np.ascontiguousarray(table[order][:, [osc.Q0, osc.V0]])
         out = np.empty((n, t_eval.size, 2))
         ok = np.zeros(n, dtype=np.bool_)
