@@ -90,8 +90,8 @@ from typing import Any, NoReturn
 
 import numpy as np
 
-from . import schema
-from .errors import CableSweepWarning, SceneError
+from .. import schema
+from ..errors import CableSweepWarning, SceneError
 
 PAPER_VELOCITY = 0.0321
 """initial.velocity (m/s) used by the paper preset when no initial condition is given."""
@@ -327,7 +327,7 @@ def parse_override(item: str) -> tuple[str, Any]:
 
 def _scenes_dir() -> Any:
     """The package-data folder of built-in scenes (works from an installed wheel too)."""
-    return resources.files(__package__ or "sweep") / "scenes"
+    return resources.files("sweep") / "scenes"
 
 
 def _builtin_file(name: str) -> Any | None:
@@ -1379,10 +1379,10 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
         params["frequency"] = None
     with np.errstate(all="ignore"):
         if kind == "longitudinal":
-            from .models.wave import wave_parameters
+            from ..models.wave import wave_parameters
             derived = wave_parameters(params, values["solver.t_end"], values["solver.transits"])
         else:
-            from .models.modal import oscillator
+            from ..models.modal import oscillator
             derived = oscillator(params)
     bad = [(name, np.atleast_1d(np.asarray(derived[name], dtype=np.float64)))
            for name in _CHECKED_COEFFICIENTS[kind]]
