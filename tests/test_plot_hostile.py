@@ -279,7 +279,7 @@ def test_a_failure_while_writing_removes_what_the_call_wrote(result, tmp_path, m
     (out / "keep.txt").write_text("not ours")
     calls = {"n": 0}
     target = ((sweep.files.tempfile, "mkstemp") if stage == "temporary"
-              else (splot.os, "replace"))
+              else (splot.figures.os, "replace"))
     real = getattr(*target)
 
     def failing(*args, **kwargs):

@@ -1,0 +1,74 @@
+"""Figures of a cable-sweep result: pick what fits the Dataset, draw it with matplotlib.
+
+    from sweep.plot import plot, save
+    figures = plot(ds)                       # {"amplitude": Figure, "state": Figure, ...}
+    save(figures, "figs", formats=("png", "svg"), prefix="fig5-")
+
+What `plot` draws, by the result's content:
+
+- transverse, one swept axis: amplitude and settling time against it (`plot_line`), markers
+  coloured by `state`;
+- transverse, two swept axes: maps (`plot_map`) of amplitude and settling time with the
+  modulated, unsettled, diverged and failed points marked, and a map of `state`
+  (`plot_state_map`); closed-form overlays where the axes allow: the principal parametric
+  resonance zone W = 2 w1 sqrt(1 +- mu), mu = P0/(2 Pcr) (docs/model.md sec. 2; dotted where
+  damping suppresses it, mu < 2 zeta) and the buckling length where P0 = Pcr; under base
+  excitation also a map of the absolute midspan acceleration in g and the linear resonance
+  f = f1 (docs/model.md sec. 5);
+- stored time series: q(t), one panel per point (`plot_time_series`, the paper's Fig 5);
+- longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
+  histories (`plot_histories`); with swept axes also the peak end displacement and the
+  dynamic amplification over them.
+
+What every figure keeps to, so that it says something:
+
+- a quantity that is NaN everywhere or has one value at every point (e.g. the settling times
+  of an undamped run, all 0 s) gets no figure; `plot` records why (`Figures.skipped`) and
+  `save` logs it;
+- displacements are in mm on every axis, colour bar and label (times and forces get the
+  prefix their size calls for); no axis uses an offset or a scientific multiplier, and
+  near-constant data get a +-5 % range around their value;
+- on a log-coloured displacement map, a cell below FLOOR (1e-3) times the map's largest
+  value is drawn white, "no response", and the colours span the three decades above it;
+- dense maps (more than 100 cells) mark the modulated, unsettled, diverged and failed points
+  by hatched regions outlined along the cell edges, so the colour under them still shows;
+- `plot` puts the load case (`footer`: model, P0, frequency, damping, initial state, t_end,
+  solver, metrics; from the result's `scene` attribute) under each figure;
+- on the paper's Fig 5 case (paper coefficients, P0 = 4 N, W/w0 = 1) the paper's amplitudes
+  4.1, 3.8, 3.4, 3.0 mm (l = 0.5, 0.7, 0.85, 1 m) are marked "paper Fig 5".
+
+More than two swept axes: `select={"dim": value, ...}` picks the values of the others (each
+value must be one of the axis's coordinates); `save` writes the selection into the file names
+(RESULT-DIM=VALUE-FIGURE.png), so that two selections do not overwrite each other. Labels read
+`long_name` and `units` from the Dataset. Like xarray's plotting functions, the single-panel
+ones take `ax=None` and return the Axes, and pass extra keyword arguments to matplotlib.
+Figures are made with the object-oriented API (`matplotlib.figure.Figure`): no pyplot, no
+display and no backend choice are needed, and none is forced on the caller.
+
+The package, split like xarray's plot/ by what is drawn:
+    result.py    reading and checking a result file, selecting points (no matplotlib)
+    style.py     what every figure shares: state colours, units shown, ticks, edges, legends
+    labels.py    axis labels, titles, the footer with the load case
+    overlays.py  the closed-form overlays of each model kind, in one table (OVERLAYS)
+    line.py      one swept axis (plot_line)
+    maps.py      two swept axes (plot_map, plot_state_map)
+    series.py    stored histories (plot_time_series, plot_snapshots, plot_histories)
+    figures.py   which figures a result gets, and writing them (plot, save)
+"""
+
+from __future__ import annotations
+
+# _HATCHES, _edges and _select_tag are private; tests/test_plot.py reaches them here.
+from .figures import Figures, _select_tag, plot, save, why_not_drawn  # noqa: F401
+from .labels import footer, label
+from .line import plot_line
+from .maps import _HATCHES, FLOOR, plot_map, plot_state_map  # noqa: F401
+from .overlays import PAPER_FIG5_AMPLITUDES
+from .result import check_result, load_result, parse_select, select_points, swept_axes
+from .series import plot_histories, plot_snapshots, plot_time_series
+from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
+
+__all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
+           "check_result", "load_result", "parse_select", "plot", "plot_histories",
+           "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
+           "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]

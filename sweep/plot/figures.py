@@ -1,0 +1,210 @@
+"""Which figures a result gets (`plot`), and writing them (`save`).
+
+`plot` draws every figure that fits the result and says nothing about none: a quantity that is
+NaN everywhere or has one value at every point gets no figure, with the reason recorded
+(`Figures.skipped`, `why_not_drawn`). `save` draws each in memory first, then writes all of
+them atomically, or none.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import os
+import re
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ..errors import UserError
+from ..files import write_temporary
+from .labels import _add_footer
+from .line import plot_line
+from .maps import plot_map, plot_state_map
+from .result import _time_dim, check_result, select_points, swept_axes
+from .series import _snapshot_fields, plot_histories, plot_snapshots, plot_time_series
+from .style import _plain_ticks, _state_meaning, _unit
+
+_log = logging.getLogger(__package__)     # "sweep.plot", the one logger of the figures
+
+
+class Figures(dict):
+    """The figures `plot` drew, by name (a dict), with the selection they were drawn for
+    (`select`, written into the file names by `save`) and the figures left out with the
+    reason (`skipped`: name -> why)."""
+
+    def __init__(self, figures: Mapping[str, Figure] | None = None, *,
+                 select: Mapping[str, Any] | None = None,
+                 skipped: Mapping[str, str] | None = None) -> None:
+        super().__init__(figures or {})
+        self.select = dict(select or {})
+        self.skipped = dict(skipped or {})
+
+
+def why_not_drawn(da: xr.DataArray) -> str | None:
+    """Why a figure of `da` would say nothing: every value NaN, or every finite value the same
+    (e.g. settling times all 0 s); None when it varies."""
+    v = np.asarray(da.values, dtype=float)
+    finite = v[np.isfinite(v)]
+    if not finite.size:
+        return "no point has a value (all NaN)"
+    if finite.min() == finite.max():
+        factor, units = _unit(da, finite)
+        value = f"{finite[0] * factor:.4g}" + (f" {units}" if units and units != "1" else "")
+        some = " with a value" if finite.size < v.size else ""
+        return f"every point{some} has the same value, {value}"
+    return None
+
+
+def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
+    """Every figure that fits the result, keyed by name (the file name `save` gives it).
+
+    Transverse: 'amplitude' and 'settling_time' (lines over one swept axis, maps over two),
+    and 'absolute_acceleration_g' under base excitation,
+    'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
+    'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
+    swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
+    settling times of an undamped run, all 0 s; a state map with one state) gets no figure:
+    the reason goes to `Figures.skipped` and the log (info here; `save` repeats it as a
+    warning, which reaches stderr by default).
+    Each figure has the load case in a footer (`footer`). An empty result when nothing fits.
+    Raises UserError (one line) for a Dataset the figures cannot be drawn from faithfully
+    (`check_result`), before drawing anything.
+    """
+    check_result(ds)
+    ds = select_points(ds, select)
+    axes = swept_axes(ds)
+    figures = Figures(select=select)
+    if ds.attrs.get("model_kind") == "longitudinal":
+        scalars = ["peak_end_displacement", "dynamic_amplification"]
+    else:
+        scalars = ["amplitude", "settling_time"]
+        if "absolute_acceleration_g" in ds:        # base excitation (docs/model.md sec. 5)
+            scalars.insert(1, "absolute_acceleration_g")
+    if len(axes) == 2:
+        scalars.append("state")
+    for var in scalars:
+        if var not in ds or len(axes) not in (1, 2):
+            continue
+        if var == "state":
+            reason = (f"every point is {_state_meaning(ds.isel({a: 0 for a in axes}))}"
+                      if np.unique(ds["state"].values).size == 1 else None)
+        else:
+            reason = why_not_drawn(ds[var])
+        if reason is not None:
+            figures.skipped[var] = reason
+            _log.info("%s: %s: no figure (%s)", ds.attrs.get("title", "result"), var, reason)
+        elif var == "state":
+            figures[var] = plot_state_map(ds).figure
+        elif len(axes) == 1:
+            figures[var] = plot_line(ds, var).figure
+        else:
+            figures[var] = plot_map(ds, var).figure
+    if "displacement" in ds and _time_dim(ds["displacement"]) is not None:
+        figures["time_series"] = plot_time_series(ds)
+    if _snapshot_fields(ds):
+        figures["snapshots"] = plot_snapshots(ds)
+    if "end_displacement" in ds or "fixed_end_force" in ds:
+        figures["histories"] = plot_histories(ds)
+    for fig in figures.values():
+        for ax in fig.axes:
+            _plain_ticks(ax)
+        _add_footer(fig, ds)
+    return figures
+
+
+def _select_tag(select: Mapping[str, Any]) -> str:
+    """'load_amplitude=4-length=0.5' for a selection, file-system safe (letters, digits and
+    . _ = + - only)."""
+    parts = []
+    for dim, value in select.items():
+        try:
+            shown = f"{float(value):g}"
+        except (TypeError, ValueError):
+            shown = str(value)
+        parts.append(re.sub(r"[^A-Za-z0-9._=+-]", "_", f"{dim}={shown}"))
+    return "-".join(parts)
+
+
+def save(figures: Mapping[str, Figure], directory: str | os.PathLike = ".",
+         formats: Iterable[str] = ("png",), *, prefix: str = "", dpi: float = 100,
+         select: Mapping[str, Any] | None = None) -> list[Path]:
+    """Write each figure as DIRECTORY/PREFIX + key + .FORMAT (the directory is created);
+    with a selection (`select`, else the one `plot` recorded on its `Figures`) the name is
+    PREFIX + 'DIM=VALUE-' ... + key, so that figures of different selections do not overwrite
+    each other (e.g. map-load_amplitude=4-amplitude.png). `dpi`: dots per inch of raster
+    formats. The figures `plot` left out (`Figures.skipped`) are logged as warnings, one line
+    each. Returns the paths written. Raises UserError for an unknown format or an
+    unwritable directory."""
+    select = getattr(figures, "select", None) if select is None else select
+    tag = _select_tag(select) + "-" if select else ""
+    formats = [f.strip().lower().lstrip(".") for f in formats if f.strip()]
+    supported = Figure().canvas.get_supported_filetypes()
+    for fmt in formats:
+        if fmt not in supported:
+            raise UserError(f"format '{fmt}': not a figure format matplotlib writes (use one of "
+                            f"{', '.join(sorted(supported))})")
+    out = Path(directory)
+    # Every figure is drawn (in memory) before any file is written: a figure that fails to
+    # draw leaves nothing behind.
+    rendered = []
+    for key, fig in figures.items():
+        for fmt in formats:
+            buffer = io.BytesIO()
+            fig.savefig(buffer, format=fmt, dpi=dpi)
+            rendered.append((out / f"{prefix}{tag}{key}.{fmt}", buffer.getvalue()))
+    for key, reason in getattr(figures, "skipped", {}).items():
+        _log.warning("%s%s%s: no figure (%s)", prefix, tag, key, reason)
+    created = _make_directory(out)
+    try:
+        return _write_all(rendered)
+    except BaseException:
+        for path in reversed(created):
+            with contextlib.suppress(OSError):
+                path.rmdir()
+        raise
+
+
+def _make_directory(out: Path) -> list[Path]:
+    """Create `out` and its missing parents; the directories created, outermost first."""
+    missing = [p for p in (out, *out.parents) if not p.exists()][::-1]
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"output directory '{out}': could not be created "
+                        f"({exc.strerror or exc})") from exc
+    return missing
+
+
+def _write_all(rendered: list[tuple[Path, bytes]]) -> list[Path]:
+    """Write each (path, bytes) atomically: all to fresh temporary files in the target
+    directory first (O_EXCL, unpredictable names, fsynced), then renamed over the targets.
+    On any failure, removes every temporary and every file this call already renamed into
+    place, and raises UserError naming the file (OSError) or re-raises."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    temps: list[str] = []
+    done: list[Path] = []
+    path = None
+    try:
+        for path, data in rendered:
+            temps.append(write_temporary(path.parent, f".{path.name}.", data, 0o666 & ~mask))
+        for (path, _data), tmp in zip(rendered, temps):
+            os.replace(tmp, path)
+            done.append(path)
+    except BaseException as exc:
+        for name in temps:
+            with contextlib.suppress(OSError):
+                os.unlink(name)
+        for written in done:
+            with contextlib.suppress(OSError):
+                written.unlink()
+        if isinstance(exc, OSError):
+            raise UserError(f"figure '{path}': could not be written ({exc.strerror or exc}); "
+                            "no figure of this call was kept") from exc
+        raise
+    return done

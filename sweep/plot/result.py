@@ -1,0 +1,393 @@
+"""A result as the figures read it: open and check a result file, pick the points to draw.
+
+`load_result` opens a netCDF written by `sweep run` and refuses, in one line (UserError), what
+is not one, before reading anything that could block or any data too large; `check_result`
+refuses a Dataset the figures cannot be drawn from faithfully. `select_points` fixes the axes
+beyond two; `_scene` and `_setting` read the load case from the result's `scene` attribute.
+No matplotlib here.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import os
+import re
+import stat
+import tomllib
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+import numpy as np
+import xarray as xr
+
+from ..errors import UserError
+from ..schema import BY_AXIS
+
+_TIME_DIMS = ("elapsed_time", "time")     # the dimension of stored histories (new, old name)
+
+# What a result may hold. `sweep run` writes far less; a file beyond these limits was not
+# written by it (or was altered since), and is refused before any of it is used: an attribute
+# is never shortened or dropped silently, since a figure without its units or state meanings
+# would show wrong numbers.
+_ATTR_CHARS = {"units": 64, "long_name": 1024, "flag_meanings": 4096, "title": 256,
+               "model_kind": 64, "coefficients": 64, "cable_sweep_version": 64}
+_ATTR_LIMIT = 65536       # characters (or array elements) of any other attribute
+_SCENE_BASE = 65536       # characters of the `scene` attribute, plus _SCENE_PER_VALUE per
+_SCENE_PER_VALUE = 64     # coordinate value (it lists the axes' values)
+_TEXT_ATTRS = ("units", "long_name", "flag_meanings")     # shown on figures: plain text only
+_MAX_FLAGS = 64
+_MAX_COORD = 1e100        # |coordinate| beyond this: cell edges and scales overflow
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+# Variables the figures read: over the swept axes only, or a history / snapshots over them.
+_OVER_AXES = ("amplitude", "settling_time", "peak_end_displacement", "dynamic_amplification",
+              "load_ratio", "natural_frequency", "transit_time", "static_end_displacement",
+              "peak_fixed_end_force", "force_amplification", "damping_ratio",
+              "absolute_acceleration_g", "transmissibility")
+_HISTORIES = ("displacement", "end_displacement", "fixed_end_force")
+_SNAPSHOTS = tuple(f"snapshot_{f}{s}" for f in ("displacement", "force", "velocity")
+                   for s in ("", "_ratio"))
+# Scene values the footer and overlays read: tables, numbers, short strings.
+_SCENE_TABLES = ("model", "cable", "load", "base", "initial", "solver", "metrics", "outputs",
+                 "run", "axes")
+_SCENE_NUMBERS = (("load", "amplitude"), ("load", "frequency_ratio"), ("load", "frequency"),
+                  ("base", "acceleration"), ("base", "acceleration_g"), ("base", "frequency"),
+                  ("base", "frequency_ratio"),
+                  ("cable", "length"), ("cable", "damping_ratio"), ("model", "membrane"),
+                  ("initial", "displacement"), ("initial", "velocity"), ("solver", "t_end"),
+                  ("solver", "intervals"), ("solver", "courant"), ("solver", "transits"),
+                  ("solver", "rtol"), ("metrics", "tail"), ("metrics", "tolerance"))
+_SCENE_STRINGS = (("model", "kind"), ("model", "coefficients"), ("model", "paper_parametric"),
+                  ("load", "type"), ("solver", "method"))
+_REWRITE = "not a result as 'sweep run' writes it; write it again with 'sweep run ... -o FILE.nc'"
+
+
+def load_result(path: str | os.PathLike) -> xr.Dataset:
+    """Open a cable-sweep result (netCDF written by `sweep run`) into memory.
+
+    Raises UserError (one line) before reading anything that could block or not end (a FIFO,
+    device or socket; a directory; an empty file or one without a netCDF/HDF5 signature), for
+    attributes beyond the sizes a result has, data declared larger than the memory available,
+    an unreadable (truncated, corrupted) file, and for a netCDF that is not a cable-sweep
+    result or contradicts itself (`check_result`).
+    """
+    raw = os.fspath(path)
+    where = f"result '{raw}'"
+    p = Path(raw)
+    try:
+        info = p.stat()
+    except FileNotFoundError:
+        raise UserError(f"{where}: no such file (give a netCDF file written by "
+                        "'sweep run ... -o FILE.nc')") from None
+    except (OSError, ValueError) as exc:
+        raise UserError(f"{where}: cannot be read ({getattr(exc, 'strerror', None) or exc})"
+                        ) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise UserError(f"{where}: is a directory, not a netCDF file")
+    if not stat.S_ISREG(info.st_mode):
+        kind = ("a FIFO" if stat.S_ISFIFO(info.st_mode) else "a socket"
+                if stat.S_ISSOCK(info.st_mode) else "a device")
+        raise UserError(f"{where}: is {kind}, not a regular file (give a netCDF file written by "
+                        "'sweep run ... -o FILE.nc')")
+    if info.st_size == 0:
+        raise UserError(f"{where}: is an empty file, not a netCDF file (give a file written by "
+                        "'sweep run ... -o FILE.nc')")
+    try:
+        with open(p, "rb") as f:
+            head = f.read(8)
+    except OSError as exc:
+        raise UserError(f"{where}: cannot be read ({exc.strerror or exc})") from None
+    if not head.startswith(_SIGNATURES):
+        raise UserError(f"{where}: not a readable netCDF file (no netCDF or HDF5 signature at "
+                        "its start); give a file written by 'sweep run ... -o FILE.nc'")
+    try:
+        opened = xr.open_dataset(p, engine="netcdf4", decode_times=False,
+                                 decode_timedelta=False)
+    except Exception as exc:  # noqa: BLE001 - any failure to open means: not a readable netCDF
+        raise _unreadable(where, exc) from exc
+    with opened:
+        _check_attrs(opened, where)
+        _check_bytes(opened, where)
+        try:
+            ds = opened.load()
+        except Exception as exc:  # noqa: BLE001 - a truncated or corrupted file
+            raise _unreadable(where, exc) from exc
+    missing = [what for what, ok in (("no 'cable_sweep_version' attribute",
+                                      "cable_sweep_version" in ds.attrs),
+                                     ("no 'state' variable", "state" in ds.data_vars)) if not ok]
+    if missing:
+        raise UserError(f"{where}: not a cable-sweep result ({' and '.join(missing)}); "
+                        "give a file written by 'sweep run ... -o FILE.nc'")
+    check_result(ds, where)
+    return ds
+
+
+def _unreadable(where: str, exc: BaseException) -> UserError:
+    reason = (exc.strerror or _short(" ".join(str(exc).split()), 80)) \
+        if isinstance(exc, OSError) else "not a format xarray recognises or damaged"
+    return UserError(f"{where}: not a readable netCDF file ({reason}); give a file written by "
+                     "'sweep run ... -o FILE.nc'")
+
+
+def _short(text: str, n: int = 60) -> str:
+    """`text` as one printable line of at most n characters (escaped, shortened)."""
+    shown = ascii(str(text)[:n + 1])[1:-1]
+    return shown if len(shown) <= n else shown[:n - 3] + "..."
+
+
+def _size(value: Any) -> int:
+    return len(value) if isinstance(value, (str, bytes)) else int(np.size(value))
+
+
+def _check_attrs(ds: xr.Dataset, where: str) -> None:
+    """Refuse attributes beyond the sizes a result has, and figure text that is not plain."""
+    values = sum(int(n) for n in ds.sizes.values())
+    owners = [(None, ds.attrs)] + [(name, var.attrs) for name, var in ds.variables.items()]
+    for var, attrs in owners:
+        for key, value in attrs.items():
+            of = f"attribute '{_short(key)}'" + (f" of variable '{_short(var)}'" if var else "")
+            limit = (_SCENE_BASE + _SCENE_PER_VALUE * values if key == "scene" and var is None
+                     else _ATTR_CHARS.get(key, _ATTR_LIMIT))
+            size = _size(value)
+            if size > limit:
+                raise UserError(f"{where}: {of} is {size:,} characters or values long, more "
+                                f"than the {limit:,} a result has; {_REWRITE}")
+            if key in _TEXT_ATTRS or (var is None and key in ("title", "model_kind",
+                                                              "coefficients", "scene")):
+                if not isinstance(value, str):
+                    raise UserError(f"{where}: {of} is {type(value).__name__} "
+                                    f"{_short(repr(value))}, not text; {_REWRITE}")
+                if key != "scene" and ("$" in value or not value.isprintable()):
+                    raise UserError(f"{where}: {of} ('{_short(value)}') holds '$' or control "
+                                    f"characters, which a figure cannot show as text; "
+                                    f"{_REWRITE}")
+
+
+def _check_bytes(ds: xr.Dataset, where: str) -> None:
+    """Refuse data declared larger than the memory available (before reading any of it)."""
+    from ..run import available_memory
+    sizes = {name: int(var.size) * var.dtype.itemsize for name, var in ds.variables.items()}
+    have = available_memory()
+    total = sum(sizes.values())
+    if have is not None and total > 0.8 * have[0]:
+        big = max(sizes, key=sizes.get)
+        dims = ", ".join(f"{d} = {n:,}" for d, n in ds[big].sizes.items())
+        raise UserError(f"{where}: declares {total / 2**30:,.1f} GiB of data (variable "
+                        f"'{_short(big)}': {dims}), more than the {have[0] / 2**30:,.1f} GiB of "
+                        f"{have[1]} here allow; {_REWRITE}")
+
+
+def _refuse(where: str, what: str) -> UserError:
+    return UserError(f"{where}: {what}; {_REWRITE}")
+
+
+def _check_axis(ds: xr.Dataset, dim: str, where: str, unique: bool) -> None:
+    """A dimension the figures draw along: a name, a 1-D numeric coordinate of finite values
+    (distinct ones for a swept axis), at least one value."""
+    if not isinstance(dim, str) or not _NAME.fullmatch(dim):
+        raise _refuse(where, f"dimension '{_short(dim)}' is not a plain name")
+    if ds.sizes[dim] == 0:
+        raise _refuse(where, f"axis '{dim}' has no values")
+    if dim not in ds.coords:
+        raise _refuse(where, f"axis '{dim}' has no coordinate variable (its values)")
+    coord = ds[dim]
+    if coord.dims != (dim,) or coord.dtype.kind not in "iuf":
+        raise _refuse(where, f"coordinate '{dim}' holds {coord.dtype} over {coord.dims}, not "
+                             f"numbers along '{dim}'")
+    v = np.asarray(coord.values, dtype=float)
+    if not np.all(np.isfinite(v)) or np.any(np.abs(v) > _MAX_COORD):
+        raise _refuse(where, f"coordinate '{dim}' has NaN, infinite or out-of-range values "
+                             f"({_values_text(v)})")
+    if unique and np.unique(v).size != v.size:
+        raise _refuse(where, f"axis '{dim}' has repeated values ({_values_text(v)})")
+
+
+def check_result(ds: xr.Dataset, where: str = "the result") -> None:
+    """Refuse (UserError, one line naming `where`) a Dataset the figures cannot be drawn from
+    faithfully: attributes beyond a result's sizes, a `state` that is not integer flags with
+    matching `flag_values` / `flag_meanings`, swept axes without finite, distinct coordinate
+    values or with none, plotted variables that are not numbers or lie over other dimensions,
+    a `scene` attribute that is not a scene of this result's model. `plot` calls it; so does
+    `load_result`."""
+    _check_attrs(ds, where)
+    if "state" not in ds.data_vars:
+        raise _refuse(where, "no 'state' variable")
+    state = ds["state"]
+    if state.dtype.kind not in "iu":
+        raise _refuse(where, f"variable 'state' holds {state.dtype}, not integer state flags")
+    flags = np.asarray(state.attrs.get("flag_values", []))
+    meanings = str(state.attrs.get("flag_meanings", "")).split()
+    if flags.ndim != 1 or flags.dtype.kind not in "iu" or not 1 <= flags.size <= _MAX_FLAGS:
+        raise _refuse(where, f"state's flag_values are {_short(repr(flags))}, not 1 to "
+                             f"{_MAX_FLAGS} integers")
+    if len(meanings) != flags.size or len(set(meanings)) != len(meanings):
+        raise _refuse(where, f"state has {flags.size} flag_values but {len(meanings)} "
+                             f"flag_meanings ({len(set(meanings))} distinct): they must pair up")
+    if np.unique(flags).size != flags.size:
+        raise _refuse(where, f"state's flag_values ({_short(repr(flags.tolist()))}) repeat a "
+                             "value")
+    if any(len(m) > 64 for m in meanings):
+        raise _refuse(where, "state has a flag meaning longer than 64 characters")
+    odd = np.setdiff1d(np.unique(state.values), flags)
+    if odd.size:
+        raise _refuse(where, f"state holds values that are not among its flag_values "
+                             f"({_short(repr(odd.tolist()))})")
+    axes = list(state.dims)
+    for dim in axes:
+        _check_axis(ds, dim, where, unique=True)
+    for name in (*_OVER_AXES, *_HISTORIES, *_SNAPSHOTS):
+        if name not in ds or name in ds.coords and name in axes:
+            continue
+        da = ds[name]
+        if da.dtype.kind not in "iuf":
+            raise _refuse(where, f"variable '{name}' holds {da.dtype}, not numbers")
+        extra = [d for d in da.dims if d not in axes]
+        if name in _HISTORIES:
+            expected = [d for d in _TIME_DIMS if d in da.dims][:1]
+        elif name in _SNAPSHOTS:
+            expected = ["snapshot_time", "position"]
+        else:
+            expected = []
+        if sorted(extra) != sorted(expected) or (expected and len(da.dims) != len(axes) + len(
+                expected)):
+            want = ", ".join(axes + (expected or ([_TIME_DIMS[0]] if name in _HISTORIES
+                                                  else [])))
+            raise _refuse(where, f"variable '{name}' lies over ({', '.join(map(str, da.dims))})"
+                                 f", not over ({want})")
+        for dim in expected:
+            _check_axis(ds, dim, where, unique=False)
+    for key in ("title", "model_kind", "coefficients", "scene"):
+        if key in ds.attrs and not isinstance(ds.attrs[key], str):
+            raise _refuse(where, f"attribute '{key}' is not text")
+    _check_scene(ds, where)
+
+
+def _check_scene(ds: xr.Dataset, where: str) -> None:
+    """The `scene` attribute, when present: TOML of this result's model, with tables where a
+    scene has tables and numbers and short strings where the figures read them."""
+    if "scene" not in ds.attrs:
+        return
+    try:
+        doc = _parse_scene(str(ds.attrs["scene"]))
+    except (tomllib.TOMLDecodeError, ValueError, RecursionError) as exc:
+        raise _refuse(where, f"its 'scene' attribute is not valid TOML "
+                             f"({_short(' '.join(str(exc).split()))})") from None
+    for section in _SCENE_TABLES:
+        if section in doc and not isinstance(doc[section], dict):
+            raise _refuse(where, f"its 'scene' attribute has '{section}' = "
+                                 f"{_short(repr(doc[section]))}, not a table")
+    for section, key in _SCENE_NUMBERS:
+        value = doc.get(section, {}).get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or not math.isfinite(value)):
+            raise _refuse(where, f"its 'scene' attribute has {section}.{key} = "
+                                 f"{_short(repr(value))}, not a finite number")
+    for section, key in _SCENE_STRINGS:
+        value = doc.get(section, {}).get(key)
+        if value is not None and not (isinstance(value, str) and len(value) <= 64
+                                      and value.isprintable() and "$" not in value):
+            raise _refuse(where, f"its 'scene' attribute has {section}.{key} = "
+                                 f"{_short(repr(value))}, not a short plain string")
+    kind = doc.get("model", {}).get("kind", "transverse")
+    stored = ds.attrs.get("model_kind")
+    if stored is not None and kind != stored:
+        raise _refuse(where, f"its 'scene' attribute is a {_short(kind)} scene but the result's "
+                             f"model_kind is {_short(stored)}")
+
+
+@functools.lru_cache(maxsize=8)
+def _parse_scene(text: str) -> dict[str, Any]:
+    """The scene TOML, parsed once per text (the figures read it many times)."""
+    return tomllib.loads(text)
+
+
+def parse_select(items: Iterable[str]) -> dict[str, float]:
+    """`["length=0.5", "frequency_ratio=2"]` -> {"length": 0.5, "frequency_ratio": 2.0}."""
+    out: dict[str, float] = {}
+    for item in items:
+        dim, sep, value = item.partition("=")
+        dim, value = dim.strip(), value.strip()
+        if not sep or not dim or not value:
+            raise UserError(f"--select '{item}': expected DIM=VALUE, e.g. --select length=0.5")
+        try:
+            out[dim] = float(value)
+        except ValueError:
+            raise UserError(f"--select '{item}': '{value}' is not a number (give an axis value, "
+                            "e.g. --select length=0.5)") from None
+    return out
+
+
+def _values_text(values: np.ndarray) -> str:
+    v = np.asarray(values)
+    if v.size <= 8:
+        return ", ".join(f"{x:g}" for x in v)
+    return f"{v.size} values from {v.min():g} to {v.max():g}: {v[0]:g}, {v[1]:g}, ..., {v[-1]:g}"
+
+
+def swept_axes(ds: xr.Dataset) -> list[str]:
+    """The result's swept axes with more than one value, in scene order (the dims of state)."""
+    return [d for d in ds["state"].dims if ds.sizes[d] > 1]
+
+
+def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr.Dataset:
+    """`ds` with each axis in `select` fixed at the given value, single-valued axes dropped to
+    scalar coordinates and the remaining axes sorted; at most two swept axes may remain.
+
+    A value must be one of the axis's coordinate values (to 1e-6 relative). Raises UserError
+    for an unknown axis, a value not on the axis, or more than two remaining swept axes.
+    """
+    if "state" not in ds.data_vars:
+        raise UserError("not a cable-sweep result: no 'state' variable")
+    axes = list(ds["state"].dims)
+    for dim, value in (select or {}).items():
+        shown = f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
+        if dim not in axes:
+            raise UserError(f"select {dim}={shown}: '{dim}' is not a swept axis of this result "
+                            f"(its axes: {', '.join(axes) or 'none'})")
+        coord = np.asarray(ds[dim].values, dtype=float)
+        try:
+            target = float(value)
+        except (TypeError, ValueError):
+            raise UserError(f"select {dim}={shown}: not a number") from None
+        scale = float(np.max(np.abs(coord))) if coord.size else 0.0
+        hits = np.flatnonzero(np.isclose(coord, target, rtol=1e-6, atol=1e-12 * scale))
+        if not hits.size:
+            raise UserError(f"select {dim}={shown}: not a value of axis '{dim}' (its values: "
+                            f"{_values_text(coord)})")
+        ds = ds.isel({dim: int(hits[0])})
+        axes.remove(dim)
+    single = {d: 0 for d in axes if ds.sizes[d] == 1}
+    ds = ds.isel(single)
+    axes = [d for d in axes if d not in single]
+    if len(axes) > 2:
+        extra = axes[2:]
+        example = " ".join(f"--select {d}={float(ds[d].values[0]):g}" for d in extra)
+        raise UserError(f"the result has {len(axes)} swept axes ({', '.join(axes)}): pick "
+                        f"the values of all but two to plot, e.g. {example} (select= in "
+                        "Python)")
+    return ds.sortby(axes) if axes else ds
+
+
+def _scene(ds: xr.Dataset) -> dict[str, Any]:
+    try:
+        return _parse_scene(str(ds.attrs.get("scene", "")))
+    except (tomllib.TOMLDecodeError, ValueError, RecursionError):
+        return {}
+
+
+def _setting(ds: xr.Dataset, section: str, key: str) -> Any:
+    """A scene value as this (selected) result has it: a fixed axis's coordinate, None while
+    the axis is still swept (its values are on the figure's axes), else the scene's value."""
+    axis = next((a for a, k in BY_AXIS.items() if (k.section, k.name) == (section, key)), None)
+    if axis is not None and axis in ds.coords:
+        return float(ds[axis].values) if ds[axis].ndim == 0 else None
+    if axis is not None and axis in _scene(ds).get("axes", {}):
+        return None
+    return _scene(ds).get(section, {}).get(key)
+
+
+
+def _time_dim(da: xr.DataArray) -> str | None:
+    """The time dimension of a stored history, None when `da` has none."""
+    return next((d for d in _TIME_DIMS if d in da.dims), None)

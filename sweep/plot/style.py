@@ -1,0 +1,172 @@
+"""What every figure shares (xarray's plot/utils.py): the colour and marker of each state, the
+units a quantity is shown in, plain tick labels, ranges and log scales, cell edges, legends.
+
+Units: displacements (units m, not the span length) are in mm everywhere; times and forces get
+the prefix their largest value calls for; a level in g reads as g; anything else as stored.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib import patheffects
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.ticker import ScalarFormatter
+
+from ..schema import G_UNITS
+
+# A fixed colour and map marker per state meaning (CF flag_meanings); marker None: a good
+# state, not marked on maps. Meanings not listed here get a fallback colour and "*".
+STATE_STYLES: dict[str, tuple[str, str | None]] = {
+    "invalid_input": ("#7f7f7f", "s"),
+    "decayed": ("#2ca02c", None),
+    "steady": ("#1f77b4", None),
+    "completed": ("#1f77b4", None),
+    "modulated": ("#ff7f0e", "o"),
+    "unsettled": ("#e6c619", "^"),
+    "diverged": ("#d62728", "X"),
+    "step_size_too_small": ("#9467bd", "P"),
+    "max_steps_reached": ("#8c564b", "D"),
+}
+_FALLBACK_COLOURS = ("#17becf", "#e377c2", "#bcbd22", "#393b79", "#637939")
+# The dark edge that keeps a white overlay line visible on any colour.
+_OUTLINE = [patheffects.Stroke(linewidth=3.0, foreground="k"), patheffects.Normal()]
+
+
+def state_styles(state: xr.DataArray) -> list[tuple[int, str, str, str | None]]:
+    """(flag value, meaning, colour, map marker) for every flag the `state` variable declares."""
+    values = np.atleast_1d(state.attrs.get("flag_values", []))
+    meanings = str(state.attrs.get("flag_meanings", "")).split()
+    styles = []
+    spare = iter(_FALLBACK_COLOURS * (1 + len(meanings) // len(_FALLBACK_COLOURS)))
+    for value, meaning in zip(values, meanings):
+        colour, marker = STATE_STYLES.get(meaning, (next(spare), "*"))
+        styles.append((int(value), meaning, colour, marker))
+    return sorted(styles)   # by flag value: colour boundaries must increase (longitudinal: 0 5 7 8)
+
+
+
+def _state_meaning(ds: xr.Dataset) -> str:
+    value = int(ds["state"].values)
+    for v, meaning, _c, _m in state_styles(ds["state"]):
+        if v == value:
+            return meaning
+    return str(value)
+
+
+def _state_colour(ds: xr.Dataset) -> str:
+    value = int(ds["state"].values)
+    return next((c for v, _m, c, _k in state_styles(ds["state"]) if v == value), "k")
+
+
+# ---------------------------------------------------------------------------------- units
+
+_PREFIXES = ((1.0, ""), (1e-3, "m"), (1e-6, "\u00b5"), (1e-9, "n"))
+
+
+def _scaled(values: np.ndarray, units: str | None) -> tuple[float, str | None]:
+    """A factor and prefixed units for m, s and N, chosen from the largest finite value."""
+    if units not in ("m", "s", "N"):
+        return 1.0, units
+    finite = np.abs(np.asarray(values, dtype=float))
+    finite = finite[np.isfinite(finite)]
+    top = float(finite.max()) if finite.size else 0.0
+    if top == 0.0:
+        return 1.0, units
+    for factor, prefix in _PREFIXES:
+        if top >= 0.999 * factor:
+            return 1.0 / factor, prefix + units
+    factor, prefix = _PREFIXES[-1]
+    return 1.0 / factor, prefix + units
+
+
+def _is_displacement(da: xr.DataArray) -> bool:
+    """A displacement (units m, not the span length): always shown in mm."""
+    return da.attrs.get("units") == "m" and da.name != "length"
+
+
+def _unit(da: xr.DataArray, values: np.ndarray | None = None) -> tuple[float, str | None]:
+    """The factor and units a variable is shown in: displacements in mm, times and forces
+    with the prefix their largest value calls for (`_scaled`), anything else as stored."""
+    if _is_displacement(da):
+        return 1e3, "mm"
+    if da.attrs.get("units") == G_UNITS:          # a level in g: "9.80665 m s-2" reads as g
+        return 1.0, "g"
+    return _scaled(da.values if values is None else values, da.attrs.get("units"))
+
+
+def _fmt(value: float, units: str | None) -> str:
+    factor, scaled = (1e3, "mm") if units == "m" else _scaled(np.array([value]), units)
+    text = f"{value * factor:.4g}"
+    return f"{text} {scaled}" if scaled and scaled != "1" else text
+
+
+def _coord(ds: xr.Dataset, dim: str) -> np.ndarray:
+    """An axis's values as drawn (displacement axes in mm)."""
+    return ds[dim].values.astype(float) * _unit(ds[dim])[0]
+
+
+# ---------------------------------------------------------------------------------- axes
+
+def _plain_ticks(ax: Axes) -> None:
+    """Tick labels that are the numbers themselves: no offset ("1e-12+2") and no scientific
+    multiplier on any linear axis (log axes keep their own formatter)."""
+    for axis in (ax.xaxis, ax.yaxis):
+        formatter = axis.get_major_formatter()
+        if isinstance(formatter, ScalarFormatter):
+            formatter.set_useOffset(False)
+            formatter.set_scientific(False)
+
+
+def _padded_range(values: np.ndarray) -> tuple[float, float] | None:
+    """For near-constant data (spread below 1e-6 of its size): its mean +- 5 %, so that the
+    axis shows the value, not round-off; None otherwise."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return None
+    mean, spread = float(v.mean()), float(v.max() - v.min())
+    if spread > 1e-6 * abs(mean) or (mean == 0.0 and spread > 0.0):
+        return None
+    half = 0.05 * abs(mean) if mean else 1.0
+    return mean - half, mean + half
+
+def _new_axes(figsize: tuple[float, float] = (6.4, 4.8)) -> Axes:
+    return Figure(figsize=figsize, layout="constrained").add_subplot()
+
+
+def _is_log_spaced(values: np.ndarray) -> bool:
+    v = np.asarray(values, dtype=float)
+    if v.size < 3 or np.any(v <= 0):
+        return False
+    d = np.diff(v)
+    if np.allclose(d, d[0], rtol=1e-6):
+        return False
+    r = v[1:] / v[:-1]
+    return bool(np.allclose(r, r[0], rtol=1e-6))
+
+
+def _edges(values: np.ndarray) -> np.ndarray:
+    """Cell edges around sorted centres (geometric for a log-spaced axis)."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 1:
+        return v[0] + (np.array([-0.05, 0.05]) * abs(v[0]) if v[0] else np.array([-0.5, 0.5]))
+    log = _is_log_spaced(v)
+    w = np.log(v) if log else v
+    mid = 0.5 * (w[1:] + w[:-1])
+    e = np.concatenate([[w[0] - (mid[0] - w[0])], mid, [w[-1] + (w[-1] - mid[-1])]])
+    return np.exp(e) if log else e
+
+
+def _wide_range(values: np.ndarray) -> bool:
+    """Positive values over more than two decades: plot them on a log scale."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    return bool(v.size and np.all(v > 0) and v.max() > 100 * v.min())
+
+def _legend(ax: Axes, handles: list, title: str | None = None) -> None:
+    if handles:
+        ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+                  ncols=min(2, len(handles)), fontsize="small", title_fontsize="small",
+                  frameon=False, handlelength=3.0)
