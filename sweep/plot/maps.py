@@ -136,7 +136,7 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
     six decades, the rest in the lowest colour). Points in a state that is not a good one
     (modulated, unsettled, diverged, failures) are marked: a marker per cell on small grids,
     hatched and outlined regions on dense ones (`_MARKER_CELLS`). The closed-form curves the
-    axes allow are drawn in white (see the module docstring). Extra keyword arguments go to
+    axes allow are drawn in white (sweep/plot/overlays.py). Extra keyword arguments go to
     `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
     """
     ds = select_points(ds, select)
