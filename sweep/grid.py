@@ -7,8 +7,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .models.rules import default_inertia
+from .scene import Scene
 from .schema import BY_AXIS
-from .scene import Scene, default_inertia
 
 
 def coordinates(scene: Scene) -> dict[str, xr.DataArray]:

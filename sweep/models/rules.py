@@ -1,0 +1,543 @@
+"""The scene rules that are physics: which keys and axes each model kind takes, its defaults,
+and the checks of a resolved scene. The scene pipeline (sweep/scene/build.py) checks every key
+against the schema, then calls `check_base`, the kind's `Rules.check`, `check_pairs`, the
+kind's `Rules.defaults` and `Rules.check_resolved` (`RULES`, through
+`sweep.models.rules_for`). Every refusal is one SceneError line, worded as the scene's own
+(sweep/scene/messages.py).
+
+Shared rules:
+- ``load.frequency`` and ``load.frequency_ratio`` are alternatives; if neither is given,
+  ``load.frequency_ratio = 1.0``. Both keys of an either-or pair (PAIRS), as scalars or axes,
+  are refused.
+- ``solver.courant`` above 1 is refused whatever the model (the scheme is unstable there).
+- ``cable.inertia`` not given: `default_inertia` of the area, the bending moment of a solid
+  round section, A^2 / (4 pi). With ``area`` swept, ``values["cable.inertia"]`` is None and the
+  inertia follows the area point by point (`sweep.grid.parameters`).
+- The derived coefficients (`sweep.models.oscillator`, `sweep.models.wave.wave_parameters`)
+  must be finite at every corner of the grid.
+
+Transverse scenes (``model.kind = "transverse"``, the default):
+- ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
+- ``outputs.sample_interval``, ``solver.max_step`` and ``solver.first_step`` must be
+  <= ``solver.t_end``; with ``outputs.time_series``, t_end / sample_interval must be
+  <= MAX_SAMPLES (10 million samples per point). ``solver.min_step`` must be <= t_end and
+  <= ``solver.max_step``.
+- With ``model.coefficients = "paper"`` the cable data is baked into Eq.32, so its
+  parameters cannot be swept, a cable key (and ``model.membrane``) other than Table 1's value
+  is refused (it would be ignored), and ``initial.velocity`` defaults to 0.0321 m/s when no
+  initial condition is given (docs/model.md: that reproduces the paper's Fig 5 amplitudes).
+- Every point starting at q = q' = 0 (an empty scene, for one) gives q = 0 everywhere (the
+  end load only changes the stiffness): load_scene warns (CableSweepWarning) and runs it,
+  unless base excitation of a non-zero level drives the span.
+
+Base excitation (``[base]``, docs/model.md sec. 5; `has_base`):
+- A ``[base]`` table or a base axis (``base_acceleration``, ``base_acceleration_g``,
+  ``base_frequency``, ``base_frequency_ratio``; an axis counts as the table's key, as the load
+  axes do) needs a level, ``base.acceleration`` (m/s^2) or ``base.acceleration_g`` (g), and a
+  frequency, ``base.frequency`` (Hz) or ``base.frequency_ratio`` (f/f1), each as a key or an
+  axis, and one spelling of each only. No defaults: a scene without them has no base motion.
+- Refused with ``model.kind = "longitudinal"`` and with ``model.coefficients = "paper"``
+  (Eq.32 as printed has no forcing term).
+
+Longitudinal scenes (``model.kind = "longitudinal"``, docs/model.md sec. 4):
+- ``load.type`` defaults to "constant", the only type allowed (a suddenly applied end load).
+- Only ``length``, ``load_amplitude``, ``youngs_modulus``, ``density`` and ``area`` can be
+  swept.
+- The end time is ``solver.t_end`` (s) or ``solver.transits`` (multiples of l/a), not both;
+  with neither, ``solver.transits = 8.0``. Exactly one of the two values is not None.
+- With ``solver.t_end`` given, every ``outputs.snapshot_times`` entry must be <= it; with
+  transits the end time depends on the point, and an entry must be <= the longest one
+  (transits x max over the grid of l sqrt(rho/E); shorter spans give NaN snapshots there),
+  and with ``outputs.histories`` t_end / sample_interval must be <= MAX_SAMPLES.
+- The most time levels a span needs, t_end / dt with dt = courant (l / intervals) / a over
+  the grid, must be <= LEVEL_LIMIT (2^62); more than ``solver.max_steps`` runs max_steps
+  levels and is flagged max_steps_reached.
+- Transverse-only keys (tolerances, coefficients, frequencies, ``[initial]``, ``[metrics]``,
+  the time-series outputs, ...) are accepted and ignored, so a resolved scene written by
+  `Scene.to_toml` loads back; the transverse time checks above are not applied.
+
+This module imports no model (no runner, no kernels beyond a plain constant) and no part of
+the scene pipeline but its messages.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import warnings
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span counts
+
+from .. import schema
+from ..errors import CableSweepWarning
+from ..scene.messages import _fail, _show
+from .modal import oscillator
+from .wave import wave_parameters
+
+PAPER_VELOCITY = 0.0321
+"""initial.velocity (m/s) used by the paper preset when no initial condition is given."""
+
+
+def default_inertia(area: Any) -> Any:
+    """cable.inertia (m^4) of a scene that gives none: the bending second moment of area of a
+    solid round section of ``area`` (m^2), pi d^4 / 64 = A^2 / (4 pi); 2.865e-12 for 6e-6.
+
+    Element-wise on floats, arrays and DataArrays. The paper's 5.73e-12 is the polar moment
+    of its 6 mm^2 section (twice this), and a stranded cable bends more easily than a solid
+    one: give a measured inertia (EI / E) for it (see the cable.inertia key in README.md).
+    """
+    return area * area / (4.0 * math.pi)
+
+
+PAPER_FIXED_AXES: tuple[str, ...] = ("youngs_modulus", "density", "area", "inertia", "membrane")
+"""Axes the paper preset cannot sweep: Eq.32 has these numbers baked in."""
+PAPER_CABLE: dict[str, tuple[float, ...]] = {
+    "cable.youngs_modulus": (1.1e11,), "cable.density": (8900.0,), "cable.area": (6e-6,),
+    # Table 1's I, and the default A^2/(4 pi) of its area (what Scene.to_toml writes)
+    "cable.inertia": (5.73e-12, 6e-6 * 6e-6 / (4.0 * math.pi)), "model.membrane": (0.375,)}
+"""The cable data Eq.32 was derived from (Table 1, docs/model.md sec. 1): under
+``model.coefficients = "paper"`` a scalar key may only repeat one of these values."""
+
+FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
+DEFAULT_FREQUENCY_RATIO = 1.0
+"""load.frequency_ratio of a scene that gives neither load frequency key."""
+
+BASE_LEVEL_KEYS: tuple[str, str] = ("base.acceleration", "base.acceleration_g")
+BASE_FREQUENCY_KEYS: tuple[str, str] = ("base.frequency", "base.frequency_ratio")
+BASE_KEYS: tuple[str, ...] = BASE_LEVEL_KEYS + BASE_FREQUENCY_KEYS
+BASE_FIX = ("add a [base] table with acceleration or acceleration_g and frequency or "
+            "frequency_ratio")
+"""How to fix a base key or axis given without the rest of the base excitation."""
+PAIRS: tuple[tuple[str, str], ...] = (FREQUENCY_KEYS, BASE_LEVEL_KEYS, BASE_FREQUENCY_KEYS)
+"""Either-or keys: two spellings of one quantity (as scalars or axes), never both."""
+_PAIR_UNITS: dict[str, str] = {
+    "load.frequency": "load.frequency is in Hz, load.frequency_ratio in multiples of w1",
+    "base.acceleration": "acceleration is in m/s^2, acceleration_g in g = "
+                         f"{schema.STANDARD_GRAVITY:g} m/s^2",
+    "base.frequency": "frequency is in Hz, frequency_ratio in multiples of f1 of the unloaded "
+                      "span"}
+
+END_TIME_KEYS: tuple[str, str] = ("solver.t_end", "solver.transits")
+DEFAULT_T_END = 5.0
+"""solver.t_end (s) of a transverse scene that gives none."""
+DEFAULT_TRANSITS = 8.0
+"""solver.transits of a longitudinal scene that gives neither solver.t_end nor transits."""
+
+LONGITUDINAL_AXES: tuple[str, ...] = ("length", "load_amplitude", "youngs_modulus", "density",
+                                      "area")
+"""The axes a longitudinal scene can sweep (the parameters of the wave problem)."""
+LONGITUDINAL_LOAD = "constant"
+"""load.type of a longitudinal scene, the only one it takes (a suddenly applied end load)."""
+
+MAX_SAMPLES = 10_000_000
+"""Most time-series samples per point (solver.t_end / outputs.sample_interval)."""
+
+
+def has_base(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
+    """Whether a resolved scene (its values and axes) has base excitation: a base level is
+    given, as a [base] key or an axis (a validated scene then has a base frequency too)."""
+    return any(values.get(d) is not None or schema.BY_DOTTED[d].axis in axes
+               for d in BASE_LEVEL_KEYS)
+
+
+def model_kind(given: Mapping[str, Any]) -> str:
+    """The model.kind of a scene's given keys (dotted key -> value): given, else the default."""
+    return given.get("model.kind", schema.BY_DOTTED["model.kind"].default)
+
+
+def check_value(where: str, dotted: str, value: Any) -> None:
+    """Refuse one key's value that the physics rules out whatever the model, beyond the
+    schema's bounds: ``solver.courant`` (dimensionless) above 1, where the central difference
+    is unstable. `where` names the key in the message."""
+    if dotted == "solver.courant" and value > 1.0:
+        _fail(where, f"must be <= 1, got {_show(value)}", _courant_fix(value))
+
+
+def _courant_fix(courant: float) -> str:
+    """Why a Courant number above 1 is refused, with the growth per step of the worst mode.
+
+    The grid-scale mode (k dx = pi) of the three-level central difference has amplification
+    factors g with g^2 - b g + 1 = 0, b = 2 - 4 C^2; for C > 1, |g| = |b|/2 + sqrt(b^2/4 - 1).
+    """
+    half_b = abs(2.0 - 4.0 * courant * courant) / 2.0
+    growth = half_b + math.sqrt(max(half_b * half_b - 1.0, 0.0))
+    if not math.isfinite(growth):
+        rate = "beyond any bound"
+    elif growth >= 1000.0:
+        rate = f"about {growth:.3g}x per step"
+    elif growth - 1.0 >= 0.01:
+        rate = f"about {growth:.2f}x per step"
+    elif growth > 1.0:
+        rate = f"about {growth:.{min(12, 1 - math.floor(math.log10(growth - 1.0)))}f}x per step"
+    else:
+        rate = "slowly"
+    return ("the explicit central difference is unstable above 1: its grid-scale mode grows "
+            f"{rate} at C = {_show(courant)}; use 1.0, which is exact at the nodes")
+
+
+def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bool,
+               file_has_base: bool) -> None:
+    """Rules of base excitation (docs/model.md sec. 5): a [base] table or base axis needs a
+    level and a frequency (each as a key or an axis), a transverse scene and the consistent
+    coefficients. given: dotted key -> value; axes: axis name -> values; `has_table`: the
+    document (overrides applied) has a [base] table; `file_has_base`: the scene file itself
+    (before overrides) has one; if not (a lone base axis, an override), the fix says to add
+    the table."""
+    named = [(f"axis '{schema.BY_DOTTED[d].axis}'" if schema.BY_DOTTED[d].axis in axes
+              else f"scene key '{d}'")
+             for d in BASE_KEYS if d in given or schema.BY_DOTTED[d].axis in axes]
+    if not named and not has_table:
+        return
+    where = named[0] if named else "scene section '[base]'"
+    if model_kind(given) == "longitudinal":
+        _fail(where, "model.kind = 'longitudinal' has no base excitation (the clamps' "
+              "transverse motion drives the transverse modal equation only)",
+              "remove the [base] table and the base axes, or use model.kind = 'transverse'")
+    if given.get("model.coefficients") == "paper":
+        _fail(where, "model.coefficients = 'paper' has no base excitation (Eq.32 as printed "
+              "has no forcing term)", "use model.coefficients = 'consistent'")
+    for pair, what, example in ((BASE_LEVEL_KEYS, "a level", "acceleration_g = 0.5 (g) or "
+                                 "acceleration = 4.9 (m/s^2)"),
+                                (BASE_FREQUENCY_KEYS, "a frequency", "frequency = 20.0 (Hz) or "
+                                 "frequency_ratio = 1.0 (f/f1)")):
+        if any(d in given or schema.BY_DOTTED[d].axis in axes for d in pair):
+            continue
+        _fail(where, f"base excitation needs {what}: the scene gives neither "
+              f"{pair[0]} nor {pair[1]} (as a key or axis)",
+              BASE_FIX if not file_has_base else f"add {example} to the [base] table")
+
+
+def check_pairs(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Refuse both keys of an either-or pair (PAIRS), as scalars (given: dotted key -> value)
+    or axes (axis name -> values)."""
+    for pair in PAIRS:
+        present = [d for d in pair if d in given or schema.BY_DOTTED[d].axis in axes]
+        if len(present) == 2:
+            _fail(f"scene keys '{pair[0]}' and '{pair[1]}'", "give one, not both (as keys or "
+                  f"axes {', '.join(schema.BY_DOTTED[d].axis or d for d in pair)})",
+                  f"remove one of them: {_PAIR_UNITS[pair[0]]}")
+
+
+def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of a transverse scene: no longitudinal-only keys, a controller for the method,
+    a load frequency to sweep, and model.coefficients = 'paper' with Table 1's cable only."""
+    if given.get("solver.transits") is not None:
+        _fail("scene key 'solver.transits'", "only for model.kind = 'longitudinal'",
+              "use solver.t_end in seconds")
+    for dotted, what in (("outputs.snapshot_times", "snapshots of the wave along the span"),
+                         ("outputs.histories", "the end histories u(l, t), N(0, t)"),
+                         ("outputs.normalised", "the N/P0 and v rho A a/P0 forms")):
+        if given.get(dotted) not in (None, False):
+            _fail(f"scene key '{dotted}'", f"only for model.kind = 'longitudinal' ({what}); a "
+                  "transverse scene would ignore it",
+                  "remove it, or use outputs.time_series = true for q(t)")
+    if given.get("solver.method") == "dop853" and given.get("solver.controller") == "pi":
+        _fail("scene keys 'solver.method' and 'solver.controller'",
+              "the PI controller is tuned for method 'rk45' only",
+              "use solver.controller = 'scipy' with method 'dop853'")
+    if given.get("load.type") == "constant":
+        for axis in ("frequency_ratio", "frequency"):
+            if axis in axes:
+                _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
+                      f"remove the {axis} axis, or use load.type = 'harmonic'")
+    if given.get("model.coefficients") == "paper":
+        for axis in axes:
+            if axis in PAPER_FIXED_AXES:
+                _fail(f"axis '{axis}'", "model.coefficients = 'paper' has no such parameter",
+                      "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
+                      "to sweep it")
+        _check_paper_cable(given)
+
+
+def _check_paper_cable(given: dict[str, Any]) -> None:
+    """Refuse cable data that Eq.32 would ignore: its coefficients are numbers for the Table 1
+    cable, so another modulus, density, area, inertia or membrane coefficient would not change
+    the result. A value equal to Table 1's (PAPER_CABLE) is accepted, so that resolved scenes
+    (every key written out) load back."""
+    for dotted, table in PAPER_CABLE.items():
+        value = given.get(dotted)
+        if value is None or any(math.isclose(value, v, rel_tol=1e-9) for v in table):
+            continue
+        _fail(f"scene key '{dotted}'",
+              f"model.coefficients = 'paper' ignores it: Eq.32 bakes in the Table 1 cable "
+              f"({dotted} = {table[0]:g}), got {value:g}",
+              "remove the key, or use model.coefficients = 'consistent' for another cable")
+
+
+def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of a longitudinal scene: a constant load, its parameters only, one end time."""
+    load_type = given.get("load.type", LONGITUDINAL_LOAD)
+    if load_type != LONGITUDINAL_LOAD:
+        _fail("scene key 'load.type'",
+              f"model.kind = 'longitudinal' takes only '{LONGITUDINAL_LOAD}'",
+              "use load.type = 'constant', a suddenly applied end load (docs/model.md sec. 4), or "
+              "model.kind = 'transverse' for a harmonic load")
+    for axis in axes:
+        if axis not in LONGITUDINAL_AXES:
+            _fail(f"axis '{axis}'", "model.kind = 'longitudinal' has no such parameter",
+                  f"remove the axis; it sweeps {', '.join(LONGITUDINAL_AXES)}")
+    if all(given.get(k) is not None for k in END_TIME_KEYS):
+        _fail("scene keys 'solver.t_end' and 'solver.transits'", "give one, not both",
+              "remove one of them: t_end is in seconds, transits in multiples of l/a")
+
+
+def _check_times(values: dict[str, Any]) -> None:
+    """Transverse: intervals and steps must fit inside the simulated time."""
+    t_end = values["solver.t_end"]
+    for dotted in ("outputs.sample_interval", "solver.max_step", "solver.first_step",
+                   "solver.min_step"):
+        value = values[dotted]
+        if value is not None and value > t_end:
+            _fail(f"scene key '{dotted}'", f"must be <= solver.t_end ({t_end!r} s), got {value!r}",
+                  "use a smaller value or a longer solver.t_end")
+    low, high = values["solver.min_step"], values["solver.max_step"]
+    if low is not None and high is not None and low > high:
+        _fail("scene key 'solver.min_step'",
+              f"must be <= solver.max_step ({high!r} s), got {low!r} (every step would be "
+              "below the smallest allowed)", "use a smaller min_step or a larger max_step")
+    _check_sample_count(values, "outputs.time_series")
+
+
+def _check_sample_count(values: dict[str, Any], wanted: str) -> None:
+    """Refuse a sample interval that gives more than MAX_SAMPLES samples per point, when the
+    samples are asked for (``wanted``) and solver.t_end is known."""
+    t_end, interval = values["solver.t_end"], values["outputs.sample_interval"]
+    if not values[wanted] or t_end is None or interval is None or t_end / interval <= MAX_SAMPLES:
+        return
+    _fail("scene key 'outputs.sample_interval'",
+          f"{interval!r} s gives {t_end / interval:.3g} samples per point over "
+          f"solver.t_end = {t_end!r} s, more than {MAX_SAMPLES}",
+          f"use outputs.sample_interval >= {t_end / MAX_SAMPLES:.3g} s, or leave it out "
+          "for t_end/1000")
+
+
+def _extreme(values: dict[str, Any], axes: dict[str, np.ndarray], dotted: str,
+             pick: Any) -> float:
+    """`pick` (np.min or np.max) of a key over the grid: its axis, or its scalar value."""
+    axis = schema.BY_DOTTED[dotted].axis
+    return float(pick(axes[axis])) if axis in axes else float(values[dotted])
+
+
+def _check_time_levels(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Longitudinal: the most time levels a span needs, t_end / dt with dt = C (l/N) / a
+    (a = sqrt(E/rho)), must be a count the kernel can hold (<= LEVEL_LIMIT, about 4.6e18):
+    a larger one overflowed int64 and ran nothing. A count above solver.max_steps but within
+    the limit runs max_steps levels and is flagged max_steps_reached."""
+    courant, n_int = values["solver.courant"], values["solver.intervals"]
+    transits = values["solver.transits"]
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        if transits is not None:          # t_end = transits l/a: the count is the same for all
+            levels = np.float64(transits) * n_int / courant
+            keys = "solver.transits, solver.intervals and solver.courant"
+        else:
+            speed = np.sqrt(np.float64(_extreme(values, axes, "cable.youngs_modulus", np.max))
+                            / _extreme(values, axes, "cable.density", np.min))
+            levels = (np.float64(values["solver.t_end"]) * speed * n_int
+                      / (courant * _extreme(values, axes, "cable.length", np.min)))
+            keys = "solver.t_end, solver.intervals, solver.courant and the cable data"
+    if math.isfinite(levels) and levels <= LEVEL_LIMIT:
+        return
+    _fail(f"scene keys {keys}",
+          f"need {float(levels):.3g} time levels per span (t_end / dt, dt = courant l / "
+          f"(intervals a)), more than any run can count ({LEVEL_LIMIT:.3g}; solver.max_steps = "
+          f"{values['solver.max_steps']})",
+          "use fewer transits or a shorter t_end, fewer intervals, or a courant number "
+          "near 1")
+
+
+def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
+                        given: dict[str, Any]) -> None:
+    """Transverse: warn (CableSweepWarning) when every point starts at q = q' = 0. The
+    oscillator has no forcing term (the end load enters the stiffness only), so such a sweep
+    stays at q = 0 everywhere: it would look like a result and say nothing. Base excitation
+    with a level above zero somewhere drives the span from rest: no warning then."""
+    if has_base(values, axes) and any(
+            _extreme(values, axes, d, np.max) > 0.0 for d in BASE_LEVEL_KEYS
+            if values[d] is not None or schema.BY_DOTTED[d].axis in axes):
+        return
+    for dotted in ("initial.displacement", "initial.velocity"):
+        if (_extreme(values, axes, dotted, np.min) != 0.0
+                or _extreme(values, axes, dotted, np.max) != 0.0):
+            return
+    what = ""
+    if not given and not axes:
+        what = (f"the scene sets no keys, so it runs one point of the defaults (a "
+                f"{values['cable.length']:g} m span, {values['load.amplitude']:g} N "
+                f"{values['load.type']} end load, {values['solver.t_end']:g} s): ")
+    warnings.warn(f"{what}initial.displacement = initial.velocity = 0 at every point, and the "
+                  "end load only changes the stiffness, so every point stays at q = 0 "
+                  "(state decayed, amplitude 0); give a start, e.g. initial.displacement = "
+                  "1e-4 (m)", CableSweepWarning, stacklevel=5)
+
+
+def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Longitudinal: with solver.t_end given, every snapshot time must be <= it; with
+    solver.transits, <= the longest span's end time, transits x max(l sqrt(rho/E)) (a time
+    after every span's end would be NaN everywhere)."""
+    t_end, times = values["solver.t_end"], values["outputs.snapshot_times"]
+    if not times:
+        return
+    if t_end is not None:
+        for number, time in enumerate(times, start=1):
+            if time > t_end:
+                _fail("scene key 'outputs.snapshot_times'",
+                      f"item {number} of the list, {time!r} s, is after solver.t_end "
+                      f"({t_end!r} s)", "use times <= solver.t_end or a longer solver.t_end")
+        return
+
+    def extreme(dotted: str, pick: Any) -> float:
+        axis = schema.BY_DOTTED[dotted].axis
+        return float(pick(axes[axis])) if axis in axes else values[dotted]
+
+    transits = values["solver.transits"]
+    # As sweep.models.wave.wave_parameters computes it: transits x (l / a), a = sqrt(E/rho).
+    latest = transits * (extreme("cable.length", np.max) / math.sqrt(
+        extreme("cable.youngs_modulus", np.min) / extreme("cable.density", np.max)))
+    for number, time in enumerate(times, start=1):
+        if time > latest:
+            _fail("scene key 'outputs.snapshot_times'",
+                  f"item {number} of the list, {time!r} s, is after the end of every span "
+                  f"(solver.transits = {transits!r} x l/a is at most {latest:.6g} s)",
+                  f"use times <= {latest:.6g} s, or more solver.transits")
+
+
+_CHECKED_COEFFICIENTS: dict[str, tuple[str, ...]] = {
+    "transverse": ("k0", "k1", "g0", "g1", "h", "omega", "mass", "damping", "q_scale",
+                   "v_scale", "natural_frequency", "buckling_load", "load_ratio", "base_accel",
+                   "base_omega"),
+    "longitudinal": ("wave_speed", "axial_stiffness", "t_end", "transit_time",
+                     "static_end_displacement", "impedance"),
+}
+
+
+def _float64(value: Any) -> Any:
+    """A float as np.float64 (IEEE overflow and division by zero give inf, not exceptions)."""
+    return np.float64(value) if isinstance(value, float) else value
+
+
+_PLAUSIBLE = (1e-100, 1e100)
+"""Magnitudes outside this range are named first when derived coefficients are not finite."""
+
+
+def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Refuse cable data whose derived coefficients are not finite floats (e.g. density =
+    5e-324 makes w1^2 = EI k^4 / (rho A) infinite; E = 1e-300 with rho = 1e308 a zero wave
+    speed): computed with the run's own formulas (sweep.models.oscillator,
+    sweep.models.wave.wave_parameters) at every corner of the grid (each axis at its first
+    and last value). Each coefficient is a product of powers of the parameters (or a sum of
+    same-signed ones), so its largest and smallest magnitudes lie at corners."""
+    kind = values["model.kind"]
+    corners = list(itertools.product(*([float(a[0]), float(a[-1])] for a in axes.values())))
+    columns = dict(zip(axes, np.array(corners, dtype=np.float64).T)) if axes else {}
+    params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
+                              for name, key in schema.BY_AXIS.items()}
+    if params["inertia"] is None:
+        params["inertia"] = default_inertia(params["area"])
+    params.update(coefficients=values["model.coefficients"], load_type=values["load.type"],
+                  paper_parametric=values["model.paper_parametric"],
+                  divergence_bound=values["metrics.divergence_bound"])
+    if params["load_type"] == "constant":
+        params["frequency"] = None
+    with np.errstate(all="ignore"):
+        if kind == "longitudinal":
+            derived = wave_parameters(params, values["solver.t_end"], values["solver.transits"])
+        else:
+            derived = oscillator(params)
+    bad = [(name, np.atleast_1d(np.asarray(derived[name], dtype=np.float64)))
+           for name in _CHECKED_COEFFICIENTS[kind]]
+    bad = [(name, v) for name, v in bad if not np.all(np.isfinite(v))]
+    if not bad:
+        return
+    name, coefficient = bad[0]
+    corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0
+    inputs = []
+    for axis, key in schema.BY_AXIS.items():
+        value = params[axis]
+        if value is None or key.section not in ("cable", "model", "load", "base"):
+            continue
+        value = float(np.atleast_1d(value)[corner % np.size(value)])
+        where = (f"axis '{axis}' at {value!r}" if axis in axes
+                 else f"scene key '{key.dotted}' = {value!r}")
+        inputs.append((not (value == 0 or _PLAUSIBLE[0] <= abs(value) <= _PLAUSIBLE[1]), where))
+    named = [w for odd, w in inputs if odd] or [w for _, w in inputs]
+    _fail(", ".join(named),
+          f"give the derived coefficient {name} = {float(coefficient[corner])!r}, not a "
+          f"finite float64 (so are: {', '.join(n for n, _ in bad)})",
+          "give the cable data in SI units with physical magnitudes, e.g. cable.density = "
+          "8900 kg/m^3, cable.area = 6e-6 m^2, cable.youngs_modulus = 1.1e11 Pa")
+
+
+def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
+    """Defaults of every kind: load.frequency_ratio 1.0 without a load frequency, and
+    cable.inertia (m^4) from a scalar area."""
+    if not any(d in mentioned for d in FREQUENCY_KEYS):
+        values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    if "cable.inertia" not in mentioned and values["cable.area"] is not None:
+        values["cable.inertia"] = default_inertia(values["cable.area"])
+
+
+def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
+                         mentioned: set[str]) -> None:
+    """solver.t_end 5 s, and the paper preset's initial.velocity without an initial condition."""
+    _shared_defaults(values, mentioned)
+    if "solver.t_end" not in mentioned:
+        values["solver.t_end"] = DEFAULT_T_END
+    paper = values["model.coefficients"] == "paper"
+    if paper and not ("initial.displacement" in mentioned or "initial.velocity" in mentioned):
+        values["initial.velocity"] = PAPER_VELOCITY
+
+
+def _longitudinal_defaults(values: dict[str, Any], given: dict[str, Any],
+                           mentioned: set[str]) -> None:
+    """load.type 'constant', and 8 transits without an end time."""
+    _shared_defaults(values, mentioned)
+    values["load.type"] = given.get("load.type", LONGITUDINAL_LOAD)
+    if not any(d in mentioned for d in END_TIME_KEYS):
+        values["solver.transits"] = DEFAULT_TRANSITS
+
+
+def _check_transverse_resolved(values: dict[str, Any], axes: dict[str, np.ndarray],
+                               given: dict[str, Any]) -> None:
+    """Finite coefficients, steps and samples within t_end, and the zero-solution warning."""
+    _check_coefficients(values, axes)
+    _check_times(values)
+    _warn_zero_solution(values, axes, given)
+
+
+def _check_longitudinal_resolved(values: dict[str, Any], axes: dict[str, np.ndarray],
+                                 given: dict[str, Any]) -> None:
+    """Finite coefficients, a countable number of time levels, snapshots within the end time,
+    and the history sample count."""
+    _check_coefficients(values, axes)
+    _check_time_levels(values, axes)
+    _check_snapshot_times(values, axes)
+    _check_sample_count(values, "outputs.histories")
+
+
+@dataclass(frozen=True)
+class Rules:
+    """The scene rules of one model kind, in the order the scene pipeline calls them.
+
+    check(given, axes): refuse keys and axes the kind cannot take (given: dotted key -> the
+        checked value; axes: axis name -> values), before any default is applied.
+    defaults(values, given, mentioned): write the kind's defaults into `values` (every dotted
+        key -> value, the schema's defaults applied); `mentioned`: the keys given or swept.
+    check_resolved(values, axes, given): refuse (or warn about) the resolved scene.
+    """
+
+    check: Callable[[dict[str, Any], dict[str, np.ndarray]], None]
+    defaults: Callable[[dict[str, Any], dict[str, Any], set[str]], None]
+    check_resolved: Callable[[dict[str, Any], dict[str, np.ndarray], dict[str, Any]], None]
+
+
+RULES: dict[str, Rules] = {
+    "transverse": Rules(_check_transverse, _transverse_defaults, _check_transverse_resolved),
+    "longitudinal": Rules(_check_longitudinal, _longitudinal_defaults,
+                          _check_longitudinal_resolved),
+}
+"""model.kind -> its rules (the keys of sweep.models.MODELS)."""

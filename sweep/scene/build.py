@@ -1,0 +1,82 @@
+"""The scene pipeline: read, parse, override, check every key and axis against the schema,
+apply the rules of the scene's model kind (sweep/models/rules.py, found through the registry,
+`sweep.models.rules_for`), resolve the defaults, and return the Scene.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .. import models, schema
+from ..models import rules
+from .axes import _check_axes, _flatten_axes
+from .document import Scene
+from .messages import _fail
+from .overrides import _apply_overrides, _parse_overrides
+from .reading import _parse_toml, _read_scene
+from .values import _check_description, _check_name, _check_sections, _check_top_level
+
+
+def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = None) -> Scene:
+    """Load a built-in scene by name, or a scene file by path, and validate it.
+
+    overrides: dotted key -> value, applied to the document before validation. Values may be
+    Python values or strings; strings are parsed as TOML values (see `parse_override`).
+    """
+    source, text, default_name = _read_scene(scene)
+    return _build(text, source, default_name, overrides)
+
+
+def load_scene_text(text: str, source: str = "<string>",
+                    overrides: Mapping[str, Any] | None = None) -> Scene:
+    """Like `load_scene`, from TOML text; ``source`` is used in error messages."""
+    return _build(text, source, "unnamed", overrides)
+
+
+def _build(text: str, source: str, default_name: str,
+           overrides: Mapping[str, Any] | None) -> Scene:
+    """Parse, override, validate and resolve a scene."""
+    doc = _parse_toml(text, source)
+    if isinstance(doc.get("axes"), dict):
+        doc["axes"] = _flatten_axes(doc["axes"])
+    file_has_base = "base" in doc
+    applied = _parse_overrides(overrides)
+    _apply_overrides(doc, applied)
+    _check_top_level(doc)
+    name = _check_name(doc.get("name", default_name))
+    description = _check_description(doc.get("description", ""))
+    given = _check_sections(doc)
+    axes = _check_axes(doc.get("axes", {}))
+    rules.check_base(given, axes, "base" in doc, file_has_base)
+    kind = models.rules_for(rules.model_kind(given))
+    kind.check(given, axes)
+    _check_run(given)
+    rules.check_pairs(given, axes)
+    values = _resolve(given, axes, kind)
+    kind.check_resolved(values, axes, given)
+    return Scene(name=name, description=description, values=values, axes=axes,
+                 text=text, source=source, overrides=applied)
+
+
+def _check_run(given: dict[str, Any]) -> None:
+    """run.workers sizes the LocalCluster of the dask backend; with threads it would be
+    ignored (run.threads is the threads backend's count)."""
+    if given.get("run.workers", 0) and given.get("run.backend", "threads") != "dask":
+        _fail("scene key 'run.workers'", "only for run.backend = 'dask' (the LocalCluster's "
+              "worker processes); the threads backend would ignore it",
+              "use run.threads for the threads backend, or set run.backend = 'dask'")
+
+
+def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray],
+             kind: rules.Rules) -> dict[str, Any]:
+    """Every dotted key -> value: given, else the default (the schema's, then those of the
+    model kind's rules); None for swept keys."""
+    swept = {schema.BY_AXIS[a].dotted for a in axes}
+    values = {k.dotted: None if k.dotted in swept else given.get(k.dotted, k.default)
+              for k in schema.KEYS}
+    kind.defaults(values, given, set(given) | swept)
+    return values
