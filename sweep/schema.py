@@ -74,7 +74,7 @@ KEYS: tuple[Key, ...] = (
         long_name="density", axis="density"),
     Key("cable", "area", "float", 6e-6, units="m2", minimum=0.0, exclusive_min=True,
         long_name="cross-sectional area", axis="area"),
-    # No fixed default: sweep.scene.default_inertia gives A^2/(4 pi) from the area.
+    # No fixed default: sweep.models.rules.default_inertia gives A^2/(4 pi) from the area.
     Key("cable", "inertia", "float", None, units="m4", minimum=0.0, exclusive_min=True,
         long_name="bending second moment of area, EI/E (default A^2/(4 pi), a solid round "
                   "section; a stranded cable's is smaller: give a measured EI/E)", axis="inertia"),
