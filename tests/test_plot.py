@@ -177,6 +177,18 @@ def test_functions_take_an_axes_like_xarray(results):
         "span length between constraints [m]"
 
 
+def test_span_lengths_stay_in_metres_where_the_overlays_are_placed(results):
+    """Span lengths below 1 m are drawn in metres (not mm, as a displacement would be): the
+    closed-form overlays (the buckling length, the paper's points) are placed in metres."""
+    ds, _ = results["map"]
+    short = ds.sel(length=ds["length"] < 1.0)
+    assert short.sizes["length"] >= 2
+    ax = splot.plot_line(short, "amplitude", select={"frequency_ratio": 2.0})
+    assert ax.get_xlabel() == "span length between constraints [m]"
+    xs = np.concatenate([np.asarray(line.get_xdata(), float) for line in ax.lines])
+    assert np.isin(short["length"].values, xs).all() and np.all(xs <= 1.0)
+
+
 def test_select_picks_values_and_names_what_is_wrong(results):
     ds, _ = results["map"]
     three = xr.concat([ds, ds], dim=xr.DataArray([0.01, 0.02], dims="damping_ratio",

@@ -87,10 +87,13 @@ def _is_displacement(da: xr.DataArray) -> bool:
 
 
 def _unit(da: xr.DataArray, values: np.ndarray | None = None) -> tuple[float, str | None]:
-    """The factor and units a variable is shown in: displacements in mm, times and forces
-    with the prefix their largest value calls for (`_scaled`), anything else as stored."""
+    """The factor and units a variable is shown in: displacements in mm, span lengths in m,
+    times and forces with the prefix their largest value calls for (`_scaled`), anything else
+    as stored."""
     if _is_displacement(da):
         return 1e3, "mm"
+    if da.name == "length":                       # span lengths: in metres, as the closed-form
+        return 1.0, "m"                           # overlays (buckling length, ...) are placed
     if da.attrs.get("units") == G_UNITS:          # a level in g: "9.80665 m s-2" reads as g
         return 1.0, "g"
     return _scaled(da.values if values is None else values, da.attrs.get("units"))
