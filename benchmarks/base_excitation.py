@@ -50,6 +50,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common
 
 from bench_common import markdown_table, parameter_table, write_json  # noqa: E402
 from sweep.kernels import oscillator as osc  # noqa: E402
+from sweep.models.transverse import set_constant_stiffness  # noqa: E402
 from sweep.kernels import transverse as tk  # noqa: E402
 from sweep.run import settings_vector, solve_points  # noqa: E402
 from sweep.scene import Scene, load_scene_text  # noqa: E402
@@ -122,8 +123,7 @@ def kernel_inputs(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     time-varying stiffness in any row, CONSTANT_STIFFNESS compiles the cos(W t) terms out."""
     table = parameter_table(scene)
     settings = settings_vector(scene)
-    varying = bool(np.any(table[:, osc.K1] != 0.0) or np.any(table[:, osc.G1] != 0.0))
-    settings[tk.CONSTANT_STIFFNESS] = 0.0 if varying else 1.0
+    set_constant_stiffness(settings, {c: table[:, osc.PARAM_NAMES.index(c)] for c in ("k1", "g1")})
     return table, settings
 
 

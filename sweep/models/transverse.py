@@ -125,6 +125,15 @@ def settings_vector(scene: Scene) -> np.ndarray:
     return s
 
 
+def set_constant_stiffness(settings: np.ndarray, coeffs: dict[str, Any]) -> None:
+    """settings[CONSTANT_STIFFNESS] from the scene's coefficients (modal.oscillator, on their
+    axes, or the parameter table's columns by name): 1.0 when no point has a time-varying
+    stiffness (k1 = g1 = 0 everywhere: a constant or zero end load), so the kernels leave the
+    cos(W t) terms out (the same results to the bit, and a cheaper right-hand side)."""
+    varying = any(bool(np.any(np.asarray(coeffs[c]) != 0.0)) for c in ("k1", "g1"))
+    settings[tk.CONSTANT_STIFFNESS] = 0.0 if varying else 1.0
+
+
 def solve_points(params: np.ndarray, settings: np.ndarray, n_samples: int,
                  threads: int = 0, progress: bool = False,
                  chunk_size: int | None = None, driver: str = "lanes") -> KernelResult:
@@ -199,10 +208,7 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size))
                  + 40, "metrics and time series")
     coeffs = modal.oscillator(params)          # derived quantities, on the axes they need
-    # No time-varying stiffness anywhere (a constant or zero end load): the kernels leave the
-    # cos(W t) terms out (the same results, bit for bit, and a cheaper right-hand side).
-    varying = any(bool(np.any(np.asarray(coeffs[c]) != 0.0)) for c in ("k1", "g1"))
-    settings[tk.CONSTANT_STIFFNESS] = 0.0 if varying else 1.0
+    set_constant_stiffness(settings, coeffs)
 
     def rows_at(points: np.ndarray) -> np.ndarray:
         at = grid.point_values(params, dims, shape, points)
