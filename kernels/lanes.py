@@ -7,7 +7,9 @@ These loops run across the lanes with straight-line arithmetic, so LLVM vectoris
 
 - `_prepare`: the next step of every lane whose step needs no special care;
 - `_attempt`: one Dormand-Prince attempt (six right-hand sides, stage sums, error norm);
-  `_attempt8` its DOP853 counterpart (twelve right-hand sides; solver.method = "dop853");
+  `_attempt8` its DOP853 counterpart (twelve right-hand sides; solver.method = "dop853").
+  Their stages are written out from each method's tableau by kernels.stages (straight-line
+  code; the scalar driver loops over the same tableau): there is no hand-written copy;
 - `_pi_factors`: the PI controller's step-size factors (only when that controller is chosen);
 - `_finish`: accept/reject and the step-size update of every lane, and the metrics of an
   ordinary accepted step;
@@ -38,6 +40,7 @@ import numpy as np
 
 from . import dop853
 from . import metrics as mt
+from . import stages
 from . import trajectory as tj
 from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
@@ -78,19 +81,7 @@ ORDINARY = 0.0        # nothing for the scalar state machine to do
 NEEDS_SCALAR = 1.0    # this lane's step or metrics need the scalar state machine
 HAS_EXTREMUM = 2.0    # as NEEDS_SCALAR, and the step holds an extremum of q for `_locate_extrema`
 
-# The tableau as compile-time constants (tuples are frozen into the code).
-_A = tuple(tuple(float(x) for x in row) for row in A)
-_B = tuple(float(x) for x in B)
-_C = tuple(float(x) for x in C)
-_E = tuple(float(x) for x in E)
 _P_COLUMNS = tuple(tuple(float(row[c]) for row in P) for c in range(4))   # P[:, c]
-
-# DOP853's tableau (rows of A and entries of B, E3, E5 that are zero are left out of the sums).
-_A8 = tuple(tuple(float(x) for x in row) for row in dop853.A)
-_B8 = tuple(float(x) for x in dop853.B)
-_C8 = tuple(float(x) for x in dop853.C)
-_E3 = tuple(float(x) for x in dop853.E3)
-_E5 = tuple(float(x) for x in dop853.E5)
 
 # Controller: below this error the accepted factor is MAX_FACTOR, SAFETY err^(-1/5) >= 10
 # (RK45), SAFETY err^(-1/8) >= 10 (DOP853).
@@ -123,6 +114,14 @@ def _accel(W, j, t, q, v, terms):
     return acceleration(t, q, v, W, W_P * LANES + j, LANES, True, terms)
 
 
+# Each method's stages, written out from its tableau (kernels.stages): straight-line code in
+# the tableau's order, so the loops across the lanes stay vectorised. RK45 sums every entry
+# of its tableau; DOP853 leaves out the zeros of its sparse one.
+_chain5 = stages.make_chain(A, B, C, _accel, sums=(E,), name="rk45_chain")
+_chain8 = stages.make_chain(dop853.A, dop853.B, dop853.C, _accel, sums=(dop853.E5, dop853.E3),
+                            skip_zeros=True, name="dop853_chain")
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _prepare(W, settings, n_run):
     """trajectory.next_attempt across lanes, for the lanes whose step is ordinary: running,
@@ -151,13 +150,12 @@ def _prepare(W, settings, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _attempt(W, rtol, n_run, terms):
-    """One Dormand-Prince attempt in every lane of W.
-
-    The stages are written out with scalar locals and the tableau's entries (dopri5.A, B, C,
-    E), summed in the scalar step's order; one loop with a run-time trip count runs across the
-    lanes with straight-line arithmetic, so LLVM vectorises it rather than unrolling it.
-    Each lane's absolute tolerances are its accumulator's (trajectory.point_atol, set by
-    trajectory.start). Lanes n_run and above are idle and skipped.
+    """One Dormand-Prince attempt in every lane of W: the stages (`_chain5`, from dopri5.A,
+    B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
+    y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
+    count runs across the lanes with straight-line arithmetic, so LLVM vectorises it rather
+    than unrolling it. Each lane's absolute tolerances are its accumulator's
+    (trajectory.point_atol, set by trajectory.start). Lanes n_run and above are idle and skipped.
     """
     L = LANES
     for j in range(n_run):
@@ -165,48 +163,22 @@ def _attempt(W, rtol, n_run, terms):
         q = W[tj.Q * L + j]
         v = W[tj.V * L + j]
         h = W[W_H * L + j]
-        k1q = W[tj.FQ * L + j]
-        k1v = W[tj.FV * L + j]
-        k2q = v + (k1v * _A[1][0]) * h
-        k2v = _accel(W, j, t + _C[1] * h, q + (k1q * _A[1][0]) * h, k2q, terms)
-        q3 = q + (k1q * _A[2][0] + k2q * _A[2][1]) * h
-        k3q = v + (k1v * _A[2][0] + k2v * _A[2][1]) * h
-        k3v = _accel(W, j, t + _C[2] * h, q3, k3q, terms)
-        q4 = q + (k1q * _A[3][0] + k2q * _A[3][1] + k3q * _A[3][2]) * h
-        k4q = v + (k1v * _A[3][0] + k2v * _A[3][1] + k3v * _A[3][2]) * h
-        k4v = _accel(W, j, t + _C[3] * h, q4, k4q, terms)
-        q5 = q + (k1q * _A[4][0] + k2q * _A[4][1] + k3q * _A[4][2] + k4q * _A[4][3]) * h
-        k5q = v + (k1v * _A[4][0] + k2v * _A[4][1] + k3v * _A[4][2] + k4v * _A[4][3]) * h
-        k5v = _accel(W, j, t + _C[4] * h, q5, k5q, terms)
-        q6 = q + (k1q * _A[5][0] + k2q * _A[5][1] + k3q * _A[5][2] + k4q * _A[5][3]
-                  + k5q * _A[5][4]) * h
-        k6q = v + (k1v * _A[5][0] + k2v * _A[5][1] + k3v * _A[5][2] + k4v * _A[5][3]
-                   + k5v * _A[5][4]) * h
-        k6v = _accel(W, j, t + _C[5] * h, q6, k6q, terms)
-        qn = q + h * (k1q * _B[0] + k2q * _B[1] + k3q * _B[2] + k4q * _B[3] + k5q * _B[4]
-                      + k6q * _B[5])
-        vn = v + h * (k1v * _B[0] + k2v * _B[1] + k3v * _B[2] + k4v * _B[3] + k5v * _B[4]
-                      + k6v * _B[5])
-        k7q = vn
-        k7v = _accel(W, j, t + h, qn, vn, terms)
-        eq = (k1q * _E[0] + k2q * _E[1] + k3q * _E[2] + k4q * _E[3] + k5q * _E[4]
-              + k6q * _E[5] + k7q * _E[6]) * h
-        ev = (k1v * _E[0] + k2v * _E[1] + k3v * _E[2] + k4v * _E[3] + k5v * _E[4]
-              + k6v * _E[5] + k7v * _E[6]) * h
-        rq = eq / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
-        rv = ev / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
-        W[(W_K + 2) * L + j] = k2q
-        W[(W_K + 3) * L + j] = k2v
-        W[(W_K + 4) * L + j] = k3q
-        W[(W_K + 5) * L + j] = k3v
-        W[(W_K + 6) * L + j] = k4q
-        W[(W_K + 7) * L + j] = k4v
-        W[(W_K + 8) * L + j] = k5q
-        W[(W_K + 9) * L + j] = k5v
-        W[(W_K + 10) * L + j] = k6q
-        W[(W_K + 11) * L + j] = k6v
-        W[(W_K + 12) * L + j] = k7q
-        W[(W_K + 13) * L + j] = k7v
+        kq, kv, qn, vn, eq, ev = _chain5(W, j, t, q, v, h, W[tj.FQ * L + j], W[tj.FV * L + j],
+                                         terms)
+        rq = (eq * h) / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
+        rv = (ev * h) / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
+        W[(W_K + 2) * L + j] = kq[1]
+        W[(W_K + 3) * L + j] = kv[1]
+        W[(W_K + 4) * L + j] = kq[2]
+        W[(W_K + 5) * L + j] = kv[2]
+        W[(W_K + 6) * L + j] = kq[3]
+        W[(W_K + 7) * L + j] = kv[3]
+        W[(W_K + 8) * L + j] = kq[4]
+        W[(W_K + 9) * L + j] = kv[4]
+        W[(W_K + 10) * L + j] = kq[5]
+        W[(W_K + 11) * L + j] = kv[5]
+        W[(W_K + 12) * L + j] = kq[6]
+        W[(W_K + 13) * L + j] = kv[6]
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
@@ -214,10 +186,11 @@ def _attempt(W, rtol, n_run, terms):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _attempt8(W, rtol, n_run, terms):
-    """One DOP853 attempt in every lane of W (as `_attempt`): the eighth-order solution
-    (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage (W_K + 12, W_K + 13) and
-    SciPy's DOP853 error norm (W_ERR). The other stages stay in registers: the DOP853 dense
-    output needs only the step's ends (dop853.hermite_coefficients).
+    """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
+    eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
+    (W_K + 12, W_K + 13) and SciPy's DOP853 error norm from dop853.E5, E3 (W_ERR). The other
+    stages stay in registers: the DOP853 dense output needs only the step's ends
+    (dop853.hermite_coefficients).
     """
     L = LANES
     for j in range(n_run):
@@ -225,71 +198,12 @@ def _attempt8(W, rtol, n_run, terms):
         q = W[tj.Q * L + j]
         v = W[tj.V * L + j]
         h = W[W_H * L + j]
-        kq0 = W[tj.FQ * L + j]
-        kv0 = W[tj.FV * L + j]
-        q1 = q + (kq0 * _A8[1][0]) * h
-        kq1 = v + (kv0 * _A8[1][0]) * h
-        kv1 = _accel(W, j, t + _C8[1] * h, q1, kq1, terms)
-        q2 = q + (kq0 * _A8[2][0] + kq1 * _A8[2][1]) * h
-        kq2 = v + (kv0 * _A8[2][0] + kv1 * _A8[2][1]) * h
-        kv2 = _accel(W, j, t + _C8[2] * h, q2, kq2, terms)
-        q3 = q + (kq0 * _A8[3][0] + kq2 * _A8[3][2]) * h
-        kq3 = v + (kv0 * _A8[3][0] + kv2 * _A8[3][2]) * h
-        kv3 = _accel(W, j, t + _C8[3] * h, q3, kq3, terms)
-        q4 = q + (kq0 * _A8[4][0] + kq2 * _A8[4][2] + kq3 * _A8[4][3]) * h
-        kq4 = v + (kv0 * _A8[4][0] + kv2 * _A8[4][2] + kv3 * _A8[4][3]) * h
-        kv4 = _accel(W, j, t + _C8[4] * h, q4, kq4, terms)
-        q5 = q + (kq0 * _A8[5][0] + kq3 * _A8[5][3] + kq4 * _A8[5][4]) * h
-        kq5 = v + (kv0 * _A8[5][0] + kv3 * _A8[5][3] + kv4 * _A8[5][4]) * h
-        kv5 = _accel(W, j, t + _C8[5] * h, q5, kq5, terms)
-        q6 = q + (kq0 * _A8[6][0] + kq3 * _A8[6][3] + kq4 * _A8[6][4] + kq5 * _A8[6][5]) * h
-        kq6 = v + (kv0 * _A8[6][0] + kv3 * _A8[6][3] + kv4 * _A8[6][4] + kv5 * _A8[6][5]) * h
-        kv6 = _accel(W, j, t + _C8[6] * h, q6, kq6, terms)
-        q7 = q + (kq0 * _A8[7][0] + kq3 * _A8[7][3] + kq4 * _A8[7][4] + kq5 * _A8[7][5]
-                  + kq6 * _A8[7][6]) * h
-        kq7 = v + (kv0 * _A8[7][0] + kv3 * _A8[7][3] + kv4 * _A8[7][4] + kv5 * _A8[7][5]
-                    + kv6 * _A8[7][6]) * h
-        kv7 = _accel(W, j, t + _C8[7] * h, q7, kq7, terms)
-        q8 = q + (kq0 * _A8[8][0] + kq3 * _A8[8][3] + kq4 * _A8[8][4] + kq5 * _A8[8][5]
-                  + kq6 * _A8[8][6] + kq7 * _A8[8][7]) * h
-        kq8 = v + (kv0 * _A8[8][0] + kv3 * _A8[8][3] + kv4 * _A8[8][4] + kv5 * _A8[8][5]
-                    + kv6 * _A8[8][6] + kv7 * _A8[8][7]) * h
-        kv8 = _accel(W, j, t + _C8[8] * h, q8, kq8, terms)
-        q9 = q + (kq0 * _A8[9][0] + kq3 * _A8[9][3] + kq4 * _A8[9][4] + kq5 * _A8[9][5]
-                  + kq6 * _A8[9][6] + kq7 * _A8[9][7] + kq8 * _A8[9][8]) * h
-        kq9 = v + (kv0 * _A8[9][0] + kv3 * _A8[9][3] + kv4 * _A8[9][4] + kv5 * _A8[9][5]
-                    + kv6 * _A8[9][6] + kv7 * _A8[9][7] + kv8 * _A8[9][8]) * h
-        kv9 = _accel(W, j, t + _C8[9] * h, q9, kq9, terms)
-        q10 = q + (kq0 * _A8[10][0] + kq3 * _A8[10][3] + kq4 * _A8[10][4] + kq5 * _A8[10][5]
-                  + kq6 * _A8[10][6] + kq7 * _A8[10][7] + kq8 * _A8[10][8] + kq9 * _A8[10][9]) * h
-        kq10 = v + (kv0 * _A8[10][0] + kv3 * _A8[10][3] + kv4 * _A8[10][4] + kv5 * _A8[10][5]
-                     + kv6 * _A8[10][6] + kv7 * _A8[10][7] + kv8 * _A8[10][8]
-                     + kv9 * _A8[10][9]) * h
-        kv10 = _accel(W, j, t + _C8[10] * h, q10, kq10, terms)
-        q11 = q + (kq0 * _A8[11][0] + kq3 * _A8[11][3] + kq4 * _A8[11][4] + kq5 * _A8[11][5]
-                  + kq6 * _A8[11][6] + kq7 * _A8[11][7] + kq8 * _A8[11][8] + kq9 * _A8[11][9]
-                  + kq10 * _A8[11][10]) * h
-        kq11 = v + (kv0 * _A8[11][0] + kv3 * _A8[11][3] + kv4 * _A8[11][4] + kv5 * _A8[11][5]
-                     + kv6 * _A8[11][6] + kv7 * _A8[11][7] + kv8 * _A8[11][8]
-                     + kv9 * _A8[11][9] + kv10 * _A8[11][10]) * h
-        kv11 = _accel(W, j, t + _C8[11] * h, q11, kq11, terms)
-        qn = q + h * (kq0 * _B8[0] + kq5 * _B8[5] + kq6 * _B8[6] + kq7 * _B8[7] + kq8 * _B8[8]
-                      + kq9 * _B8[9] + kq10 * _B8[10] + kq11 * _B8[11])
-        vn = v + h * (kv0 * _B8[0] + kv5 * _B8[5] + kv6 * _B8[6] + kv7 * _B8[7] + kv8 * _B8[8]
-                      + kv9 * _B8[9] + kv10 * _B8[10] + kv11 * _B8[11])
-        fv_new = _accel(W, j, t + h, qn, vn, terms)
-        e5q = (kq0 * _E5[0] + kq5 * _E5[5] + kq6 * _E5[6] + kq7 * _E5[7] + kq8 * _E5[8]
-               + kq9 * _E5[9] + kq10 * _E5[10] + kq11 * _E5[11])
-        e5v = (kv0 * _E5[0] + kv5 * _E5[5] + kv6 * _E5[6] + kv7 * _E5[7] + kv8 * _E5[8]
-               + kv9 * _E5[9] + kv10 * _E5[10] + kv11 * _E5[11])
-        e3q = (kq0 * _E3[0] + kq5 * _E3[5] + kq6 * _E3[6] + kq7 * _E3[7] + kq8 * _E3[8]
-               + kq9 * _E3[9] + kq10 * _E3[10] + kq11 * _E3[11])
-        e3v = (kv0 * _E3[0] + kv5 * _E3[5] + kv6 * _E3[6] + kv7 * _E3[7] + kv8 * _E3[8]
-               + kv9 * _E3[9] + kv10 * _E3[10] + kv11 * _E3[11])
+        kq, kv, qn, vn, e5q, e5v, e3q, e3v = _chain8(W, j, t, q, v, h, W[tj.FQ * L + j],
+                                                     W[tj.FV * L + j], terms)
         sq = W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol
         sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
         W[(W_K + 12) * L + j] = vn
-        W[(W_K + 13) * L + j] = fv_new
+        W[(W_K + 13) * L + j] = kv[dop853.N_STAGES]
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
