@@ -46,7 +46,7 @@ from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
 from .layout import (MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BASE_TERM, BOUND, N_PARAMS, acceleration, prepare
+from .oscillator import BASE_TERM, BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
 
@@ -74,7 +74,8 @@ W_FLAG = W_QN + 3                 # NEEDS_SCALAR or HAS_EXTREMUM: the scalar sta
 W_XE = W_QN + 4                   # the accepted step's extremum of q: x = (t - t_old)/h, or -1
 W_QE = W_QN + 5                   # q there (m)
 W_FACTOR = W_QN + 6               # the PI controller's step-size factor for the attempt
-W_ROWS = W_QN + 7
+W_AB = W_QN + 7                   # base excitation a_b(t + h) at the attempt's end (m/s^2)
+W_ROWS = W_QN + 8
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -182,6 +183,8 @@ def _attempt(W, rtol, n_run, terms):
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
+        if terms[BASE_TERM] is not None:      # the last stage's own a_b (the same arithmetic)
+            W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -207,6 +210,8 @@ def _attempt8(W, rtol, n_run, terms):
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
+        if terms[BASE_TERM] is not None:
+            W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -311,8 +316,8 @@ def _observe_acceleration(W, settings, n_run):
     for j in range(n_run):
         done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
                 & (W[W_FLAG * L + j] == ORDINARY))
-        tj.observe_acceleration(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], W[tj.FV * L + j],
-                                t_tail, done, True)
+        tj.observe_acceleration(W, j, L, W[tj.T * L + j],
+                                W[tj.FV * L + j] + W[W_AB * L + j], t_tail, done)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

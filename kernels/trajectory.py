@@ -265,15 +265,15 @@ def interpolant(settings, acc, K, q_new, v_new, h, Qc):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def observe_acceleration(acc, a, sa, p, o, s, t_new, fv_new, t_tail, take, fast):
-    """The Observer's base-excitation metric at an accepted step's end (t_new, s; q'' there
-    fv_new, m/s^2), accessors as `observe_step_end`: the tail's peak absolute midspan
-    acceleration |q'' + a_b| (m/s^2), from the step-end samples, each local extremum of them
-    refined by the parabola through the last three. Only where `take`; straight-line selects
+def observe_acceleration(acc, a, sa, t_new, a3, t_tail, take):
+    """The Observer's base-excitation metric at an accepted step's end (t_new, s), where the
+    absolute midspan acceleration q'' + a_b is a3 (m/s^2: the last stage's q'' plus its a_b),
+    accumulator at acc[a + slot * sa] as `observe_step_end`'s: the tail's peak absolute
+    midspan acceleration |q'' + a_b| (m/s^2), from the step-end samples, each local extremum
+    of them refined by the parabola through the last three. Only where `take`; straight-line selects
     (the lanes driver runs it in a loop of its own, `lanes._observe_acceleration`, which keeps
     `_finish` vectorised, and only near and in the tail window: samples that are not the ends
     of consecutive steps are never joined by a parabola, ACC_STEP)."""
-    a3 = fv_new + base_acceleration(t_new, p, o, s, fast)
     a1 = acc[a + ACC_1 * sa]
     t1 = acc[a + T_1 * sa]
     a2 = acc[a + ACC_2 * sa]
@@ -328,7 +328,8 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, tr
     last_above = acc[a + LAST_ABOVE * sa]
     acc[a + LAST_ABOVE * sa] = t + h if take & track & above else last_above
     if terms[BASE_TERM] is not None:
-        observe_acceleration(acc, a, sa, p, o, s, t_new, fv_new, t_tail, take, fast)
+        observe_acceleration(acc, a, sa, t_new, fv_new + base_acceleration(t + h, p, o, s, fast),
+                             t_tail, take)
     return thr, above
 
 
