@@ -151,15 +151,7 @@ def _as_floats(where: str, key: schema.Key, raw: Any) -> tuple[float, ...]:
         _fail(where, f"must be a list of numbers, got {_show(raw)}", fix)
     values = []
     for number, item in enumerate(raw, start=1):
-        if isinstance(item, bool) or not isinstance(item, (int, float)):
-            _fail(where, f"item {number} of the list must be a number, got {_show(item)}", fix)
-        try:
-            value = float(item)
-        except OverflowError:
-            value = math.inf
-        if not math.isfinite(value):
-            _fail(where, f"item {number} of the list must be a finite number, got {_show(item)}",
-                  fix)
+        value = _as_float(where, item, fix, f"item {number} of the list ")
         if not _within(key, np.array(value)):
             _fail(where, f"item {number} of the list must be {_bounds_text(key)}, "
                          f"got {_show(item)}", _HINTS.get(key.dotted) or _generic_hint(key))
@@ -185,16 +177,17 @@ def _example(key: schema.Key) -> str:
     return f"write e.g. {key.name} = {_toml_value(key.default)}"
 
 
-def _as_float(where: str, raw: Any, fix: str) -> float:
-    """A finite float from an int or float (never a bool)."""
+def _as_float(where: str, raw: Any, fix: str, what: str = "") -> float:
+    """A finite float from an int or float (never a bool); `what` names the value in the
+    message when it is not the key's own (an item of a list)."""
     if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-        _fail(where, f"must be a number, got {_show(raw)}", fix)
+        _fail(where, f"{what}must be a number, got {_show(raw)}", fix)
     try:
         value = float(raw)
     except OverflowError:
         value = math.inf
     if not math.isfinite(value):
-        _fail(where, f"must be a finite number, got {_show(raw)}", fix)
+        _fail(where, f"{what}must be a finite number, got {_show(raw)}", fix)
     return value
 
 
