@@ -229,7 +229,7 @@ def _pi_factors(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _finish(W, settings, n_samples, n_run, pi, eighth):
+def _finish(W, settings, n_samples, n_run, pi, eighth, terms):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
     ordinary accepted step the first metrics pass (threshold tol * peak around 0; the
     base-excitation metric is `_observe_acceleration`'s) and the move
@@ -242,8 +242,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
     True); otherwise the PI controller's factor comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
     vectorising the loop. Returns how many lanes it flagged, how many of those HAS_EXTREMUM,
-    and how many ordinary steps end within two steps of the tail window or in it (the
-    base-excitation metric needs those: `_observe_acceleration`).
+    and, with base excitation (`terms`), how many ordinary steps end within two steps of the
+    tail window or in it (the base-excitation metric needs those: `_observe_acceleration`).
     Compiled without reference counting (`_nrt=False`; nothing here allocates): W passed to the
     Observer as its arrays would otherwise cost atomic counter updates in the loop, which stop
     LLVM vectorising it.
@@ -288,7 +288,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth):
         W[W_FLAG * L + j] = (HAS_EXTREMUM if locate else NEEDS_SCALAR) if event else ORDINARY
         n_flagged += 1 if event else 0
         n_extrema += 1 if event & locate else 0
-        n_near += 1 if done & (t_new + 2.0 * h >= t_tail) else 0
+        if terms[BASE_TERM] is not None:
+            n_near += 1 if done & (t_new + 2.0 * h >= t_tail) else 0
         W[tj.RHS_EVALS * L + j] += rhs_per_attempt if active else 0.0
         W[tj.H_ABS * L + j] *= factor if active else 1.0
         W[tj.REJECTED_NOW * L + j] = (0.0 if accepted else 1.0) if active else (
@@ -523,7 +524,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             _attempt8(W, rtol, n_run, terms)
         if pi is not None:
             _pi_factors(W, n_run)
-        n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth)
+        n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth, terms)
         if terms[BASE_TERM] is not None and n_near > 0:
             _observe_acceleration(W, settings, n_run)
         if n_flagged == 0:
