@@ -46,7 +46,7 @@ def scipy_rhs(row: np.ndarray) -> Callable[[float, np.ndarray], list[float]]:
 
     def rhs(t: float, y: np.ndarray) -> list[float]:
         q, v = y
-        return [v, acceleration(t, q, v, p, 0, 1, None, terms)]
+        return [v, acceleration(t, q, v, p, 0, 1, None, *terms)]
 
     return rhs
 

@@ -127,7 +127,7 @@ CABLE_DOP853 = "cable-sweep (DOP853)"   # solver.method = "dop853"
 NS_MAX_STEPS = 2_000_000_000        # numbalsoda mxstep (a C int): no practical bound
 NS_COUNTER = osc.N_PARAMS           # slot of the RHS-call counter in a numbalsoda data row,
                                     # after the prepared parameter row
-NS_TERMS = (True, None)             # the oscillator's `terms` in the numbalsoda rhs: the
+NS_TERMS = (True, None)             # the oscillator's (parametric, base) in the numbalsoda rhs: the
                                     # cos(W t) load terms, no base excitation (this scene has none)
 NS_ROW = 24                         # data row length: 192 bytes, so that one point's counter
                                     # never shares a cache line with another point's row
@@ -259,7 +259,7 @@ def acceleration(row: np.ndarray, t: np.ndarray, q: np.ndarray, v: np.ndarray) -
     p = [float(x) for x in prepared]                  # list indexing: Python floats
     terms = osc.terms_of(parametric=True, base=bool(row[osc.BASE_ACCEL] != 0.0))
     rhs = osc.acceleration.py_func
-    return np.array([rhs(ti, qi, vi, p, 0, 1, None, terms)
+    return np.array([rhs(ti, qi, vi, p, 0, 1, None, *terms)
                      for ti, qi, vi in zip(t.tolist(), q.tolist(), v.tolist())])
 
 
@@ -362,7 +362,7 @@ class Numbalsoda:
             q = u[0]
             v = u[1]
             du[0] = v
-            du[1] = acceleration(t, q, v, p, 0, 1, None, NS_TERMS)
+            du[1] = acceleration(t, q, v, p, 0, 1, None, True, None)  # NS_TERMS
             p[NS_COUNTER] += 1.0
 
         def make_loop(solver):

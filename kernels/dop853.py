@@ -123,13 +123,13 @@ E5[11] = -0.2235530786388629525884427845e-1
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def rk_step(t, y, h, p, K, y_new, terms):
+def rk_step(t, y, h, p, K, y_new, parametric, base):
     """One DOP853 step of size h (s) from (t, y); K (N_STAGES + 1, 2), K[0] must hold f(t, y).
 
     Fills K[1..11] with the stage derivatives, K[12] with f(t + h, y_new) and y_new with the
     eighth-order solution. Twelve right-hand-side evaluations.
     """
-    explicit_rk_step(t, y, h, p, K, y_new, A, B, C, terms)
+    explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -57,7 +57,7 @@ MIN_RTOL = 100 * np.finfo(float).eps   # SciPy raises smaller rtol to this
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, terms):
+def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base):
     """One step of size h (s) from (t, y) of the explicit Runge-Kutta method with tableau
     (A, B, C), as SciPy's `rk_step`; K[0] must hold f(t, y). p: a prepared parameter row
     (oscillator.prepare); base: oscillator's base-excitation switch (None or True).
@@ -75,7 +75,7 @@ def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, terms):
         q = y[0] + dq * h
         v = y[1] + dv * h
         K[s, 0] = v
-        K[s, 1] = acceleration(t + C[s] * h, q, v, p, 0, 1, None, terms)
+        K[s, 1] = acceleration(t + C[s] * h, q, v, p, 0, 1, None, parametric, base)
     sq = 0.0
     sv = 0.0
     for j in range(n_stages):
@@ -84,17 +84,17 @@ def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, terms):
     y_new[0] = y[0] + h * sq
     y_new[1] = y[1] + h * sv
     K[n_stages, 0] = y_new[1]
-    K[n_stages, 1] = acceleration(t + h, y_new[0], y_new[1], p, 0, 1, None, terms)
+    K[n_stages, 1] = acceleration(t + h, y_new[0], y_new[1], p, 0, 1, None, parametric, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def rk_step(t, y, h, p, K, y_new, terms):
+def rk_step(t, y, h, p, K, y_new, parametric, base):
     """One Dormand-Prince step of size h (s) from (t, y); K[0] must hold f(t, y).
 
     Fills K[1..6] with the stage derivatives (K[6] = f(t + h, y_new)) and y_new with the
     fifth-order solution. Six right-hand-side evaluations.
     """
-    explicit_rk_step(t, y, h, p, K, y_new, A, B, C, terms)
+    explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -171,7 +171,8 @@ def _rms2(a, b):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, o, s, order, terms):
+def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, o, s, order, parametric,
+                 base):
     """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4) for a method whose
     error estimator has order `order` (ERROR_ESTIMATOR_ORDER for RK45); absolute tolerances
     atol_q (m) and atol_v (m/s); the prepared row at p[o + column * s]
@@ -191,7 +192,7 @@ def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, o, s, ord
     q1 = y[0] + h0 * f[0]
     v1 = y[1] + h0 * f[1]
     fq1 = v1
-    fv1 = acceleration(t0 + h0, q1, v1, p, o, s, None, terms)
+    fv1 = acceleration(t0 + h0, q1, v1, p, o, s, None, parametric, base)
     d2 = _rms2((fq1 - f[0]) / sq, (fv1 - f[1]) / sv) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)

@@ -46,7 +46,7 @@ from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
 from .layout import (MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BASE_TERM, BOUND, N_PARAMS, acceleration, base_acceleration, prepare
+from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
 
@@ -109,10 +109,10 @@ def _step_factor(err, rejected_before, eighth):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _accel(W, j, t, q, v, terms):
+def _accel(W, j, t, q, v, parametric, base):
     """q'' (m/s^2) of lane j at (t, q, v): the System's one right-hand side
     (oscillator.acceleration) on the lane's prepared row, with vecmath's cos and sin."""
-    return acceleration(t, q, v, W, W_P * LANES + j, LANES, True, terms)
+    return acceleration(t, q, v, W, W_P * LANES + j, LANES, True, parametric, base)
 
 
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in
@@ -150,7 +150,7 @@ def _prepare(W, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt(W, rtol, n_run, terms):
+def _attempt(W, rtol, n_run, parametric, base):
     """One Dormand-Prince attempt in every lane of W: the stages (`_chain5`, from dopri5.A,
     B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
     y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
@@ -165,7 +165,7 @@ def _attempt(W, rtol, n_run, terms):
         v = W[tj.V * L + j]
         h = W[W_H * L + j]
         kq, kv, qn, vn, eq, ev = _chain5(W, j, t, q, v, h, W[tj.FQ * L + j], W[tj.FV * L + j],
-                                         terms)
+                                         parametric, base)
         rq = (eq * h) / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
         rv = (ev * h) / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
         W[(W_K + 2) * L + j] = kq[1]
@@ -183,12 +183,12 @@ def _attempt(W, rtol, n_run, terms):
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
-        if terms[BASE_TERM] is not None:      # the last stage's own a_b (the same arithmetic)
+        if base is not None:      # the last stage's own a_b (the same arithmetic)
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt8(W, rtol, n_run, terms):
+def _attempt8(W, rtol, n_run, parametric, base):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
     (W_K + 12, W_K + 13) and SciPy's DOP853 error norm from dop853.E5, E3 (W_ERR). The other
@@ -202,7 +202,7 @@ def _attempt8(W, rtol, n_run, terms):
         v = W[tj.V * L + j]
         h = W[W_H * L + j]
         kq, kv, qn, vn, e5q, e5v, e3q, e3v = _chain8(W, j, t, q, v, h, W[tj.FQ * L + j],
-                                                     W[tj.FV * L + j], terms)
+                                                     W[tj.FV * L + j], parametric, base)
         sq = W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol
         sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
         W[(W_K + 12) * L + j] = vn
@@ -210,7 +210,7 @@ def _attempt8(W, rtol, n_run, terms):
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
-        if terms[BASE_TERM] is not None:
+        if base is not None:
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True)
 
 
@@ -229,7 +229,7 @@ def _pi_factors(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _finish(W, settings, n_samples, n_run, pi, eighth, terms):
+def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
     ordinary accepted step the first metrics pass (threshold tol * peak around 0; the
     base-excitation metric is `_observe_acceleration`'s) and the move
@@ -242,7 +242,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, terms):
     True); otherwise the PI controller's factor comes from `_pi_factors`.
     Every value is loaded unconditionally at the top: a load under a condition would stop LLVM
     vectorising the loop. Returns how many lanes it flagged, how many of those HAS_EXTREMUM,
-    and, with base excitation (`terms`), how many ordinary steps end within two steps of the
+    and, with base excitation (`base`), how many ordinary steps end within two steps of the
     tail window or in it (the base-excitation metric needs those: `_observe_acceleration`).
     Compiled without reference counting (`_nrt=False`; nothing here allocates): W passed to the
     Observer as its arrays would otherwise cost atomic counter updates in the loop, which stop
@@ -288,7 +288,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, terms):
         W[W_FLAG * L + j] = (HAS_EXTREMUM if locate else NEEDS_SCALAR) if event else ORDINARY
         n_flagged += 1 if event else 0
         n_extrema += 1 if event & locate else 0
-        if terms[BASE_TERM] is not None:
+        if base is not None:
             n_near += 1 if done & (t_new + 2.0 * h >= t_tail) else 0
         W[tj.RHS_EVALS * L + j] += rhs_per_attempt if active else 0.0
         W[tj.H_ABS * L + j] *= factor if active else 1.0
@@ -297,7 +297,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, terms):
         W[tj.REJECTED * L + j] += 1.0 if active & (not accepted) else 0.0
         W[tj.STEPS * L + j] += 1.0 if active & accepted else 0.0
         tj.observe_step_end(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], h, t_new, qn, fv_new,
-                            t_tail, track, 0.0, 0.0, thr_rel, done, True, (None, None))
+                            t_tail, track, 0.0, 0.0, thr_rel, done, True, None, None)
         W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
         W[tj.Q * L + j] = qn if done else q_old
         W[tj.V * L + j] = vn if done else v_old
@@ -433,7 +433,8 @@ def _locate_extrema8(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _load_lane(params, settings, point, lane, W, states, reals, counts, series, terms):
+def _load_lane(params, settings, point, lane, W, states, reals, counts, series, parametric,
+               base):
     """Give `lane` the trajectory of row `point`; an invalid row is answered at once.
     Returns False when the row needs no integration."""
     p = params[point]
@@ -442,12 +443,14 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series, 
         states[point] = mt.INVALID_INPUT
         return False
     prepare(p, W, W_P * LANES + lane, LANES)
-    tj.start(W, W_P * LANES + lane, LANES, settings, W[lane::LANES], series[point], terms)
+    tj.start(W, W_P * LANES + lane, LANES, settings, W[lane::LANES], series[point], parametric,
+             base)
     return True
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, terms):
+def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, parametric,
+                 base):
     """trajectory.record_step for lane j (point i) after an accepted attempt. The lane's views of
     W and of the point's time-series row are taken here, where Numba keeps no reference counts
     (`_nrt=False`; nothing here allocates): taken in solve_block, each view cost two atomic
@@ -455,11 +458,12 @@ def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, term
     L = LANES
     tj.record_step(W, W_P * L + j, L, settings, W[j::L], K, W[W_QN * L + j],
                    W[W_VN * L + j], W[W_H * L + j], Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], terms)
+                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth, terms):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth,
+                parametric, base):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
 
@@ -502,12 +506,12 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                         i = point[j]
                         tj.end_series(acc, series[i])
                         states[i] = classify(W, W_P * L + j, L, settings, acc, bufs[j],
-                                             reals[i], counts[i], terms)
+                                             reals[i], counts[i], parametric, base)
                         point[j] = -1
                     if next_point >= hi:
                         break
                     if _load_lane(params, settings, next_point, j, W, states, reals, counts,
-                                  series, terms):
+                                  series, parametric, base):
                         point[j] = next_point
                         bufs[j] = tj.new_buffer()
                         capacity[j] = bufs[j].shape[0]
@@ -519,13 +523,14 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         if eighth is None:
-            _attempt(W, rtol, n_run, terms)
+            _attempt(W, rtol, n_run, parametric, base)
         else:
-            _attempt8(W, rtol, n_run, terms)
+            _attempt8(W, rtol, n_run, parametric, base)
         if pi is not None:
             _pi_factors(W, n_run)
-        n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth, terms)
-        if terms[BASE_TERM] is not None and n_near > 0:
+        n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth,
+                                               parametric, base)
+        if base is not None and n_near > 0:
             _observe_acceleration(W, settings, n_run)
         if n_flagged == 0:
             continue
@@ -552,4 +557,5 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             if W[tj.N_EXT * L + j] >= capacity[j]:
                 bufs[j] = tj.with_room(bufs[j], W[j::L])
                 capacity[j] = bufs[j].shape[0]
-            _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe, terms)
+            _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe,
+                         parametric, base)

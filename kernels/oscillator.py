@@ -20,12 +20,16 @@ Compile-time switches (None or True: Numba compiles one specialisation per choic
 branches not taken are not in it):
     fast   None: libm's cos and sin (the scalar driver, SciPy's arithmetic);
            True: vecmath's vectorisable fast_cos and fast_sin (the lanes driver)
-    terms  a tuple: which optional terms of the equation a scene has (`terms_of`)
-           terms[PARAMETRIC_TERM]  the load's cos(W t) parts k1, g1 (None: every row of the
-                                   scene has k1 = g1 = 0, a constant or zero load, and cos is
-                                   not evaluated; the result is the same to the last bit)
-           terms[BASE_TERM]        the base excitation -G a_b(t), and the absolute
-                                   acceleration metric (kernels.trajectory.observe_acceleration)
+    the optional terms of the equation a scene has (`terms_of`), two separate arguments:
+    parametric  the load's cos(W t) parts k1, g1 (None: every row of the scene has k1 = g1 = 0,
+                a constant or zero load, and cos is not evaluated; the result is the same to
+                the last bit)
+    base        the base excitation -G a_b(t), and the absolute acceleration metric
+                (kernels.trajectory.observe_acceleration)
+Separate None-or-True arguments, not a tuple: Numba prunes a branch on `arg is None` even where
+the function is inlined into a caller, so a term a scene does not have is neither typed nor
+compiled there (a tuple item's branch would be typed at every inlined copy: seconds of compile
+time in the stage chains).
 
 Q_SCALE and V_SCALE are the size of the point's response (sweep.models.state_scale): with
 settings[ATOL_SCALE] > 0 the absolute tolerances are that fraction of rtol times these scales
@@ -64,15 +68,12 @@ PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v
 # The columns `prepare` divides by -m.
 FORCE_COLUMNS = (DAMPING, K0, K1, G0, G1, H)
 
-# Indices into `terms`, the tuple of the equation's optional terms (module docstring).
-PARAMETRIC_TERM = 0
-BASE_TERM = 1
-ALL_TERMS = (True, True)
 
 
 def terms_of(parametric: bool, base: bool) -> tuple:
-    """The `terms` switches of a scene: whether any row has a time-varying stiffness (k1 or
-    g1 not 0) and whether the scene has base excitation (settings[layout.BASE])."""
+    """The (parametric, base) switches of a scene: whether any row has a time-varying
+    stiffness (k1 or g1 not 0) and whether the scene has base excitation
+    (settings[layout.BASE])."""
     return (True if parametric else None, True if base else None)
 
 
@@ -98,14 +99,14 @@ def base_acceleration(t, p, o, s, fast):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def acceleration(t, q, v, p, o, s, fast, terms):
+def acceleration(t, q, v, p, o, s, fast, parametric, base):
     """q'' (m/s^2) at time t (s) for deflection q (m) and velocity v (m/s), from a prepared
-    row (`prepare`) at p[o + column * s]; `fast`, `terms`: the module's switches.
+    row (`prepare`) at p[o + column * s]; `fast`, `parametric`, `base`: the module's switches.
 
     The velocity term is added after the stiffness terms, so in a chain of stages each waits
     on the previous one for two fused multiply-adds rather than for the whole sum."""
     q2 = q * q
-    if terms[PARAMETRIC_TERM] is not None:
+    if parametric is not None:
         x = p[o + OMEGA * s] * t
         if fast is None:
             cw = math.cos(x)
@@ -117,7 +118,7 @@ def acceleration(t, q, v, p, o, s, fast, terms):
     else:
         a = p[o + K0 * s] * q + p[o + G0 * s] * q * q2 + p[o + H * s] * q * q2 * q2
     a = a + p[o + DAMPING * s] * v
-    if terms[BASE_TERM] is not None:
+    if base is not None:
         a = a - p[o + PARTICIPATION * s] * base_acceleration(t, p, o, s, fast)
     return a
 

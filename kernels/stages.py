@@ -6,22 +6,22 @@ that loop. It needs straight-line code, one statement per stage. Rather than a h
 copy of each method's stages, `chain_source` writes that code from the tableau (A, B, C) and
 `make_chain` compiles it: an inline-always Numba function
 
-    chain(W, j, t, q, v, h, k0q, k0v, terms) -> (kq, kv, qn, vn, s0q, s0v, s1q, s1v, ...)
+    chain(W, j, t, q, v, h, k0q, k0v, parametric, base) -> (kq, kv, qn, vn, s0q, s0v, s1q, s1v, ...)
 
 for the oscillator y = (q, q') (m, m/s) at time t (s), step h (s), with k0 = f(t, y)
 (m/s, m/s^2) given. Stage s (1 .. n - 1) is
 
     q_s  = q + (k0q A[s][0] + k1q A[s][1] + ... + k(s-1)q A[s][s-1]) h
     ksq  = v + (k0v A[s][0] + ... + k(s-1)v A[s][s-1]) h
-    ksv  = rhs(W, j, t + C[s] h, q_s, ksq, terms)
+    ksv  = rhs(W, j, t + C[s] h, q_s, ksq, parametric, base)
 
 then the solution qn = q + h (k0q B[0] + ...), vn likewise, and the last stage
-knq = vn, knv = rhs(W, j, t + h, qn, vn, terms): f at the step's end (FSAL). kq and kv are the
-tuples (k0 .. kn) of both components (m/s and m/s^2); s_iq, s_iv are the sums
+knq = vn, knv = rhs(W, j, t + h, qn, vn, parametric, base): f at the step's end (FSAL). kq
+and kv are the tuples (k0 .. kn) of both components (m/s and m/s^2); s_iq, s_iv are the sums
 k0 w_i[0] + ... + kn w_i[n] of each weight vector w_i of `sums` (an error estimator's E, not
 yet times h). Every sum runs over the stages in order, left to right; with skip_zeros the
-terms whose tableau entry is exactly 0 are left out (a sparse tableau: DOP853's). `rhs` is the driver's right-hand side (for the lanes, lanes._accel: lane j
-of the working memory W).
+terms whose tableau entry is exactly 0 are left out (a sparse tableau: DOP853's). `rhs` is the
+driver's right-hand side (for the lanes, lanes._accel: lane j of the working memory W).
 
 The source is generated and exec'd once per process, at import (microseconds; print it with
 `chain_source`). A chain is never compiled on its own: Numba inlines it into its caller's IR
@@ -36,7 +36,7 @@ from typing import Callable, Sequence
 
 import numba as nb
 
-CHAIN_ARGS = "W, j, t, q, v, h, k0q, k0v, terms"
+CHAIN_ARGS = "W, j, t, q, v, h, k0q, k0v, parametric, base"
 
 
 def _literal(value: float) -> str:
@@ -70,14 +70,15 @@ def chain_source(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[f
         dv = _weighted(kv[:s], row, skip_zeros)
         lines.append(f"    q{s} = q + ({dq}) * h" if dq else f"    q{s} = q")
         lines.append(f"    {kq[s]} = v + ({dv}) * h" if dv else f"    {kq[s]} = v")
-        lines.append(f"    {kv[s]} = rhs(W, j, t + {_literal(C[s])} * h, q{s}, {kq[s]}, terms)")
+        lines.append(f"    {kv[s]} = rhs(W, j, t + {_literal(C[s])} * h, q{s}, {kq[s]}, "
+                     "parametric, base)")
     weights = [float(x) for x in B]
     sq = _weighted(kq[:n], weights, skip_zeros)
     sv = _weighted(kv[:n], weights, skip_zeros)
     lines.append(f"    qn = q + h * ({sq})" if sq else "    qn = q")
     lines.append(f"    vn = v + h * ({sv})" if sv else "    vn = v")
     lines.append(f"    {kq[n]} = vn")
-    lines.append(f"    {kv[n]} = rhs(W, j, t + h, qn, vn, terms)")
+    lines.append(f"    {kv[n]} = rhs(W, j, t + h, qn, vn, parametric, base)")
     results = [f"({', '.join(kq)})", f"({', '.join(kv)})", "qn", "vn"]
     for i, w in enumerate(sums):
         values = [float(x) for x in w]
@@ -101,7 +102,7 @@ def make_chain(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[flo
                rhs: Callable, sums: Sequence[Sequence[float]] = (), skip_zeros: bool = False,
                name: str = "chain") -> Callable:
     """The stage chain of (A, B, C) (`chain_source`) as an inline-always Numba function that
-    calls `rhs` (a Numba function rhs(W, j, t, q, v, terms) -> q'' in m/s^2)."""
+    calls `rhs` (a Numba function rhs(W, j, t, q, v, parametric, base) -> q'' in m/s^2)."""
     source = chain_source(A, B, C, sums, skip_zeros, name)
     namespace = {"rhs": nb.njit(nogil=True, error_model="numpy",
                                 inline=_inline_outside_chains)(rhs.py_func)}

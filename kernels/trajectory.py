@@ -29,7 +29,7 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR
                      pi_step_factor, step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      MIN_STEP, RTOL, SAMPLE_DT, TAIL, T_END)
-from .oscillator import BASE_TERM, BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
+from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
 from .vecmath import log2_fast
 
 # Slots of a trajectory's accumulator row.
@@ -103,7 +103,7 @@ def point_atol(p, o, s, settings, rtol):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def start(p, o, s, settings, acc, series, terms):
+def start(p, o, s, settings, acc, series, parametric, base):
     """Set up a trajectory at t = 0 from its prepared parameter row at p[o + column * s]
     (oscillator.prepare); q(0) goes to series[0]. base: oscillator's switch."""
     rtol = max(settings[RTOL], MIN_RTOL)
@@ -115,7 +115,7 @@ def start(p, o, s, settings, acc, series, terms):
     acc[Q] = q
     acc[V] = v
     acc[FQ] = v
-    acc[FV] = acceleration(0.0, q, v, p, o, s, None, terms)
+    acc[FV] = acceleration(0.0, q, v, p, o, s, None, parametric, base)
     acc[RHS_EVALS] = 1.0
     acc[ATOL_Q], acc[ATOL_V] = point_atol(p, o, s, settings, rtol)
     if settings[FIRST_STEP] > 0.0:
@@ -127,7 +127,7 @@ def start(p, o, s, settings, acc, series, terms):
         f[0], f[1] = acc[FQ], acc[FV]
         order = dop853.ERROR_ESTIMATOR_ORDER if settings[METHOD] != 0.0 else ERROR_ESTIMATOR_ORDER
         acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, acc[ATOL_Q],
-                                  acc[ATOL_V], p, o, s, order, terms)
+                                  acc[ATOL_V], p, o, s, order, parametric, base)
         acc[RHS_EVALS] += 1.0
     acc[T_NEW] = 0.0
     acc[REJECTED_NOW] = 0.0
@@ -147,7 +147,7 @@ def start(p, o, s, settings, acc, series, terms):
     acc[N_EXT] = 0.0
     acc[LOG2_ERR_PREV] = _LOG2_ERR_PREV_START
     a0 = acc[FV]
-    if terms[BASE_TERM] is not None:
+    if base is not None:
         a0 += base_acceleration(0.0, p, o, s, None)
     acc[ACC_AMP] = abs(a0) if t_tail <= 0.0 else 0.0
     acc[ACC_1] = a0
@@ -237,7 +237,7 @@ def control(settings, acc, err):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
-                   track, centre, thr_fixed, thr_rel, terms):
+                   track, centre, thr_fixed, thr_rel, parametric, base):
     """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
     y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
     SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
@@ -248,7 +248,7 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
         if acc[N_EXT] >= buf.shape[0]:
             buf = with_room(buf, acc)
         record_step(p, 0, 1, settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
-                    centre, thr_fixed, thr_rel, -1.0, 0.0, terms)
+                    centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base)
     return buf
 
 
@@ -298,15 +298,16 @@ def observe_acceleration(acc, a, sa, t_new, a3, t_tail, take):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, track, centre,
-                     thr_fixed, thr_rel, take, fast, terms):
+                     thr_fixed, thr_rel, take, fast, parametric, base):
     """The Observer: what every accepted step's end adds to the metrics, for both drivers
     (`record_step`, and `kernels.lanes._finish` for the lanes' ordinary steps).
 
     The accumulator is read at acc[a + slot * sa], the prepared parameter row at
     p[o + column * s] (a trajectory's own arrays: a = o = 0, sa = s = 1; a lane of the lock-step
     driver: its offsets and the number of lanes). The step of size h (s) from t ends at t_new
-    (the attempt's end as next_attempt set it) with q_new (m) and q'' = fv_new (m/s^2). Updates, only where `take` (straight-line selects, so
-    the lanes' loop vectorises): the running peak |q|; the tail window's max |q| and range
+    (the attempt's end as next_attempt set it) with q_new (m) and q'' = fv_new (m/s^2).
+    Updates, only where `take` (straight-line selects, so the lanes' loop vectorises): the
+    running peak |q|; the tail window's max |q| and range
     (from t_tail, s); with `track`, the last time |q - centre| was above the threshold
     thr_fixed + thr_rel * peak (m); with base excitation (`base` True),
     `observe_acceleration` (`fast`: oscillator's switch for a_b).
@@ -327,7 +328,7 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, tr
     above = abs(q_new - centre) > thr
     last_above = acc[a + LAST_ABOVE * sa]
     acc[a + LAST_ABOVE * sa] = t + h if take & track & above else last_above
-    if terms[BASE_TERM] is not None:
+    if base is not None:
         observe_acceleration(acc, a, sa, t_new, fv_new + base_acceleration(t + h, p, o, s, fast),
                              t_tail, take)
     return thr, above
@@ -335,7 +336,7 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, tr
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
-                thr_fixed, thr_rel, xe_known, qe_known, terms):
+                thr_fixed, thr_rel, xe_known, qe_known, parametric, base):
     """Reduce the metrics of an accepted step [acc[T], acc[T_NEW]] on its dense output and
     advance the trajectory to its end. p[o + column * s]: the point's prepared row (its
     divergence bound on |q|, m, and base excitation); `buf` must have room for one more
@@ -403,7 +404,8 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qt)
 
     thr, above = observe_step_end(acc, 0, 1, p, o, s, t, h, t_new, q_new, K[K.shape[0] - 1, 1],
-                                  t_tail, track, centre, thr_fixed, thr_rel, True, None, terms)
+                                  t_tail, track, centre, thr_fixed, thr_rel, True, None, parametric,
+                                  base)
 
     if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)

@@ -29,11 +29,11 @@ from .layout import *  # noqa: F401,F403  (settings and output layouts, re-expor
 from .layout import (ACCELERATION, AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BASE_TERM, BOUND, MASS, N_PARAMS, acceleration, prepare, stiffness
+from .oscillator import BOUND, MASS, N_PARAMS, acceleration, prepare, stiffness
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, terms):
+def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric, base):
     """Integrate one point (p: its prepared row, oscillator.prepare) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing metrics on the fly. base: oscillator's
     base-excitation switch (None or True).
@@ -49,7 +49,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, terms):
     Qc = np.empty((2, 5))
     y = np.empty(2)
     y_new = np.empty(2)
-    tj.start(p, 0, 1, settings, acc, series, terms)
+    tj.start(p, 0, 1, settings, acc, series, parametric, base)
     while True:
         h = tj.next_attempt(settings, acc)
         if h == 0.0:
@@ -59,13 +59,13 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, terms):
         K[0, 0] = acc[tj.FQ]
         K[0, 1] = acc[tj.FV]
         if eighth:
-            dop853.rk_step(acc[tj.T], y, h, p, K, y_new, terms)
+            dop853.rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
         else:
-            rk_step(acc[tj.T], y, h, p, K, y_new, terms)
+            rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
         buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
-                                series, track, centre, thr_fixed, thr_rel, terms)
+                                series, track, centre, thr_fixed, thr_rel, parametric, base)
     tj.end_series(acc, series)
     return acc, buf
 
@@ -91,7 +91,7 @@ def reject_point(reals, counts, series):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def classify(p, o, s, settings, acc, buf, reals, counts, terms):
+def classify(p, o, s, settings, acc, buf, reals, counts, parametric, base):
     """State flag and metrics of a finished trajectory (metrics module); fills reals, counts.
     p[o + column * s]: the point's prepared row (oscillator.prepare).
 
@@ -116,7 +116,7 @@ def classify(p, o, s, settings, acc, buf, reals, counts, terms):
     n_ext = int(acc[tj.N_EXT])
     reals[AMPLITUDE] = tail_amp
     reals[PEAK] = peak
-    if terms[BASE_TERM] is not None:
+    if base is not None:
         reals[ACCELERATION] = acc[tj.ACC_AMP]
     n_max, n_min, period = mt.tail_counts(buf, n_ext, t_tail)
     reals[PERIOD] = period
@@ -142,7 +142,8 @@ def classify(p, o, s, settings, acc, buf, reals, counts, terms):
         if mt.tail_trend(buf, n_ext, t_tail, settings[T_END]):
             return mt.UNSETTLED
         return mt.MODULATED
-    if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band and at_rest(p, o, s, acc, band, terms):
+    if (acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band
+            and at_rest(p, o, s, acc, band, parametric, base)):
         # At rest away from zero (e.g. post-buckled): its settling time (on the final value)
         # needs a second integration, left to settle_second_pass so that the drivers do not
         # compile the scalar integrator for a case most sweeps never meet.
@@ -153,7 +154,7 @@ def classify(p, o, s, settings, acc, buf, reals, counts, terms):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def at_rest(p, o, s, acc, band, terms):
+def at_rest(p, o, s, acc, band, parametric, base):
     """Whether the final state (acc's t, q, q') lies within `band` (m) of a stable equilibrium.
 
     Linearised about the final q: stiffness per unit mass k = d(force)/dq / m
@@ -168,14 +169,14 @@ def at_rest(p, o, s, acc, band, terms):
     k = stiffness(t, q, p, o, s)
     if not k > 0.0:
         return False
-    static = -acceleration(t, q, 0.0, p, o, s, None, terms)   # the restoring force at q per mass
+    static = -acceleration(t, q, 0.0, p, o, s, None, parametric, base)   # restoring force per mass
     offset = static / k
     speed = v / math.sqrt(k)
     return math.sqrt(offset * offset + speed * speed) <= band
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, settings, states, reals, counts, terms):
+def settle_second_pass(params, settings, states, reals, counts, parametric, base):
     """Finish the points a driver left as SECOND_PASS (at rest away from zero): integrate
     again to find the final value, then a second time tracking |q - q_final| against the band
     tol * amplitude; the settling time is the last time q was outside it. The state becomes
@@ -187,9 +188,11 @@ def settle_second_pass(params, settings, states, reals, counts, terms):
             continue
         p = np.empty(N_PARAMS)
         prepare(params[i], p, 0, 1)
-        first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0), terms)
+        first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0), parametric,
+                             base)
         band = settings[TOL] * first[tj.TAIL_AMP]
-        second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), terms)
+        second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), parametric,
+                              base)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -198,7 +201,7 @@ def settle_second_pass(params, settings, states, reals, counts, terms):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, settings, reals, counts, series, terms):
+def solve_point(row, settings, reals, counts, series, parametric, base):
     """Integrate the point of parameter row `row` and classify it. Never raises for bad
     parameters: they give INVALID_INPUT."""
     if not valid(row):
@@ -207,12 +210,12 @@ def solve_point(row, settings, reals, counts, series, terms):
     p = np.empty(N_PARAMS)
     prepare(row, p, 0, 1)
     acc, buf = integrate(p, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                         settings[TOL], series, terms)
-    return classify(p, 0, 1, settings, acc, buf, reals, counts, terms)
+                         settings[TOL], series, parametric, base)
+    return classify(p, 0, 1, settings, acc, buf, reals, counts, parametric, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series, terms):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, parametric, base):
     """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
@@ -223,4 +226,5 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, terms):
     settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one).
     """
     for i in range(lo, hi):
-        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], terms)
+        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], parametric,
+                                base)

@@ -91,23 +91,24 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     constant = settings[tk.CONSTANT_STIFFNESS] != 0.0
     if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
-    terms = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
+    parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
     if driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
-            tk.solve_block(params, settings, lo, hi, states, reals, counts, series, terms)
+            tk.solve_block(params, settings, lo, hi, states, reals, counts, series, parametric,
+                           base)
     else:
         pi = True if settings[tk.CONTROLLER] != 0.0 else None
         eighth = True if settings[tk.METHOD] != 0.0 else None
 
         def kernel(lo: int, hi: int) -> None:
             lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi,
-                              eighth, terms)
+                              eighth, parametric, base)
 
     def solve_block(lo: int, hi: int) -> None:
         kernel(lo, hi)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             tk.settle_second_pass(params[lo:hi], settings, states[lo:hi], reals[lo:hi],
-                                  counts[lo:hi], terms)
+                                  counts[lo:hi], parametric, base)
         if on_block is not None:
             on_block(lo, hi)
 

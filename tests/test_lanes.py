@@ -246,14 +246,14 @@ def test_sweep_run_refuses_a_negative_thread_count():
 
 
 _VECTOR_LOOPS = [("_prepare", lambda W, s: (W, s, lanes.LANES)),
-                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, (True, None))),
-                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, (None, True))),
-                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, (True, True))),
-                 ("_attempt8", lambda W, s: (W, 1e-7, lanes.LANES, (True, None))),
+                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, True, None)),
+                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, None, True)),
+                 ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, True, True)),
+                 ("_attempt8", lambda W, s: (W, 1e-7, lanes.LANES, True, None)),
                  ("_pi_factors", lambda W, s: (W, lanes.LANES)),
-                 ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, None, (True, None))),
-                 ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, True, (True, None))),
-                 ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, None, (True, True))),
+                 ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, None, True, None)),
+                 ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, True, True, None)),
+                 ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, None, True, True)),
                  ("_observe_acceleration", lambda W, s: (W, s, lanes.LANES)),
                  ("_locate_extrema", lambda W, s: (W, lanes.LANES)),
                  ("_locate_extrema8", lambda W, s: (W, lanes.LANES))]
@@ -294,7 +294,7 @@ s = settings(rtol=1e-6, t_end=5.0, sample_dt=0.05)
 n = rows.shape[0]
 out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)), np.empty((n, tk.N_COUNTS), np.int64),
        np.empty((n, 101)))
-lanes.solve_block(rows, s, 0, n, *out, None, None, (True, None))
+lanes.solve_block(rows, s, 0, n, *out, None, None, True, None)
 np.savez({result!r}, *out)
 """
 
