@@ -1,0 +1,77 @@
+"""Two versions of cable-sweep side by side on the reference sweep: the paired runs of RESULTS.md.
+
+Each pair runs both checkouts at the same time, one pinned to each core (`taskset`), then
+swapped, so that both see the same machine at the same moment (a VM's timings wander by several
+per cent from one minute to the next). Each run is a fresh process that solves the 10 000-point
+reference sweep (benchmarks/reference_sweep.py's scene, `sweep.run.solve_points`) on one thread
+`--repeats` times after one warm-up call and prints its best wall time (s).
+
+    python benchmarks/before_after.py BEFORE_ROOT AFTER_ROOT [--method rk45|dop853]
+        [--driver lanes|scalar] [--repeats 40] [--pairs 2]
+
+BEFORE_ROOT and AFTER_ROOT are repository checkouts (e.g. `git clone . /tmp/before && git -C
+/tmp/before checkout REV`); each is imported from its own directory. Needs 2 cores and taskset.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+from pathlib import Path
+
+ONE_RUN = """
+import sys, time
+root, method, driver, repeats = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+sys.path[:0] = [root, root + "/benchmarks"]
+import reference_sweep as rs
+from bench_common import parameter_table
+from sweep.run import settings_vector, solve_points
+from sweep.scene import load_scene_text
+scene = load_scene_text(rs.SCENE.format(n=100, rtol=1e-8, atol=1e-12),
+                        overrides={"solver.method": method})
+table, settings = parameter_table(scene), settings_vector(scene)
+solve_points(table[:32], settings, 0, threads=1, driver=driver)
+best = float("inf")
+for _ in range(repeats):
+    start = time.perf_counter()
+    solve_points(table, settings, 0, threads=1, driver=driver)
+    best = min(best, time.perf_counter() - start)
+print(best)
+"""
+
+
+def pair(roots: tuple[str, str], cores: tuple[int, int], args: argparse.Namespace) -> list[float]:
+    """Best times (s) of both roots, run at once on the given cores."""
+    procs = [subprocess.Popen(["taskset", "-c", str(core), sys.executable, "-c", ONE_RUN, root,
+                               args.method, args.driver, str(args.repeats)],
+                              cwd=root, stdout=subprocess.PIPE, text=True)
+             for root, core in zip(roots, cores)]
+    return [float(p.communicate()[0].split()[-1]) for p in procs]
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("before")
+    p.add_argument("after")
+    p.add_argument("--method", choices=("rk45", "dop853"), default="rk45")
+    p.add_argument("--driver", choices=("lanes", "scalar"), default="lanes")
+    p.add_argument("--repeats", type=int, default=40)
+    p.add_argument("--pairs", type=int, default=2)
+    args = p.parse_args()
+    roots = (str(Path(args.before).resolve()), str(Path(args.after).resolve()))
+    before, after = [], []
+    for _ in range(args.pairs):
+        for cores in ((0, 1), (1, 0)):
+            b, a = pair(roots, cores, args)
+            before.append(b)
+            after.append(a)
+    ratios = ", ".join(f"{a / b:.3f}" for a, b in zip(after, before))
+    print(f"{args.driver} {args.method}, 1 thread, best of {args.repeats} each run")
+    print(f"before: best {min(before):.4f} s  runs {', '.join(f'{b:.4f}' for b in before)}")
+    print(f"after:  best {min(after):.4f} s  runs {', '.join(f'{a:.4f}' for a in after)}")
+    print(f"after / before: best {min(after) / min(before):.3f}; per pair {ratios}")
+
+
+if __name__ == "__main__":
+    main()
