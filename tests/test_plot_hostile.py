@@ -225,35 +225,34 @@ def test_huge_declared_dimensions_are_refused_before_reading(tmp_path, capsys):
 
 # ------------------------------------------------------------- as real processes
 
+def _assert_refused(done: subprocess.CompletedProcess, fragment: str, figs: Path) -> None:
+    """`sweep plot` exited 2 with one line on stderr holding `fragment`, and wrote no figures."""
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and fragment in lines[0], done.stderr
+    assert not figs.exists()
+
+
 def test_a_fifo_is_refused_without_opening_it(tmp_path):
     fifo = tmp_path / "result.nc"
     os.mkfifo(fifo)
-    done = _subprocess(fifo, "-o", tmp_path / "figs", timeout=120)
-    assert done.returncode == 2, done.stderr
-    lines = done.stderr.splitlines()
-    assert len(lines) == 1 and "is a FIFO, not a regular file" in lines[0], done.stderr
-    assert not (tmp_path / "figs").exists()
+    _assert_refused(_subprocess(fifo, "-o", tmp_path / "figs", timeout=120),
+                    "is a FIFO, not a regular file", tmp_path / "figs")
 
 
 def test_a_10_mb_attribute_is_refused_in_one_line(result, tmp_path):
     _, ds = result
     path = tmp_path / "big.nc"
     ds.assign_attrs(scene=ds.attrs["scene"] + "#" * 10 * 2**20).to_netcdf(path, engine="netcdf4")
-    done = _subprocess(path, "-o", tmp_path / "figs")
-    assert done.returncode == 2, done.stderr
-    lines = done.stderr.splitlines()
-    assert len(lines) == 1 and "attribute 'scene' is 10,4" in lines[0], done.stderr
-    assert not (tmp_path / "figs").exists()
+    _assert_refused(_subprocess(path, "-o", tmp_path / "figs"), "attribute 'scene' is 10,4",
+                    tmp_path / "figs")
 
 
 def test_a_truncated_file_is_refused_in_one_line(result, tmp_path):
     path = tmp_path / "cut.nc"
     _truncated(result[0], path)
-    done = _subprocess(path, "-o", tmp_path / "figs")
-    assert done.returncode == 2, done.stderr
-    lines = done.stderr.splitlines()
-    assert len(lines) == 1 and "not a readable netCDF file" in lines[0], done.stderr
-    assert not (tmp_path / "figs").exists()
+    _assert_refused(_subprocess(path, "-o", tmp_path / "figs"), "not a readable netCDF file",
+                    tmp_path / "figs")
 
 
 # ------------------------------------------------------------- all figures or none
