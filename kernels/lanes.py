@@ -297,7 +297,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
         W[tj.REJECTED * L + j] += 1.0 if active & (not accepted) else 0.0
         W[tj.STEPS * L + j] += 1.0 if active & accepted else 0.0
         tj.observe_step_end(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], h, t_new, qn, fv_new,
-                            t_tail, track, 0.0, 0.0, thr_rel, done, True, None, None)
+                            t_tail, track, 0.0, 0.0, thr_rel, done, True, None)
         W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
         W[tj.Q * L + j] = qn if done else q_old
         W[tj.V * L + j] = vn if done else v_old

@@ -17,10 +17,10 @@ METHOD = 12         # integrator: 0.0 RK45 (Dormand-Prince 5(4)), 1.0 DOP853 (8(
 ATOL_SCALE = 13     # c, 1: absolute tolerances c rtol q_scale (m) and c rtol v_scale (m/s)
                     # from each point's own scales (oscillator.Q_SCALE); 0.0: ATOL alone
 BASE = 14           # 1.0: the scene has base excitation (the forcing term and the absolute
-                    # acceleration are compiled in: oscillator.BASE_TERM); 0.0: none
+                    # acceleration are compiled in: oscillator's `base` switch); 0.0: none
 CONSTANT_STIFFNESS = 15  # 1.0: no row has a time-varying stiffness (k1 = g1 = 0 everywhere: a
                     # constant or zero end load), so cos(W t) is compiled out
-                    # (oscillator.PARAMETRIC_TERM); 0.0, the default: rows may have one
+                    # (oscillator's `parametric` switch); 0.0, the default: rows may have one
 N_SETTINGS = 16
 
 # Columns of the `reals` output.

@@ -298,7 +298,7 @@ def observe_acceleration(acc, a, sa, t_new, a3, t_tail, take):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, track, centre,
-                     thr_fixed, thr_rel, take, fast, parametric, base):
+                     thr_fixed, thr_rel, take, fast, base):
     """The Observer: what every accepted step's end adds to the metrics, for both drivers
     (`record_step`, and `kernels.lanes._finish` for the lanes' ordinary steps).
 
@@ -404,8 +404,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qt)
 
     thr, above = observe_step_end(acc, 0, 1, p, o, s, t, h, t_new, q_new, K[K.shape[0] - 1, 1],
-                                  t_tail, track, centre, thr_fixed, thr_rel, True, None, parametric,
-                                  base)
+                                  t_tail, track, centre, thr_fixed, thr_rel, True, None, base)
 
     if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
