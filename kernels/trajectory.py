@@ -108,27 +108,47 @@ def start(p, o, s, settings, acc, series, parametric, base):
     (oscillator.prepare); q(0) goes to series[0]. base: oscillator's switch."""
     rtol = max(settings[RTOL], MIN_RTOL)
     t_end = settings[T_END]
-    t_tail = t_end * (1.0 - settings[TAIL])
     q = p[o + Q0 * s]
     v = p[o + V0 * s]
-    acc[T] = 0.0
-    acc[Q] = q
-    acc[V] = v
-    acc[FQ] = v
-    acc[FV] = acceleration(0.0, q, v, p, o, s, None, parametric, base)
-    acc[RHS_EVALS] = 1.0
-    acc[ATOL_Q], acc[ATOL_V] = point_atol(p, o, s, settings, rtol)
+    fv = acceleration(0.0, q, v, p, o, s, None, parametric, base)
+    atol_q, atol_v = point_atol(p, o, s, settings, rtol)
+    evals = 1.0
     if settings[FIRST_STEP] > 0.0:
-        acc[H_ABS] = min(settings[FIRST_STEP], t_end)
+        h_abs = min(settings[FIRST_STEP], t_end)
     else:
         y = np.empty(2)
         f = np.empty(2)
         y[0], y[1] = q, v
-        f[0], f[1] = acc[FQ], acc[FV]
+        f[0], f[1] = v, fv
         order = dop853.ERROR_ESTIMATOR_ORDER if settings[METHOD] != 0.0 else ERROR_ESTIMATOR_ORDER
-        acc[H_ABS] = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, acc[ATOL_Q],
-                                  acc[ATOL_V], p, o, s, order, parametric, base)
-        acc[RHS_EVALS] += 1.0
+        h_abs = initial_step(0.0, y, f, t_end, settings[MAX_STEP], rtol, atol_q, atol_v,
+                             p, o, s, order, parametric, base)
+        evals += 1.0
+    a0 = fv
+    if base is not None:
+        a0 += base_acceleration(0.0, p, o, s, None)
+    begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, p[o + BOUND * s])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, bound):
+    """Write a trajectory's accumulator at t = 0 for any system whose observed quantity is q
+    (m) with rate v (m/s) and second derivative fv (m/s^2): `start`'s for the oscillator, and
+    the multi-mode driver's for the midspan deflection. a0: the absolute acceleration fv + a_b
+    at t = 0 (m/s^2; fv without base excitation); atol_q, atol_v: the absolute tolerances
+    (`point_atol`); h_abs: the first step to try (s); evals: the right-hand sides spent so far;
+    bound: the divergence bound on |q| (m). q(0) goes to series[0]."""
+    t_end = settings[T_END]
+    t_tail = t_end * (1.0 - settings[TAIL])
+    acc[T] = 0.0
+    acc[Q] = q
+    acc[V] = v
+    acc[FQ] = v
+    acc[FV] = fv
+    acc[RHS_EVALS] = evals
+    acc[ATOL_Q] = atol_q
+    acc[ATOL_V] = atol_v
+    acc[H_ABS] = h_abs
     acc[T_NEW] = 0.0
     acc[REJECTED_NOW] = 0.0
     acc[STATUS] = mt.RUNNING
@@ -146,16 +166,13 @@ def start(p, o, s, settings, acc, series, parametric, base):
         acc[SAMPLE] = 1.0
     acc[N_EXT] = 0.0
     acc[LOG2_ERR_PREV] = _LOG2_ERR_PREV_START
-    a0 = acc[FV]
-    if base is not None:
-        a0 += base_acceleration(0.0, p, o, s, None)
     acc[ACC_AMP] = abs(a0) if t_tail <= 0.0 else 0.0
     acc[ACC_1] = a0
     acc[T_1] = 0.0
     acc[ACC_2] = math.nan
     acc[T_2] = math.nan
     acc[ACC_STEP] = 0.0
-    if not abs(q) <= p[o + BOUND * s]:
+    if not abs(q) <= bound:
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = 0.0
 
