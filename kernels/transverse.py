@@ -93,10 +93,22 @@ def reject_point(reals, counts, series):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def classify(p, o, s, settings, acc, buf, reals, counts, parametric, base):
     """State flag and metrics of a finished trajectory (metrics module); fills reals, counts.
-    p[o + column * s]: the point's prepared row (oscillator.prepare).
+    p[o + column * s]: the point's prepared row (oscillator.prepare). `classify_metrics`'s,
+    with the oscillator's at-rest test (`at_rest`)."""
+    band = settings[TOL] * acc[tj.TAIL_AMP]
+    return classify_metrics(settings, acc, buf, reals, counts, base,
+                            at_rest(p, o, s, acc, band, parametric, base))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def classify_metrics(settings, acc, buf, reals, counts, base, resting):
+    """State flag and metrics of a finished trajectory of any system from its accumulator and
+    extrema (metrics module); fills reals, counts. resting: whether the final state lies
+    within the settling band (settings[TOL] x the tail amplitude) of a stable equilibrium (the
+    system's own at-rest test: `at_rest` for the oscillator).
 
     A trajectory that came to rest away from zero without oscillating is integrated a second
-    time to find when it settled on its final value.
+    time to find when it settled on its final value (SECOND_PASS).
     """
     for j in range(N_REALS):
         reals[j] = math.nan
@@ -142,8 +154,7 @@ def classify(p, o, s, settings, acc, buf, reals, counts, parametric, base):
         if mt.tail_trend(buf, n_ext, t_tail, settings[T_END]):
             return mt.UNSETTLED
         return mt.MODULATED
-    if (acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band
-            and at_rest(p, o, s, acc, band, parametric, base)):
+    if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band and resting:
         # At rest away from zero (e.g. post-buckled): its settling time (on the final value)
         # needs a second integration, left to settle_second_pass so that the drivers do not
         # compile the scalar integrator for a case most sweeps never meet.

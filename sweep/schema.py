@@ -67,6 +67,9 @@ KEYS: tuple[Key, ...] = (
         long_name="membrane stretching coefficient alpha", axis="membrane"),
     Key("model", "paper_parametric", "str", "printed", choices=("printed", "corrected"),
         long_name="paper preset: Eq.32's parametric (cos) terms as printed or 10x-corrected"),
+    Key("model", "modes", "int", 1, units="1", minimum=1, maximum=12,
+        long_name="transverse: Galerkin modes kept, sin(n pi x/l) for n = 1..modes, coupled by "
+                  "the nonlinear terms (1: the paper's one-mode model)"),
     # [cable]
     Key("cable", "youngs_modulus", "float", 1.1e11, units="Pa", minimum=0.0, exclusive_min=True,
         long_name="Young's modulus", axis="youngs_modulus"),
@@ -109,6 +112,12 @@ KEYS: tuple[Key, ...] = (
         long_name="initial midspan deflection q(0)", axis="initial_displacement"),
     Key("initial", "velocity", "float", 0.0, units="m s-1",
         long_name="initial midspan velocity q'(0)", axis="initial_velocity"),
+    Key("initial", "modal_displacement", "floats", None, units="m",
+        long_name="initial modal deflections q_1(0), ..., q_N(0), one per mode (N = "
+                  "model.modes); replaces initial.displacement, mode 1's alone"),
+    Key("initial", "modal_velocity", "floats", None, units="m s-1",
+        long_name="initial modal velocities q_1'(0), ..., q_N'(0), one per mode; replaces "
+                  "initial.velocity, mode 1's alone"),
     # [solver]
     Key("solver", "rtol", "float", 1e-8, units="1", minimum=1e-14, maximum=0.1,
         long_name="relative tolerance"),

@@ -112,7 +112,37 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         if on_block is not None:
             on_block(lo, hi)
 
-    n = params.shape[0]
+    run_blocks(solve_block, params.shape[0], threads, stop)
+
+
+def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
+                reals: np.ndarray, counts: np.ndarray, series: np.ndarray, modal: np.ndarray,
+                *, threads: int = 0, on_block: Callable[[int, int], None] | None = None,
+                stop: threading.Event | None = None) -> None:
+    """`solve_transverse` for the multi-mode System (kernels.modal_driver, its scalar driver):
+    rows of kernels.modes columns for n_modes modes in, the same outputs plus modal (n,
+    n_modes), each mode's tail amplitude (m)."""
+    from sweep.kernels import layout as tk
+    from sweep.kernels import metrics as mt
+    from sweep.kernels import modal_driver
+    base = True if settings[tk.BASE] != 0.0 else None
+
+    def solve_block(lo: int, hi: int) -> None:
+        modal_driver.solve_block(params, n_modes, settings, lo, hi, states, reals, counts,
+                                 series, modal, base)
+        if np.any(states[lo:hi] == mt.SECOND_PASS):
+            modal_driver.settle_second_pass(params[lo:hi], n_modes, settings, states[lo:hi],
+                                            reals[lo:hi], counts[lo:hi], base)
+        if on_block is not None:
+            on_block(lo, hi)
+
+    run_blocks(solve_block, params.shape[0], threads, stop)
+
+
+def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
+               stop: threading.Event | None) -> None:
+    """Run solve_block(lo, hi) over blocks covering rows 0..n-1 on `threads` threads (0: all),
+    guided scheduling and timed blocks (module docstring); with `stop` set no new block starts."""
     n_threads = max(1, min(thread_count(threads), -(-n // LANES_PER_THREAD)))
     stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
     most = SOLO_BLOCK if n_threads == 1 else MAX_BLOCK

@@ -238,3 +238,52 @@ def _finite_or_nan(value: Any) -> Any:
     if isinstance(value, xr.DataArray):
         return value.where(np.isfinite(value))
     return np.where(np.isfinite(value), value, np.nan)[()]
+
+
+def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: int,
+                  q0: Any, v0: Any) -> dict[str, Any]:
+    """The multi-mode kernel's raw columns (kernels.modes: FIXED_NAMES, then q0_1..q0_N and
+    v0_1..v0_N) of the consistent model with n_modes modes (docs/model.md sec. 7).
+
+    p: the scene's parameters by axis name, as `oscillator` takes them; one_mode: `oscillator`(p)
+    (its load frequency, bound and base columns are shared by every mode); q0, v0: sequences of
+    n_modes initial modal deflections (m) and velocities (m/s), each a scalar or an array over
+    the points. The state scales are `state_scale`'s with the largest initial deflection and
+    velocity of any mode.
+    """
+    k = np.pi / p["length"]
+    rho_a = p["density"] * p["area"]
+    w1_sq = p["youngs_modulus"] * p["inertia"] / rho_a * k ** 4
+    w1 = np.sqrt(w1_sq)
+    load = p["load_amplitude"] * k ** 2 / rho_a
+    harmonic = p["load_type"] == "harmonic"
+    out = {
+        "w1_sq": w1_sq,
+        "damping": 2.0 * p["damping_ratio"] * w1,
+        "load_mean": 0.0 if harmonic else load,
+        "load_cos": load if harmonic else 0.0,
+        "membrane": 4.0 * p["membrane"] * p["youngs_modulus"] / p["density"] * k ** 4,
+        "k_sq": k ** 2,
+        "omega": one_mode["omega"],
+        "bound": one_mode["bound"],
+        "base_accel": one_mode["base_accel"],
+        "base_omega": one_mode["base_omega"],
+        "participation": one_mode["participation"],
+    }
+    q_max = np.max(np.abs(np.broadcast_arrays(*[np.asarray(q, float) for q in q0])), axis=0)
+    v_max = np.max(np.abs(np.broadcast_arrays(*[np.asarray(v, float) for v in v0])), axis=0)
+    out["q_scale"], out["v_scale"] = state_scale(
+        q_max, v_max, w1, out["bound"], one_mode["participation"] * one_mode["base_accel"],
+        one_mode["base_omega"])
+    for n in range(n_modes):
+        out[f"q0_{n + 1}"] = q0[n]
+        out[f"v0_{n + 1}"] = v0[n]
+    return out
+
+
+def modal_frequencies(natural_frequency: Any, n_modes: int) -> xr.DataArray:
+    """n^2 f1 (Hz) for n = 1..n_modes on a dimension `mode`: the linear natural frequencies of
+    the unloaded span's modes (w_n = n^2 w1), natural_frequency being f1 (Hz, a float or a
+    DataArray over some axes)."""
+    n = xr.DataArray(np.arange(1, n_modes + 1), dims="mode")
+    return (n * n * natural_frequency).astype(float)

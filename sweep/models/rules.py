@@ -245,6 +245,7 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
             if axis in axes:
                 _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
                       f"remove the {axis} axis, or use load.type = 'harmonic'")
+    _check_modes(given, axes)
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:
@@ -252,6 +253,29 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
         _check_paper_cable(given)
+
+
+def _check_modes(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of model.modes: more than one mode needs the consistent coefficients (Eq.32 is one
+    mode's), and each modal initial-condition list has one entry per mode and replaces the
+    one-mode key (initial.displacement or initial.velocity, as a key or an axis)."""
+    n_modes = given.get("model.modes", 1)
+    if n_modes > 1 and given.get("model.coefficients") == "paper":
+        _fail("scene key 'model.modes'", f"model.coefficients = 'paper' has one mode only "
+              f"(Eq.32), got modes = {n_modes}",
+              "use model.coefficients = 'consistent' for several modes, or remove model.modes")
+    for listed, single in (("initial.modal_displacement", "initial.displacement"),
+                           ("initial.modal_velocity", "initial.velocity")):
+        values = given.get(listed)
+        if values is None:
+            continue
+        if len(values) != n_modes:
+            _fail(f"scene key '{listed}'", f"has {len(values)} entries for model.modes = "
+                  f"{n_modes}", f"give one value per mode, q_1 .. q_{n_modes} "
+                  f"({schema.BY_DOTTED[listed].units})")
+        if single in given or schema.BY_DOTTED[single].axis in axes:
+            _fail(f"scene keys '{single}' and '{listed}'", "give one, not both",
+                  f"remove {single} (mode 1 alone) or put its value first in {listed}")
 
 
 def _check_paper_cable(given: dict[str, Any]) -> None:
@@ -363,6 +387,9 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
     for dotted in ("initial.displacement", "initial.velocity"):
         if (_extreme(values, axes, dotted, np.min) != 0.0
                 or _extreme(values, axes, dotted, np.max) != 0.0):
+            return
+    for dotted in ("initial.modal_displacement", "initial.modal_velocity"):
+        if any(v != 0.0 for v in values.get(dotted) or ()):
             return
     what = ""
     if not given and not axes:

@@ -29,6 +29,7 @@ from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
 from . import modal
 
 KIND = "transverse"
+MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
 ATOL_SCALE = 0.01              # default atol: this x rtol x each point's own scales (m, m/s)
 
 # name -> (kernel column, units, long_name, scene output switch)
@@ -86,6 +87,7 @@ class KernelResult:
     counts: np.ndarray      # (n, kernels.transverse.N_COUNTS) int64
     series: np.ndarray      # (n, n_samples) q samples (m); n_samples may be 0
     sample_times: np.ndarray
+    modal: np.ndarray | None = None    # (n, N) each mode's tail amplitude (m); N >= 2 only
 
 
 def sample_times(t_end: float, dt: float) -> np.ndarray:
@@ -162,7 +164,11 @@ class Inputs:
     settings: the kernel settings vector (`settings_vector`); sample_times: the time-series
     sample times (s; empty when none are stored); driver, method, controller: solver.driver,
     solver.method, solver.controller; wanted: the outputs.* switches that are on (dotted
-    keys); has_base: the scene has base excitation; origin: its provenance.
+    keys); has_base: the scene has base excitation; origin: its provenance; n_modes:
+    model.modes; modal_q0, modal_v0: the initial modal deflections (m) and velocities (m/s),
+    n_modes scalars or axis parameters each (mode 1's from initial.displacement and
+    initial.velocity, the others 0, unless the scene gives initial.modal_displacement or
+    initial.modal_velocity).
     """
     coords: dict[str, xr.DataArray]
     dims: tuple[str, ...]
@@ -176,6 +182,9 @@ class Inputs:
     wanted: frozenset[str]
     has_base: bool
     origin: Provenance
+    n_modes: int = 1
+    modal_q0: tuple = ()
+    modal_v0: tuple = ()
 
 
 def resolve(scene: Scene) -> Inputs:
@@ -186,11 +195,20 @@ def resolve(scene: Scene) -> Inputs:
     wanted = frozenset(k for k in scene.values if k.startswith("outputs.") and scene.get(k) is True)
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if "outputs.time_series" in wanted else np.empty(0))
+    params = grid.parameters(scene, coords)
+    n_modes = scene.get("model.modes")
+    initial = []
+    for listed, single in (("initial.modal_displacement", "initial_displacement"),
+                           ("initial.modal_velocity", "initial_velocity")):
+        values = scene.get(listed)
+        initial.append(tuple(values) if values is not None
+                       else (params[single],) + (0.0,) * (n_modes - 1))
     return Inputs(coords=coords, dims=dims, shape=tuple(coords[d].size for d in dims),
-                  params=grid.parameters(scene, coords), settings=settings, sample_times=times,
+                  params=params, settings=settings, sample_times=times,
                   driver=scene.get("solver.driver"), method=scene.get("solver.method"),
                   controller=scene.get("solver.controller"), wanted=wanted,
-                  has_base=scene.has_base, origin=provenance(scene))
+                  has_base=scene.has_base, origin=provenance(scene), n_modes=n_modes,
+                  modal_q0=initial[0], modal_v0=initial[1])
 
 
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:
@@ -209,18 +227,49 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
                  + 40, "metrics and time series")
     coeffs = modal.oscillator(params)          # derived quantities, on the axes they need
     set_constant_stiffness(settings, coeffs)
+    started = time.perf_counter()
+    n_samples = inputs.sample_times.size
+    if inputs.n_modes > 1:
+        out = _solve_modes(inputs, options, settings)
+    else:
+        def rows_at(points: np.ndarray) -> np.ndarray:
+            at = grid.point_values(params, dims, shape, points)
+            return grid.rows(modal.oscillator(at), PARAM_NAMES, points.size)
+
+        out = solve_chunked(options, transverse_chunk, rows_at,
+                            (settings, n_samples, inputs.driver),
+                            transverse_outputs(n_points, n_samples))
+    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"],
+                          inputs.sample_times, out.get("modal"))
+    return assemble(inputs, coeffs, result, time.perf_counter() - started)
+
+
+def _solve_modes(inputs: Inputs, options: RunOptions, settings: np.ndarray
+                 ) -> dict[str, np.ndarray]:
+    """The multi-mode kernel (kernels.modal_driver, its scalar driver on every thread) over
+    the grid of `inputs` (model.modes >= 2): outputs by name, grid order."""
+    from sweep.kernels.modes import FIXED_NAMES
+
+    from ..execute import modes_chunk, modes_outputs
+    dims, shape, params, n = inputs.dims, inputs.shape, inputs.params, inputs.n_modes
+    names = FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n + 1)) + tuple(
+        f"v0_{i}" for i in range(1, n + 1))
+
+    def values_at(points: np.ndarray, modal_values: tuple) -> list:
+        return [grid.point_values({"v": v}, dims, shape, points)["v"] for v in modal_values]
 
     def rows_at(points: np.ndarray) -> np.ndarray:
         at = grid.point_values(params, dims, shape, points)
-        return grid.rows(modal.oscillator(at), PARAM_NAMES, points.size)
+        columns = modal.modes_columns(at, modal.oscillator(at), n,
+                                      values_at(points, inputs.modal_q0),
+                                      values_at(points, inputs.modal_v0))
+        return grid.rows(columns, names, points.size)
 
-    started = time.perf_counter()
+    n_points = int(np.prod(shape, dtype=np.int64))
     n_samples = inputs.sample_times.size
-    out = solve_chunked(options, transverse_chunk, rows_at, (settings, n_samples, inputs.driver),
-                        transverse_outputs(n_points, n_samples))
-    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"],
-                          inputs.sample_times)
-    return assemble(inputs, coeffs, result, time.perf_counter() - started)
+    check_memory(n_points, 2.0 * 8 * n, "modal amplitudes")
+    return solve_chunked(options, modes_chunk, rows_at, (settings, n_samples, n),
+                         modes_outputs(n_points, n_samples, n))
 
 
 def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
@@ -243,6 +292,23 @@ def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
                                                "acceleration amplitude over the base level A"}
     return {"absolute_acceleration": absolute, "absolute_acceleration_g": in_g,
             "transmissibility": ratio}
+
+
+def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...],
+                  coeffs: dict[str, Any], coords: dict[str, xr.DataArray]
+                  ) -> dict[str, xr.DataArray]:
+    """The outputs of a multi-mode run (docs/model.md sec. 7): modal_amplitude, each mode's
+    max |q_n| over the tail window (m, over dims and `mode`; NaN where the point failed), and
+    modal_frequency, n^2 f1 (Hz, over `mode` and the axes f1 depends on)."""
+    n_modes = amplitudes.shape[1]
+    amplitude = xr.DataArray(amplitudes.reshape(shape + (n_modes,)), dims=dims + (MODE_DIM,),
+                             attrs={"units": "m", "long_name": "modal amplitude: max |q_n| over "
+                                    "the tail window, q_n the coefficient of sin(n pi x/l)"})
+    frequency = modal.modal_frequencies(derived(coeffs["natural_frequency"], coords),
+                                        n_modes).transpose(..., MODE_DIM)
+    frequency.attrs = {"units": "Hz", "long_name": "linear natural frequency of mode n of the "
+                                                  "unloaded span, n^2 f1"}
+    return {"modal_amplitude": amplitude, "modal_frequency": frequency}
 
 
 def state_attrs() -> dict[str, Any]:
@@ -279,15 +345,23 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
         if name in coeffs and name not in coords:
             data[name] = derived(coeffs[name], coords)
             data[name].attrs = {"units": units, "long_name": long_name}
+    if result.modal is not None:
+        data.update(modal_outputs(result.modal, dims, shape, coeffs, coords))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         data.update(base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                  derived(coeffs["base_accel"], coords)))
     all_coords: dict[str, Any] = dict(coords)
+    if result.modal is not None:
+        all_coords[MODE_DIM] = xr.DataArray(
+            np.arange(1, result.modal.shape[1] + 1, dtype=np.int32), dims=MODE_DIM,
+            attrs={"units": "1", "long_name": "Galerkin mode number n of sin(n pi x/l)"})
     if result.series.shape[1] > 0:
         all_coords[TIME_DIM] = elapsed_time(result.sample_times)
         data["displacement"] = xr.DataArray(
             result.series.reshape(shape + (result.series.shape[1],)), dims=dims + (TIME_DIM,),
             attrs={"units": "m", "long_name": "midspan deflection q(t)"})
+    system = ("transverse modal oscillator" if inputs.n_modes == 1 else
+              f"transverse Galerkin model, {inputs.n_modes} coupled modes (scalar driver)")
     attrs = global_attrs(inputs.origin, shape, elapsed,
-                         f"transverse modal oscillator, {method}, {CONTROLLERS[inputs.controller]}")
+                         f"{system}, {method}, {CONTROLLERS[inputs.controller]}")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)

@@ -1,0 +1,373 @@
+"""Scalar driver of the multi-mode System (kernels.modes): one trajectory after another.
+
+The state is y = (q_1..q_N, q_1'..q_N') (m, m/s). Each step is SciPy's RK45 or DOP853 on the
+whole state (the tableaux of kernels.dopri5 and kernels.dop853, looped over as SciPy's
+`rk_step` does), with SciPy's RMS error norm over its 2N components and SciPy's controller, so
+the attempts are those of solve_ivp on the same system.
+
+The metrics are the one-mode trajectory's (kernels.trajectory, the same accumulator and the
+same Observer) applied to the midspan deflection q_mid = sum q_n sin(n pi / 2): every
+Runge-Kutta stage, solution and dense output is linear in the state, so the step's stage
+derivatives projected on q_mid (K_mid) are exactly the stages of q_mid, and its interpolants
+(RK45's quartic, DOP853's quintic Hermite) are exactly those of q_mid. On top, each mode's
+tail amplitude max |q_n| (step ends, the tail's start and every extremum of q_n located on its
+own interpolant) and a divergence test on every mode (a mode with no midspan deflection, an
+even one, can grow unseen at midspan).
+
+Units: t in s, q in m, q' in m/s.
+"""
+
+import math
+
+import numba as nb
+import numpy as np
+
+from . import dop853
+from . import dopri5
+from . import metrics as mt
+from . import modes as md
+from . import oscillator as osc
+from . import trajectory as tj
+from .layout import (FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS, RHS_EVALS, RTOL,
+                     SETTLING, TAIL, TOL, T_END, WANT_SETTLING)
+from .transverse import classify_metrics
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def observer_row(row, n_modes):
+    """The oscillator-layout row (kernels.oscillator columns) the trajectory module's Observer
+    reads for the midspan deflection: its divergence bound, scales and base excitation."""
+    p = np.zeros(osc.N_PARAMS)
+    p[osc.MASS] = 1.0
+    p[osc.BOUND] = row[md.BOUND]
+    p[osc.Q_SCALE] = row[md.Q_SCALE]
+    p[osc.V_SCALE] = row[md.V_SCALE]
+    p[osc.BASE_ACCEL] = row[md.BASE_ACCEL]
+    p[osc.BASE_OMEGA] = row[md.BASE_OMEGA]
+    p[osc.PARTICIPATION] = row[md.PARTICIPATION]
+    return p
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def valid(row, n_modes):
+    """Whether a raw multi-mode row can be integrated: finite, w1^2 > 0 and bound > 0."""
+    for j in range(row.shape[0]):
+        if not math.isfinite(row[j]):
+            return False
+    return row[md.W1_SQ] > 0.0 and row[md.BOUND] > 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _project(v, weights, offset, n):
+    """sum_i weights[i] v[offset + i]."""
+    s = 0.0
+    for i in range(n):
+        s += weights[i] * v[offset + i]
+    return s
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def rk_step(t, y, h, pp, n_modes, T, work, K, y_new, stage, A, B, C, base):
+    """One step of size h (s) of the explicit tableau (A, B, C) from (t, y), SciPy's
+    `rk_step` on the 2N-component state; K[0] must hold f(t, y). Fills K[1..n_stages] (the
+    last: f(t + h, y_new)) and y_new. stage: scratch of length 2N."""
+    n_stages = B.shape[0]
+    dim = 2 * n_modes
+    for s in range(1, n_stages):
+        for i in range(dim):
+            d = 0.0
+            for j in range(s):
+                d += K[j, i] * A[s, j]
+            stage[i] = y[i] + d * h
+        md.derivative(t + C[s] * h, stage, K[s], pp, n_modes, T, work, base)
+    for i in range(dim):
+        d = 0.0
+        for j in range(n_stages):
+            d += K[j, i] * B[j]
+        y_new[i] = y[i] + h * d
+    md.derivative(t + h, y_new, K[n_stages], pp, n_modes, T, work, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def error_norm(K, h, y, y_new, rtol, atol_q, atol_v, n_modes, eighth):
+    """SciPy's error norm of the attempt over all 2N components: RK45's RMS of h K^T E / scale,
+    or DOP853's combination of its fifth- and third-order estimates; scale = atol +
+    rtol max(|y|, |y_new|), atol_q (m) for displacements, atol_v (m/s) for velocities."""
+    dim = 2 * n_modes
+    e_a = 0.0
+    e_b = 0.0
+    for i in range(dim):
+        atol = atol_q if i < n_modes else atol_v
+        scale = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+        if eighth:
+            s5 = 0.0
+            s3 = 0.0
+            for j in range(K.shape[0]):
+                s5 += K[j, i] * dop853.E5[j]
+                s3 += K[j, i] * dop853.E3[j]
+            e_a += (s5 / scale) ** 2
+            e_b += (s3 / scale) ** 2
+        else:
+            s = 0.0
+            for j in range(K.shape[0]):
+                s += K[j, i] * dopri5.E[j]
+            e_a += (s * h / scale) ** 2
+    if eighth:
+        if e_a == 0.0 and e_b == 0.0:
+            return 0.0
+        return abs(h) * e_a / math.sqrt((e_a + dop853.ERR3_WEIGHT * e_b) * dim)
+    return math.sqrt(e_a / dim)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, pp, n_modes, T, work,
+                 base):
+    """SciPy's `select_initial_step` on the 2N-component state from t = 0 (f = f(0, y)).
+    One evaluation."""
+    dim = 2 * n_modes
+    if t_end == 0.0:
+        return 0.0
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(dim):
+        scale = (atol_q if i < n_modes else atol_v) + abs(y[i]) * rtol
+        d0 += (y[i] / scale) ** 2
+        d1 += (f[i] / scale) ** 2
+    d0 = math.sqrt(d0 / dim)
+    d1 = math.sqrt(d1 / dim)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, t_end)
+    y1 = np.empty(dim)
+    f1 = np.empty(dim)
+    for i in range(dim):
+        y1[i] = y[i] + h0 * f[i]
+    md.derivative(h0, y1, f1, pp, n_modes, T, work, base)
+    d2 = 0.0
+    for i in range(dim):
+        scale = (atol_q if i < n_modes else atol_v) + abs(y[i]) * rtol
+        d2 += ((f1[i] - f[i]) / scale) ** 2
+    d2 = math.sqrt(d2 / dim) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+    return min(100.0 * h0, h1, t_end, max_step)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _mode_extremum(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
+    """q_i at its extremum inside the accepted step (its interpolant's root of q_i') and where
+    (x = (t - t_old)/h): Km (n_stages + 1, 2) and Qm (2, 5) are scratch."""
+    last = K.shape[0] - 1
+    if eighth:
+        dop853.hermite_coefficients(y[i], y[n_modes + i], K[0, n_modes + i], y_new[i],
+                                    y_new[n_modes + i], K[last, n_modes + i], h, Qm)
+    else:
+        for j in range(K.shape[0]):
+            Km[j, 0] = K[j, i]
+            Km[j, 1] = K[j, n_modes + i]
+        dopri5.dense_coefficients(Km, Qm)
+    x = dopri5.dense_root(y[n_modes + i], h, Qm[1], 0.0, 0.0, 1.0)
+    return dopri5.dense_value(y[i], h, Qm[0], x), x
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, Qm):
+    """Each mode's running tail amplitude modal[i] = max |q_i| over the tail (m): the step's
+    end, the tail's start inside the step, and an extremum of q_i inside the step."""
+    for i in range(n_modes):
+        v0 = y[n_modes + i]
+        v1 = y_new[n_modes + i]
+        if t_new >= t_tail:
+            modal[i] = max(modal[i], abs(y_new[i]))
+        turns = (v0 > 0.0 and v1 <= 0.0) or (v0 < 0.0 and v1 >= 0.0)
+        starts = t < t_tail <= t_new
+        if turns or starts:
+            qe, x = _mode_extremum(y, y_new, K, h, i, n_modes, eighth, Km, Qm)
+            if turns and t + x * h >= t_tail:
+                modal[i] = max(modal[i], abs(qe))
+            if starts:
+                qt = dopri5.dense_value(y[i], h, Qm[0], (t_tail - t) / h)
+                modal[i] = max(modal[i], abs(qt))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base):
+    """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
+    SciPy's RK45 or DOP853 (settings[METHOD]), reducing the midspan deflection's metrics
+    (kernels.trajectory's accumulator) and each mode's tail amplitude (modal, length N, m) on
+    the fly; `track`, centre, thr_fixed, thr_rel: as transverse.integrate. Returns
+    (accumulator, extrema buffer, final state y)."""
+    n = n_modes
+    dim = 2 * n
+    rtol = max(settings[RTOL], dopri5.MIN_RTOL)
+    t_end = settings[T_END]
+    t_tail = t_end * (1.0 - settings[TAIL])
+    eighth = settings[METHOD] != 0.0
+    n_stages = dop853.N_STAGES if eighth else dopri5.N_STAGES
+    A = dop853.A if eighth else dopri5.A
+    B = dop853.B if eighth else dopri5.B
+    C = dop853.C if eighth else dopri5.C
+    T = md.tables(n)
+    work = np.empty((4, T.shape[2]))
+    pp = np.empty(4 * n + md.N_SCALARS)
+    md.prepare(row, n, pp)
+    p1 = observer_row(row, n)
+    weights = md.midspan_weights(n)
+    K = np.empty((n_stages + 1, dim))
+    K_mid = np.empty((n_stages + 1, 2))
+    Km = np.empty((n_stages + 1, 2))
+    Qc = np.empty((2, 5))
+    Qm = np.empty((2, 5))
+    y = np.empty(dim)
+    y_new = np.empty(dim)
+    stage = np.empty(dim)
+    acc = np.empty(tj.N_SLOTS)
+    buf = tj.new_buffer()
+
+    for i in range(dim):
+        y[i] = row[md.N_FIXED + i]
+    md.derivative(0.0, y, K[0], pp, n, T, work, base)
+    atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
+    evals = 1.0
+    if settings[FIRST_STEP] > 0.0:
+        h_abs = min(settings[FIRST_STEP], t_end)
+    else:
+        order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
+        h_abs = initial_step(y, K[0], t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
+                             pp, n, T, work, base)
+        evals += 1.0
+    fv = _project(K[0], weights, n, n)
+    a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
+    tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
+             fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
+    for i in range(n):
+        modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
+        if not abs(y[i]) <= row[md.BOUND]:
+            acc[tj.STATUS] = mt.DIVERGED
+            acc[tj.T_STOP] = 0.0
+
+    while True:
+        h = tj.next_attempt(settings, acc)
+        if h == 0.0:
+            break
+        t = acc[tj.T]
+        rk_step(t, y, h, pp, n, T, work, K, y_new, stage, A, B, C, base)
+        err = error_norm(K, h, y, y_new, rtol, atol_q, atol_v, n, eighth)
+        if not tj.control(settings, acc, err):
+            continue
+        t_new = acc[tj.T_NEW]
+        for i in range(n):
+            if not (abs(y_new[i]) <= row[md.BOUND] and math.isfinite(y_new[n + i])):
+                acc[tj.STATUS] = mt.DIVERGED
+                acc[tj.T_STOP] = t_new
+        if acc[tj.STATUS] != mt.RUNNING:
+            break
+        _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, Qm)
+        for j in range(n_stages + 1):
+            K_mid[j, 0] = _project(K[j], weights, 0, n)
+            K_mid[j, 1] = _project(K[j], weights, n, n)
+        if acc[tj.N_EXT] >= buf.shape[0]:
+            buf = tj.with_room(buf, acc)
+        tj.record_step(p1, 0, 1, settings, acc, K_mid, _project(y_new, weights, 0, n),
+                       _project(y_new, weights, n, n), h, Qc, buf, series, track, centre,
+                       thr_fixed, thr_rel, -1.0, 0.0, True, base)
+        for i in range(dim):
+            y[i] = y_new[i]
+        K[0, :] = K[n_stages, :]
+    tj.end_series(acc, series)
+    return acc, buf, y
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def at_rest(row, n_modes, t, y, band, base):
+    """Whether the final state y at time t lies within `band` (m) of a stable equilibrium:
+    per mode, linearised about the final q (stiffness k_i = -d q_i''/d q_i by a central
+    difference), the equilibrium lies d_i = (restoring force_i) / k_i away and the motion about
+    it has amplitude sqrt(d_i^2 + (q_i'/sqrt(k_i))^2); at rest when the root sum of squares of
+    these over the modes is <= band. Any k_i <= 0: not at rest (kernels.transverse.at_rest
+    for one mode)."""
+    n = n_modes
+    T = md.tables(n)
+    work = np.empty((4, T.shape[2]))
+    pp = np.empty(4 * n + md.N_SCALARS)
+    md.prepare(row, n, pp)
+    z = np.empty(2 * n)
+    f = np.empty(2 * n)
+    for i in range(n):
+        z[i] = y[i]
+        z[n + i] = 0.0
+    md.derivative(t, z, f, pp, n, T, work, base)
+    up = np.empty(2 * n)
+    down = np.empty(2 * n)
+    total = 0.0
+    for i in range(n):
+        step = 1e-6 * max(abs(y[i]), 1e-9 * row[md.BOUND])
+        z[i] = y[i] + step
+        md.derivative(t, z, up, pp, n, T, work, base)
+        z[i] = y[i] - step
+        md.derivative(t, z, down, pp, n, T, work, base)
+        z[i] = y[i]
+        k = -(up[n + i] - down[n + i]) / (2.0 * step)
+        if not k > 0.0:
+            return False
+        offset = -f[n + i] / k
+        speed = y[n + i] / math.sqrt(k)
+        total += offset * offset + speed * speed
+    return math.sqrt(total) <= band
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_point(row, n_modes, settings, reals, counts, series, modal, base):
+    """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
+    mode's tail amplitude in modal, m). Bad parameters give INVALID_INPUT, NaN metrics."""
+    if not valid(row, n_modes):
+        for j in range(N_REALS):
+            reals[j] = math.nan
+        for j in range(N_COUNTS):
+            counts[j] = 0
+        for j in range(series.shape[0]):
+            series[j] = math.nan
+        for j in range(n_modes):
+            modal[j] = math.nan
+        return mt.INVALID_INPUT
+    acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
+                            settings[TOL], series, modal, base)
+    resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
+    state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
+    if state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS:
+        for j in range(n_modes):
+            modal[j] = math.nan
+    return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def settle_second_pass(params, n_modes, settings, states, reals, counts, base):
+    """Finish the points left SECOND_PASS (at rest away from zero), as
+    kernels.transverse.settle_second_pass does for one mode: integrate again to find the
+    final midspan value, then track |q_mid - final| against the band."""
+    done = 0
+    modal = np.empty(n_modes)
+    for i in range(params.shape[0]):
+        if states[i] != mt.SECOND_PASS:
+            continue
+        first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
+                                np.empty(0), modal, base)
+        band = settings[TOL] * first[tj.TAIL_AMP]
+        second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
+                                 np.empty(0), modal, base)
+        reals[i, SETTLING] = second[tj.LAST_ABOVE]
+        counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
+        states[i] = mt.STEADY
+        done += 1
+    return done
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, base):
+    """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
+    kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
+    max |q_n| (m). Releases the GIL (sweep.threads runs blocks on threads)."""
+    for i in range(lo, hi):
+        states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
+                                modal[i], base)

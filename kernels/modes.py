@@ -1,0 +1,191 @@
+"""The multi-mode transverse System: the span's first N Galerkin modes, coupled (SI units).
+
+    w(x, t) = sum_{n=1..N} q_n(t) sin(n k x),  k = pi / l,
+
+projected on every sin(m k x) and divided by rho A l / 2 (docs/model.md sec. 7):
+
+    q_m'' = -2 zeta w_m q_m' - (w_m^2 - m^2 P(t) k^2 / rho A) q_m - N_m(q, t) - Gamma_m a_b(t)
+
+with w_m = m^2 w1, Gamma_m = 4 / (m pi) for odd m and 0 for even m, and N_m the projection of
+Eq.17's nonlinear terms. In the dimensionless fields of xi = k x in [0, pi]
+
+    a = sum n q_n cos(n xi),    b = -sum n^2 q_n sin(n xi),
+    c = -sum n^3 q_n cos(n xi), d = sum n^4 q_n sin(n xi)
+
+(w_x = k a, w_xx = k^2 b, w_xxx = k^3 c, w_xxxx = k^4 d), Eq.17's nonlinear force per unit
+rho A is
+
+    F = beta_b (-3 b^3 - 11 a b c - 3 a^2 d) - beta_m(t) a^2 b + (21/2) beta_q a^2 b^3,
+    beta_b = w1^2 k^2,  beta_q = w1^2 k^4,  beta_m(t) = (4 alpha EA + 2 P(t)) k^4 / rho A,
+
+and N_m = (2 / pi) int_0^pi F sin(m xi) d xi. The integrand is odd in xi and 2 pi periodic, so
+its integral over [0, pi] is half the integral over a period of an even trigonometric
+polynomial of degree at most 6N (the quintic term: five fields of degree N times sin(m xi)).
+The trapezoidal rule on M >= 3N + 1 equal intervals of [0, pi] (2M points a period) is exact
+for it: N_m = (2 / M) sum_{j=1..M-1} F(xi_j) sin(m xi_j), xi_j = j pi / M (the end points add
+nothing: b = d = 0 there). So the projection is evaluated at M - 1 nodes inside the right-hand
+side, exact to round-off, at a cost that grows as N^2 (fields and projection), where
+precomputed coupling tensors would grow as N^6 (the quintic's). With N = 1 and M = 4 it
+reproduces the one-mode coefficients K3 and K5 of docs/model.md sec. 2 (tests/test_modes.py).
+
+A point's raw row (columns below) holds mode 1's linear coefficients, the load, the membrane
+and the base excitation, then the initial state of every mode; `prepare` expands it into the
+per-mode coefficients the right-hand side reads. P > 0 is compression.
+"""
+
+import math
+
+import numba as nb
+import numpy as np
+
+# Columns of a raw multi-mode row.
+W1_SQ = 0           # w1^2 = (EI / rho A) k^4, the first mode's linear stiffness  (1/s^2)
+DAMPING = 1         # 2 zeta w1 (mode n: n^2 times this)                          (1/s)
+LOAD_MEAN = 2       # P_mean k^2 / rho A (the constant part of P)                   (1/s^2)
+LOAD_COS = 3        # P0 k^2 / rho A, the part times cos(W t)                       (1/s^2)
+MEMBRANE = 4        # 4 alpha EA k^4 / rho A                                        (1/(s^2 m^2))
+K_SQ = 5            # k^2 = (pi / l)^2                                              (1/m^2)
+OMEGA = 6           # W, the load's angular frequency                               (rad/s)
+BOUND = 7           # |q_n| (and |midspan deflection|) beyond which a point diverged  (m)
+Q_SCALE = 8         # the point's displacement scale (sweep.models.modal.state_scale) (m)
+V_SCALE = 9         # its velocity scale                                            (m/s)
+BASE_ACCEL = 10     # A, base acceleration amplitude                                (m/s^2)
+BASE_OMEGA = 11     # w_b, base angular frequency                                   (rad/s)
+PARTICIPATION = 12  # Gamma_1 = 4 / pi (0 without base excitation); mode n: Gamma_1 / n, odd n
+N_FIXED = 13        # then q_n(0) (m) for n = 1..N, then q_n'(0) (m/s) for n = 1..N
+
+FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", "omega",
+               "bound", "q_scale", "v_scale", "base_accel", "base_omega", "participation")
+
+
+def n_columns(n_modes: int) -> int:
+    """Columns of a raw row for n_modes modes."""
+    return N_FIXED + 2 * n_modes
+
+
+# The prepared row `prepare` writes (length prepared_size(N)): four blocks of N per-mode
+# coefficients, then the scalars.
+P_DAMPING = 0       # block 0: -n^2 (2 zeta w1)                                     (1/s)
+P_STIFF = 1         # block 1: -(n^4 w1^2 - n^2 P_mean k^2 / rho A)                 (1/s^2)
+P_STIFF_COS = 2     # block 2: n^2 P0 k^2 / rho A (times cos W t)                   (1/s^2)
+P_FORCE = 3         # block 3: -Gamma_n                                              (1)
+S_BETA_B = 0        # scalars after the blocks: beta_b = w1^2 k^2                   (1/(s^2 m^2))
+S_BETA_Q = 1        # beta_q = w1^2 k^4                                              (1/(s^2 m^4))
+S_BETA_M0 = 2       # beta_m's constant part: 4 alpha EA k^4/rho A + 2 k^2 P_mean k^2/rho A
+S_BETA_M1 = 3       # beta_m's cos(W t) part: 2 k^2 P0 k^2 / rho A
+S_OMEGA = 4
+S_BASE_ACCEL = 5
+S_BASE_OMEGA = 6
+N_SCALARS = 7
+
+
+def prepared_size(n_modes: int) -> int:
+    """Length of a prepared row for n_modes modes."""
+    return 4 * n_modes + N_SCALARS
+
+
+def intervals(n_modes: int) -> int:
+    """M, the trapezoidal rule's intervals on [0, pi] that make the projection exact: 3N + 1."""
+    return 3 * n_modes + 1
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def tables(n_modes):
+    """The mode shapes at the quadrature nodes xi_j = j pi / M, j = 1..M - 1, M = 3N + 1:
+    T[0, n - 1, j - 1] = n cos(n xi_j) (a), T[1] = -n^2 sin (b), T[2] = -n^3 cos (c),
+    T[3] = n^4 sin (d), T[4] = (2 / M) sin(n xi_j) (the projection's weights)."""
+    m = 3 * n_modes + 1
+    t = np.empty((5, n_modes, m - 1))
+    for i in range(n_modes):
+        n = i + 1.0
+        for j in range(m - 1):
+            xi = (j + 1.0) * math.pi / m
+            sn = math.sin(n * xi)
+            cn = math.cos(n * xi)
+            t[0, i, j] = n * cn
+            t[1, i, j] = -n * n * sn
+            t[2, i, j] = -n * n * n * cn
+            t[3, i, j] = n * n * n * n * sn
+            t[4, i, j] = 2.0 / m * sn
+    return t
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def midspan_weights(n_modes):
+    """sin(n pi / 2) for n = 1..N: 1, 0, -1, 0, 1, ... (the midspan deflection is the sum of
+    q_n times these)."""
+    s = np.zeros(n_modes)
+    for i in range(0, n_modes, 2):
+        s[i] = 1.0 if (i // 2) % 2 == 0 else -1.0
+    return s
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def prepare(row, n_modes, pp):
+    """Write the prepared row pp (prepared_size(N)) of raw row `row` (columns above)."""
+    n_b = n_modes
+    k2 = row[K_SQ]
+    for i in range(n_modes):
+        n2 = (i + 1.0) * (i + 1.0)
+        pp[P_DAMPING * n_b + i] = -n2 * row[DAMPING]
+        pp[P_STIFF * n_b + i] = -(n2 * n2 * row[W1_SQ] - n2 * row[LOAD_MEAN])
+        pp[P_STIFF_COS * n_b + i] = n2 * row[LOAD_COS]
+        pp[P_FORCE * n_b + i] = -row[PARTICIPATION] / (i + 1.0) if i % 2 == 0 else 0.0
+    s = 4 * n_b
+    pp[s + S_BETA_B] = row[W1_SQ] * k2
+    pp[s + S_BETA_Q] = row[W1_SQ] * k2 * k2
+    pp[s + S_BETA_M0] = row[MEMBRANE] + 2.0 * k2 * row[LOAD_MEAN]
+    pp[s + S_BETA_M1] = 2.0 * k2 * row[LOAD_COS]
+    pp[s + S_OMEGA] = row[OMEGA]
+    pp[s + S_BASE_ACCEL] = row[BASE_ACCEL]
+    pp[s + S_BASE_OMEGA] = row[BASE_OMEGA]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def base_acceleration(t, pp, n_modes):
+    """a_b(t) = A sin(w_b t) (m/s^2) of a prepared row."""
+    s = 4 * n_modes
+    return pp[s + S_BASE_ACCEL] * math.sin(pp[s + S_BASE_OMEGA] * t)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def derivative(t, y, dy, pp, n_modes, T, work, base):
+    """dy = f(t, y) for y = (q_1..q_N, q_1'..q_N') (m, m/s): dy = (q', q'') (m/s, m/s^2).
+    pp: a prepared row (`prepare`); T: `tables`(N); work: scratch of shape (4, M - 1).
+    base: None (no base excitation term) or True."""
+    n = n_modes
+    s = 4 * n
+    nodes = T.shape[2]
+    for j in range(nodes):
+        work[0, j] = 0.0
+        work[1, j] = 0.0
+        work[2, j] = 0.0
+        work[3, j] = 0.0
+    for i in range(n):
+        qi = y[i]
+        for j in range(nodes):
+            work[0, j] += T[0, i, j] * qi
+            work[1, j] += T[1, i, j] * qi
+            work[2, j] += T[2, i, j] * qi
+            work[3, j] += T[3, i, j] * qi
+    cw = math.cos(pp[s + S_OMEGA] * t)
+    beta_b = pp[s + S_BETA_B]
+    beta_q = pp[s + S_BETA_Q]
+    beta_m = pp[s + S_BETA_M0] + pp[s + S_BETA_M1] * cw
+    for j in range(nodes):
+        a = work[0, j]
+        b = work[1, j]
+        c = work[2, j]
+        d = work[3, j]
+        a2 = a * a
+        b2 = b * b
+        work[0, j] = (beta_b * (-3.0 * b2 * b - 11.0 * a * b * c - 3.0 * a2 * d)
+                      - beta_m * a2 * b + 10.5 * beta_q * a2 * b2 * b)
+    ab = base_acceleration(t, pp, n) if base is not None else 0.0
+    for i in range(n):
+        force = 0.0
+        for j in range(nodes):
+            force += T[4, i, j] * work[0, j]
+        dy[i] = y[n + i]
+        dy[n + i] = ((pp[P_STIFF * n + i] + pp[P_STIFF_COS * n + i] * cw) * y[i]
+                     + pp[P_DAMPING * n + i] * y[n + i] - force + pp[P_FORCE * n + i] * ab)
