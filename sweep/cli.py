@@ -2,6 +2,7 @@
 
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
+    sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -79,6 +80,19 @@ def _parser() -> argparse.ArgumentParser:
                            "axes when a result has more than two), e.g. --select length=0.5")
     plot.add_argument("--dpi", type=float, default=100.0, metavar="N",
                       help="resolution of raster formats in dots per inch (default: 100)")
+    modes = sub.add_parser("modes", help="is the number of Galerkin modes enough? run a "
+                                         "transverse scene with N and N + 2 modes and compare")
+    modes.add_argument("scene", metavar="SCENE",
+                       help="a built-in scene name (see 'sweep scenes') or a .toml file")
+    modes.add_argument("--modes", type=int, default=None, metavar="N",
+                       help="the modes to check (default: the scene's model.modes)")
+    modes.add_argument("--set", dest="overrides", action="append", default=[],
+                       metavar="KEY=VALUE", help="override a dotted scene key, as for 'run'")
+    modes.add_argument("--tolerance", type=float, default=0.01, metavar="REL",
+                       help="relative change that counts as converged (default: 0.01)")
+    modes.add_argument("--threads", type=int, default=None, metavar="N",
+                       help="worker threads (default: all)")
+    modes.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     sub.add_parser("scenes", help="list the built-in scenes")
     keys = sub.add_parser("keys", help="every scene key: type, default, units, allowed values")
     keys.add_argument("which", nargs="?", default=None, metavar="SECTION | KEY",
@@ -175,6 +189,22 @@ def _plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _modes(args: argparse.Namespace) -> int:
+    from .convergence import mode_convergence
+    from .scene import parse_override
+    if args.threads is not None and args.threads < 1:
+        raise UserError(f"--threads {args.threads}: must be a positive number of threads "
+                        "(give --threads 1 or more, or leave it out to use every core)")
+    if not 0.0 < args.tolerance < 1.0:
+        raise UserError(f"--tolerance {args.tolerance:g}: must be a relative change between 0 "
+                        "and 1, e.g. --tolerance 0.01")
+    overrides = dict(parse_override(item) for item in args.overrides)
+    report, _, _ = mode_convergence(args.scene, overrides, args.modes, threads=args.threads,
+                                    progress=False if args.quiet else None)
+    print(report.text(args.tolerance))
+    return 0
+
+
 def _scenes() -> int:
     from .scene import builtin_scenes
     scenes = builtin_scenes()
@@ -245,6 +275,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _plot(args)
         if args.command == "keys":
             return _keys(args)
+        if args.command == "modes":
+            return _modes(args)
         return _scenes()
     except UserError as exc:
         print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)

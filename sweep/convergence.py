@@ -1,0 +1,158 @@
+"""Is N modes enough? Run a transverse scene with N and N + 2 Galerkin modes and compare.
+
+    sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01]
+
+The odd modes are the ones a symmetric load drives (base excitation; an even mode takes part
+only through a parametric instability of its own), so the check adds two modes, the next odd
+one among them (docs/model.md sec. 7). For every metric of the result (amplitude, peak
+amplitude, settling time, response period, absolute acceleration, and each modal amplitude
+the coarse run has) it reports the largest relative change |x(N + 2) - x(N)| / |x(N + 2)| over
+the grid points where both runs succeeded, and where on the grid that is; points whose state
+changed are counted apart. N is enough for a tolerance when every change is within it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+import xarray as xr
+
+from .errors import UserError
+
+METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
+           "absolute_acceleration", "modal_amplitude")
+"""The result variables compared, where both runs have them."""
+SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled")
+"""States whose metrics mean something (the failure states have NaN metrics)."""
+
+
+@dataclass(frozen=True)
+class Change:
+    """One metric's largest relative change between the coarse and the fine run.
+
+    metric: the variable (with the mode for modal amplitudes, e.g. "modal_amplitude[mode=1]");
+    relative: the largest |fine - coarse| / |fine| (1; NaN where no point has both values);
+    where: the grid point of it, axis name -> value; compared: the points compared.
+    """
+    metric: str
+    relative: float
+    where: dict[str, Any]
+    compared: int
+
+
+@dataclass(frozen=True)
+class Report:
+    """The comparison of a scene's result with n_modes and with n_modes + 2 modes."""
+    n_modes: int
+    changes: list[Change]
+    state_changes: int       # grid points whose state differs between the two runs
+    points: int
+
+    def enough(self, tolerance: float) -> bool:
+        """Whether every metric changed by at most `tolerance` (relative) and no state did."""
+        return self.state_changes == 0 and all(
+            not c.relative > tolerance for c in self.changes)
+
+    def text(self, tolerance: float) -> str:
+        """The report as a short table for a terminal."""
+        fine = self.n_modes + 2
+        lines = [f"modes {self.n_modes} against {fine}: largest relative change over "
+                 f"{self.points} point{'s' if self.points != 1 else ''}",
+                 f"  {'metric':<32} {'change':>10}  where"]
+        for c in self.changes:
+            where = ", ".join(f"{k}={_short(v)}" for k, v in c.where.items()) or "-"
+            value = "n/a" if math.isnan(c.relative) else f"{c.relative:.2e}"
+            lines.append(f"  {c.metric:<32} {value:>10}  {where}")
+        if self.state_changes:
+            lines.append(f"  state changed at {self.state_changes} point(s)")
+        modes = f"{self.n_modes} mode{'s' if self.n_modes != 1 else ''}"
+        if self.enough(tolerance):
+            lines.append(f"{modes}: enough for {tolerance:g} relative (every metric within it, "
+                         "no state change)")
+        else:
+            worse = [c.metric for c in self.changes if c.relative > tolerance]
+            why = ", ".join(worse + (["the state"] if self.state_changes else []))
+            lines.append(f"{modes}: NOT enough for {tolerance:g} relative ({why} changed by "
+                         f"more; run 'sweep modes' with --modes {fine} to check {fine})")
+        return "\n".join(lines)
+
+
+def _short(value: Any) -> str:
+    return f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
+
+
+def compare(coarse: xr.Dataset, fine: xr.Dataset) -> Report:
+    """The Report of two results of one scene, with N (coarse) and N + 2 (fine) modes."""
+    n_modes = coarse.sizes.get("mode", 1)
+    meanings = coarse["state"].attrs["flag_meanings"].split()
+    flags = np.atleast_1d(coarse["state"].attrs["flag_values"])
+    ok = [int(f) for f, m in zip(flags, meanings) if m in SUCCESS_STATES]
+    both = coarse["state"].isin(ok) & fine["state"].isin(ok)
+    state_changes = int((coarse["state"] != fine["state"]).sum())
+    changes = []
+    for name in METRICS:
+        if name not in coarse or name not in fine:
+            continue
+        a, b = coarse[name], fine[name]
+        if "mode" in a.dims:
+            for n in a["mode"].values:
+                changes.append(_change(f"{name}[mode={n}]", a.sel(mode=n), b.sel(mode=n), both))
+        else:
+            changes.append(_change(name, a, b, both))
+    return Report(n_modes, changes, state_changes, int(np.prod(coarse["state"].shape)))
+
+
+def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.DataArray) -> Change:
+    """The largest relative change of one variable over the points of `mask`."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = (abs(fine - coarse) / abs(fine)).where(mask & np.isfinite(coarse)
+                                                     & np.isfinite(fine))
+        rel = rel.where(~((fine == 0) & (coarse == 0)), 0.0).where(mask)
+    values = rel.values
+    finite = np.isfinite(values)
+    if not finite.any():
+        return Change(metric, math.nan, {}, 0)
+    index = np.unravel_index(int(np.nanargmax(np.where(finite, values, -1.0))), values.shape)
+    where = {d: rel[d].values[i].item() for d, i in zip(rel.dims, index) if d in rel.coords}
+    return Change(metric, float(values[index]), where, int(finite.sum()))
+
+
+def overrides_for(scene: Any, n_modes: int) -> dict[str, Any]:
+    """The scene key overrides that run `scene` (a Scene) with n_modes modes: model.modes, and
+    the modal initial-condition lists padded with zeros (the added modes start at rest)."""
+    out: dict[str, Any] = {"model.modes": n_modes}
+    for dotted in ("initial.modal_displacement", "initial.modal_velocity"):
+        values = scene.get(dotted)
+        if values is not None:
+            if len(values) > n_modes:
+                raise UserError(f"scene key '{dotted}': has {len(values)} entries, more than "
+                                f"the {n_modes} modes compared (give --modes {len(values)} "
+                                "or more)")
+            out[dotted] = list(values) + [0.0] * (n_modes - len(values))
+    return out
+
+
+def mode_convergence(source: str, overrides: Mapping[str, Any] | None = None,
+                     n_modes: int | None = None, threads: int | None = None,
+                     progress: bool | None = None) -> tuple[Report, xr.Dataset, xr.Dataset]:
+    """Run the scene `source` (a built-in name or a .toml file, with `overrides`) with n_modes
+    (default: the scene's model.modes) and n_modes + 2 modes; returns the Report and both
+    results."""
+    from .run import run
+    from .scene import load_scene
+    overrides = dict(overrides or {})
+    scene = load_scene(source, overrides=overrides)
+    if scene.get("model.kind") != "transverse":
+        raise UserError(f"scene '{source}': model.kind = '{scene.get('model.kind')}' has no "
+                        "modes to compare (the mode check is for transverse scenes)")
+    n = n_modes if n_modes is not None else scene.get("model.modes")
+    if n < 1:
+        raise UserError(f"--modes {n}: must be 1 or more")
+    results = []
+    for count in (n, n + 2):
+        resolved = load_scene(source, overrides={**overrides, **overrides_for(scene, count)})
+        results.append(run(resolved, threads=threads, progress=progress))
+    return compare(results[0], results[1]), results[0], results[1]
