@@ -1,0 +1,190 @@
+"""An independent N-mode Galerkin reference for the transverse span (tests only).
+
+Written from the equation of motion (the paper's Eq.17, membrane term generalised with alpha,
+P > 0 compression, both clamps accelerating as a_b(t), w relative to the clamps):
+
+    rho A (w_tt + a_b) + P w_xx + EI w_xxxx - 3 EI w_xx^3 - 11 EI w_xx w_xxx w_x
+        - (2 P + 4 alpha EA) w_xx w_x^2 - 3 EI w_xxxx w_x^2 + (21/2) EI w_xx^3 w_x^2 = 0,
+
+pinned at x = 0 and x = l, with w = sum_{n=1..N} q_n(t) sin(n k x), k = pi / l. Projected on
+sin(m k x) and divided by rho A l / 2, with modal viscous damping 2 zeta w_m q_m':
+
+    q_m'' + 2 zeta w_m q_m' + F_m(q, P) = -Gamma_m a_b(t),
+    F_m = (2 / (rho A l)) int_0^l R(x) sin(m k x) dx,   R = everything above but rho A (w_tt + a_b),
+    w_m = m^2 w1 (unloaded), w1^2 = (EI / rho A) k^4, Gamma_m = 4 / (m pi) (odd m), 0 (even m).
+
+The projections F_m are computed at run time by quadrature of R, not from coefficient
+tensors: the midpoint rule with M nodes x_j = (j + 1/2) l / M on [0, l]. That rule is exact
+(to round-off) here, not merely accurate: every term of R is odd about x = 0 and 2l-periodic
+(w, w_xx, w_xxxx are odd, w_x, w_xxx even, and each term has an odd number of odd factors), so
+R sin(m k x) is even and 2l-periodic, and the midpoint rule on [0, l] is the 2M-point uniform
+rule over the whole period [0, 2l], exact for trigonometric polynomials of degree < 2M. R
+sin(m k x) has degree <= 6N (five factors of degree N, times sin(m k x)); M = 8N + 8 nodes
+(default) leaves a wide margin. Checked in tests/test_modes.py against Gauss-Legendre.
+
+Units: SI throughout; q_n in m, t in s, forces per unit modal mass in m s-2.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from scipy.integrate import OdeSolution, solve_ivp
+from scipy.optimize import brentq
+
+
+@dataclass(frozen=True)
+class Cable:
+    """A span's data (SI): E (Pa), rho (kg m-3), A (m2), I (m4), l (m), alpha, zeta."""
+    youngs_modulus: float = 1.1e11
+    density: float = 8900.0
+    area: float = 6e-6
+    inertia: float = 2.865e-12
+    length: float = 0.5
+    membrane: float = 0.375
+    damping_ratio: float = 0.0
+
+    @property
+    def k(self) -> float:
+        """pi / l (m-1)."""
+        return math.pi / self.length
+
+    @property
+    def w1(self) -> float:
+        """First natural frequency of the unloaded span, sqrt(EI / rho A) k^2 (rad/s)."""
+        return math.sqrt(self.youngs_modulus * self.inertia
+                         / (self.density * self.area)) * self.k ** 2
+
+
+def participation(n_modes: int) -> np.ndarray:
+    """Gamma_n = (2 / l) int_0^l sin(n k x) dx = 4 / (n pi) for odd n, 0 for even n."""
+    n = np.arange(1, n_modes + 1)
+    return np.where(n % 2 == 1, 4.0 / (n * math.pi), 0.0)
+
+
+class Projection:
+    """F(q, P) of the module docstring, by the midpoint rule with `nodes` nodes (default
+    8N + 8), or by Gauss-Legendre when `gauss` is True (for checking the rule's exactness)."""
+
+    def __init__(self, cable: Cable, n_modes: int, nodes: int | None = None,
+                 gauss: bool = False) -> None:
+        self.cable = cable
+        self.n_modes = n_modes
+        l, k = cable.length, cable.k
+        m = nodes if nodes is not None else 8 * n_modes + 8
+        if gauss:
+            s, weights = np.polynomial.legendre.leggauss(m)
+            x = 0.5 * l * (s + 1.0)
+            weights = 0.5 * l * weights
+        else:
+            x = (np.arange(m) + 0.5) * l / m
+            weights = np.full(m, l / m)
+        n = np.arange(1, n_modes + 1, dtype=float)[:, None]
+        sin = np.sin(n * k * x[None, :])
+        cos = np.cos(n * k * x[None, :])
+        # derivative matrices: w_x = q @ d1 etc., shape (N, M)
+        self.d1 = n * k * cos
+        self.d2 = -(n * k) ** 2 * sin
+        self.d3 = -(n * k) ** 3 * cos
+        self.d4 = (n * k) ** 4 * sin
+        rho_a = cable.density * cable.area
+        # F_m = sum_j R_j (2 / (rho A l)) weight_j sin(m k x_j)
+        self.project = (2.0 / (rho_a * l)) * (sin * weights[None, :]).T      # (M, N)
+
+    def parts(self, q: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(linear, cubic, quintic) parts of F (m s-2) at modal coordinates q (m) and end load
+        p (N, compression > 0); q may be (N,) or (..., N)."""
+        c = self.cable
+        ei = c.youngs_modulus * c.inertia
+        ea = c.youngs_modulus * c.area
+        q = np.asarray(q, dtype=float)
+        w1, w2, w3, w4 = q @ self.d1, q @ self.d2, q @ self.d3, q @ self.d4
+        linear = p * w2 + ei * w4
+        cubic = (-3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1
+                 - (2.0 * p + 4.0 * c.membrane * ea) * w2 * w1 ** 2 - 3.0 * ei * w4 * w1 ** 2)
+        quintic = 10.5 * ei * w2 ** 3 * w1 ** 2
+        return linear @ self.project, cubic @ self.project, quintic @ self.project
+
+    def force(self, q: np.ndarray, p: float) -> np.ndarray:
+        """F(q, P) (m s-2): the sum of `parts`."""
+        linear, cubic, quintic = self.parts(q, p)
+        return linear + cubic + quintic
+
+
+def load_function(amplitude: float, omega: float, kind: str = "harmonic") -> Callable:
+    """P(t) (N): P0 cos(W t) (kind "harmonic", W in rad/s) or P0 (kind "constant")."""
+    if kind == "constant":
+        return lambda t: amplitude
+    return lambda t: amplitude * math.cos(omega * t)
+
+
+def galerkin_rhs(cable: Cable, n_modes: int, load_amplitude: float = 0.0,
+                 load_omega: float = 0.0, load_type: str = "harmonic",
+                 base_acceleration: float = 0.0, base_frequency: float = 0.0,
+                 nodes: int | None = None) -> Callable[[float, np.ndarray], np.ndarray]:
+    """SciPy right-hand side f(t, y), y = (q_1..q_N (m), q_1'..q_N' (m/s)), of the projected
+    equations: load P0 (N) at W = load_omega (rad/s) or constant, base acceleration
+    a_b = A sin(2 pi f t) (A in m s-2, f = base_frequency in Hz)."""
+    proj = Projection(cable, n_modes, nodes)
+    n = np.arange(1, n_modes + 1)
+    damping = 2.0 * cable.damping_ratio * cable.w1 * n ** 2
+    forcing = participation(n_modes) * base_acceleration
+    base_omega = 2.0 * math.pi * base_frequency
+    load = load_function(load_amplitude, load_omega, load_type)
+
+    def f(t: float, y: np.ndarray) -> np.ndarray:
+        q, v = y[:n_modes], y[n_modes:]
+        a = -damping * v - proj.force(q, load(t)) - forcing * math.sin(base_omega * t)
+        return np.concatenate((v, a))
+    return f
+
+
+def integrate(cable: Cable, n_modes: int, y0, t_end: float, scale: float,
+              rtol: float = 1e-11, **rhs_args) -> OdeSolution:
+    """SciPy DOP853 from y0 = (q(0) (m), q'(0) (m/s)) over [0, t_end] (s) at rtol, atol
+    1e-3 rtol x scale for q (scale: the response's size, m) and that x N^2 w1 for q'; returns
+    the dense output (an OdeSolution). rhs_args go to galerkin_rhs."""
+    f = galerkin_rhs(cable, n_modes, **rhs_args)
+    atol_q = 1e-3 * rtol * scale
+    atol = np.concatenate((np.full(n_modes, atol_q),
+                           np.full(n_modes, atol_q * n_modes ** 2 * cable.w1)))
+    sol = solve_ivp(f, (0.0, t_end), np.asarray(y0, dtype=float), method="DOP853",
+                    rtol=rtol, atol=atol, dense_output=True)
+    assert sol.success, sol.message
+    return sol.sol
+
+
+def _tail_max(values: Callable, rates: Callable, t: np.ndarray) -> float:
+    """max |values(t)| over [t[0], t[-1]]: on the grid t, then at every sign change of rates
+    whose grid value is within 1 % of the grid's largest, located by brentq."""
+    x, r = values(t), rates(t)
+    peak = float(np.max(np.abs(x)))
+    near = np.maximum(np.abs(x[:-1]), np.abs(x[1:])) >= 0.99 * peak
+    for i in np.nonzero(near & (np.signbit(r[:-1]) != np.signbit(r[1:])))[0]:
+        root = brentq(lambda s: float(rates(s)), t[i], t[i + 1], xtol=1e-15, rtol=1e-15)
+        peak = max(peak, abs(float(values(root))))
+    return peak
+
+
+def tail_maxima(sol: OdeSolution, n_modes: int, t_end: float, tail: float = 0.5,
+                fastest_hz: float = 1.0,
+                samples_per_period: int = 64) -> tuple[np.ndarray, float]:
+    """(max |q_n| per mode (m), max |sum_n q_n sin(n pi / 2)| (m), the midspan deflection) over
+    the tail window [t_end (1 - tail), t_end] (s) of a dense output: sampled at the step ends
+    and samples_per_period points per period of the fastest motion (fastest_hz, Hz), each crest
+    then located at the sign change of the dense output's velocity (brentq)."""
+    t0 = t_end * (1.0 - tail)
+    grid = np.linspace(t0, t_end, int(samples_per_period * fastest_hz * (t_end - t0)) + 2)
+    ends = np.asarray(sol.ts)
+    t = np.unique(np.concatenate((grid, ends[(ends > t0) & (ends < t_end)])))
+    modal = np.empty(n_modes)
+    for i in range(n_modes):
+        modal[i] = _tail_max(lambda s, i=i: sol(s)[i], lambda s, i=i: sol(s)[n_modes + i], t)
+    shape = np.sin(np.arange(1, n_modes + 1) * math.pi / 2.0)
+    shape[np.abs(shape) < 0.5] = 0.0                       # exactly 0, +-1
+    midspan = _tail_max(lambda s: shape @ sol(s)[:n_modes],
+                        lambda s: shape @ sol(s)[n_modes:], t)
+    return modal, midspan
