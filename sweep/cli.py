@@ -200,8 +200,9 @@ def _modes(args: argparse.Namespace) -> int:
                         "and 1, e.g. --tolerance 0.01")
     overrides = dict(parse_override(item) for item in args.overrides)
     report, _, _ = mode_convergence(args.scene, overrides, args.modes, threads=args.threads,
-                                    progress=False if args.quiet else None)
-    print(report.text(args.tolerance))
+                                    progress=False if args.quiet else None,
+                                    tolerance=args.tolerance)
+    print(report.text())
     return 0
 
 

@@ -35,48 +35,53 @@ class Change:
 
     metric: the variable (with the mode for modal amplitudes, e.g. "modal_amplitude[mode=1]");
     relative: the largest |fine - coarse| / |fine| (1; NaN where no point has both values);
-    where: the grid point of it, axis name -> value; compared: the points compared.
+    where: the grid point of it, axis name -> value; compared: the points compared; over: how
+    many of them changed by more than the Report's tolerance.
     """
     metric: str
     relative: float
     where: dict[str, Any]
     compared: int
+    over: int
 
 
 @dataclass(frozen=True)
 class Report:
-    """The comparison of a scene's result with n_modes and with n_modes + 2 modes."""
+    """The comparison of a scene's result with n_modes and with n_modes + 2 modes, against a
+    relative tolerance."""
     n_modes: int
+    tolerance: float
     changes: list[Change]
     state_changes: int       # grid points whose state differs between the two runs
     points: int
 
-    def enough(self, tolerance: float) -> bool:
-        """Whether every metric changed by at most `tolerance` (relative) and no state did."""
-        return self.state_changes == 0 and all(
-            not c.relative > tolerance for c in self.changes)
+    def enough(self) -> bool:
+        """Whether every metric changed by at most the tolerance (relative) and no state did."""
+        return self.state_changes == 0 and all(c.over == 0 for c in self.changes)
 
-    def text(self, tolerance: float) -> str:
+    def text(self) -> str:
         """The report as a short table for a terminal."""
-        fine = self.n_modes + 2
-        lines = [f"modes {self.n_modes} against {fine}: largest relative change over "
-                 f"{self.points} point{'s' if self.points != 1 else ''}",
-                 f"  {'metric':<32} {'change':>10}  where"]
+        fine, tolerance = self.n_modes + 2, self.tolerance
+        lines = [f"modes {self.n_modes} against {fine}, {self.points} point"
+                 f"{'s' if self.points != 1 else ''}: the largest relative change of each "
+                 f"metric, where, and at how many points it exceeds {tolerance:g}",
+                 f"  {'metric':<28} {'largest':>9}  {'over':>9}  where"]
         for c in self.changes:
             where = ", ".join(f"{k}={_short(v)}" for k, v in c.where.items()) or "-"
             value = "n/a" if math.isnan(c.relative) else f"{c.relative:.2e}"
-            lines.append(f"  {c.metric:<32} {value:>10}  {where}")
+            lines.append(f"  {c.metric:<28} {value:>9}  {c.over:>4}/{c.compared:<4}  {where}")
         if self.state_changes:
-            lines.append(f"  state changed at {self.state_changes} point(s)")
+            lines.append(f"  state changed at {self.state_changes} of {self.points} points")
         modes = f"{self.n_modes} mode{'s' if self.n_modes != 1 else ''}"
-        if self.enough(tolerance):
-            lines.append(f"{modes}: enough for {tolerance:g} relative (every metric within it, "
-                         "no state change)")
+        if self.enough():
+            lines.append(f"{modes}: enough for {tolerance:g} relative (every metric within it "
+                         "at every point, no state change)")
         else:
-            worse = [c.metric for c in self.changes if c.relative > tolerance]
+            worse = [c.metric for c in self.changes if c.over]
             why = ", ".join(worse + (["the state"] if self.state_changes else []))
-            lines.append(f"{modes}: NOT enough for {tolerance:g} relative ({why} changed by "
-                         f"more; run 'sweep modes' with --modes {fine} to check {fine})")
+            lines.append(f"{modes}: NOT enough for {tolerance:g} relative everywhere ({why} "
+                         f"changed by more somewhere; 'sweep modes --modes {fine}' checks "
+                         f"{fine})")
         return "\n".join(lines)
 
 
@@ -84,7 +89,7 @@ def _short(value: Any) -> str:
     return f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
 
 
-def compare(coarse: xr.Dataset, fine: xr.Dataset) -> Report:
+def compare(coarse: xr.Dataset, fine: xr.Dataset, tolerance: float = 0.01) -> Report:
     """The Report of two results of one scene, with N (coarse) and N + 2 (fine) modes."""
     n_modes = coarse.sizes.get("mode", 1)
     meanings = coarse["state"].attrs["flag_meanings"].split()
@@ -99,13 +104,16 @@ def compare(coarse: xr.Dataset, fine: xr.Dataset) -> Report:
         a, b = coarse[name], fine[name]
         if "mode" in a.dims:
             for n in a["mode"].values:
-                changes.append(_change(f"{name}[mode={n}]", a.sel(mode=n), b.sel(mode=n), both))
+                changes.append(_change(f"{name}[mode={n}]", a.sel(mode=n), b.sel(mode=n), both,
+                                       tolerance))
         else:
-            changes.append(_change(name, a, b, both))
-    return Report(n_modes, changes, state_changes, int(np.prod(coarse["state"].shape)))
+            changes.append(_change(name, a, b, both, tolerance))
+    return Report(n_modes, tolerance, changes, state_changes,
+                  int(np.prod(coarse["state"].shape)))
 
 
-def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.DataArray) -> Change:
+def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.DataArray,
+            tolerance: float) -> Change:
     """The largest relative change of one variable over the points of `mask`."""
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = (abs(fine - coarse) / abs(fine)).where(mask & np.isfinite(coarse)
@@ -114,10 +122,11 @@ def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.Data
     values = rel.values
     finite = np.isfinite(values)
     if not finite.any():
-        return Change(metric, math.nan, {}, 0)
+        return Change(metric, math.nan, {}, 0, 0)
     index = np.unravel_index(int(np.nanargmax(np.where(finite, values, -1.0))), values.shape)
     where = {d: rel[d].values[i].item() for d, i in zip(rel.dims, index) if d in rel.coords}
-    return Change(metric, float(values[index]), where, int(finite.sum()))
+    return Change(metric, float(values[index]), where, int(finite.sum()),
+                  int((values[finite] > tolerance).sum()))
 
 
 def overrides_for(scene: Any, n_modes: int) -> dict[str, Any]:
@@ -137,10 +146,11 @@ def overrides_for(scene: Any, n_modes: int) -> dict[str, Any]:
 
 def mode_convergence(source: str, overrides: Mapping[str, Any] | None = None,
                      n_modes: int | None = None, threads: int | None = None,
-                     progress: bool | None = None) -> tuple[Report, xr.Dataset, xr.Dataset]:
+                     progress: bool | None = None, tolerance: float = 0.01
+                     ) -> tuple[Report, xr.Dataset, xr.Dataset]:
     """Run the scene `source` (a built-in name or a .toml file, with `overrides`) with n_modes
-    (default: the scene's model.modes) and n_modes + 2 modes; returns the Report and both
-    results."""
+    (default: the scene's model.modes) and n_modes + 2 modes; returns the Report (against the
+    relative `tolerance`) and both results."""
     from .run import run
     from .scene import load_scene
     overrides = dict(overrides or {})
@@ -155,4 +165,4 @@ def mode_convergence(source: str, overrides: Mapping[str, Any] | None = None,
     for count in (n, n + 2):
         resolved = load_scene(source, overrides={**overrides, **overrides_for(scene, count)})
         results.append(run(resolved, threads=threads, progress=progress))
-    return compare(results[0], results[1]), results[0], results[1]
+    return compare(results[0], results[1], tolerance), results[0], results[1]

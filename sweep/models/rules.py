@@ -26,6 +26,10 @@ Transverse scenes (``model.kind = "transverse"``, the default):
   parameters cannot be swept, a cable key (and ``model.membrane``) other than Table 1's value
   is refused (it would be ignored), and ``initial.velocity`` defaults to 0.0321 m/s when no
   initial condition is given (docs/model.md: that reproduces the paper's Fig 5 amplitudes).
+- ``model.modes`` above 1 (docs/model.md sec. 7) needs ``model.coefficients = "consistent"``
+  (Eq.32 is one mode's). ``initial.modal_displacement`` and ``initial.modal_velocity`` have one
+  entry per mode and replace ``initial.displacement`` / ``initial.velocity`` (mode 1's alone):
+  both spellings of one, as keys or axes, are refused.
 - Every point starting at q = q' = 0 (an empty scene, for one) gives q = 0 everywhere (the
   end load only changes the stiffness): load_scene warns (CableSweepWarning) and runs it,
   unless base excitation of a non-zero level drives the span.
