@@ -1,0 +1,632 @@
+"""Lock-step driver of the multi-mode System (kernels.modes): LANES trajectories side by side.
+
+The interface and results (to round-off) of kernels.modal_driver.solve_block, for any number
+of modes N. Each lane is one trajectory with its own time, step size and accept/reject
+decision: SciPy's RK45 or DOP853 on the 2N state, SciPy's error norm over its 2N components,
+SciPy's controller (or the PI controller), in SciPy's order of attempts.
+
+The lanes' state lives in arrays whose LAST axis is the lane (contiguous): Y[c, l] (the state,
+component c of lane l), K[s, c, l] (stage s; K[0] = f(t, y)), PP[c, l] (the prepared rows of
+kernels.modes.prepare), FLD[f, j, l] (the fields a, b, c, d at quadrature node j). Every loop
+over stages, modes, components or nodes sits OUTSIDE the innermost loop, which runs across the
+lanes with straight-line arithmetic, so LLVM vectorises it (measured: `_rhs` and `_attempt`
+compile to packed AVX-512 FMAs on zmm registers):
+
+- `_rhs`: the right-hand side of kernels.modes.derivative for every lane, cos(W t) and
+  sin(w_b t) by vecmath.fast_cos / fast_sin;
+- `_attempt`: one attempt of the tableau (A, B, C) (stage sums, the right-hand sides, the
+  solution, f(t + h, y_new)) and SciPy's error norm;
+- `_control`: accept/reject and the step-size update, err^(-1/5) by vecmath.inv_fifth_root
+  (kernels.lanes._step_factor);
+- `_prepare`: trajectory.next_attempt for the lanes whose step needs no special care;
+- `_midspan`, `_mode_events`, `_finish`, `_tail_modes`, `_advance`: the accepted step's
+  stages projected on the midspan deflection (K_mid), the test for anything unusual, the
+  Observer's step-end metrics of an ordinary step (trajectory.observe_step_end), each mode's
+  tail amplitude at the step's end, and the move to the step's end.
+
+An accepted step with anything to locate on a dense output (an extremum of the midspan
+deflection or of any mode, the tail's start, a time-series sample, a threshold crossing) or a
+divergence goes to the scalar path for that lane alone (`_flagged_lane`): the scalar driver's
+own functions on copies of the lane's columns (the divergence test on every mode,
+modal_driver._observe_modes, trajectory.record_step on the lane's accumulator W[j::LANES]).
+So do a lane's unusual steps to try (trajectory.next_attempt). A lane whose trajectory ends is
+classified as modal_driver.solve_point does and takes the next point of the block. Set-up
+(f(0), SciPy's initial step) is the scalar driver's arithmetic.
+
+Not bit for bit the scalar driver's (fast_cos, fast_sin, inv_fifth_root to an ulp or two; the
+loops fuse multiply-adds), so results equal its results to what a trajectory makes of
+round-off (tests/test_modal_lanes.py measures that spread with a one-ulp change of q_1(0)).
+Units: t in s, q in m, q' in m/s.
+"""
+
+import math
+
+import numba as nb
+import numpy as np
+
+from . import dop853
+from . import dopri5
+from . import metrics as mt
+from . import modal_driver as drv
+from . import modes as md
+from . import trajectory as tj
+from .lanes import _step_factor
+from .layout import (CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
+                     N_REALS, RTOL, SAMPLE_DT, TAIL, TOL, T_END, WANT_SETTLING)
+from .oscillator import BOUND, N_PARAMS
+from .transverse import classify_metrics
+from .vecmath import fast_cos, fast_sin
+
+# The vector loops may fuse a * b + c into one fused multiply-add (no reordering).
+_CONTRACT = {"contract"}
+
+LANES = 32      # trajectories per lock-step group: the lane loops' trip count; 32 lets LLVM's
+                # interleaved vector loops (4 x 8 doubles) run whole (16: 2.3x slower a lane)
+SIMD = 4        # the vector loops cover the active lanes rounded up to this
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _rhs(tt, X, K, s, PP, n, T, FLD, SC, n_run, base):
+    """K[s, :, l] = f(tt[l], X[:, l]) for lanes l < n_run: kernels.modes.derivative across the
+    lanes (same sums in the same order), with vecmath's cos and sin. PP: prepared rows
+    (modes.prepare) by lane; T: modes.tables(N); FLD (4, nodes, LANES) and SC (4, LANES)
+    scratch. base: None or True (the base-excitation term)."""
+    sc = 4 * n
+    nodes = T.shape[2]
+    for l in range(n_run):
+        cw = fast_cos(PP[sc + md.S_OMEGA, l] * tt[l])
+        SC[0, l] = cw
+        SC[1, l] = PP[sc + md.S_BETA_M0, l] + PP[sc + md.S_BETA_M1, l] * cw
+    if base is not None:
+        for l in range(n_run):
+            SC[2, l] = PP[sc + md.S_BASE_ACCEL, l] * fast_sin(PP[sc + md.S_BASE_OMEGA, l] * tt[l])
+    for j in range(nodes):
+        t0 = T[0, 0, j]
+        t1 = T[1, 0, j]
+        t2 = T[2, 0, j]
+        t3 = T[3, 0, j]
+        for l in range(n_run):
+            q = X[0, l]
+            FLD[0, j, l] = t0 * q
+            FLD[1, j, l] = t1 * q
+            FLD[2, j, l] = t2 * q
+            FLD[3, j, l] = t3 * q
+    for i in range(1, n):
+        for j in range(nodes):
+            t0 = T[0, i, j]
+            t1 = T[1, i, j]
+            t2 = T[2, i, j]
+            t3 = T[3, i, j]
+            for l in range(n_run):
+                q = X[i, l]
+                FLD[0, j, l] += t0 * q
+                FLD[1, j, l] += t1 * q
+                FLD[2, j, l] += t2 * q
+                FLD[3, j, l] += t3 * q
+    for j in range(nodes):
+        for l in range(n_run):
+            a = FLD[0, j, l]
+            b = FLD[1, j, l]
+            c = FLD[2, j, l]
+            d = FLD[3, j, l]
+            a2 = a * a
+            b2 = b * b
+            FLD[0, j, l] = (PP[sc + md.S_BETA_B, l] * (-3.0 * b2 * b - 11.0 * a * b * c
+                                                        - 3.0 * a2 * d)
+                            - SC[1, l] * a2 * b + 10.5 * PP[sc + md.S_BETA_Q, l] * a2 * b2 * b)
+    for i in range(n):
+        w = T[4, i, 0]
+        for l in range(n_run):
+            SC[3, l] = w * FLD[0, 0, l]
+        for j in range(1, nodes):
+            w = T[4, i, j]
+            for l in range(n_run):
+                SC[3, l] += w * FLD[0, j, l]
+        for l in range(n_run):
+            acc = ((PP[md.P_STIFF * n + i, l] + PP[md.P_STIFF_COS * n + i, l] * SC[0, l])
+                   * X[i, l] + PP[md.P_DAMPING * n + i, l] * X[n + i, l] - SC[3, l])
+            if base is not None:
+                acc += PP[md.P_FORCE * n + i, l] * SC[2, l]
+            K[s, i, l] = X[n + i, l]
+            K[s, n + i, l] = acc
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
+    """OUT[c, l] = Y[c, l] + (K[0, c, l] w[0] + ... + K[s - 1, c, l] w[s - 1]) H[l] (SciPy's
+    stage sums, in order; with skip_zeros the zero weights are left out)."""
+    for c in range(dim):
+        first = True
+        for k in range(s):
+            wk = w[k]
+            if skip_zeros and wk == 0.0:
+                continue
+            if first:
+                for l in range(n_run):
+                    OUT[c, l] = K[k, c, l] * wk
+                first = False
+            else:
+                for l in range(n_run):
+                    OUT[c, l] += K[k, c, l] * wk
+        if first:
+            for l in range(n_run):
+                OUT[c, l] = Y[c, l]
+        else:
+            for l in range(n_run):
+                OUT[c, l] = Y[c, l] + OUT[c, l] * H[l]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
+             base):
+    """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
+    rk_step: K[1..n_stages] and YN = y_new, K[n_stages] = f(t + h, y_new); K[0] = f(t, y)
+    given) and SciPy's error norm over the 2N components (ERR): RK45's RMS, or DOP853's
+    combination of its fifth- and third-order estimates (`eighth`). The absolute tolerances are
+    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n')."""
+    L = LANES
+    dim = 2 * n
+    n_stages = B.shape[0]
+    for s in range(1, n_stages):
+        _combine(K, s, A[s], Y, H, ST, dim, n_run, eighth)
+        c = C[s]
+        for l in range(n_run):
+            TT[l] = W[tj.T * L + l] + c * H[l]
+        _rhs(TT, ST, K, s, PP, n, T, FLD, SC, n_run, base)
+    _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
+    for l in range(n_run):
+        TT[l] = W[tj.T * L + l] + H[l]
+    _rhs(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, base)
+    # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
+    for l in range(n_run):
+        ST[0, l] = 0.0
+        ST[1, l] = 0.0
+    for c in range(dim):
+        r = (tj.ATOL_Q if c < n else tj.ATOL_V) * L
+        if eighth:
+            for k in range(n_stages + 1):
+                e5 = dop853.E5[k]
+                e3 = dop853.E3[k]
+                if k == 0:
+                    for l in range(n_run):
+                        SC[0, l] = K[0, c, l] * e5
+                        SC[1, l] = K[0, c, l] * e3
+                elif e5 != 0.0 or e3 != 0.0:
+                    for l in range(n_run):
+                        SC[0, l] += K[k, c, l] * e5
+                        SC[1, l] += K[k, c, l] * e3
+            for l in range(n_run):
+                scale = W[r + l] + max(abs(Y[c, l]), abs(YN[c, l])) * rtol
+                x5 = SC[0, l] / scale
+                x3 = SC[1, l] / scale
+                ST[0, l] += x5 * x5
+                ST[1, l] += x3 * x3
+        else:
+            for l in range(n_run):
+                SC[0, l] = K[0, c, l] * dopri5.E[0]
+            for k in range(1, n_stages + 1):
+                e = dopri5.E[k]
+                if e != 0.0:
+                    for l in range(n_run):
+                        SC[0, l] += K[k, c, l] * e
+            for l in range(n_run):
+                scale = W[r + l] + max(abs(Y[c, l]), abs(YN[c, l])) * rtol
+                x = SC[0, l] * H[l] / scale
+                ST[0, l] += x * x
+    if eighth:
+        for l in range(n_run):
+            e_a = ST[0, l]
+            e_b = ST[1, l]
+            err = abs(H[l]) * e_a / math.sqrt((e_a + dop853.ERR3_WEIGHT * e_b) * dim)
+            ERR[l] = 0.0 if (e_a == 0.0) & (e_b == 0.0) else err
+    else:
+        for l in range(n_run):
+            ERR[l] = math.sqrt(ST[0, l] / dim)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _control(W, H, ERR, SC, settings, n_run):
+    """trajectory.control across the lanes with an attempt (H > 0): the counts, the step-size
+    update (SciPy's controller for the method, or the PI controller) and accept/reject. SC[0]:
+    scratch for the step-size factors."""
+    L = LANES
+    eighth = settings[METHOD] != 0.0
+    per_attempt = float(dop853.RHS_PER_ATTEMPT if eighth else dopri5.RHS_PER_ATTEMPT)
+    pi = settings[CONTROLLER] != 0.0
+    FAC = SC[0]
+    if pi:
+        for l in range(n_run):
+            err = ERR[l]
+            memory = W[tj.LOG2_ERR_PREV * L + l]
+            FAC[l] = dopri5.pi_step_factor(err, memory, W[tj.REJECTED_NOW * L + l] != 0.0)
+            take = (H[l] > 0.0) & (err < 1.0)
+            W[tj.LOG2_ERR_PREV * L + l] = dopri5.pi_log2_err(err) if take else memory
+    elif eighth:
+        for l in range(n_run):
+            FAC[l] = _step_factor(ERR[l], W[tj.REJECTED_NOW * L + l] != 0.0, True)
+    else:
+        for l in range(n_run):
+            FAC[l] = _step_factor(ERR[l], W[tj.REJECTED_NOW * L + l] != 0.0, None)
+    for l in range(n_run):
+        active = H[l] > 0.0
+        accepted = ERR[l] < 1.0
+        rejected_before = W[tj.REJECTED_NOW * L + l] != 0.0
+        W[tj.RHS_EVALS * L + l] += per_attempt if active else 0.0
+        W[tj.H_ABS * L + l] *= FAC[l] if active else 1.0
+        W[tj.REJECTED_NOW * L + l] = (0.0 if accepted else 1.0) if active else (
+            1.0 if rejected_before else 0.0)
+        W[tj.REJECTED * L + l] += 1.0 if active & (not accepted) else 0.0
+        W[tj.STEPS * L + l] += 1.0 if active & accepted else 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _prepare(W, H, FLAG, settings, n_run):
+    """trajectory.next_attempt across the lanes whose step is ordinary: running, before t_end,
+    within max_steps and far above the minimum step (10 ulps of t or solver.min_step), so
+    SciPy's clamp and failure cannot apply (H: the step, FLAG 0). Other lanes get FLAG 1 (the
+    scalar next_attempt's turn) and are left as they are."""
+    L = LANES
+    t_end = settings[T_END]
+    max_step = settings[MAX_STEP]
+    max_steps = settings[MAX_STEPS]
+    min_user = settings[MIN_STEP]
+    for l in range(n_run):
+        t = W[tj.T * L + l]
+        h_abs = W[tj.H_ABS * L + l]
+        fresh = W[tj.REJECTED_NOW * L + l] == 0.0
+        h_try = min(h_abs, max_step) if fresh else h_abs
+        ok = ((W[tj.STATUS * L + l] == mt.RUNNING) & (t < t_end)
+              & ((not fresh) | (W[tj.STEPS * L + l] < max_steps))
+              & (h_try > 1e-14 * t) & (h_try > min_user) & (h_try > 1e-300))
+        t_new = min(t + h_try, t_end)
+        h = t_new - t
+        H[l] = h if ok else 0.0
+        W[tj.H_ABS * L + l] = abs(h) if ok else h_abs
+        W[tj.T_NEW * L + l] = t_new if ok else W[tj.T_NEW * L + l]
+        FLAG[l] = 0.0 if ok else 1.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
+    """KM[s, 0, l], KM[s, 1, l]: the stages of lane l projected on the midspan deflection and
+    its rate (modal_driver._project's sums, in order), for the stages record_step reads: all
+    for RK45, the last (f(t + h, y_new), at KM[1]) for DOP853; QV[0, l], QV[1, l]: y_new's."""
+    for s in range(n_stages + 2):
+        if eighth and s < n_stages:
+            continue
+        r = 1 if eighth else s
+        for part in range(2):
+            for l in range(n_run):
+                if s <= n_stages:
+                    KM[r, part, l] = 0.0
+                else:
+                    QV[part, l] = 0.0
+            for i in range(n):
+                w = weights[i]
+                if w == 0.0:
+                    continue
+                if s <= n_stages:
+                    for l in range(n_run):
+                        KM[r, part, l] += w * K[s, part * n + i, l]
+                else:
+                    for l in range(n_run):
+                        QV[part, l] += w * YN[part * n + i, l]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _mode_events(Y, YN, H, ERR, BOUNDS, EV, n, n_run):
+    """EV[l] = 1 where lane l's accepted attempt has, in some mode, an extremum of q_n or a
+    divergence (|q_n| > bound, or q_n' not finite): the scalar path's turn; else 0."""
+    for l in range(n_run):
+        EV[l] = 0.0
+    for i in range(n):
+        for l in range(n_run):
+            v0 = Y[n + i, l]
+            v1 = YN[n + i, l]
+            turns = ((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0))
+            bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
+            EV[l] = 1.0 if turns | bad else EV[l]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_run, base):
+    """For every lane's accepted attempt: an ordinary step (nothing to locate on the dense
+    output: no extremum of the midspan deflection or of any mode (EV), no divergence, not the
+    tail's start, no time-series sample, no threshold crossing) gets the Observer's step-end
+    metrics (trajectory.observe_step_end, as in record_step) and moves to its end (MOVE 1);
+    any other is left to the scalar path (FLAG 2). Returns how many lanes it flagged."""
+    L = LANES
+    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    track = settings[WANT_SETTLING] != 0.0
+    thr_rel = settings[TOL]
+    dt_sample = settings[SAMPLE_DT]
+    n_flagged = 0
+    for l in range(n_run):
+        active = H[l] > 0.0
+        accepted = ERR[l] < 1.0
+        t = W[tj.T * L + l]
+        t_new = W[tj.T_NEW * L + l]
+        q_old = W[tj.Q * L + l]
+        v_old = W[tj.V * L + l]
+        qn = QV[0, l]
+        vn = QV[1, l]
+        fv_new = KM[last, 1, l]
+        peak_new = max(W[tj.PEAK * L + l], abs(qn))
+        thr = thr_rel * peak_new
+        extremum = ((v_old > 0.0) & (vn <= 0.0)) | ((v_old < 0.0) & (vn >= 0.0))
+        bounded = (abs(qn) <= P1[BOUND * L + l]) & (abs(vn) <= 1e308)
+        straddles = (t < t_tail) & (t_tail <= t_new)
+        sample = W[tj.SAMPLE * L + l]
+        due = (sample < n_samples) & (sample * dt_sample <= t_new)
+        crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
+        event = active & accepted & ((EV[l] != 0.0) | extremum | (not bounded) | straddles
+                                     | due | crosses)
+        done = active & accepted & (not event)
+        FLAG[l] = 2.0 if event else 0.0
+        MOVE[l] = 1.0 if done else 0.0
+        n_flagged += 1 if event else 0
+        tj.observe_step_end(W, l, L, P1, l, L, t, H[l], t_new, qn, fv_new, t_tail, track, 0.0,
+                            0.0, thr_rel, done, True, base)
+        W[tj.T * L + l] = t_new if done else t
+        W[tj.Q * L + l] = qn if done else q_old
+        W[tj.V * L + l] = vn if done else v_old
+        W[tj.FQ * L + l] = vn if done else W[tj.FQ * L + l]
+        W[tj.FV * L + l] = fv_new if done else W[tj.FV * L + l]
+    return n_flagged
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, t_tail, n_run):
+    """Each mode's tail amplitude at the end of an ordinary accepted step (MOVE 1, FLAG 0):
+    MOD[i, l] = max(MOD[i, l], |q_i(t_new)|) once t_new >= t_tail."""
+    L = LANES
+    for i in range(n):
+        for l in range(n_run):
+            take = (MOVE[l] != 0.0) & (FLAG[l] == 0.0) & (W[tj.T_NEW * L + l] >= t_tail)
+            MOD[i, l] = max(MOD[i, l], abs(YN[i, l])) if take else MOD[i, l]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
+    """The lanes with MOVE[l] != 0 (an accepted step that goes on) move to the step's end:
+    Y = y_new and K[0] = f(t + h, y_new)."""
+    for c in range(dim):
+        for l in range(n_run):
+            move = MOVE[l] != 0.0
+            Y[c, l] = YN[c, l] if move else Y[c, l]
+            K[0, c, l] = K[n_stages, c, l] if move else K[0, c, l]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
+               series, modal, T, work, pp, yl, fl, base):
+    """Give lane j the trajectory of row `point`, set up as modal_driver.integrate does (f(0),
+    SciPy's initial step, the midspan accumulator, each mode's tail amplitude and divergence
+    at t = 0). An invalid row is answered at once (modal_driver.solve_point): returns False."""
+    L = LANES
+    row = params[point]
+    dim = 2 * n
+    if not drv.valid(row, n):
+        for c in range(N_REALS):
+            reals[point, c] = math.nan
+        for c in range(N_COUNTS):
+            counts[point, c] = 0
+        for c in range(series.shape[1]):
+            series[point, c] = math.nan
+        for c in range(n):
+            modal[point, c] = math.nan
+        states[point] = mt.INVALID_INPUT
+        return False
+    rtol = max(settings[RTOL], dopri5.MIN_RTOL)
+    t_end = settings[T_END]
+    t_tail = t_end * (1.0 - settings[TAIL])
+    eighth = settings[METHOD] != 0.0
+    md.prepare(row, n, pp)
+    for c in range(pp.shape[0]):
+        PP[c, j] = pp[c]
+    p1 = drv.observer_row(row, n)
+    for c in range(N_PARAMS):
+        P1[c * L + j] = p1[c]
+    for c in range(dim):
+        yl[c] = row[md.N_FIXED + c]
+        Y[c, j] = yl[c]
+    md.derivative(0.0, yl, fl, pp, n, T, work, base)
+    for c in range(dim):
+        K[0, c, j] = fl[c]
+    atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
+    evals = 1.0
+    if settings[FIRST_STEP] > 0.0:
+        h_abs = min(settings[FIRST_STEP], t_end)
+    else:
+        order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
+        h_abs = drv.initial_step(yl, fl, t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
+                                 pp, n, T, work, base)
+        evals += 1.0
+    weights = md.midspan_weights(n)
+    fv = drv._project(fl, weights, n, n)
+    a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
+    acc = W[j::L]
+    tj.begin(settings, acc, series[point], drv._project(yl, weights, 0, n),
+             drv._project(yl, weights, n, n), fv, a0, atol_q, atol_v, h_abs, evals,
+             row[md.BOUND])
+    for c in range(n):
+        MOD[c, j] = abs(yl[c]) if t_tail <= 0.0 else 0.0
+        if not abs(yl[c]) <= row[md.BOUND]:
+            acc[tj.STATUS] = mt.DIVERGED
+            acc[tj.T_STOP] = 0.0
+    return True
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, series, modal,
+              buf, yl, base):
+    """Classify lane j's finished trajectory (row `point`) as modal_driver.solve_point does."""
+    acc = W[j::LANES]
+    tj.end_series(acc, series[point])
+    for c in range(2 * n):
+        yl[c] = Y[c, j]
+    resting = drv.at_rest(params[point], n, acc[tj.T], yl, settings[TOL] * acc[tj.TAIL_AMP],
+                          base)
+    state = classify_metrics(settings, acc, buf, reals[point], counts[point], base, resting)
+    failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
+    for c in range(n):
+        modal[point, c] = math.nan if failed else MOD[c, j]
+    states[point] = state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, buf, series, i,
+                  track, thr_rel, t_tail, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc,
+                  base):
+    """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
+    modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
+    by modal_driver._observe_modes, the midspan Observer trajectory.record_step) on copies of
+    the lane's columns. Returns whether the lane moves on to the step's end (False: a mode
+    diverged)."""
+    L = LANES
+    acc = W[j::L]
+    t = acc[tj.T]
+    t_new = acc[tj.T_NEW]
+    h = H[j]
+    for c in range(n):
+        if not (abs(YN[c, j]) <= bound and math.isfinite(YN[n + c, j])):
+            acc[tj.STATUS] = mt.DIVERGED
+            acc[tj.T_STOP] = t_new
+    if acc[tj.STATUS] != mt.RUNNING:
+        return False
+    for s in range(n_stages + 1):
+        for c in range(2 * n):
+            Kl[s, c] = K[s, c, j]
+    for c in range(2 * n):
+        yl[c] = Y[c, j]
+        ynl[c] = YN[c, j]
+    for c in range(n):
+        ml[c] = MOD[c, j]
+    drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
+    for c in range(n):
+        MOD[c, j] = ml[c]
+    for r in range(Kmid.shape[0]):
+        Kmid[r, 0] = KM[r, 0, j]
+        Kmid[r, 1] = KM[r, 1, j]
+    q_new = drv._project(ynl, weights, 0, n)
+    v_new = drv._project(ynl, weights, n, n)
+    tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
+                   0.0, 0.0, thr_rel, -1.0, 0.0, True, base)
+    return True                  # (a midspan divergence moves on, as in the scalar driver)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, base):
+    """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
+    the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
+    modal (n, N), each mode's tail amplitude max |q_n|, m). base: None, or True when
+    settings[BASE] is 1. Releases the GIL (sweep.threads runs blocks on threads)."""
+    L = LANES
+    n = n_modes
+    dim = 2 * n
+    rtol = max(settings[RTOL], dopri5.MIN_RTOL)
+    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    track = settings[WANT_SETTLING] != 0.0
+    thr_rel = settings[TOL]
+    n_samples = series.shape[1]
+    eighth = settings[METHOD] != 0.0
+    n_stages = dop853.N_STAGES if eighth else dopri5.N_STAGES
+    last = 1 if eighth else n_stages          # f(t + h, y_new)'s row of KM
+    A = dop853.A if eighth else dopri5.A
+    B = dop853.B if eighth else dopri5.B
+    C = dop853.C if eighth else dopri5.C
+    T = md.tables(n)
+    nodes = T.shape[2]
+    weights = md.midspan_weights(n)
+    W = np.zeros(tj.N_SLOTS * L)
+    for j in range(L):
+        W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
+    Y = np.zeros((dim, L))
+    YN = np.zeros((dim, L))
+    ST = np.zeros((dim, L))
+    K = np.zeros((n_stages + 1, dim, L))
+    KM = np.zeros((n_stages + 1, 2, L))
+    QV = np.zeros((2, L))
+    MOD = np.zeros((n, L))
+    PP = np.zeros((4 * n + md.N_SCALARS, L))
+    P1 = np.zeros(N_PARAMS * L)
+    FLD = np.zeros((4, nodes, L))
+    SC = np.zeros((4, L))
+    TT = np.zeros(L)
+    H = np.zeros(L)
+    ERR = np.zeros(L)
+    EV = np.zeros(L)
+    FLAG = np.zeros(L)
+    MOVE = np.zeros(L)
+    BOUNDS = np.zeros(L)
+    work = np.empty((4, nodes))
+    pp = np.empty(4 * n + md.N_SCALARS)
+    yl = np.empty(dim)
+    ynl = np.empty(dim)
+    fl = np.empty(dim)
+    ml = np.empty(n)
+    Kl = np.empty((n_stages + 1, dim))
+    Km = np.empty((n_stages + 1, 2))
+    Qm = np.empty((2, 5))
+    Kmid = np.empty((2 if eighth else n_stages + 1, 2))
+    Qc = np.empty((2, 5))
+    bufs = [tj.new_buffer() for _ in range(L)]
+    capacity = np.full(L, bufs[0].shape[0], np.int64)
+    point = np.full(L, -1, np.int64)
+    next_point = lo
+    n_run = min(L, hi - lo)
+    while True:
+        _prepare(W, H, FLAG, settings, n_run)
+        top = 0
+        for j in range(L):
+            if j < n_run and FLAG[j] == 0.0:
+                top = j + 1
+                continue
+            if j >= n_run and point[j] < 0 and next_point >= hi:
+                H[j] = 0.0
+                continue
+            acc = W[j::L]
+            step = 0.0
+            while True:
+                if point[j] >= 0:
+                    step = tj.next_attempt(settings, acc)
+                    if step > 0.0:
+                        break
+                    _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
+                              counts, series, modal, bufs[j], yl, base)
+                    point[j] = -1
+                if next_point >= hi:
+                    break
+                if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, MOD,
+                              states, reals, counts, series, modal, T, work, pp, yl, fl, base):
+                    point[j] = next_point
+                    bufs[j] = tj.new_buffer()
+                    capacity[j] = bufs[j].shape[0]
+                    BOUNDS[j] = params[next_point, md.BOUND]
+                next_point += 1
+            H[j] = step
+            if step > 0.0:
+                top = j + 1
+        if top == 0:
+            return
+        n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
+        _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
+                 n_run, base)
+        _control(W, H, ERR, SC, settings, n_run)
+        _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
+        _mode_events(Y, YN, H, ERR, BOUNDS, EV, n, n_run)
+        n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
+                            n_run, base)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, t_tail, n_run)
+        if n_flagged > 0:
+            for j in range(n_run):
+                if FLAG[j] != 2.0:
+                    continue
+                if W[tj.N_EXT * L + j] >= capacity[j]:
+                    bufs[j] = tj.with_room(bufs[j], W[j::L])
+                    capacity[j] = bufs[j].shape[0]
+                if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
+                                 weights, bufs[j], series, point[j], track, thr_rel, t_tail,
+                                 eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
+                    MOVE[j] = 1.0
+        _advance(Y, YN, K, MOVE, dim, n_stages, n_run)
