@@ -1,0 +1,146 @@
+"""The multi-mode driver at N = 1 against the one-mode kernel, a divergence only an even mode
+shows, and the `sweep modes` convergence check (docs/model.md sec. 7).
+
+The one-mode kernel (kernels.transverse, from sweep/models/modal.py's closed-form K3 and K5)
+and the multi-mode driver (kernels.modal_driver, whose nonlinear terms are Eq.17 projected by
+quadrature at run time) share no coefficient code: at N = 1 they must agree to round-off and
+take the same steps. The convergence check's figures are checked against the two results it
+compares, recomputed here from two plain sweep.run calls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import sweep
+from sweep.cli import main
+from sweep.convergence import compare
+from sweep.kernels import layout as tk
+from sweep.kernels import modes as md
+from sweep.kernels import oscillator as osc
+from sweep.models import modal
+
+from conftest import settings, solve
+
+TABLE1 = {"youngs_modulus": 1.1e11, "density": 8900.0, "area": 6e-6, "inertia": 2.865e-12,
+          "membrane": 0.375, "coefficients": "consistent", "paper_parametric": "printed",
+          "divergence_bound": None}
+
+
+def _params(**changes):
+    """The parameters by axis name that sweep.models.modal takes, for one point."""
+    p = dict(TABLE1, length=0.5, damping_ratio=0.02, load_amplitude=1.0, load_type="harmonic",
+             frequency=None, frequency_ratio=2.0, initial_displacement=1e-3,
+             initial_velocity=0.0, base_acceleration=None, base_acceleration_g=1.0,
+             base_frequency=None, base_frequency_ratio=1.3)
+    p.update(changes)
+    return p
+
+
+def _solve_modes(rows, n_modes, s):
+    from sweep.kernels import modal_driver
+    rows = np.atleast_2d(rows)
+    n = rows.shape[0]
+    states = np.empty(n, np.int8)
+    reals = np.empty((n, tk.N_REALS))
+    counts = np.empty((n, tk.N_COUNTS), np.int64)
+    modal_amp = np.empty((n, n_modes))
+    modal_driver.solve_block(rows, n_modes, s, 0, n, states, reals, counts, np.empty((n, 0)),
+                             modal_amp, True if s[tk.BASE] else None)
+    return states, reals, counts, modal_amp
+
+
+def _mode_row(p, q0, v0):
+    one = modal.oscillator(p)
+    columns = modal.modes_columns(p, one, len(q0), q0, v0)
+    names = md.FIXED_NAMES + tuple(f"q0_{i + 1}" for i in range(len(q0))) + tuple(
+        f"v0_{i + 1}" for i in range(len(q0)))
+    return np.array([columns[name] for name in names], dtype=float), one
+
+
+@pytest.mark.parametrize("method", ["rk45", "dop853"])
+def test_one_mode_of_the_modal_driver_is_the_one_mode_kernel(method):
+    p = _params()
+    row, one = _mode_row(p, [1e-3], [0.0])
+    s = settings(rtol=1e-9, atol=0.0, t_end=3.0, method=method)
+    s[tk.ATOL_SCALE] = 0.01
+    s[tk.BASE] = 1.0
+    st_m, re_m, co_m, amp_m = _solve_modes(row, 1, s)
+    one_row = np.array([one[name] for name in osc.PARAM_NAMES], dtype=float)
+    st_1, re_1, co_1, _ = solve(one_row, s)
+    assert st_m[0] == st_1[0]
+    assert np.array_equal(co_m, co_1)                     # the same steps, rejections, RHS
+    for col in (tk.AMPLITUDE, tk.PEAK, tk.SETTLING, tk.PERIOD):
+        assert re_m[0, col] == pytest.approx(re_1[0, col], rel=1e-10, nan_ok=True)
+    # The acceleration peak is a parabola's vertex through three step-end samples: a difference
+    # of nearly equal numbers, so round-off in the samples reaches it amplified (3e-10 measured).
+    assert re_m[0, tk.ACCELERATION] == pytest.approx(re_1[0, tk.ACCELERATION], rel=1e-8)
+    assert amp_m[0, 0] == pytest.approx(re_1[0, tk.AMPLITUDE], rel=1e-10)
+
+
+def test_a_growing_even_mode_diverges_though_the_midspan_stays_at_rest():
+    """Mode 2 has a node at midspan: its parametric resonance (W = 2 w_2) grows unseen there,
+    and the point must still be flagged diverged when q_2 passes the bound."""
+    p = _params(load_amplitude=40.0, damping_ratio=0.0, base_acceleration_g=None,
+                base_frequency_ratio=None, frequency_ratio=8.0, divergence_bound=1e-4)
+    row, _ = _mode_row(p, [0.0, 1e-7], [0.0, 0.0])
+    s = settings(rtol=1e-8, atol=1e-14, t_end=5.0)
+    states, reals, _, modal_amp = _solve_modes(row, 2, s)
+    assert states[0] == 5                                  # diverged
+    assert 0.0 < reals[0, tk.FAILURE_TIME] < 5.0
+    assert np.all(np.isnan(modal_amp[0]))
+
+
+def _scene(modes, lengths=(0.4, 0.7), frequencies=(12.0, 40.0)):
+    text = f"""
+name = "modes-check"
+[model]
+modes = {modes}
+[cable]
+inertia = 2.865e-12
+damping_ratio = 0.02
+[load]
+amplitude = 0.0
+[base]
+acceleration_g = 0.5
+[solver]
+t_end = 3.0
+[axes]
+length = {list(lengths)}
+base_frequency = {list(frequencies)}
+"""
+    return text
+
+
+def test_sweep_modes_reports_the_changes_of_the_two_runs(tmp_path, capsys):
+    path = tmp_path / "modes-check.toml"
+    path.write_text(_scene(1))
+    assert main(["modes", str(path), "-q", "--tolerance", "0.001"]) == 0
+    out = capsys.readouterr().out
+    coarse = sweep.run(sweep.load_scene(str(path)), progress=False)
+    fine = sweep.run(sweep.load_scene(str(path), overrides={"model.modes": 3}), progress=False)
+    assert "modes 1 against 3, 4 points" in out
+    rel = np.abs(fine["amplitude"] - coarse["amplitude"]) / np.abs(fine["amplitude"])
+    largest = float(rel.max())
+    line = next(l for l in out.splitlines() if l.strip().startswith("amplitude "))
+    assert float(line.split()[1]) == pytest.approx(largest, rel=1e-2)
+    assert f"{int((rel > 0.001).sum())}/4" in line
+    report = compare(coarse, fine, tolerance=10.0)
+    assert report.enough() == (report.state_changes == 0)
+    # The 0.7 m span's third mode (9 f1 = 54 Hz unloaded) is driven hard at 40 Hz with its
+    # stretching: one mode is far off there, and the verdict says so.
+    assert "NOT enough" in out
+
+
+def test_sweep_modes_refuses_what_it_cannot_compare(tmp_path, capsys):
+    path = tmp_path / "modes-check.toml"
+    path.write_text(_scene(1))
+    assert main(["modes", str(path), "--tolerance", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--tolerance" in err
+    assert main(["modes", "paper-fig5"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "model.modes" in err and "paper" in err
