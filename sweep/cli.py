@@ -277,7 +277,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "keys":
             return _keys(args)
         if args.command == "modes":
-            return _modes(args)
+            from .execute import terminate_raises
+            with terminate_raises():
+                return _modes(args)
         return _scenes()
     except UserError as exc:
         print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)
