@@ -103,17 +103,18 @@ def modes_outputs(n: int, n_samples: int, n_modes: int) -> dict[str, np.ndarray]
 
 
 def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, n_modes: int,
-                threads: int = 0,
+                driver: str = "lanes", threads: int = 0,
                 on_block: Callable[[int, int, dict], None] | None = None,
                 stop: threading.Event | None = None) -> dict[str, np.ndarray]:
     """The multi-mode kernel (kernels.modal_driver) over `params` rows (kernels.modes columns
-    for n_modes modes); outputs by name (`modes_outputs`), on_block and stop as
-    `transverse_chunk`'s."""
+    for n_modes modes); outputs by name (`modes_outputs`); driver "lanes" or "scalar"
+    (threads.solve_modes); on_block and stop as `transverse_chunk`'s."""
     from .threads import solve_modes
     out = modes_outputs(params.shape[0], n_samples, n_modes)
     report = None if on_block is None else (lambda lo, hi: on_block(lo, hi, out))
     solve_modes(params, n_modes, settings, out["states"], out["reals"], out["counts"],
-                out["series"], out["modal"], threads=threads, on_block=report, stop=stop)
+                out["series"], out["modal"], driver=driver, threads=threads, on_block=report,
+                stop=stop)
     return out
 
 
@@ -510,7 +511,7 @@ def chunk_template(chunk_fn: Callable[..., dict], args: tuple) -> dict[str, np.n
         _, n_samples, _ = args
         return transverse_outputs(0, n_samples)
     if chunk_fn is modes_chunk:
-        _, n_samples, n_modes = args
+        _, n_samples, n_modes, _ = args
         return modes_outputs(0, n_samples, n_modes)
     if chunk_fn is longitudinal_chunk:
         _, snapshot_times, n_hist, n_nodes = args

@@ -117,19 +117,27 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
 
 def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
                 reals: np.ndarray, counts: np.ndarray, series: np.ndarray, modal: np.ndarray,
-                *, threads: int = 0, on_block: Callable[[int, int], None] | None = None,
+                *, driver: str = "lanes", threads: int = 0,
+                on_block: Callable[[int, int], None] | None = None,
                 stop: threading.Event | None = None) -> None:
-    """`solve_transverse` for the multi-mode System (kernels.modal_driver, its scalar driver):
-    rows of kernels.modes columns for n_modes modes in, the same outputs plus modal (n,
-    n_modes), each mode's tail amplitude (m)."""
+    """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for n_modes
+    modes in, the same outputs plus modal (n, n_modes), each mode's tail amplitude (m).
+    driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
+    (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off."""
     from sweep.kernels import layout as tk
     from sweep.kernels import metrics as mt
     from sweep.kernels import modal_driver
+    if driver not in ("lanes", "scalar"):
+        raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
+    if driver == "lanes":
+        from sweep.kernels import modal_lanes as kernel
+    else:
+        kernel = modal_driver
     base = True if settings[tk.BASE] != 0.0 else None
 
     def solve_block(lo: int, hi: int) -> None:
-        modal_driver.solve_block(params, n_modes, settings, lo, hi, states, reals, counts,
-                                 series, modal, base)
+        kernel.solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series,
+                           modal, base)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             modal_driver.settle_second_pass(params[lo:hi], n_modes, settings, states[lo:hi],
                                             reals[lo:hi], counts[lo:hi], base)

@@ -246,8 +246,8 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
 
 def _solve_modes(inputs: Inputs, options: RunOptions, settings: np.ndarray
                  ) -> dict[str, np.ndarray]:
-    """The multi-mode kernel (kernels.modal_driver, its scalar driver on every thread) over
-    the grid of `inputs` (model.modes >= 2): outputs by name, grid order."""
+    """The multi-mode kernel (kernels.modal_lanes or kernels.modal_driver, as solver.driver
+    says) over the grid of `inputs` (model.modes >= 2): outputs by name, grid order."""
     from sweep.kernels.modes import FIXED_NAMES
 
     from ..execute import modes_chunk, modes_outputs
@@ -268,7 +268,7 @@ def _solve_modes(inputs: Inputs, options: RunOptions, settings: np.ndarray
     n_points = int(np.prod(shape, dtype=np.int64))
     n_samples = inputs.sample_times.size
     check_memory(n_points, 2.0 * 8 * n, "modal amplitudes")
-    return solve_chunked(options, modes_chunk, rows_at, (settings, n_samples, n),
+    return solve_chunked(options, modes_chunk, rows_at, (settings, n_samples, n, inputs.driver),
                          modes_outputs(n_points, n_samples, n))
 
 
@@ -361,7 +361,7 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
             result.series.reshape(shape + (result.series.shape[1],)), dims=dims + (TIME_DIM,),
             attrs={"units": "m", "long_name": "midspan deflection q(t)"})
     system = ("transverse modal oscillator" if inputs.n_modes == 1 else
-              f"transverse Galerkin model, {inputs.n_modes} coupled modes (scalar driver)")
+              f"transverse Galerkin model, {inputs.n_modes} coupled modes")
     attrs = global_attrs(inputs.origin, shape, elapsed,
                          f"{system}, {method}, {CONTROLLERS[inputs.controller]}")
     return xr.Dataset(data, coords=all_coords, attrs=attrs)
