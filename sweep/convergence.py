@@ -7,8 +7,10 @@ only through a parametric instability of its own), so the check adds two modes, 
 one among them (docs/model.md sec. 7). For every metric of the result (amplitude, peak
 amplitude, settling time, response period, absolute acceleration, and each modal amplitude
 the coarse run has) it reports the largest relative change |x(N + 2) - x(N)| / |x(N + 2)| over
-the grid points where both runs succeeded, and where on the grid that is; points whose state
-changed are counted apart. N is enough for a tolerance when every change is within it.
+the grid points where both runs succeeded, where on the grid that is, and at how many points
+the change exceeds the tolerance; points whose state changed are counted apart. A modal
+amplitude's change is taken relative to the point's largest modal amplitude (a mode at rest,
+round-off in both runs, does not count). N is enough for a tolerance when every change is within it.
 """
 
 from __future__ import annotations
@@ -103,9 +105,12 @@ def compare(coarse: xr.Dataset, fine: xr.Dataset, tolerance: float = 0.01) -> Re
             continue
         a, b = coarse[name], fine[name]
         if "mode" in a.dims:
+            # relative to the point's largest modal amplitude: a mode at rest (an even one under
+            # base excitation, round-off on both sides) changes by nothing that matters
+            scale = b.max("mode")
             for n in a["mode"].values:
                 changes.append(_change(f"{name}[mode={n}]", a.sel(mode=n), b.sel(mode=n), both,
-                                       tolerance))
+                                       tolerance, scale))
         else:
             changes.append(_change(name, a, b, both, tolerance))
     return Report(n_modes, tolerance, changes, state_changes,
@@ -113,11 +118,12 @@ def compare(coarse: xr.Dataset, fine: xr.Dataset, tolerance: float = 0.01) -> Re
 
 
 def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.DataArray,
-            tolerance: float) -> Change:
-    """The largest relative change of one variable over the points of `mask`."""
+            tolerance: float, scale: xr.DataArray | None = None) -> Change:
+    """The largest relative change of one variable over the points of `mask`: |fine - coarse|
+    over |fine|, or over `scale` where given."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        rel = (abs(fine - coarse) / abs(fine)).where(mask & np.isfinite(coarse)
-                                                     & np.isfinite(fine))
+        rel = (abs(fine - coarse) / abs(fine if scale is None else scale)).where(
+            mask & np.isfinite(coarse) & np.isfinite(fine))
         rel = rel.where(~((fine == 0) & (coarse == 0)), 0.0).where(mask)
     values = rel.values
     finite = np.isfinite(values)
