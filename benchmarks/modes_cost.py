@@ -109,14 +109,16 @@ def solve(driver: str, rows: np.ndarray, n: int, s: np.ndarray, threads: int) ->
     counts = np.empty((m, tk.N_COUNTS), np.int64)
     series = np.empty((m, 0))
     modal_amp = np.empty((m, n))
+    final = np.empty((m, 2 * n))
     base = True if s[tk.BASE] != 0.0 else None
     began = time.perf_counter()
     if driver == "scalar":
-        solve_modes(rows, n, s, states, reals, counts, series, modal_amp, threads=threads)
+        solve_modes(rows, n, s, states, reals, counts, series, modal_amp, final,
+                    driver="scalar", threads=threads)
     else:
         def block(lo: int, hi: int) -> None:
             modal_lanes.solve_block(rows, n, s, lo, hi, states, reals, counts, series,
-                                    modal_amp, base)
+                                    modal_amp, final, base)
             if np.any(states[lo:hi] == mt.SECOND_PASS):
                 modal_driver.settle_second_pass(rows[lo:hi], n, s, states[lo:hi],
                                                 reals[lo:hi], counts[lo:hi], base)

@@ -31,7 +31,9 @@ PERIOD = 3          # mean time between maxima of q in the tail (s) or NaN
 FAILURE_TIME = 4    # time at which a diverged or failed point stopped (s) or NaN
 ACCELERATION = 5    # max |q'' + a_b| over the tail window (m/s^2): the absolute midspan
                     # acceleration amplitude under base excitation; NaN without (BASE = 0)
-N_REALS = 6
+Q_END = 6           # q at the end of the run (m): where a stepped sweep's next point starts;
+V_END = 7           # q' there (m/s); both NaN where the point failed
+N_REALS = 8
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

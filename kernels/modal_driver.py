@@ -318,9 +318,10 @@ def at_rest(row, n_modes, t, y, band, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, n_modes, settings, reals, counts, series, modal, base):
+def solve_point(row, n_modes, settings, reals, counts, series, modal, final, base):
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
-    mode's tail amplitude in modal, m). Bad parameters give INVALID_INPUT, NaN metrics."""
+    mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
+    parameters give INVALID_INPUT, NaN metrics."""
     if not valid(row, n_modes):
         for j in range(N_REALS):
             reals[j] = math.nan
@@ -330,14 +331,18 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, base):
             series[j] = math.nan
         for j in range(n_modes):
             modal[j] = math.nan
+        for j in range(2 * n_modes):
+            final[j] = math.nan
         return mt.INVALID_INPUT
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
                             settings[TOL], series, modal, base)
     resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
-    if state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS:
-        for j in range(n_modes):
-            modal[j] = math.nan
+    failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
+    for j in range(n_modes):
+        modal[j] = math.nan if failed else modal[j]
+    for j in range(2 * n_modes):
+        final[j] = math.nan if failed else y[j]
     return state
 
 
@@ -364,10 +369,13 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, base):
+def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
+                final, base):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
     kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
-    max |q_n| (m). Releases the GIL (sweep.threads runs blocks on threads)."""
+    max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
+    failed: where a stepped sweep's next point starts). Releases the GIL (sweep.threads runs
+    blocks on threads)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
-                                modal[i], base)
+                                modal[i], final[i], base)

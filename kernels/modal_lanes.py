@@ -399,7 +399,7 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
-               series, modal, T, work, pp, yl, fl, base):
+               series, modal, final, T, work, pp, yl, fl, base):
     """Give lane j the trajectory of row `point`, set up as modal_driver.integrate does (f(0),
     SciPy's initial step, the midspan accumulator, each mode's tail amplitude and divergence
     at t = 0). An invalid row is answered at once (modal_driver.solve_point): returns False."""
@@ -415,6 +415,8 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
             series[point, c] = math.nan
         for c in range(n):
             modal[point, c] = math.nan
+        for c in range(2 * n):
+            final[point, c] = math.nan
         states[point] = mt.INVALID_INPUT
         return False
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
@@ -459,7 +461,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, series, modal,
-              buf, yl, base):
+              final, buf, yl, base):
     """Classify lane j's finished trajectory (row `point`) as modal_driver.solve_point does."""
     acc = W[j::LANES]
     tj.end_series(acc, series[point])
@@ -471,6 +473,8 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for c in range(n):
         modal[point, c] = math.nan if failed else MOD[c, j]
+    for c in range(2 * n):
+        final[point, c] = math.nan if failed else yl[c]
     states[point] = state
 
 
@@ -516,10 +520,12 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, base):
+def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, final,
+                base):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
-    modal (n, N), each mode's tail amplitude max |q_n|, m). base: None, or True when
+    modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
+    state). base: None, or True when
     settings[BASE] is 1. Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
     n = n_modes
@@ -593,12 +599,13 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     if step > 0.0:
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
-                              counts, series, modal, bufs[j], yl, base)
+                              counts, series, modal, final, bufs[j], yl, base)
                     point[j] = -1
                 if next_point >= hi:
                     break
                 if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, MOD,
-                              states, reals, counts, series, modal, T, work, pp, yl, fl, base):
+                              states, reals, counts, series, modal, final, T, work, pp, yl, fl,
+                              base):
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()
                     capacity[j] = bufs[j].shape[0]

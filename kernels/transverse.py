@@ -27,6 +27,7 @@ from . import dop853
 from .dopri5 import MIN_RTOL, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
 from .layout import (ACCELERATION, AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
+                     Q_END, V_END,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
 from .oscillator import BOUND, MASS, N_PARAMS, acceleration, prepare, stiffness
@@ -120,6 +121,8 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
         reals[FAILURE_TIME] = acc[tj.T_STOP]
         return status
 
+    reals[Q_END] = acc[tj.Q]
+    reals[V_END] = acc[tj.V]
     want_settling = settings[WANT_SETTLING] != 0.0
     tol = settings[TOL]
     t_tail = settings[T_END] * (1.0 - settings[TAIL])

@@ -98,8 +98,9 @@ def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, d
 
 def modes_outputs(n: int, n_samples: int, n_modes: int) -> dict[str, np.ndarray]:
     """Empty multi-mode outputs of n points: `transverse_outputs` plus modal (n, n_modes), each
-    mode's tail amplitude (m)."""
-    return {**transverse_outputs(n, n_samples), "modal": np.empty((n, n_modes))}
+    mode's tail amplitude (m), and final (n, 2 n_modes), the final state (m, m/s)."""
+    return {**transverse_outputs(n, n_samples), "modal": np.empty((n, n_modes)),
+            "final": np.empty((n, 2 * n_modes))}
 
 
 def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, n_modes: int,
@@ -113,7 +114,7 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, n_mode
     out = modes_outputs(params.shape[0], n_samples, n_modes)
     report = None if on_block is None else (lambda lo, hi: on_block(lo, hi, out))
     solve_modes(params, n_modes, settings, out["states"], out["reals"], out["counts"],
-                out["series"], out["modal"], driver=driver, threads=threads, on_block=report,
+                out["series"], out["modal"], out["final"], driver=driver, threads=threads, on_block=report,
                 stop=stop)
     return out
 

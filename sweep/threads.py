@@ -117,11 +117,12 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
 
 def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
                 reals: np.ndarray, counts: np.ndarray, series: np.ndarray, modal: np.ndarray,
-                *, driver: str = "lanes", threads: int = 0,
+                final: np.ndarray, *, driver: str = "lanes", threads: int = 0,
                 on_block: Callable[[int, int], None] | None = None,
                 stop: threading.Event | None = None) -> None:
     """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for n_modes
-    modes in, the same outputs plus modal (n, n_modes), each mode's tail amplitude (m).
+    modes in, the same outputs plus modal (n, n_modes), each mode's tail amplitude (m), and
+    final (n, 2 n_modes), the final state (m, m/s).
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
     (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off."""
     from sweep.kernels import layout as tk
@@ -137,7 +138,7 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
 
     def solve_block(lo: int, hi: int) -> None:
         kernel.solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series,
-                           modal, base)
+                           modal, final, base)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             modal_driver.settle_second_pass(params[lo:hi], n_modes, settings, states[lo:hi],
                                             reals[lo:hi], counts[lo:hi], base)

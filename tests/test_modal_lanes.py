@@ -44,11 +44,11 @@ def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
 
 
 def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int) -> tuple:
-    """(states, reals, counts, series, modal) of driver.solve_block over every row."""
+    """(states, reals, counts, series, modal, final) of driver.solve_block over every row."""
     n = rows.shape[0]
     out = (np.full(n, 99, np.int8), np.full((n, tk.N_REALS), -1.0),
            np.full((n, tk.N_COUNTS), -1, np.int64), np.full((n, n_samples), -1.0),
-           np.full((n, n_modes), -1.0))
+           np.full((n, n_modes), -1.0), np.full((n, 2 * n_modes), -1.0))
     driver.solve_block(rows, n_modes, s, 0, n, *out, True if s[tk.BASE] != 0.0 else None)
     return out
 
@@ -180,12 +180,14 @@ def test_lanes_equal_the_scalar_modal_driver(name):
     step_end = 20.0 * np.finfo(float).eps / s[tk.RTOL]
     peak = np.abs(a[1][:, tk.PEAK])
     for col in range(tk.N_REALS):
-        length = col in (tk.AMPLITUDE, tk.PEAK)
+        length = col in (tk.AMPLITUDE, tk.PEAK, tk.Q_END)
         assert_within_round_off(b[1][:, col], a[1][:, col], [m[1][:, col] for m in moved],
                                 1e-12 * peak if length else 1e-15,
                                 step_end if col in (tk.FAILURE_TIME, tk.ACCELERATION) else 1e-9)
     assert_within_round_off(b[3], a[3], [m[3] for m in moved], 1e-12 * peak[:, None])
     assert_within_round_off(b[4], a[4], [m[4] for m in moved], 1e-12 * peak[:, None])
+    speed = np.nanmax(np.abs(a[5]), axis=1, initial=0.0)[:, None]   # the final state's scale
+    assert_within_round_off(b[5], a[5], [m[5] for m in moved], 1e-12 * speed)
     if n_samples:
         assert np.isfinite(b[3][states == km.STEADY]).all()
 

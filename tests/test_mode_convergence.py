@@ -49,7 +49,7 @@ def _solve_modes(rows, n_modes, s):
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     modal_amp = np.empty((n, n_modes))
     modal_driver.solve_block(rows, n_modes, s, 0, n, states, reals, counts, np.empty((n, 0)),
-                             modal_amp, True if s[tk.BASE] else None)
+                             modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None)
     return states, reals, counts, modal_amp
 
 
