@@ -67,10 +67,11 @@ def _project(v, weights, offset, n):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def rk_step(t, y, h, pp, n_modes, T, work, K, y_new, stage, A, B, C, base):
+def rk_step(t, y, h, S, n_modes, T, K, y_new, stage, A, B, C, base):
     """One step of size h (s) of the explicit tableau (A, B, C) from (t, y), SciPy's
     `rk_step` on the 2N-component state; K[0] must hold f(t, y). Fills K[1..n_stages] (the
-    last: f(t + h, y_new)) and y_new. stage: scratch of length 2N."""
+    last: f(t + h, y_new)) and y_new. S: the right-hand side's scratch (modes.scratch); stage:
+    scratch of length 2N."""
     n_stages = B.shape[0]
     dim = 2 * n_modes
     for s in range(1, n_stages):
@@ -79,13 +80,13 @@ def rk_step(t, y, h, pp, n_modes, T, work, K, y_new, stage, A, B, C, base):
             for j in range(s):
                 d += K[j, i] * A[s, j]
             stage[i] = y[i] + d * h
-        md.derivative(t + C[s] * h, stage, K[s], pp, n_modes, T, work, base)
+        md.derivative(t + C[s] * h, stage, K[s], S, n_modes, T, base)
     for i in range(dim):
         d = 0.0
         for j in range(n_stages):
             d += K[j, i] * B[j]
         y_new[i] = y[i] + h * d
-    md.derivative(t + h, y_new, K[n_stages], pp, n_modes, T, work, base)
+    md.derivative(t + h, y_new, K[n_stages], S, n_modes, T, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -120,8 +121,7 @@ def error_norm(K, h, y, y_new, rtol, atol_q, atol_v, n_modes, eighth):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, pp, n_modes, T, work,
-                 base):
+def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, S, n_modes, T, base):
     """SciPy's `select_initial_step` on the 2N-component state from t = 0 (f = f(0, y)).
     One evaluation."""
     dim = 2 * n_modes
@@ -141,7 +141,7 @@ def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, pp, n_modes
     f1 = np.empty(dim)
     for i in range(dim):
         y1[i] = y[i] + h0 * f[i]
-    md.derivative(h0, y1, f1, pp, n_modes, T, work, base)
+    md.derivative(h0, y1, f1, S, n_modes, T, base)
     d2 = 0.0
     for i in range(dim):
         scale = (atol_q if i < n_modes else atol_v) + abs(y[i]) * rtol
@@ -209,9 +209,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
     T = md.tables(n)
-    work = np.empty((4, T.shape[2]))
     pp = np.empty(4 * n + md.N_SCALARS)
     md.prepare(row, n, pp)
+    S = md.scratch(pp, n, T)
     p1 = observer_row(row, n)
     weights = md.midspan_weights(n)
     K = np.empty((n_stages + 1, dim))
@@ -227,7 +227,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
 
     for i in range(dim):
         y[i] = row[md.N_FIXED + i]
-    md.derivative(0.0, y, K[0], pp, n, T, work, base)
+    md.derivative(0.0, y, K[0], S, n, T, base)
     atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
     evals = 1.0
     if settings[FIRST_STEP] > 0.0:
@@ -235,7 +235,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     else:
         order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
         h_abs = initial_step(y, K[0], t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
-                             pp, n, T, work, base)
+                             S, n, T, base)
         evals += 1.0
     fv = _project(K[0], weights, n, n)
     a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
@@ -252,7 +252,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         if h == 0.0:
             break
         t = acc[tj.T]
-        rk_step(t, y, h, pp, n, T, work, K, y_new, stage, A, B, C, base)
+        rk_step(t, y, h, S, n, T, K, y_new, stage, A, B, C, base)
         err = error_norm(K, h, y, y_new, rtol, atol_q, atol_v, n, eighth)
         if not tj.control(settings, acc, err):
             continue
@@ -289,24 +289,24 @@ def at_rest(row, n_modes, t, y, band, base):
     for one mode)."""
     n = n_modes
     T = md.tables(n)
-    work = np.empty((4, T.shape[2]))
     pp = np.empty(4 * n + md.N_SCALARS)
     md.prepare(row, n, pp)
+    S = md.scratch(pp, n, T)
     z = np.empty(2 * n)
     f = np.empty(2 * n)
     for i in range(n):
         z[i] = y[i]
         z[n + i] = 0.0
-    md.derivative(t, z, f, pp, n, T, work, base)
+    md.derivative(t, z, f, S, n, T, base)
     up = np.empty(2 * n)
     down = np.empty(2 * n)
     total = 0.0
     for i in range(n):
         step = 1e-6 * max(abs(y[i]), 1e-9 * row[md.BOUND])
         z[i] = y[i] + step
-        md.derivative(t, z, up, pp, n, T, work, base)
+        md.derivative(t, z, up, S, n, T, base)
         z[i] = y[i] - step
-        md.derivative(t, z, down, pp, n, T, work, base)
+        md.derivative(t, z, down, S, n, T, base)
         z[i] = y[i]
         k = -(up[n + i] - down[n + i]) / (2.0 * step)
         if not k > 0.0:

@@ -9,11 +9,12 @@ The lanes' state lives in arrays whose LAST axis is the lane (contiguous): Y[c, 
 component c of lane l), K[s, c, l] (stage s; K[0] = f(t, y)), PP[c, l] (the prepared rows of
 kernels.modes.prepare), FLD[f, j, l] (the fields a, b, c, d at quadrature node j). Every loop
 over stages, modes, components or nodes sits OUTSIDE the innermost loop, which runs across the
-lanes with straight-line arithmetic, so LLVM vectorises it (measured: `_rhs` and `_attempt`
+lanes with straight-line arithmetic, so LLVM vectorises it (measured: the right-hand side and `_attempt`
 compile to packed AVX-512 FMAs on zmm registers):
 
-- `_rhs`: the right-hand side of kernels.modes.derivative for every lane, cos(W t) and
-  sin(w_b t) by vecmath.fast_cos / fast_sin;
+- the System's one right-hand side, kernels.modes.lanes_derivative, for every lane, cos(W t)
+  and sin(w_b t) by vecmath.fast_cos / fast_sin (the scalar driver runs it with one lane and
+  libm's);
 - `_attempt`: one attempt of the tableau (A, B, C) (stage sums, the right-hand sides, the
   solution, f(t + h, y_new)) and SciPy's error norm;
 - `_control`: accept/reject and the step-size update, err^(-1/5) by vecmath.inv_fifth_root
@@ -66,72 +67,6 @@ SIMD = 4        # the vector loops cover the active lanes rounded up to this
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _rhs(tt, X, K, s, PP, n, T, FLD, SC, n_run, base):
-    """K[s, :, l] = f(tt[l], X[:, l]) for lanes l < n_run: kernels.modes.derivative across the
-    lanes (same sums in the same order), with vecmath's cos and sin. PP: prepared rows
-    (modes.prepare) by lane; T: modes.tables(N); FLD (4, nodes, LANES) and SC (4, LANES)
-    scratch. base: None or True (the base-excitation term)."""
-    sc = 4 * n
-    nodes = T.shape[2]
-    for l in range(n_run):
-        cw = fast_cos(PP[sc + md.S_OMEGA, l] * tt[l])
-        SC[0, l] = cw
-        SC[1, l] = PP[sc + md.S_BETA_M0, l] + PP[sc + md.S_BETA_M1, l] * cw
-    if base is not None:
-        for l in range(n_run):
-            SC[2, l] = PP[sc + md.S_BASE_ACCEL, l] * fast_sin(PP[sc + md.S_BASE_OMEGA, l] * tt[l])
-    for j in range(nodes):
-        t0 = T[0, 0, j]
-        t1 = T[1, 0, j]
-        t2 = T[2, 0, j]
-        t3 = T[3, 0, j]
-        for l in range(n_run):
-            q = X[0, l]
-            FLD[0, j, l] = t0 * q
-            FLD[1, j, l] = t1 * q
-            FLD[2, j, l] = t2 * q
-            FLD[3, j, l] = t3 * q
-    for i in range(1, n):
-        for j in range(nodes):
-            t0 = T[0, i, j]
-            t1 = T[1, i, j]
-            t2 = T[2, i, j]
-            t3 = T[3, i, j]
-            for l in range(n_run):
-                q = X[i, l]
-                FLD[0, j, l] += t0 * q
-                FLD[1, j, l] += t1 * q
-                FLD[2, j, l] += t2 * q
-                FLD[3, j, l] += t3 * q
-    for j in range(nodes):
-        for l in range(n_run):
-            a = FLD[0, j, l]
-            b = FLD[1, j, l]
-            c = FLD[2, j, l]
-            d = FLD[3, j, l]
-            a2 = a * a
-            b2 = b * b
-            FLD[0, j, l] = (PP[sc + md.S_BETA_B, l] * (-3.0 * b2 * b - 11.0 * a * b * c
-                                                        - 3.0 * a2 * d)
-                            - SC[1, l] * a2 * b + 10.5 * PP[sc + md.S_BETA_Q, l] * a2 * b2 * b)
-    for i in range(n):
-        w = T[4, i, 0]
-        for l in range(n_run):
-            SC[3, l] = w * FLD[0, 0, l]
-        for j in range(1, nodes):
-            w = T[4, i, j]
-            for l in range(n_run):
-                SC[3, l] += w * FLD[0, j, l]
-        for l in range(n_run):
-            acc = ((PP[md.P_STIFF * n + i, l] + PP[md.P_STIFF_COS * n + i, l] * SC[0, l])
-                   * X[i, l] + PP[md.P_DAMPING * n + i, l] * X[n + i, l] - SC[3, l])
-            if base is not None:
-                acc += PP[md.P_FORCE * n + i, l] * SC[2, l]
-            K[s, i, l] = X[n + i, l]
-            K[s, n + i, l] = acc
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
     """OUT[c, l] = Y[c, l] + (K[0, c, l] w[0] + ... + K[s - 1, c, l] w[s - 1]) H[l] (SciPy's
     stage sums, in order; with skip_zeros the zero weights are left out)."""
@@ -172,11 +107,11 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
         c = C[s]
         for l in range(n_run):
             TT[l] = W[tj.T * L + l] + c * H[l]
-        _rhs(TT, ST, K, s, PP, n, T, FLD, SC, n_run, base)
+        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base)
     _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
     for l in range(n_run):
         TT[l] = W[tj.T * L + l] + H[l]
-    _rhs(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, base)
+    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base)
     # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
     for l in range(n_run):
         ST[0, l] = 0.0
@@ -399,7 +334,7 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
-               series, modal, final, T, work, pp, yl, fl, base):
+               series, modal, final, T, pp, yl, fl, base):
     """Give lane j the trajectory of row `point`, set up as modal_driver.integrate does (f(0),
     SciPy's initial step, the midspan accumulator, each mode's tail amplitude and divergence
     at t = 0). An invalid row is answered at once (modal_driver.solve_point): returns False."""
@@ -424,6 +359,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
     t_tail = t_end * (1.0 - settings[TAIL])
     eighth = settings[METHOD] != 0.0
     md.prepare(row, n, pp)
+    S = md.scratch(pp, n, T)
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
     p1 = drv.observer_row(row, n)
@@ -432,7 +368,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
     for c in range(dim):
         yl[c] = row[md.N_FIXED + c]
         Y[c, j] = yl[c]
-    md.derivative(0.0, yl, fl, pp, n, T, work, base)
+    md.derivative(0.0, yl, fl, S, n, T, base)
     for c in range(dim):
         K[0, c, j] = fl[c]
     atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
@@ -442,7 +378,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
     else:
         order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
         h_abs = drv.initial_step(yl, fl, t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
-                                 pp, n, T, work, base)
+                                 S, n, T, base)
         evals += 1.0
     weights = md.midspan_weights(n)
     fv = drv._project(fl, weights, n, n)
@@ -565,7 +501,6 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     FLAG = np.zeros(L)
     MOVE = np.zeros(L)
     BOUNDS = np.zeros(L)
-    work = np.empty((4, nodes))
     pp = np.empty(4 * n + md.N_SCALARS)
     yl = np.empty(dim)
     ynl = np.empty(dim)
@@ -604,7 +539,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                 if next_point >= hi:
                     break
                 if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, MOD,
-                              states, reals, counts, series, modal, final, T, work, pp, yl, fl,
+                              states, reals, counts, series, modal, final, T, pp, yl, fl,
                               base):
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()

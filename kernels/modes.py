@@ -38,6 +38,8 @@ import math
 import numba as nb
 import numpy as np
 
+from .vecmath import fast_cos, fast_sin
+
 # Columns of a raw multi-mode row.
 W1_SQ = 0           # w1^2 = (EI / rho A) k^4, the first mode's linear stiffness  (1/s^2)
 DAMPING = 1         # 2 zeta w1 (mode n: n^2 times this)                          (1/s)
@@ -52,10 +54,13 @@ V_SCALE = 9         # its velocity scale                                        
 BASE_ACCEL = 10     # A, base acceleration amplitude                                (m/s^2)
 BASE_OMEGA = 11     # w_b, base angular frequency                                   (rad/s)
 PARTICIPATION = 12  # Gamma_1 = 4 / pi (0 without base excitation); mode n: Gamma_1 / n, odd n
-N_FIXED = 13        # then q_n(0) (m) for n = 1..N, then q_n'(0) (m/s) for n = 1..N
+BASE_PHASE = 13     # phi_b: a_b(t) = A sin(w_b t + phi_b) (a stepped sweep's carried phase) (rad)
+LOAD_PHASE = 14     # phi_W: P(t) = P0 cos(W t + phi_W)                                    (rad)
+N_FIXED = 15        # then q_n(0) (m) for n = 1..N, then q_n'(0) (m/s) for n = 1..N
 
 FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", "omega",
-               "bound", "q_scale", "v_scale", "base_accel", "base_omega", "participation")
+               "bound", "q_scale", "v_scale", "base_accel", "base_omega", "participation",
+               "base_phase", "load_phase")
 
 
 def n_columns(n_modes: int) -> int:
@@ -76,7 +81,9 @@ S_BETA_M1 = 3       # beta_m's cos(W t) part: 2 k^2 P0 k^2 / rho A
 S_OMEGA = 4
 S_BASE_ACCEL = 5
 S_BASE_OMEGA = 6
-N_SCALARS = 7
+S_BASE_PHASE = 7
+S_LOAD_PHASE = 8
+N_SCALARS = 9
 
 
 def prepared_size(n_modes: int) -> int:
@@ -139,53 +146,114 @@ def prepare(row, n_modes, pp):
     pp[s + S_OMEGA] = row[OMEGA]
     pp[s + S_BASE_ACCEL] = row[BASE_ACCEL]
     pp[s + S_BASE_OMEGA] = row[BASE_OMEGA]
+    pp[s + S_BASE_PHASE] = row[BASE_PHASE]
+    pp[s + S_LOAD_PHASE] = row[LOAD_PHASE]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def base_acceleration(t, pp, n_modes):
-    """a_b(t) = A sin(w_b t) (m/s^2) of a prepared row."""
+    """a_b(t) = A sin(w_b t + phi_b) (m/s^2) of a prepared row."""
     s = 4 * n_modes
-    return pp[s + S_BASE_ACCEL] * math.sin(pp[s + S_BASE_OMEGA] * t)
+    return pp[s + S_BASE_ACCEL] * math.sin(pp[s + S_BASE_OMEGA] * t + pp[s + S_BASE_PHASE])
+
+
+# The right-hand side may fuse a * b + c into one fused multiply-add (no reordering): the lanes
+# driver's vector loops gain most of it; both drivers run this one function.
+_CONTRACT = {"contract"}
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base):
+    """The System's right-hand side for n_run states side by side (lanes l < n_run):
+    K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
+    (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: `tables`(N); FLD
+    (4, M - 1, lanes) and SC (4, lanes): scratch. fast: None (libm's cos and sin) or True
+    (vecmath's vectorisable ones); base: None (no base excitation term) or True.
+
+    The lane is every array's last, contiguous axis and every loop over modes and quadrature
+    nodes sits outside the loop across the lanes, which is straight-line arithmetic, so LLVM
+    vectorises it. The one-state `derivative` is this with one lane."""
+    n = n_modes
+    sc = 4 * n
+    nodes = T.shape[2]
+    for l in range(n_run):
+        x = PP[sc + S_OMEGA, l] * tt[l] + PP[sc + S_LOAD_PHASE, l]
+        cw = math.cos(x) if fast is None else fast_cos(x)
+        SC[0, l] = cw
+        SC[1, l] = PP[sc + S_BETA_M0, l] + PP[sc + S_BETA_M1, l] * cw
+    if base is not None:
+        for l in range(n_run):
+            x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]
+            SC[2, l] = PP[sc + S_BASE_ACCEL, l] * (math.sin(x) if fast is None else fast_sin(x))
+    for j in range(nodes):
+        t0 = T[0, 0, j]
+        t1 = T[1, 0, j]
+        t2 = T[2, 0, j]
+        t3 = T[3, 0, j]
+        for l in range(n_run):
+            q = X[0, l]
+            FLD[0, j, l] = t0 * q
+            FLD[1, j, l] = t1 * q
+            FLD[2, j, l] = t2 * q
+            FLD[3, j, l] = t3 * q
+    for i in range(1, n):
+        for j in range(nodes):
+            t0 = T[0, i, j]
+            t1 = T[1, i, j]
+            t2 = T[2, i, j]
+            t3 = T[3, i, j]
+            for l in range(n_run):
+                q = X[i, l]
+                FLD[0, j, l] += t0 * q
+                FLD[1, j, l] += t1 * q
+                FLD[2, j, l] += t2 * q
+                FLD[3, j, l] += t3 * q
+    for j in range(nodes):
+        for l in range(n_run):
+            a = FLD[0, j, l]
+            b = FLD[1, j, l]
+            c = FLD[2, j, l]
+            d = FLD[3, j, l]
+            a2 = a * a
+            b2 = b * b
+            FLD[0, j, l] = (PP[sc + S_BETA_B, l] * (-3.0 * b2 * b - 11.0 * a * b * c
+                                                     - 3.0 * a2 * d)
+                            - SC[1, l] * a2 * b + 10.5 * PP[sc + S_BETA_Q, l] * a2 * b2 * b)
+    for i in range(n):
+        w = T[4, i, 0]
+        for l in range(n_run):
+            SC[3, l] = w * FLD[0, 0, l]
+        for j in range(1, nodes):
+            w = T[4, i, j]
+            for l in range(n_run):
+                SC[3, l] += w * FLD[0, j, l]
+        for l in range(n_run):
+            acc = ((PP[P_STIFF * n + i, l] + PP[P_STIFF_COS * n + i, l] * SC[0, l])
+                   * X[i, l] + PP[P_DAMPING * n + i, l] * X[n + i, l] - SC[3, l])
+            if base is not None:
+                acc += PP[P_FORCE * n + i, l] * SC[2, l]
+            K[s, i, l] = X[n + i, l]
+            K[s, n + i, l] = acc
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def derivative(t, y, dy, pp, n_modes, T, work, base):
-    """dy = f(t, y) for y = (q_1..q_N, q_1'..q_N') (m, m/s): dy = (q', q'') (m/s, m/s^2).
-    pp: a prepared row (`prepare`); T: `tables`(N); work: scratch of shape (4, M - 1).
-    base: None (no base excitation term) or True."""
-    n = n_modes
-    s = 4 * n
-    nodes = T.shape[2]
-    for j in range(nodes):
-        work[0, j] = 0.0
-        work[1, j] = 0.0
-        work[2, j] = 0.0
-        work[3, j] = 0.0
-    for i in range(n):
-        qi = y[i]
-        for j in range(nodes):
-            work[0, j] += T[0, i, j] * qi
-            work[1, j] += T[1, i, j] * qi
-            work[2, j] += T[2, i, j] * qi
-            work[3, j] += T[3, i, j] * qi
-    cw = math.cos(pp[s + S_OMEGA] * t)
-    beta_b = pp[s + S_BETA_B]
-    beta_q = pp[s + S_BETA_Q]
-    beta_m = pp[s + S_BETA_M0] + pp[s + S_BETA_M1] * cw
-    for j in range(nodes):
-        a = work[0, j]
-        b = work[1, j]
-        c = work[2, j]
-        d = work[3, j]
-        a2 = a * a
-        b2 = b * b
-        work[0, j] = (beta_b * (-3.0 * b2 * b - 11.0 * a * b * c - 3.0 * a2 * d)
-                      - beta_m * a2 * b + 10.5 * beta_q * a2 * b2 * b)
-    ab = base_acceleration(t, pp, n) if base is not None else 0.0
-    for i in range(n):
-        force = 0.0
-        for j in range(nodes):
-            force += T[4, i, j] * work[0, j]
-        dy[i] = y[n + i]
-        dy[n + i] = ((pp[P_STIFF * n + i] + pp[P_STIFF_COS * n + i] * cw) * y[i]
-                     + pp[P_DAMPING * n + i] * y[n + i] - force + pp[P_FORCE * n + i] * ab)
+def scratch(pp, n_modes, T):
+    """The one-state right-hand side's working arrays for prepared row pp (`derivative`)."""
+    PP = np.empty((pp.shape[0], 1))
+    for c in range(pp.shape[0]):
+        PP[c, 0] = pp[c]
+    return (PP, np.empty((2 * n_modes, 1)), np.empty((1, 2 * n_modes, 1)), np.empty(1),
+            np.empty((4, T.shape[2], 1)), np.empty((4, 1)))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def derivative(t, y, dy, S, n_modes, T, base):
+    """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s): `lanes_derivative` with
+    one lane and libm's cos and sin. S: `scratch`(prepared row, N, T); T: `tables`(N)."""
+    PP, X, K, tt, FLD, SC = S
+    for c in range(2 * n_modes):
+        X[c, 0] = y[c]
+    tt[0] = t
+    lanes_derivative(tt, X, K, 0, PP, n_modes, T, FLD, SC, 1, None, base)
+    for c in range(2 * n_modes):
+        dy[c] = K[0, c, 0]

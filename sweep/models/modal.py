@@ -269,6 +269,8 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
         "base_accel": one_mode["base_accel"],
         "base_omega": one_mode["base_omega"],
         "participation": one_mode["participation"],
+        "base_phase": 0.0,
+        "load_phase": 0.0,
     }
     q_max = np.max(np.abs(np.broadcast_arrays(*[np.asarray(q, float) for q in q0])), axis=0)
     v_max = np.max(np.abs(np.broadcast_arrays(*[np.asarray(v, float) for v in v0])), axis=0)
