@@ -8,7 +8,8 @@ one among them (docs/model.md sec. 7). For every metric of the result (amplitude
 amplitude, settling time, response period, absolute acceleration, and each modal amplitude
 the coarse run has) it reports the largest relative change |x(N + 2) - x(N)| / |x(N + 2)| over
 the grid points where both runs succeeded, where on the grid that is, and at how many points
-the change exceeds the tolerance; points whose state changed are counted apart. A modal
+the change exceeds the tolerance; points whose state changed are counted apart. The tail
+window's metrics (TAIL_METRICS) are not compared at points that decayed in either run. A modal
 amplitude's change is taken relative to the point's largest modal amplitude (a mode at rest,
 round-off in both runs, does not count). N is enough for a tolerance when every change is within it.
 """
@@ -29,6 +30,10 @@ METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
 """The result variables compared, where both runs have them."""
 SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled")
 """States whose metrics mean something (the failure states have NaN metrics)."""
+TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude")
+"""Metrics of the tail window, not compared where either run decayed: a decayed point's tail
+is below metrics.tolerance x its peak by definition, and what is left of it there (its rate
+of decay, round-off near the absolute tolerance) is no answer to compare."""
 
 
 @dataclass(frozen=True)
@@ -98,21 +103,24 @@ def compare(coarse: xr.Dataset, fine: xr.Dataset, tolerance: float = 0.01) -> Re
     flags = np.atleast_1d(coarse["state"].attrs["flag_values"])
     ok = [int(f) for f, m in zip(flags, meanings) if m in SUCCESS_STATES]
     both = coarse["state"].isin(ok) & fine["state"].isin(ok)
+    decayed = [int(f) for f, m in zip(flags, meanings) if m == "decayed"]
+    live = both & ~coarse["state"].isin(decayed) & ~fine["state"].isin(decayed)
     state_changes = int((coarse["state"] != fine["state"]).sum())
     changes = []
     for name in METRICS:
         if name not in coarse or name not in fine:
             continue
         a, b = coarse[name], fine[name]
+        mask = live if name in TAIL_METRICS else both
         if "mode" in a.dims:
             # relative to the point's largest modal amplitude: a mode at rest (an even one under
             # base excitation, round-off on both sides) changes by nothing that matters
             scale = b.max("mode")
             for n in a["mode"].values:
-                changes.append(_change(f"{name}[mode={n}]", a.sel(mode=n), b.sel(mode=n), both,
+                changes.append(_change(f"{name}[mode={n}]", a.sel(mode=n), b.sel(mode=n), mask,
                                        tolerance, scale))
         else:
-            changes.append(_change(name, a, b, both, tolerance))
+            changes.append(_change(name, a, b, mask, tolerance))
     return Report(n_modes, tolerance, changes, state_changes,
                   int(np.prod(coarse["state"].shape)))
 
