@@ -1,7 +1,7 @@
 """The transverse System: the modal oscillator of docs/model.md, written once (SI units).
 
-    m q'' + c q' + (k0 + k1 cos W t) q + (g0 + g1 cos W t) q^3 + h q^5 = -m G a_b(t),
-    a_b(t) = A sin(w_b t)
+    m q'' + c q' + (k0 + k1 cos(W t + phi_W)) q + (g0 + g1 cos(W t + phi_W)) q^3 + h q^5
+        = -m G a_b(t),    a_b(t) = A sin(w_b t + phi_b)
 
 q is the midspan deflection relative to the clamps (m), t the time (s), a_b the transverse
 acceleration of both clamps (base excitation, m/s^2) and G its participation factor (4/pi for
@@ -60,10 +60,13 @@ V_SCALE = 12    # the point's velocity scale                (m/s)
 BASE_ACCEL = 13     # A    base acceleration amplitude      (m/s^2 peak)
 BASE_OMEGA = 14     # w_b  base angular frequency           (rad/s)
 PARTICIPATION = 15  # G    participation factor of the mode (1)
-N_PARAMS = 16
+BASE_PHASE = 16     # phi_b base excitation phase at t = 0   (rad; a stepped sweep's carried
+LOAD_PHASE = 17     # phi_W load phase at t = 0               phases, else 0)
+N_PARAMS = 18
 
 PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound",
-               "q_scale", "v_scale", "base_accel", "base_omega", "participation")
+               "q_scale", "v_scale", "base_accel", "base_omega", "participation", "base_phase",
+               "load_phase")
 
 # The columns `prepare` divides by -m.
 FORCE_COLUMNS = (DAMPING, K0, K1, G0, G1, H)
@@ -91,8 +94,8 @@ def prepare(row, p, o, s):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def base_acceleration(t, p, o, s, fast):
-    """a_b(t) = A sin(w_b t) (m/s^2): the clamps' acceleration at time t (s)."""
-    x = p[o + BASE_OMEGA * s] * t
+    """a_b(t) = A sin(w_b t + phi_b) (m/s^2): the clamps' acceleration at time t (s)."""
+    x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
     if fast is None:
         return p[o + BASE_ACCEL * s] * math.sin(x)
     return p[o + BASE_ACCEL * s] * fast_sin(x)
@@ -107,7 +110,7 @@ def acceleration(t, q, v, p, o, s, fast, parametric, base):
     on the previous one for two fused multiply-adds rather than for the whole sum."""
     q2 = q * q
     if parametric is not None:
-        x = p[o + OMEGA * s] * t
+        x = p[o + OMEGA * s] * t + p[o + LOAD_PHASE * s]
         if fast is None:
             cw = math.cos(x)
         else:
@@ -128,7 +131,7 @@ def stiffness(t, q, p, o, s):
     """d(restoring force)/dq per unit mass m (1/s^2) at time t (s) and deflection q (m), from a
     prepared row: (k0 + k1 cos Wt + 3 (g0 + g1 cos Wt) q^2 + 5 h q^4) / m, the derivative of
     -`acceleration` with respect to q."""
-    cw = math.cos(p[o + OMEGA * s] * t)
+    cw = math.cos(p[o + OMEGA * s] * t + p[o + LOAD_PHASE * s])
     q2 = q * q
     return -(p[o + K0 * s] + p[o + K1 * s] * cw + 3.0 * (p[o + G0 * s] + p[o + G1 * s] * cw) * q2
              + 5.0 * p[o + H * s] * q2 * q2)

@@ -176,6 +176,16 @@ KEYS: tuple[Key, ...] = (
         long_name="longitudinal: times of the field snapshots u(x), N(x), v(x)"),
     Key("outputs", "normalised", "bool", False,
         long_name="longitudinal: also store N/P0 and v rho A a/P0 snapshots"),
+    # [continuation]
+    Key("continuation", "axis", "str", None,
+        long_name="stepped sweep: the axis solved in order, each point starting from the "
+                  "previous one's final state with the excitation phase carried on"),
+    Key("continuation", "direction", "str", "up", choices=("up", "down", "both"),
+        long_name="stepped sweep: along increasing axis values (up), decreasing (down), or both "
+                  "(a direction dimension)"),
+    Key("continuation", "jump_ratio", "float", 1.5, units="1", minimum=1.0, exclusive_min=True,
+        long_name="stepped sweep: a jump is where the tail amplitude of one step differs from "
+                  "the step before by more than this factor"),
     # [run]
     Key("run", "threads", "int", 0, units="1", minimum=0,
         long_name="worker threads (0 = all cores)"),

@@ -177,6 +177,8 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"], p["length"])
     base = base_excitation(p, c["omega_1"])
     out.update(base)
+    out["base_phase"] = 0.0              # a stepped sweep's carried phases (continuation.py)
+    out["load_phase"] = 0.0
     if base["participation"] != 0.0:
         out.update(base_response(base["base_accel"], base["base_omega"], c["omega_1"],
                                  p["damping_ratio"]))

@@ -250,6 +250,7 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                 _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
                       f"remove the {axis} axis, or use load.type = 'harmonic'")
     _check_modes(given, axes)
+    _check_continuation(given, axes)
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:
@@ -280,6 +281,36 @@ def _check_modes(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
         if single in given or schema.BY_DOTTED[single].axis in axes:
             _fail(f"scene keys '{single}' and '{listed}'", "give one, not both",
                   f"remove {single} (mode 1 alone) or put its value first in {listed}")
+
+
+def _check_continuation(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of a stepped sweep ([continuation]): its axis is one of the scene's axes with more
+    than one value, and the other continuation keys need it; the time series and the resumable
+    (chunked, dask) runs are not offered along a continued axis."""
+    axis = given.get("continuation.axis")
+    if axis is None:
+        for dotted in ("continuation.direction", "continuation.jump_ratio"):
+            # a default value is accepted (a resolved scene writes every key out)
+            if dotted in given and given[dotted] != schema.BY_DOTTED[dotted].default:
+                _fail(f"scene key '{dotted}'", "needs continuation.axis (the axis to step "
+                      "along)", "add continuation.axis = NAME, one of the scene's axes, or "
+                      "remove the key")
+        return
+    if axis not in axes:
+        named = ", ".join(axes) if axes else "none"
+        _fail("scene key 'continuation.axis'", f"'{axis}' is not an axis of the scene (its "
+              f"axes: {named})", "name one of the scene's axes, e.g. continuation.axis = "
+              "'base_frequency' with that axis under [axes]")
+    if len(axes[axis]) < 2:
+        _fail("scene key 'continuation.axis'", f"axis '{axis}' has one value: nothing to step "
+              "along", "give the axis two or more values")
+    if given.get("outputs.time_series"):
+        _fail("scene key 'outputs.time_series'", "not stored for a stepped sweep "
+              "([continuation]): every step restarts the clock", "remove it, or remove "
+              "[continuation] to store q(t) of independent points")
+    if given.get("run.backend", "threads") != "threads":
+        _fail("scene key 'run.backend'", "a stepped sweep ([continuation]) runs in-process: "
+              "its steps are solved in order", "use run.backend = 'threads'")
 
 
 def _check_paper_cable(given: dict[str, Any]) -> None:

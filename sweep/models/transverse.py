@@ -168,7 +168,8 @@ class Inputs:
     model.modes; modal_q0, modal_v0: the initial modal deflections (m) and velocities (m/s),
     n_modes scalars or axis parameters each (mode 1's from initial.displacement and
     initial.velocity, the others 0, unless the scene gives initial.modal_displacement or
-    initial.modal_velocity).
+    initial.modal_velocity); continuation, direction, jump_ratio: the stepped sweep's axis
+    (None: every point independent), its direction and its jump factor ([continuation]).
     """
     coords: dict[str, xr.DataArray]
     dims: tuple[str, ...]
@@ -185,6 +186,9 @@ class Inputs:
     n_modes: int = 1
     modal_q0: tuple = ()
     modal_v0: tuple = ()
+    continuation: str | None = None
+    direction: str = "up"
+    jump_ratio: float = 1.5
 
 
 def resolve(scene: Scene) -> Inputs:
@@ -208,68 +212,155 @@ def resolve(scene: Scene) -> Inputs:
                   driver=scene.get("solver.driver"), method=scene.get("solver.method"),
                   controller=scene.get("solver.controller"), wanted=wanted,
                   has_base=scene.has_base, origin=provenance(scene), n_modes=n_modes,
-                  modal_q0=initial[0], modal_v0=initial[1])
+                  modal_q0=initial[0], modal_v0=initial[1],
+                  continuation=scene.get("continuation.axis"),
+                  direction=scene.get("continuation.direction"),
+                  jump_ratio=scene.get("continuation.jump_ratio"))
 
 
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     """The transverse sweep of `scene` as a Dataset, run as `options` say: the model's entry
     point (sweep.models.model_for)."""
-    from sweep.kernels.oscillator import PARAM_NAMES
-
-    from ..execute import transverse_chunk, transverse_outputs
     inputs = resolve(scene)
-    dims, shape, params = inputs.dims, inputs.shape, inputs.params
+    shape = inputs.shape
     settings = inputs.settings.copy()
     n_points = int(np.prod(shape, dtype=np.int64))
     # Outputs (and their Dataset copies), the solve order and a few derived quantities: the
     # parameter rows are built chunk by chunk and never held for the whole grid.
-    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size))
+    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size
+                                           + (inputs.n_modes if inputs.n_modes > 1 else 0)))
                  + 40, "metrics and time series")
-    coeffs = modal.oscillator(params)          # derived quantities, on the axes they need
+    coeffs = modal.oscillator(inputs.params)   # derived quantities, on the axes they need
     set_constant_stiffness(settings, coeffs)
+    system = _system(inputs, settings)
     started = time.perf_counter()
+    if inputs.continuation is not None:
+        return _run_stepped(inputs, options, coeffs, system, settings, started)
+    out = solve_chunked(options, system.chunk_fn, system.rows_at, system.args,
+                        system.outputs(n_points))
+    return assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
+
+
+@dataclass(frozen=True)
+class _System:
+    """How the runner drives one of the transverse Systems (the one-mode oscillator or the
+    N-mode Galerkin model): rows_at(points) their raw parameter rows, chunk_fn(rows, *args) the
+    kernel call (sweep.execute), outputs(n) its empty outputs, carry what a stepped sweep
+    carries from one dwell to the next (sweep/models/continuation.py)."""
+    rows_at: Any
+    chunk_fn: Any
+    args: tuple
+    outputs: Any
+    carry: Any
+
+
+def _system(inputs: Inputs, settings: np.ndarray) -> _System:
+    """The _System of `inputs`: the one-mode oscillator (model.modes = 1) or the N-mode model."""
+    from sweep.kernels import modes as md
+    from sweep.kernels import oscillator as osc
+
+    from ..execute import modes_chunk, modes_outputs, transverse_chunk, transverse_outputs
+    from .continuation import Carry
+    dims, shape, params, n = inputs.dims, inputs.shape, inputs.params, inputs.n_modes
     n_samples = inputs.sample_times.size
-    if inputs.n_modes > 1:
-        out = _solve_modes(inputs, options, settings)
-    else:
+    if n == 1:
         def rows_at(points: np.ndarray) -> np.ndarray:
             at = grid.point_values(params, dims, shape, points)
-            return grid.rows(modal.oscillator(at), PARAM_NAMES, points.size)
+            return grid.rows(modal.oscillator(at), osc.PARAM_NAMES, points.size)
 
-        out = solve_chunked(options, transverse_chunk, rows_at,
-                            (settings, n_samples, inputs.driver),
-                            transverse_outputs(n_points, n_samples))
-    result = KernelResult(out["states"], out["reals"], out["counts"], out["series"],
-                          inputs.sample_times, out.get("modal"))
-    return assemble(inputs, coeffs, result, time.perf_counter() - started)
+        carry = None if inputs.continuation is None else Carry(
+            state=(osc.Q0, osc.V0), base_phase=osc.BASE_PHASE, load_phase=osc.LOAD_PHASE,
+            base_omega=osc.BASE_OMEGA, load_omega=osc.OMEGA,
+            final=lambda out: out["reals"][:, [tk.Q_END, tk.V_END]])
+        return _System(rows_at, transverse_chunk, (settings, n_samples, inputs.driver),
+                       lambda m: transverse_outputs(m, n_samples), carry)
 
-
-def _solve_modes(inputs: Inputs, options: RunOptions, settings: np.ndarray
-                 ) -> dict[str, np.ndarray]:
-    """The multi-mode kernel (kernels.modal_lanes or kernels.modal_driver, as solver.driver
-    says) over the grid of `inputs` (model.modes >= 2): outputs by name, grid order."""
-    from sweep.kernels.modes import FIXED_NAMES
-
-    from ..execute import modes_chunk, modes_outputs
-    dims, shape, params, n = inputs.dims, inputs.shape, inputs.params, inputs.n_modes
-    names = FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n + 1)) + tuple(
+    names = md.FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n + 1)) + tuple(
         f"v0_{i}" for i in range(1, n + 1))
 
     def values_at(points: np.ndarray, modal_values: tuple) -> list:
         return [grid.point_values({"v": v}, dims, shape, points)["v"] for v in modal_values]
 
-    def rows_at(points: np.ndarray) -> np.ndarray:
+    def modes_rows_at(points: np.ndarray) -> np.ndarray:
         at = grid.point_values(params, dims, shape, points)
         columns = modal.modes_columns(at, modal.oscillator(at), n,
                                       values_at(points, inputs.modal_q0),
                                       values_at(points, inputs.modal_v0))
         return grid.rows(columns, names, points.size)
 
+    carry = None if inputs.continuation is None else Carry(
+        state=tuple(range(md.N_FIXED, md.N_FIXED + 2 * n)), base_phase=md.BASE_PHASE,
+        load_phase=md.LOAD_PHASE, base_omega=md.BASE_OMEGA, load_omega=md.OMEGA,
+        final=lambda out: out["final"])
+    return _System(modes_rows_at, modes_chunk, (settings, n_samples, n, inputs.driver),
+                   lambda m: modes_outputs(m, n_samples, n), carry)
+
+
+def _result(out: dict[str, np.ndarray], inputs: Inputs) -> KernelResult:
+    """The KernelResult of a kernel's outputs by name."""
+    return KernelResult(out["states"], out["reals"], out["counts"], out["series"],
+                        inputs.sample_times, out.get("modal"))
+
+
+def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], system: _System,
+                 settings: np.ndarray, started: float) -> xr.Dataset:
+    """A stepped sweep along inputs.continuation (sweep/models/continuation.py): each
+    direction's Dataset, with its `jump` flags; both directions on a `direction` dimension."""
+    from ..execute import Progress
+    from ..errors import UserError
+    from . import continuation as ct
+    if options.resume:
+        raise UserError("--resume: a stepped sweep ([continuation]) is solved in order and "
+                        "keeps no chunks to resume from; run it again without --resume")
+    dims, shape = inputs.dims, inputs.shape
     n_points = int(np.prod(shape, dtype=np.int64))
-    n_samples = inputs.sample_times.size
-    check_memory(n_points, 2.0 * 8 * n, "modal amplitudes")
-    return solve_chunked(options, modes_chunk, rows_at, (settings, n_samples, n, inputs.driver),
-                         modes_outputs(n_points, n_samples, n))
+    axis = dims.index(inputs.continuation)
+    values = inputs.coords[inputs.continuation].values
+    directions = ["up", "down"] if inputs.direction == "both" else [inputs.direction]
+    rows = system.rows_at(np.arange(n_points))
+    progress = Progress(n_points * len(directions), 0, options.progress)
+    results = []
+    try:
+        for direction in directions:
+            order = ct.dwell_order(values, direction)
+            out = ct.solve_continued(
+                rows, shape, axis, order, system.carry, float(settings[tk.T_END]),
+                lambda batch: system.chunk_fn(batch, *system.args, threads=options.threads),
+                system.outputs(n_points), progress.advance)
+            ds = assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
+            flags = ct.jumps(out["reals"][:, tk.AMPLITUDE].reshape(shape),
+                             out["states"].reshape(shape), axis, order, inputs.jump_ratio)
+            ds["jump"] = xr.DataArray(flags, dims=dims,
+                                      attrs=ct.jump_attrs(inputs.continuation, inputs.jump_ratio))
+            results.append(ds)
+    finally:
+        progress.close()
+    if len(results) == 1:
+        ds = results[0]
+    else:
+        ds = _both_directions(results, dims, directions)
+    ds.attrs["continuation_axis"] = inputs.continuation
+    ds.attrs["continuation_direction"] = inputs.direction
+    ds.attrs["run_seconds"] = time.perf_counter() - started
+    return ds
+
+
+def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...],
+                     directions: list[str]) -> xr.Dataset:
+    """The up and down Datasets of a stepped sweep as one, what the kernel solved on a leading
+    `direction` dimension, the rest (closed forms of the parameters) once."""
+    from . import continuation as ct
+    first = results[0]
+    solved = {"state", "jump", "modal_amplitude", *_REALS, *_COUNTS, *base_outputs_names()}
+    per_point = [name for name in first.data_vars if name in solved]
+    stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
+    ds = first.drop_vars(per_point).merge(stacked)
+    ds = ds.assign_coords({ct.DIRECTION_DIM: ct.direction_coordinate(directions)})
+    for name in per_point:
+        ds[name] = ds[name].transpose(ct.DIRECTION_DIM, *first[name].dims)
+        ds[name].attrs = first[name].attrs
+    ds.attrs = first.attrs
+    return ds
 
 
 def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
@@ -309,6 +400,11 @@ def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[in
     frequency.attrs = {"units": "Hz", "long_name": "linear natural frequency of mode n of the "
                                                   "unloaded span, n^2 f1"}
     return {"modal_amplitude": amplitude, "modal_frequency": frequency}
+
+
+def base_outputs_names() -> tuple[str, ...]:
+    """The names of `base_outputs`' variables."""
+    return ("absolute_acceleration", "absolute_acceleration_g", "transmissibility")
 
 
 def state_attrs() -> dict[str, Any]:

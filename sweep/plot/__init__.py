@@ -16,6 +16,9 @@ What `plot` draws, by the result's content:
   excitation also a map of the absolute midspan acceleration in g and the linear resonance
   f = f1 (docs/model.md sec. 5);
 - stored time series: q(t), one panel per point (`plot_time_series`, the paper's Fig 5);
+- a stepped sweep ([continuation]): amplitude (and the absolute acceleration in g under base
+  excitation) against the stepped axis, one curve per value of one other axis, stepped up solid
+  and down dashed, the jumps marked by triangles (`plot_branches`);
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
   histories (`plot_histories`); with swept axes also the peak end displacement and the
   dynamic amplification over them.
@@ -53,6 +56,7 @@ The package, split like xarray's plot/ by what is drawn:
     line.py      one swept axis (plot_line)
     maps.py      two swept axes (plot_map, plot_state_map)
     series.py    stored histories (plot_time_series, plot_snapshots, plot_histories)
+    branches.py  a stepped sweep: up and down against the stepped axis, the jumps (plot_branches)
     figures.py   which figures a result gets, and writing them (plot, save)
 """
 
@@ -60,6 +64,7 @@ from __future__ import annotations
 
 # _HATCHES, _edges and _select_tag are private; tests/test_plot.py reaches them here.
 from .figures import Figures, _select_tag, plot, save, why_not_drawn  # noqa: F401
+from .branches import plot_branches
 from .labels import footer, label
 from .line import plot_line
 from .maps import _HATCHES, FLOOR, plot_map, plot_state_map  # noqa: F401
@@ -69,6 +74,7 @@ from .series import plot_histories, plot_snapshots, plot_time_series
 from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
-           "check_result", "load_result", "parse_select", "plot", "plot_histories",
+           "check_result", "load_result", "parse_select", "plot", "plot_branches",
+           "plot_histories",
            "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
            "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]

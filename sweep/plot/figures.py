@@ -23,6 +23,7 @@ from matplotlib.figure import Figure
 from ..errors import UserError
 from ..files import write_temporary
 from .labels import _add_footer
+from .branches import plot_branches, stepped_axis
 from .line import plot_line
 from .maps import plot_map, plot_state_map
 from .result import _time_dim, check_result, select_points, swept_axes
@@ -76,6 +77,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     (`check_result`), before drawing anything.
     """
     check_result(ds)
+    if stepped_axis(ds) is not None:
+        return _stepped_figures(ds, select)
     ds = select_points(ds, select)
     axes = swept_axes(ds)
     figures = Figures(select=select)
@@ -114,6 +117,26 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
         for ax in fig.axes:
             _plain_ticks(ax)
         _add_footer(fig, ds)
+    return figures
+
+
+def _stepped_figures(ds: xr.Dataset, select: Mapping[str, Any] | None) -> Figures:
+    """The figures of a stepped sweep: amplitude (and, under base excitation, the absolute
+    acceleration in g) against the stepped axis, up and down with the jumps (`plot_branches`)."""
+    figures = Figures(select=select)
+    for var in ("amplitude", "absolute_acceleration_g"):
+        if var not in ds:
+            continue
+        reason = why_not_drawn(ds[var])
+        if reason is not None:
+            figures.skipped[var] = reason
+            continue
+        figures[var] = plot_branches(ds, var, select=select).figure
+    shown = select_points(ds, select)
+    for fig in figures.values():
+        for ax in fig.axes:
+            _plain_ticks(ax)
+        _add_footer(fig, shown)
     return figures
 
 

@@ -25,6 +25,8 @@ from ..errors import UserError
 from ..schema import BY_AXIS
 
 _TIME_DIMS = ("elapsed_time", "time")     # the dimension of stored histories (new, old name)
+DIRECTION_DIM = "direction"                # a stepped sweep's up and down (continuation)
+_DIRECTIONS = ("up", "down")
 
 # What a result may hold. `sweep run` writes far less; a file beyond these limits was not
 # written by it (or was altered since), and is refused before any of it is used: an attribute
@@ -203,6 +205,16 @@ def _check_axis(ds: xr.Dataset, dim: str, where: str, unique: bool) -> None:
         raise _refuse(where, f"axis '{dim}' has repeated values ({_values_text(v)})")
 
 
+def _check_directions(ds: xr.Dataset, where: str) -> None:
+    """A stepped sweep's `direction` coordinate: 'up' and/or 'down', each once."""
+    if DIRECTION_DIM not in ds.coords:
+        raise _refuse(where, f"axis '{DIRECTION_DIM}' has no coordinate variable (its values)")
+    values = [str(v) for v in np.atleast_1d(ds[DIRECTION_DIM].values)]
+    if not values or any(v not in _DIRECTIONS for v in values) or len(set(values)) != len(values):
+        raise _refuse(where, f"coordinate '{DIRECTION_DIM}' holds {_short(repr(values))}, not "
+                             "'up' and 'down', each once")
+
+
 def check_result(ds: xr.Dataset, where: str = "the result") -> None:
     """Refuse (UserError, one line naming `where`) a Dataset the figures cannot be drawn from
     faithfully: attributes beyond a result's sizes, a `state` that is not integer flags with
@@ -233,16 +245,18 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
     if odd.size:
         raise _refuse(where, f"state holds values that are not among its flag_values "
                              f"({_short(repr(odd.tolist()))})")
-    axes = list(state.dims)
+    axes = [d for d in state.dims if d != DIRECTION_DIM]
     for dim in axes:
         _check_axis(ds, dim, where, unique=True)
+    if DIRECTION_DIM in state.dims:
+        _check_directions(ds, where)
     for name in (*_OVER_AXES, *_HISTORIES, *_SNAPSHOTS):
         if name not in ds or name in ds.coords and name in axes:
             continue
         da = ds[name]
         if da.dtype.kind not in "iuf":
             raise _refuse(where, f"variable '{name}' holds {da.dtype}, not numbers")
-        extra = [d for d in da.dims if d not in axes]
+        extra = [d for d in da.dims if d not in axes and d != DIRECTION_DIM]
         if name in _HISTORIES:
             expected = [d for d in _TIME_DIMS if d in da.dims][:1]
         elif name in _SNAPSHOTS:
@@ -326,8 +340,9 @@ def _values_text(values: np.ndarray) -> str:
 
 
 def swept_axes(ds: xr.Dataset) -> list[str]:
-    """The result's swept axes with more than one value, in scene order (the dims of state)."""
-    return [d for d in ds["state"].dims if ds.sizes[d] > 1]
+    """The result's swept axes with more than one value, in scene order (the dims of state; a
+    stepped sweep's `direction` is not one)."""
+    return [d for d in ds["state"].dims if ds.sizes[d] > 1 and d != DIRECTION_DIM]
 
 
 def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr.Dataset:
@@ -339,7 +354,7 @@ def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr
     """
     if "state" not in ds.data_vars:
         raise UserError("not a cable-sweep result: no 'state' variable")
-    axes = list(ds["state"].dims)
+    axes = [d for d in ds["state"].dims if d != DIRECTION_DIM]
     for dim, value in (select or {}).items():
         shown = f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
         if dim not in axes:

@@ -1,0 +1,146 @@
+"""Stepped sweeps with continuation: one axis of a transverse scene solved in order.
+
+Along the continuation axis (`[continuation] axis`) every grid point is a dwell of
+`solver.t_end` seconds that starts from the final state of the dwell before it (q, q' of every
+mode) with the excitation's phase carried on (docs/model.md sec. 6):
+
+    phi_(k+1) = phi_k + w_k T_d      (the base excitation's and the end load's, each)
+
+so the excitation is one continuous signal whose frequency (or level, or load) steps. Each
+dwell's clock restarts at 0, the System being autonomous but for the excitation, whose phase
+offsets are columns of its row; its metrics (amplitude, settling time, state, ...) are taken
+on its own tail window, as for an independent point. The first dwell starts from the scene's
+initial conditions; so does a dwell after one that failed (diverged, step too small, too many
+steps), its phases from zero: there is no final state to carry on.
+
+The other axes stay parallel: dwell k of every line (every combination of the other axes'
+values) is solved in one kernel call on every thread, then dwell k + 1, so a 100-length x 400-
+frequency stepped map makes 400 calls of 100 points. Directions: "up" (increasing axis values),
+"down" (decreasing) or "both" (a `direction` dimension, up then down, each from the initial
+conditions). Results are stored in the axis's own order whatever the direction.
+
+Jumps: where a dwell's tail amplitude differs from the previous dwell's (in the sweep's order)
+by more than `continuation.jump_ratio`, the response changed branch: the `jump` flag says up
+(the amplitude rose) or down (it fell) at that dwell.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import xarray as xr
+
+from sweep.kernels import states as km
+
+DIRECTION_DIM = "direction"
+NO_JUMP, JUMP_UP, JUMP_DOWN = 0, 1, 2
+JUMP_MEANINGS = "none jump_up jump_down"
+FAILED = (km.DIVERGED, km.STEP_TOO_SMALL, km.MAX_STEPS, km.INVALID_INPUT)
+
+
+@dataclass(frozen=True)
+class Carry:
+    """What a System's rows carry from one dwell to the next (column indices of its rows).
+
+    state: the columns of the initial state (q's then q''s, m and m/s); base_phase,
+    load_phase: the phase offsets (rad) of the base excitation and of the end load;
+    base_omega, load_omega: their angular frequencies (rad/s); final: a function of a
+    kernel call's outputs giving the final state of each point, (n, len(state)).
+    """
+    state: tuple[int, ...]
+    base_phase: int
+    load_phase: int
+    base_omega: int
+    load_omega: int
+    final: Callable[[dict[str, np.ndarray]], np.ndarray]
+
+
+def dwell_order(values: np.ndarray, direction: str) -> np.ndarray:
+    """Indices of the axis values in the order a sweep visits them: increasing ("up") or
+    decreasing ("down") values."""
+    order = np.argsort(values, kind="stable")
+    return order if direction == "up" else order[::-1]
+
+
+def _wrap(phase: np.ndarray) -> np.ndarray:
+    """A phase (rad) reduced to [-pi, pi]: the same sine, and small enough that w t + phi keeps
+    the digits of w t over a dwell."""
+    return np.remainder(phase + math.pi, 2.0 * math.pi) - math.pi
+
+
+def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int, order: np.ndarray,
+                    carry: Carry, dwell: float, solve: Callable[[np.ndarray], dict],
+                    outputs: dict[str, np.ndarray],
+                    advance: Callable[[int], None] | None = None) -> dict[str, np.ndarray]:
+    """Solve every grid point of `rows` (the raw rows of all points, grid C order, shape
+    (prod(shape), columns)) as a stepped sweep along dimension `axis` of the grid, visiting its
+    indices in `order` (`dwell_order`), filling `outputs` (grid order, first axis = points;
+    the names `solve` returns).
+
+    solve(rows) runs the kernel on a batch of rows and returns its outputs by name; dwell: the
+    dwell time solver.t_end (s); advance(points): progress, called after each dwell.
+    """
+    n_points = rows.shape[0]
+    lines = np.moveaxis(np.arange(n_points).reshape(shape), axis, -1).reshape(-1, shape[axis])
+    columns = list(carry.state)
+    start = rows[lines[:, order[0]]][:, columns]       # the scene's initial conditions
+    state = start.copy()
+    phase_b = np.zeros(lines.shape[0])
+    phase_w = np.zeros(lines.shape[0])
+    for k in order:
+        points = lines[:, k]
+        batch = rows[points].copy()
+        batch[:, columns] = state
+        batch[:, carry.base_phase] = phase_b
+        batch[:, carry.load_phase] = phase_w
+        out = solve(batch)
+        for name, values in out.items():
+            outputs[name][points] = values
+        failed = np.isin(out["states"], FAILED)
+        state = np.where(failed[:, None], start, carry.final(out))
+        phase_b = np.where(failed, 0.0, _wrap(phase_b + batch[:, carry.base_omega] * dwell))
+        phase_w = np.where(failed, 0.0, _wrap(phase_w + batch[:, carry.load_omega] * dwell))
+        if advance is not None:
+            advance(points.size)
+    return outputs
+
+
+def jumps(amplitude: np.ndarray, states: np.ndarray, axis: int, order: np.ndarray,
+          ratio: float) -> np.ndarray:
+    """The jump flag of every point (grid shape, int8): JUMP_UP at the dwell whose tail
+    amplitude is more than `ratio` times the previous dwell's in the sweep's `order` along
+    `axis`, JUMP_DOWN where it is less than 1/ratio of it, NO_JUMP elsewhere (and where either
+    dwell failed or has no amplitude). A jump that takes more than one dwell (the first one
+    still ringing down from the old branch) is flagged once, at its first dwell."""
+    a = np.moveaxis(amplitude, axis, -1)[..., order]
+    ok = ~np.isin(np.moveaxis(states, axis, -1)[..., order], FAILED) & np.isfinite(a)
+    flags = np.zeros(a.shape, np.int8)
+    prev, cur = a[..., :-1], a[..., 1:]
+    both = ok[..., :-1] & ok[..., 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        flags[..., 1:] = np.where(both & (cur > ratio * prev), JUMP_UP,
+                                  np.where(both & (cur * ratio < prev), JUMP_DOWN, NO_JUMP))
+    repeated = np.zeros(flags.shape, bool)
+    repeated[..., 1:] = (flags[..., 1:] != NO_JUMP) & (flags[..., 1:] == flags[..., :-1])
+    flags[repeated] = NO_JUMP
+    back = np.empty_like(flags)
+    back[..., order] = flags
+    return np.moveaxis(back, -1, axis)
+
+
+def jump_attrs(axis_name: str, ratio: float) -> dict[str, object]:
+    """CF flag attributes of the `jump` variable."""
+    return {"units": "1", "flag_values": np.array([NO_JUMP, JUMP_UP, JUMP_DOWN], np.int8),
+            "flag_meanings": JUMP_MEANINGS,
+            "long_name": f"jump of the tail amplitude from the previous step along {axis_name} "
+                         f"in the sweep's direction (by more than a factor {ratio:g})"}
+
+
+def direction_coordinate(directions: list[str]) -> xr.DataArray:
+    """The `direction` coordinate of a result swept both ways."""
+    return xr.DataArray(np.array(directions, dtype=object), dims=DIRECTION_DIM,
+                        attrs={"long_name": "direction of the stepped sweep along the "
+                                            "continuation axis (up: increasing values)"})
