@@ -117,10 +117,21 @@ def _accel(W, j, t, q, v, parametric, base):
 
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in
 # the tableau's order, so the loops across the lanes stay vectorised. RK45 sums every entry
-# of its tableau; DOP853 leaves out the zeros of its sparse one.
-_chain5 = stages.make_chain(A, B, C, _accel, sums=(E,), name="rk45_chain")
-_chain8 = stages.make_chain(dop853.A, dop853.B, dop853.C, _accel, sums=(dop853.E5, dop853.E3),
-                            skip_zeros=True, name="dop853_chain")
+# of its tableau; DOP853 leaves out the zeros of its sparse one. One chain per combination of
+# the System's optional terms (suffix p: parametric, b: base), its right-hand side written
+# out for those terms alone: `_attempt` picks one by its switches, in branches on its own
+# arguments, which Numba prunes before it inlines, so it copies only the chain it uses, and
+# only the code of those terms (each copy costs compile time).
+def _chains(A, B, C, sums, skip_zeros, name):
+    return tuple(stages.make_chain(A, B, C, _accel, sums, skip_zeros, f"{name}{suffix}",
+                                   {"parametric": parametric, "base": base})
+                 for parametric, base, suffix in ((None, None, ""), (True, None, "_p"),
+                                                  (None, True, "_b"), (True, True, "_pb")))
+
+
+_chain5, _chain5_p, _chain5_b, _chain5_pb = _chains(A, B, C, (E,), False, "rk45_chain")
+_chain8, _chain8_p, _chain8_b, _chain8_pb = _chains(dop853.A, dop853.B, dop853.C,
+                                                    (dop853.E5, dop853.E3), True, "dop853_chain")
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -164,8 +175,18 @@ def _attempt(W, rtol, n_run, parametric, base):
         q = W[tj.Q * L + j]
         v = W[tj.V * L + j]
         h = W[W_H * L + j]
-        kq, kv, qn, vn, eq, ev = _chain5(W, j, t, q, v, h, W[tj.FQ * L + j], W[tj.FV * L + j],
-                                         parametric, base)
+        fq = W[tj.FQ * L + j]
+        fv = W[tj.FV * L + j]
+        if parametric is None:
+            if base is None:
+                stages_ = _chain5(W, j, t, q, v, h, fq, fv, parametric, base)
+            else:
+                stages_ = _chain5_b(W, j, t, q, v, h, fq, fv, parametric, base)
+        elif base is None:
+            stages_ = _chain5_p(W, j, t, q, v, h, fq, fv, parametric, base)
+        else:
+            stages_ = _chain5_pb(W, j, t, q, v, h, fq, fv, parametric, base)
+        kq, kv, qn, vn, eq, ev = stages_
         rq = (eq * h) / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
         rv = (ev * h) / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
         W[(W_K + 2) * L + j] = kq[1]
@@ -201,8 +222,18 @@ def _attempt8(W, rtol, n_run, parametric, base):
         q = W[tj.Q * L + j]
         v = W[tj.V * L + j]
         h = W[W_H * L + j]
-        kq, kv, qn, vn, e5q, e5v, e3q, e3v = _chain8(W, j, t, q, v, h, W[tj.FQ * L + j],
-                                                     W[tj.FV * L + j], parametric, base)
+        fq = W[tj.FQ * L + j]
+        fv = W[tj.FV * L + j]
+        if parametric is None:
+            if base is None:
+                stages_ = _chain8(W, j, t, q, v, h, fq, fv, parametric, base)
+            else:
+                stages_ = _chain8_b(W, j, t, q, v, h, fq, fv, parametric, base)
+        elif base is None:
+            stages_ = _chain8_p(W, j, t, q, v, h, fq, fv, parametric, base)
+        else:
+            stages_ = _chain8_pb(W, j, t, q, v, h, fq, fv, parametric, base)
+        kq, kv, qn, vn, e5q, e5v, e3q, e3v = stages_
         sq = W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol
         sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
         W[(W_K + 12) * L + j] = vn

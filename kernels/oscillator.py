@@ -31,6 +31,13 @@ the function is inlined into a caller, so a term a scene does not have is neithe
 compiled there (a tuple item's branch would be typed at every inlined copy: seconds of compile
 time in the stage chains).
 
+Inlined or called: `acceleration` and `base_acceleration` are inlined where `fast` is True (the
+lanes' vector loops, where a call would stop LLVM vectorising; kernels.stages.InlineWhereTrue)
+and compiled once and called elsewhere (the scalar paths, where inlining bought nothing but
+compile time). The lanes' stage chains do not inline them through Numba: kernels.stages
+writes this function's body, and its callees', into their right-hand side's source
+(`stages.written_out`), one specialisation per combination of the terms.
+
 Q_SCALE and V_SCALE are the size of the point's response (sweep.models.state_scale): with
 settings[ATOL_SCALE] > 0 the absolute tolerances are that fraction of rtol times these scales
 (trajectory.point_atol), so a response and the same response scaled by any factor are
@@ -41,6 +48,7 @@ import math
 
 import numba as nb
 
+from .stages import InlineWhereTrue
 from .vecmath import fast_cos, fast_sin
 
 # Columns of a parameter row.
@@ -92,7 +100,7 @@ def prepare(row, p, o, s):
         p[o + c * s] = row[c] * minus_inv_m
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4))
 def base_acceleration(t, p, o, s, fast):
     """a_b(t) = A sin(w_b t + phi_b) (m/s^2): the clamps' acceleration at time t (s)."""
     x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
@@ -101,7 +109,7 @@ def base_acceleration(t, p, o, s, fast):
     return p[o + BASE_ACCEL * s] * fast_sin(x)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(6))
 def acceleration(t, q, v, p, o, s, fast, parametric, base):
     """q'' (m/s^2) at time t (s) for deflection q (m) and velocity v (m/s), from a prepared
     row (`prepare`) at p[o + column * s]; `fast`, `parametric`, `base`: the module's switches.

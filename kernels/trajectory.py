@@ -30,6 +30,7 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      MIN_STEP, RTOL, SAMPLE_DT, TAIL, T_END)
 from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
+from .stages import InlineWhereTrue
 from .vecmath import log2_fast
 
 # Slots of a trajectory's accumulator row.
@@ -313,7 +314,7 @@ def observe_acceleration(acc, a, sa, t_new, a3, t_tail, take):
     acc[a + T_1 * sa] = t_new if take else t1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline=InlineWhereTrue(17))
 def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, track, centre,
                      thr_fixed, thr_rel, take, fast, base):
     """The Observer: what every accepted step's end adds to the metrics, for both drivers
@@ -329,7 +330,9 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, tr
     thr_fixed + thr_rel * peak (m); with base excitation (`base` True),
     `observe_acceleration` (`fast`: oscillator's switch for a_b).
     Returns (threshold, whether q_new is above it): record_step finds a crossing inside the
-    step itself.
+    step itself. Inlined where `fast` is True (the lanes' loop, which it must not stop
+    vectorising), compiled once and called elsewhere (record_step: inlining its selects cost
+    compile time in every caller; stages.InlineWhereTrue).
     """
     peak = acc[a + PEAK * sa]
     peak_new = max(peak, abs(q_new))
@@ -346,9 +349,19 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, fv_new, t_tail, tr
     last_above = acc[a + LAST_ABOVE * sa]
     acc[a + LAST_ABOVE * sa] = t + h if take & track & above else last_above
     if base is not None:
-        observe_acceleration(acc, a, sa, t_new, fv_new + base_acceleration(t + h, p, o, s, fast),
-                             t_tail, take)
+        _observe_base(acc, a, sa, p, o, s, t, h, t_new, fv_new, t_tail, take, fast, base)
     return thr, above
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline=InlineWhereTrue(13))
+def _observe_base(acc, a, sa, p, o, s, t, h, t_new, fv_new, t_tail, take, fast, base):
+    """`observe_step_end`'s base-excitation part: `observe_acceleration` with a_b(t + h) (fast:
+    oscillator's switch). A function of its own, inlined only where `base` is the constant
+    True: where it is None (lanes._finish, whose lanes get the metric from
+    lanes._observe_acceleration) its branch is dead, and Numba does not copy it in before it
+    prunes the branch."""
+    observe_acceleration(acc, a, sa, t_new, fv_new + base_acceleration(t + h, p, o, s, fast),
+                         t_tail, take)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
