@@ -23,6 +23,8 @@ REDUCED = {
     "harness-parametric": {"axes.length": [0.5, 1.0], "axes.frequency_ratio": [1.0, 2.0],
                            "solver.t_end": 1.0},
     "paper-fig7": {"solver.intervals": 50},
+    "harness-base-sine": {"axes.length": [0.3, 0.8], "axes.base_frequency": [10.0, 50.0],
+                          "solver.t_end": 1.0},
     "harness-stepped-sine": {"axes.length": [0.5], "axes.base_frequency_ratio": [1.0, 1.2, 1.4],
                              "solver.t_end": 1.0},
 }
