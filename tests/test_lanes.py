@@ -37,17 +37,24 @@ def _assert_equal_to_round_off(rows, s, a, b, n_samples):
         moved.append(_solve("scalar", nudged, s, n_samples))
     peak = np.abs(a[1][:, tk.PEAK])
 
-    def check(got, want, up, down, atol):
+    def check(got, want, up, down, atol, rtol=1e-9):
         np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
         spread = np.maximum(np.abs(up - want), np.abs(down - want))
-        excess = np.abs(got - want) - (atol + 1e-9 * np.abs(want) + 5.0 * spread)
+        excess = np.abs(got - want) - (atol + rtol * np.abs(want) + 5.0 * spread)
         assert not np.nanmax(excess, initial=-1.0) > 0.0, (
             f"differs beyond round-off at {np.unravel_index(np.nanargmax(excess), excess.shape)}")
 
+    # The final state (where a stepped sweep's next point starts) is a value at a fixed time,
+    # first-order sensitive to the phase a trajectory has gathered, where an amplitude, a
+    # maximum, is stationary to it: 1e-8 relative (measured 1.2e-9 where amplitudes show 7e-10;
+    # the one-ulp nudge does not reach vecmath's cosine), velocities on the table's own scale.
+    speed = np.nanmax(np.abs(a[1][:, tk.V_END]), initial=0.0)
     for col in range(tk.N_REALS):
-        length = col in (tk.AMPLITUDE, tk.PEAK)
-        check(b[1][:, col], a[1][:, col], moved[0][1][:, col], moved[1][1][:, col],
-              1e-12 * peak if length else 1e-15)
+        final = col in (tk.Q_END, tk.V_END)
+        length = col in (tk.AMPLITUDE, tk.PEAK, tk.Q_END)
+        atol = 1e-12 * peak if length else (1e-12 * speed if col == tk.V_END else 1e-15)
+        check(b[1][:, col], a[1][:, col], moved[0][1][:, col], moved[1][1][:, col], atol,
+              1e-8 if final else 1e-9)
     check(b[3], a[3], moved[0][3], moved[1][3], 1e-12 * peak[:, None])
 
 
