@@ -276,3 +276,14 @@ def test_sweep_plot_draws_the_branches_of_a_stepped_result(tmp_path):
     dashed = [line for line in ax.lines if line.get_linestyle() == "--"]
     assert len(dashed) == 2
     ds.close()
+
+
+def test_a_stepped_result_does_not_depend_on_the_threads():
+    scene = sweep.load_scene("harness-stepped-sine", overrides={
+        "axes.length": [0.4, 0.45, 0.5, 0.55, 0.6],
+        "axes.base_frequency_ratio": {"start": 1.0, "stop": 1.4, "num": 9},
+        "solver.t_end": 1.0})
+    one = sweep.run(scene, threads=1, progress=False)
+    two = sweep.run(scene, threads=2, progress=False)
+    for name in ("state", "amplitude", "settling_time", "jump", "n_steps"):
+        np.testing.assert_array_equal(one[name].values, two[name].values)

@@ -39,6 +39,7 @@ DIRECTION_DIM = "direction"
 NO_JUMP, JUMP_UP, JUMP_DOWN = 0, 1, 2
 JUMP_MEANINGS = "none jump_up jump_down"
 FAILED = (km.DIVERGED, km.STEP_TOO_SMALL, km.MAX_STEPS, km.INVALID_INPUT)
+MIN_SHARE = 16     # lines a task takes at least (a lanes group: kernels.lanes.LANES)
 
 
 @dataclass(frozen=True)
@@ -71,20 +72,50 @@ def _wrap(phase: np.ndarray) -> np.ndarray:
     return np.remainder(phase + math.pi, 2.0 * math.pi) - math.pi
 
 
-def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int, order: np.ndarray,
-                    carry: Carry, dwell: float, solve: Callable[[np.ndarray], dict],
-                    outputs: dict[str, np.ndarray],
-                    advance: Callable[[int], None] | None = None) -> dict[str, np.ndarray]:
+def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int,
+                    orders: list[np.ndarray], carry: Carry, dwell: float,
+                    solve: Callable[[np.ndarray], dict], outputs: list[dict[str, np.ndarray]],
+                    advance: Callable[[int], None] | None = None,
+                    workers: int = 1) -> list[dict[str, np.ndarray]]:
     """Solve every grid point of `rows` (the raw rows of all points, grid C order, shape
-    (prod(shape), columns)) as a stepped sweep along dimension `axis` of the grid, visiting its
-    indices in `order` (`dwell_order`), filling `outputs` (grid order, first axis = points;
-    the names `solve` returns).
+    (prod(shape), columns)) as stepped sweeps along dimension `axis` of the grid, one for each
+    visiting order of its indices in `orders` (`dwell_order`: up, down), filling the matching
+    `outputs` (grid order, first axis = points; the names `solve` returns).
 
-    solve(rows) runs the kernel on a batch of rows and returns its outputs by name; dwell: the
-    dwell time solver.t_end (s); advance(points): progress, called after each dwell.
-    """
+    solve(rows) runs the kernel on a batch of rows (on one thread) and returns its outputs by
+    name; dwell: the dwell time solver.t_end (s); advance(points): progress, called after each
+    dwell; workers: threads. The work is cut into tasks, a direction and a share of the lines
+    (every combination of the other axes' values) each, the lines dealt out in turn so that
+    the shares cost alike (a short span takes more steps than a long one); each task sweeps its
+    lines through all the dwells, so no thread waits for another between dwells. A line's
+    results do not depend on its share or on the number of threads."""
     n_points = rows.shape[0]
     lines = np.moveaxis(np.arange(n_points).reshape(shape), axis, -1).reshape(-1, shape[axis])
+    # shares of at least one lanes group each: fewer lines than that a call leaves lanes idle,
+    # and two such calls side by side took longer than one thread doing both (measured)
+    per_direction = max(1, min(lines.shape[0] // MIN_SHARE, -(-workers // len(orders))))
+    tasks = [(order, lines[i::per_direction], out) for order, out in zip(orders, outputs)
+             for i in range(per_direction)]
+
+    def run(task) -> None:
+        order, share, out = task
+        _sweep_lines(rows, share, order, carry, dwell, solve, out, advance)
+
+    if workers <= 1 or len(tasks) == 1:
+        for task in tasks:
+            run(task)
+        return outputs
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(min(workers, len(tasks)), thread_name_prefix="cable-sweep") as pool:
+        for future in [pool.submit(run, task) for task in tasks]:
+            future.result()
+    return outputs
+
+
+def _sweep_lines(rows: np.ndarray, lines: np.ndarray, order: np.ndarray, carry: Carry,
+                 dwell: float, solve: Callable[[np.ndarray], dict],
+                 outputs: dict[str, np.ndarray], advance: Callable[[int], None] | None) -> None:
+    """The dwells of `lines` (point indices, one line a row, dwells along it) in `order`."""
     columns = list(carry.state)
     start = rows[lines[:, order[0]]][:, columns]       # the scene's initial conditions
     state = start.copy()
@@ -105,7 +136,6 @@ def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int, order: 
         phase_w = np.where(failed, 0.0, _wrap(phase_w + batch[:, carry.load_omega] * dwell))
         if advance is not None:
             advance(points.size)
-    return outputs
 
 
 def jumps(amplitude: np.ndarray, states: np.ndarray, axis: int, order: np.ndarray,

@@ -306,8 +306,9 @@ def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], sy
                  settings: np.ndarray, started: float) -> xr.Dataset:
     """A stepped sweep along inputs.continuation (sweep/models/continuation.py): each
     direction's Dataset, with its `jump` flags; both directions on a `direction` dimension."""
-    from ..execute import Progress
     from ..errors import UserError
+    from ..execute import Progress
+    from ..threads import thread_count
     from . import continuation as ct
     if options.resume:
         raise UserError("--resume: a stepped sweep ([continuation]) is solved in order and "
@@ -318,23 +319,24 @@ def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], sy
     values = inputs.coords[inputs.continuation].values
     directions = ["up", "down"] if inputs.direction == "both" else [inputs.direction]
     rows = system.rows_at(np.arange(n_points))
+    orders = [ct.dwell_order(values, direction) for direction in directions]
     progress = Progress(n_points * len(directions), 0, options.progress)
-    results = []
     try:
-        for direction in directions:
-            order = ct.dwell_order(values, direction)
-            out = ct.solve_continued(
-                rows, shape, axis, order, system.carry, float(settings[tk.T_END]),
-                lambda batch: system.chunk_fn(batch, *system.args, threads=options.threads),
-                system.outputs(n_points), progress.advance)
-            ds = assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
-            flags = ct.jumps(out["reals"][:, tk.AMPLITUDE].reshape(shape),
-                             out["states"].reshape(shape), axis, order, inputs.jump_ratio)
-            ds["jump"] = xr.DataArray(flags, dims=dims,
-                                      attrs=ct.jump_attrs(inputs.continuation, inputs.jump_ratio))
-            results.append(ds)
+        outs = ct.solve_continued(
+            rows, shape, axis, orders, system.carry, float(settings[tk.T_END]),
+            lambda batch: system.chunk_fn(batch, *system.args, threads=1),
+            [system.outputs(n_points) for _ in directions], progress.advance,
+            workers=thread_count(options.threads))
     finally:
         progress.close()
+    results = []
+    for order, out in zip(orders, outs):
+        ds = assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
+        flags = ct.jumps(out["reals"][:, tk.AMPLITUDE].reshape(shape),
+                         out["states"].reshape(shape), axis, order, inputs.jump_ratio)
+        ds["jump"] = xr.DataArray(flags, dims=dims,
+                                  attrs=ct.jump_attrs(inputs.continuation, inputs.jump_ratio))
+        results.append(ds)
     if len(results) == 1:
         ds = results[0]
     else:
