@@ -192,6 +192,43 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
+    """Set up a trajectory at t = 0 from raw row `row` for both multi-mode drivers: the initial
+    state y and f = f(0, y) (length 2N each, written here), SciPy's initial step, the midspan
+    deflection's accumulator acc (trajectory.begin; p1: `observer_row`), each mode's tail
+    amplitude modal (length N) and the divergence test of every mode at t = 0. pp, S, T: the
+    prepared row, the right-hand side's scratch and the tables (modes.prepare, scratch,
+    tables)."""
+    n = n_modes
+    rtol = max(settings[RTOL], dopri5.MIN_RTOL)
+    t_end = settings[T_END]
+    t_tail = t_end * (1.0 - settings[TAIL])
+    for i in range(2 * n):
+        y[i] = row[md.N_FIXED + i]
+    md.derivative(0.0, y, f, S, n, T, base)
+    atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
+    evals = 1.0
+    if settings[FIRST_STEP] > 0.0:
+        h_abs = min(settings[FIRST_STEP], t_end)
+    else:
+        eighth = settings[METHOD] != 0.0
+        order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
+        h_abs = initial_step(y, f, t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
+                             S, n, T, base)
+        evals += 1.0
+    weights = md.midspan_weights(n)
+    fv = _project(f, weights, n, n)
+    a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
+    tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
+             fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
+    for i in range(n):
+        modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
+        if not abs(y[i]) <= row[md.BOUND]:
+            acc[tj.STATUS] = mt.DIVERGED
+            acc[tj.T_STOP] = 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the midspan deflection's metrics
@@ -225,27 +262,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     acc = np.empty(tj.N_SLOTS)
     buf = tj.new_buffer()
 
-    for i in range(dim):
-        y[i] = row[md.N_FIXED + i]
-    md.derivative(0.0, y, K[0], S, n, T, base)
-    atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
-    evals = 1.0
-    if settings[FIRST_STEP] > 0.0:
-        h_abs = min(settings[FIRST_STEP], t_end)
-    else:
-        order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
-        h_abs = initial_step(y, K[0], t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
-                             S, n, T, base)
-        evals += 1.0
-    fv = _project(K[0], weights, n, n)
-    a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
-    tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
-             fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
-    for i in range(n):
-        modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
-        if not abs(y[i]) <= row[md.BOUND]:
-            acc[tj.STATUS] = mt.DIVERGED
-            acc[tj.T_STOP] = 0.0
+    start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, base)
+    atol_q = acc[tj.ATOL_Q]
+    atol_v = acc[tj.ATOL_V]
 
     while True:
         h = tj.next_attempt(settings, acc)

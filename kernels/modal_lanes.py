@@ -52,11 +52,10 @@ from . import modal_driver as drv
 from . import modes as md
 from . import trajectory as tj
 from .lanes import _step_factor
-from .layout import (CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
+from .layout import (CONTROLLER, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
                      N_REALS, RTOL, SAMPLE_DT, TAIL, TOL, T_END, WANT_SETTLING)
 from .oscillator import BOUND, N_PARAMS
 from .transverse import classify_metrics
-from .vecmath import fast_cos, fast_sin
 
 # The vector loops may fuse a * b + c into one fused multiply-add (no reordering).
 _CONTRACT = {"contract"}
@@ -335,9 +334,10 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
                series, modal, final, T, pp, yl, fl, base):
-    """Give lane j the trajectory of row `point`, set up as modal_driver.integrate does (f(0),
-    SciPy's initial step, the midspan accumulator, each mode's tail amplitude and divergence
-    at t = 0). An invalid row is answered at once (modal_driver.solve_point): returns False."""
+    """Give lane j the trajectory of row `point`, set up by the scalar driver's own
+    modal_driver.start (f(0), SciPy's initial step, the midspan accumulator, each mode's tail
+    amplitude and divergence at t = 0). An invalid row is answered at once
+    (modal_driver.solve_point): returns False."""
     L = LANES
     row = params[point]
     dim = 2 * n
@@ -354,10 +354,6 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
             final[point, c] = math.nan
         states[point] = mt.INVALID_INPUT
         return False
-    rtol = max(settings[RTOL], dopri5.MIN_RTOL)
-    t_end = settings[T_END]
-    t_tail = t_end * (1.0 - settings[TAIL])
-    eighth = settings[METHOD] != 0.0
     md.prepare(row, n, pp)
     S = md.scratch(pp, n, T)
     for c in range(pp.shape[0]):
@@ -365,33 +361,13 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
     p1 = drv.observer_row(row, n)
     for c in range(N_PARAMS):
         P1[c * L + j] = p1[c]
+    mod = np.empty(n)
+    drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod, base)
     for c in range(dim):
-        yl[c] = row[md.N_FIXED + c]
         Y[c, j] = yl[c]
-    md.derivative(0.0, yl, fl, S, n, T, base)
-    for c in range(dim):
         K[0, c, j] = fl[c]
-    atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
-    evals = 1.0
-    if settings[FIRST_STEP] > 0.0:
-        h_abs = min(settings[FIRST_STEP], t_end)
-    else:
-        order = dop853.ERROR_ESTIMATOR_ORDER if eighth else dopri5.ERROR_ESTIMATOR_ORDER
-        h_abs = drv.initial_step(yl, fl, t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
-                                 S, n, T, base)
-        evals += 1.0
-    weights = md.midspan_weights(n)
-    fv = drv._project(fl, weights, n, n)
-    a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
-    acc = W[j::L]
-    tj.begin(settings, acc, series[point], drv._project(yl, weights, 0, n),
-             drv._project(yl, weights, n, n), fv, a0, atol_q, atol_v, h_abs, evals,
-             row[md.BOUND])
     for c in range(n):
-        MOD[c, j] = abs(yl[c]) if t_tail <= 0.0 else 0.0
-        if not abs(yl[c]) <= row[md.BOUND]:
-            acc[tj.STATUS] = mt.DIVERGED
-            acc[tj.T_STOP] = 0.0
+        MOD[c, j] = mod[c]
     return True
 
 
