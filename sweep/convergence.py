@@ -92,6 +92,11 @@ class Report:
         return "\n".join(lines)
 
 
+def _plain(value: Any) -> Any:
+    """A coordinate value as a Python scalar (a number, or a label such as 'up')."""
+    return value.item() if hasattr(value, "item") else value
+
+
 def _short(value: Any) -> str:
     return f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
 
@@ -138,7 +143,7 @@ def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.Data
     if not finite.any():
         return Change(metric, math.nan, {}, 0, 0)
     index = np.unravel_index(int(np.nanargmax(np.where(finite, values, -1.0))), values.shape)
-    where = {d: rel[d].values[i].item() for d, i in zip(rel.dims, index) if d in rel.coords}
+    where = {d: _plain(rel[d].values[i]) for d, i in zip(rel.dims, index) if d in rel.coords}
     return Change(metric, float(values[index]), where, int(finite.sum()),
                   int((values[finite] > tolerance).sum()))
 
