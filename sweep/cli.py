@@ -255,7 +255,8 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                 "finishes it)")
     store = store_path(output)
     if not store.exists():
-        return "interrupted before any point was solved; nothing kept, no output written"
+        return ("interrupted before any chunk was kept (a stepped sweep, [continuation], keeps "
+                "none: its steps are solved in order); nothing kept, no output written")
     words = list(sys.argv[1:] if argv is None else argv)
     command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
     kept = (f"{exc.kept:,} of {exc.total:,} points are kept" if hasattr(exc, "kept")
