@@ -24,6 +24,7 @@ import numpy as np
 import xarray as xr
 
 from .errors import UserError
+from .schema import BY_DOTTED
 
 METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
            "absolute_acceleration", "modal_amplitude")
@@ -178,8 +179,10 @@ def mode_convergence(source: str, overrides: Mapping[str, Any] | None = None,
         raise UserError(f"scene '{source}': model.kind = '{scene.get('model.kind')}' has no "
                         "modes to compare (the mode check is for transverse scenes)")
     n = n_modes if n_modes is not None else scene.get("model.modes")
-    if n < 1:
-        raise UserError(f"--modes {n}: must be 1 or more")
+    most = int(BY_DOTTED["model.modes"].maximum)
+    if not 1 <= n <= most - 2:
+        raise UserError(f"--modes {n}: the check runs {n} and {n + 2} modes, and model.modes "
+                        f"is 1 to {most} (give --modes 1 to {most - 2})")
     results = []
     for count in (n, n + 2):
         resolved = load_scene(source, overrides={**overrides, **overrides_for(scene, count)})

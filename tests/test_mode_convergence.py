@@ -144,3 +144,6 @@ def test_sweep_modes_refuses_what_it_cannot_compare(tmp_path, capsys):
     assert main(["modes", "paper-fig5"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "model.modes" in err and "paper" in err
+    assert main(["modes", str(path), "--modes", "11"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--modes 11" in err and "1 to 10" in err
