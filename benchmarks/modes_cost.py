@@ -10,9 +10,9 @@ ratios in [0.5, 2], t in [0, 5] s, rtol 1e-8 (each point's own atol), RK45 (--me
 - "one-mode lanes": N = 1 through sweep.run with model.modes = 1 (kernels.lanes, the
   one-mode oscillator), Dataset building included;
 - "scalar" and "lanes" for N in --modes: the multi-mode System (kernels.modes) on rows built
-  as sweep.run builds them (sweep.models.modal.modes_columns), solved by
-  kernels.modal_driver.solve_block (sweep.threads.solve_modes) and by
-  kernels.modal_lanes.solve_block (on the same sweep.threads.run_blocks), in the same run.
+  as sweep.run builds them (sweep.models.transverse.modal_rows), solved by
+  kernels.modal_driver.solve_block and by kernels.modal_lanes.solve_block, both through
+  sweep.threads.solve_modes as sweep.run calls them, in the same run.
 
 For each: mean accepted steps and right-hand-side evaluations per point (the kernels' own
 counts), wall time per point on one thread, trajectories/s on 1 and 2 threads (--threads),
@@ -43,12 +43,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common
 from bench_common import markdown_table  # noqa: E402
 
 import sweep  # noqa: E402
-from sweep import grid  # noqa: E402
 from sweep.kernels import layout as tk  # noqa: E402
-from sweep.kernels import modes as md  # noqa: E402
-from sweep.models import modal  # noqa: E402
 from sweep.models import transverse as tm  # noqa: E402
-from sweep.threads import run_blocks, solve_modes  # noqa: E402
+from sweep.threads import solve_modes  # noqa: E402
 
 SCENE = """
 name = "modes-cost"
@@ -85,24 +82,14 @@ def scene_text(n: int, method: str, points: int, threads: int = 1) -> str:
 def modes_rows(text: str, n: int) -> tuple[np.ndarray, np.ndarray]:
     """(rows in kernels.modes columns, settings) of the scene's grid, as sweep.run builds them."""
     inputs = tm.resolve(sweep.load_scene_text(text))
-    points = np.arange(int(np.prod(inputs.shape)))
-    at = grid.point_values(inputs.params, inputs.dims, inputs.shape, points)
-
-    def per_point(values: tuple) -> list:
-        return [grid.point_values({"v": v}, inputs.dims, inputs.shape, points)["v"]
-                for v in values]
-
-    columns = modal.modes_columns(at, modal.oscillator(at), n, per_point(inputs.modal_q0),
-                                  per_point(inputs.modal_v0))
-    names = md.FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n + 1)) + tuple(
-        f"v0_{i}" for i in range(1, n + 1))
-    return grid.rows(columns, names, points.size), inputs.settings.copy()
+    assert inputs.n_modes == n
+    rows = tm.modal_rows(inputs, np.arange(int(np.prod(inputs.shape))))
+    return rows, inputs.settings.copy()
 
 
 def solve(driver: str, rows: np.ndarray, n: int, s: np.ndarray, threads: int) -> tuple:
-    """(wall time in s, counts) of one driver over every row on `threads` threads."""
-    from sweep.kernels import metrics as mt
-    from sweep.kernels import modal_driver, modal_lanes
+    """(wall time in s, counts) of one driver over every row on `threads` threads, through
+    sweep.threads.solve_modes as sweep.run calls it."""
     m = rows.shape[0]
     states = np.empty(m, np.int8)
     reals = np.empty((m, tk.N_REALS))
@@ -110,19 +97,9 @@ def solve(driver: str, rows: np.ndarray, n: int, s: np.ndarray, threads: int) ->
     series = np.empty((m, 0))
     modal_amp = np.empty((m, n))
     final = np.empty((m, 2 * n))
-    base = True if s[tk.BASE] != 0.0 else None
     began = time.perf_counter()
-    if driver == "scalar":
-        solve_modes(rows, n, s, states, reals, counts, series, modal_amp, final,
-                    driver="scalar", threads=threads)
-    else:
-        def block(lo: int, hi: int) -> None:
-            modal_lanes.solve_block(rows, n, s, lo, hi, states, reals, counts, series,
-                                    modal_amp, final, base)
-            if np.any(states[lo:hi] == mt.SECOND_PASS):
-                modal_driver.settle_second_pass(rows[lo:hi], n, s, states[lo:hi],
-                                                reals[lo:hi], counts[lo:hi], base)
-        run_blocks(block, m, threads, None)
+    solve_modes(rows, n, s, states, reals, counts, series, modal_amp, final, driver=driver,
+                threads=threads)
     return time.perf_counter() - began, counts
 
 

@@ -51,7 +51,7 @@ def observer_row(row, n_modes):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def valid(row, n_modes):
     """Whether a raw multi-mode row can be integrated: finite, w1^2 > 0 and bound > 0."""
-    for j in range(row.shape[0]):
+    for j in range(md.n_columns(n_modes)):
         if not math.isfinite(row[j]):
             return False
     return row[md.W1_SQ] > 0.0 and row[md.BOUND] > 0.0
@@ -246,7 +246,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
     T = md.tables(n)
-    pp = np.empty(4 * n + md.N_SCALARS)
+    pp = np.empty(md.prepared_size(n))
     md.prepare(row, n, pp)
     S = md.scratch(pp, n, T)
     p1 = observer_row(row, n)
@@ -308,7 +308,7 @@ def at_rest(row, n_modes, t, y, band, base):
     for one mode)."""
     n = n_modes
     T = md.tables(n)
-    pp = np.empty(4 * n + md.N_SCALARS)
+    pp = np.empty(md.prepared_size(n))
     md.prepare(row, n, pp)
     S = md.scratch(pp, n, T)
     z = np.empty(2 * n)

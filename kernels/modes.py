@@ -63,8 +63,9 @@ FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", 
                "base_phase", "load_phase")
 
 
-def n_columns(n_modes: int) -> int:
-    """Columns of a raw row for n_modes modes."""
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def n_columns(n_modes):
+    """Columns of a raw row for n_modes modes (callable from Python and from the kernels)."""
     return N_FIXED + 2 * n_modes
 
 
@@ -86,12 +87,14 @@ S_LOAD_PHASE = 8
 N_SCALARS = 9
 
 
-def prepared_size(n_modes: int) -> int:
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def prepared_size(n_modes):
     """Length of a prepared row for n_modes modes."""
     return 4 * n_modes + N_SCALARS
 
 
-def intervals(n_modes: int) -> int:
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def intervals(n_modes):
     """M, the trapezoidal rule's intervals on [0, pi] that make the projection exact: 3N + 1."""
     return 3 * n_modes + 1
 
@@ -101,7 +104,7 @@ def tables(n_modes):
     """The mode shapes at the quadrature nodes xi_j = j pi / M, j = 1..M - 1, M = 3N + 1:
     T[0, n - 1, j - 1] = n cos(n xi_j) (a), T[1] = -n^2 sin (b), T[2] = -n^3 cos (c),
     T[3] = n^4 sin (d), T[4] = (2 / M) sin(n xi_j) (the projection's weights)."""
-    m = 3 * n_modes + 1
+    m = intervals(n_modes)
     t = np.empty((5, n_modes, m - 1))
     for i in range(n_modes):
         n = i + 1.0

@@ -6,8 +6,8 @@ more rows than lanes so that lanes take new points as theirs end), plus a row th
 and an invalid one (NaN): the same states, step counts within a few, the metrics and modal
 amplitudes equal to round-off. Round-off here is what these trajectories make of it,
 measured as test_lanes.py does for one mode: the scalar driver's own results with q_1(0)
-moved by one ulp either way. The rows are built from cable data by the model's own
-modes_columns (sweep/models/modal.py), as sweep.run builds them.
+moved by one ulp either way. The rows are built from cable data as sweep.run builds them
+(sweep.models.transverse.modal_rows).
 """
 
 from __future__ import annotations
@@ -16,31 +16,19 @@ import numpy as np
 import pytest
 
 import sweep
-from sweep import grid
 from sweep.kernels import layout as tk
 from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
-from sweep.models import modal
 from sweep.models import transverse as tm
 
 
 def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
     """(rows in kernels.modes columns, settings, samples per series) of a scene's grid."""
     inputs = tm.resolve(sweep.load_scene_text(text))
-    points = np.arange(int(np.prod(inputs.shape)))
-    at = grid.point_values(inputs.params, inputs.dims, inputs.shape, points)
-
-    def per_point(values: tuple) -> list:
-        return [grid.point_values({"v": v}, inputs.dims, inputs.shape, points)["v"]
-                for v in values]
-
-    columns = modal.modes_columns(at, modal.oscillator(at), n_modes, per_point(inputs.modal_q0),
-                                  per_point(inputs.modal_v0))
-    names = md.FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n_modes + 1)) + tuple(
-        f"v0_{i}" for i in range(1, n_modes + 1))
-    return grid.rows(columns, names, points.size), inputs.settings.copy(), \
-        inputs.sample_times.size
+    assert inputs.n_modes == n_modes
+    rows = tm.modal_rows(inputs, np.arange(int(np.prod(inputs.shape))))
+    return rows, inputs.settings.copy(), inputs.sample_times.size
 
 
 def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int) -> tuple:

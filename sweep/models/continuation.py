@@ -13,9 +13,10 @@ on its own tail window, as for an independent point. The first dwell starts from
 initial conditions; so does a dwell after one that failed (diverged, step too small, too many
 steps), its phases from zero: there is no final state to carry on.
 
-The other axes stay parallel: dwell k of every line (every combination of the other axes'
-values) is solved in one kernel call on every thread, then dwell k + 1, so a 100-length x 400-
-frequency stepped map makes 400 calls of 100 points. Directions: "up" (increasing axis values),
+The other axes stay parallel: the lines (every combination of the other axes' values) are
+dealt out to the threads, each sweeping its share through every dwell with one kernel call a
+dwell (`solve_continued`), so a 100-length x 400-frequency stepped map still uses every core.
+Directions: "up" (increasing axis values),
 "down" (decreasing) or "both" (a `direction` dimension, up then down, each from the initial
 conditions). Results are stored in the axis's own order whatever the direction.
 

@@ -30,6 +30,8 @@ from . import modal
 
 KIND = "transverse"
 MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
+BASE_OUTPUTS = ("absolute_acceleration", "absolute_acceleration_g", "transmissibility")
+"""The variables `base_outputs` makes, in its order."""
 ATOL_SCALE = 0.01              # default atol: this x rtol x each point's own scales (m, m/s)
 
 # name -> (kernel column, units, long_name, scene output switch)
@@ -254,8 +256,27 @@ class _System:
     carry: Any
 
 
+def modal_rows(inputs: Inputs, points: np.ndarray) -> np.ndarray:
+    """The raw rows (kernels.modes columns) of the N-mode System, N = inputs.n_modes (1 too),
+    at grid points `points` (flat indices): what a run with model.modes >= 2 solves; tests and
+    benchmarks take their rows from here."""
+    from sweep.kernels import modes as md
+    dims, shape, params, n = inputs.dims, inputs.shape, inputs.params, inputs.n_modes
+    names = md.FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n + 1)) + tuple(
+        f"v0_{i}" for i in range(1, n + 1))
+
+    def values_at(modal_values: tuple) -> list:
+        return [grid.point_values({"v": v}, dims, shape, points)["v"] for v in modal_values]
+
+    at = grid.point_values(params, dims, shape, points)
+    columns = modal.modes_columns(at, modal.oscillator(at), n, values_at(inputs.modal_q0),
+                                  values_at(inputs.modal_v0))
+    return grid.rows(columns, names, points.size)
+
+
 def _system(inputs: Inputs, settings: np.ndarray) -> _System:
-    """The _System of `inputs`: the one-mode oscillator (model.modes = 1) or the N-mode model."""
+    """How the runner drives the System of `inputs`: the one-mode oscillator (model.modes = 1)
+    or the N-mode model (`modal_rows`)."""
     from sweep.kernels import modes as md
     from sweep.kernels import oscillator as osc
 
@@ -275,24 +296,12 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
         return _System(rows_at, transverse_chunk, (settings, n_samples, inputs.driver),
                        lambda m: transverse_outputs(m, n_samples), carry)
 
-    names = md.FIXED_NAMES + tuple(f"q0_{i}" for i in range(1, n + 1)) + tuple(
-        f"v0_{i}" for i in range(1, n + 1))
-
-    def values_at(points: np.ndarray, modal_values: tuple) -> list:
-        return [grid.point_values({"v": v}, dims, shape, points)["v"] for v in modal_values]
-
-    def modes_rows_at(points: np.ndarray) -> np.ndarray:
-        at = grid.point_values(params, dims, shape, points)
-        columns = modal.modes_columns(at, modal.oscillator(at), n,
-                                      values_at(points, inputs.modal_q0),
-                                      values_at(points, inputs.modal_v0))
-        return grid.rows(columns, names, points.size)
-
     carry = None if inputs.continuation is None else Carry(
         state=tuple(range(md.N_FIXED, md.N_FIXED + 2 * n)), base_phase=md.BASE_PHASE,
         load_phase=md.LOAD_PHASE, base_omega=md.BASE_OMEGA, load_omega=md.OMEGA,
         final=lambda out: out["final"])
-    return _System(modes_rows_at, modes_chunk, (settings, n_samples, n, inputs.driver),
+    return _System(lambda points: modal_rows(inputs, points), modes_chunk,
+                   (settings, n_samples, n, inputs.driver),
                    lambda m: modes_outputs(m, n_samples, n), carry)
 
 
@@ -353,7 +362,7 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...],
     `direction` dimension, the rest (closed forms of the parameters) once."""
     from . import continuation as ct
     first = results[0]
-    solved = {"state", "jump", "modal_amplitude", *_REALS, *_COUNTS, *base_outputs_names()}
+    solved = {"state", "jump", "modal_amplitude", *_REALS, *_COUNTS, *BASE_OUTPUTS}
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
     ds = first.drop_vars(per_point).merge(stacked)
@@ -383,8 +392,7 @@ def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
         ratio = xr.where(level > 0, absolute / level, np.nan).transpose(*dims)
     ratio.attrs = {"units": "1", "long_name": "transmissibility: absolute midspan "
                                                "acceleration amplitude over the base level A"}
-    return {"absolute_acceleration": absolute, "absolute_acceleration_g": in_g,
-            "transmissibility": ratio}
+    return dict(zip(BASE_OUTPUTS, (absolute, in_g, ratio)))
 
 
 def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...],
@@ -402,11 +410,6 @@ def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[in
     frequency.attrs = {"units": "Hz", "long_name": "linear natural frequency of mode n of the "
                                                   "unloaded span, n^2 f1"}
     return {"modal_amplitude": amplitude, "modal_frequency": frequency}
-
-
-def base_outputs_names() -> tuple[str, ...]:
-    """The names of `base_outputs`' variables."""
-    return ("absolute_acceleration", "absolute_acceleration_g", "transmissibility")
 
 
 def state_attrs() -> dict[str, Any]:
