@@ -155,9 +155,10 @@ def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, S, n_modes,
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _mode_extremum(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
-    """q_i at its extremum inside the accepted step (its interpolant's root of q_i') and where
-    (x = (t - t_old)/h): Km (n_stages + 1, 2) and Qm (2, 5) are scratch."""
+def _mode_interpolant(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
+    """Qm (2, 5): mode i's dense output over the accepted step (RK45's quartic from the stages,
+    DOP853's quintic Hermite), in dopri5.dense_coefficients' layout; Km (n_stages + 1, 2) is
+    scratch."""
     last = K.shape[0] - 1
     if eighth:
         dop853.hermite_coefficients(y[i], y[n_modes + i], K[0, n_modes + i], y_new[i],
@@ -167,8 +168,6 @@ def _mode_extremum(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
             Km[j, 0] = K[j, i]
             Km[j, 1] = K[j, n_modes + i]
         dopri5.dense_coefficients(Km, Qm)
-    x = dopri5.dense_root(y[n_modes + i], h, Qm[1], 0.0, 0.0, 1.0)
-    return dopri5.dense_value(y[i], h, Qm[0], x), x
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -183,12 +182,14 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         turns = (v0 > 0.0 and v1 <= 0.0) or (v0 < 0.0 and v1 >= 0.0)
         starts = t < t_tail <= t_new
         if turns or starts:
-            qe, x = _mode_extremum(y, y_new, K, h, i, n_modes, eighth, Km, Qm)
-            if turns and t + x * h >= t_tail:
-                modal[i] = max(modal[i], abs(qe))
-            if starts:
-                qt = dopri5.dense_value(y[i], h, Qm[0], (t_tail - t) / h)
-                modal[i] = max(modal[i], abs(qt))
+            _mode_interpolant(y, y_new, K, h, i, n_modes, eighth, Km, Qm)
+        if turns:                     # the extremum: where the interpolant's q_i' is 0
+            x = dopri5.dense_root(y[n_modes + i], h, Qm[1], 0.0, 0.0, 1.0)
+            if t + x * h >= t_tail:
+                modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, Qm[0], x)))
+        if starts:
+            qt = dopri5.dense_value(y[i], h, Qm[0], (t_tail - t) / h)
+            modal[i] = max(modal[i], abs(qt))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
