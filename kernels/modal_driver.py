@@ -23,6 +23,7 @@ import numba as nb
 import numpy as np
 
 from . import dop853
+from . import excitation as ex
 from . import dopri5
 from . import metrics as mt
 from . import modes as md
@@ -42,8 +43,8 @@ def observer_row(row, n_modes):
     p[osc.BOUND] = row[md.BOUND]
     p[osc.Q_SCALE] = row[md.Q_SCALE]
     p[osc.V_SCALE] = row[md.V_SCALE]
-    p[osc.BASE_ACCEL] = row[md.BASE_ACCEL]
-    p[osc.BASE_OMEGA] = row[md.BASE_OMEGA]
+    for c in range(ex.SIZE):
+        p[osc.EXCITATION + c] = row[md.EXCITATION + c]
     p[osc.PARTICIPATION] = row[md.PARTICIPATION]
     return p
 

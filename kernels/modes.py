@@ -38,6 +38,7 @@ import math
 import numba as nb
 import numpy as np
 
+from . import excitation as ex
 from .vecmath import fast_cos, fast_sin
 
 # Columns of a raw multi-mode row.
@@ -51,16 +52,16 @@ OMEGA = 6           # W, the load's angular frequency                           
 BOUND = 7           # |q_n| (and |midspan deflection|) beyond which a point diverged  (m)
 Q_SCALE = 8         # the point's displacement scale (sweep.models.modal.state_scale) (m)
 V_SCALE = 9         # its velocity scale                                            (m/s)
-BASE_ACCEL = 10     # A, base acceleration amplitude                                (m/s^2)
-BASE_OMEGA = 11     # w_b, base angular frequency                                   (rad/s)
-PARTICIPATION = 12  # Gamma_1 = 4 / pi (0 without base excitation); mode n: Gamma_1 / n, odd n
-BASE_PHASE = 13     # phi_b: a_b(t) = A sin(w_b t + phi_b) (a stepped sweep's carried phase) (rad)
-LOAD_PHASE = 14     # phi_W: P(t) = P0 cos(W t + phi_W)                                    (rad)
-N_FIXED = 15        # then q_n(0) (m) for n = 1..N, then q_n'(0) (m/s) for n = 1..N
+PARTICIPATION = 10  # Gamma_1 = 4 / pi (0 without base excitation); mode n: Gamma_1 / n, odd n
+LOAD_PHASE = 11     # phi_W: P(t) = P0 cos(W t + phi_W)                                    (rad)
+EXCITATION = 12     # the base excitation block (kernels.excitation): a_b(t), fixed or swept
+BASE_ACCEL = EXCITATION + ex.ACCEL   # A, base acceleration amplitude                     (m/s^2)
+BASE_OMEGA = EXCITATION + ex.OMEGA   # w_b, base angular frequency (a sweep's start)      (rad/s)
+BASE_PHASE = EXCITATION + ex.PHASE   # phi_b (a stepped sweep's carried phase)            (rad)
+N_FIXED = EXCITATION + ex.SIZE       # then q_n(0) (m) for n = 1..N, then q_n'(0) (m/s)
 
 FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", "omega",
-               "bound", "q_scale", "v_scale", "base_accel", "base_omega", "participation",
-               "base_phase", "load_phase")
+               "bound", "q_scale", "v_scale", "participation", "load_phase") + ex.NAMES
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -80,11 +81,12 @@ S_BETA_Q = 1        # beta_q = w1^2 k^4                                         
 S_BETA_M0 = 2       # beta_m's constant part: 4 alpha EA k^4/rho A + 2 k^2 P_mean k^2/rho A
 S_BETA_M1 = 3       # beta_m's cos(W t) part: 2 k^2 P0 k^2 / rho A
 S_OMEGA = 4
-S_BASE_ACCEL = 5
-S_BASE_OMEGA = 6
-S_BASE_PHASE = 7
-S_LOAD_PHASE = 8
-N_SCALARS = 9
+S_LOAD_PHASE = 5
+S_EXCITATION = 6    # the excitation block, copied from the raw row
+S_BASE_ACCEL = S_EXCITATION + ex.ACCEL
+S_BASE_OMEGA = S_EXCITATION + ex.OMEGA
+S_BASE_PHASE = S_EXCITATION + ex.PHASE
+N_SCALARS = S_EXCITATION + ex.SIZE
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -147,17 +149,15 @@ def prepare(row, n_modes, pp):
     pp[s + S_BETA_M0] = row[MEMBRANE] + 2.0 * k2 * row[LOAD_MEAN]
     pp[s + S_BETA_M1] = 2.0 * k2 * row[LOAD_COS]
     pp[s + S_OMEGA] = row[OMEGA]
-    pp[s + S_BASE_ACCEL] = row[BASE_ACCEL]
-    pp[s + S_BASE_OMEGA] = row[BASE_OMEGA]
-    pp[s + S_BASE_PHASE] = row[BASE_PHASE]
     pp[s + S_LOAD_PHASE] = row[LOAD_PHASE]
+    for c in range(ex.SIZE):
+        pp[s + S_EXCITATION + c] = row[EXCITATION + c]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def base_acceleration(t, pp, n_modes):
-    """a_b(t) = A sin(w_b t + phi_b) (m/s^2) of a prepared row."""
-    s = 4 * n_modes
-    return pp[s + S_BASE_ACCEL] * math.sin(pp[s + S_BASE_OMEGA] * t + pp[s + S_BASE_PHASE])
+    """a_b(t) (m/s^2) of a prepared row (kernels.excitation)."""
+    return ex.acceleration(t, pp, 4 * n_modes + S_EXCITATION, 1)
 
 
 # The right-hand side may fuse a * b + c into one fused multiply-add (no reordering): the lanes
@@ -185,9 +185,15 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base):
         SC[0, l] = cw
         SC[1, l] = PP[sc + S_BETA_M0, l] + PP[sc + S_BETA_M1, l] * cw
     if base is not None:
-        for l in range(n_run):
-            x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]
-            SC[2, l] = PP[sc + S_BASE_ACCEL, l] * (math.sin(x) if fast is None else fast_sin(x))
+        if fast is None:                # libm, and any excitation (kernels.excitation)
+            flat = PP.reshape(PP.size)
+            lanes = PP.shape[1]
+            for l in range(n_run):
+                SC[2, l] = ex.acceleration(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes)
+        else:                           # the lanes: fixed frequency and level, vectorised
+            for l in range(n_run):
+                x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]
+                SC[2, l] = PP[sc + S_BASE_ACCEL, l] * fast_sin(x)
     for j in range(nodes):
         t0 = T[0, 0, j]
         t1 = T[1, 0, j]

@@ -48,6 +48,7 @@ import math
 
 import numba as nb
 
+from . import excitation as ex
 from .stages import InlineWhereTrue
 from .vecmath import fast_cos, fast_sin
 
@@ -65,16 +66,16 @@ V0 = 9          # q'(0)                                     (m/s)
 BOUND = 10      # |q| beyond which the point is diverged    (m)
 Q_SCALE = 11    # the point's displacement scale            (m)
 V_SCALE = 12    # the point's velocity scale                (m/s)
-BASE_ACCEL = 13     # A    base acceleration amplitude      (m/s^2 peak)
-BASE_OMEGA = 14     # w_b  base angular frequency           (rad/s)
-PARTICIPATION = 15  # G    participation factor of the mode (1)
-BASE_PHASE = 16     # phi_b base excitation phase at t = 0   (rad; a stepped sweep's carried
-LOAD_PHASE = 17     # phi_W load phase at t = 0               phases, else 0)
-N_PARAMS = 18
+PARTICIPATION = 13  # G    participation factor of the mode (1)
+LOAD_PHASE = 14     # phi_W load phase at t = 0 (rad; a stepped sweep's carried phase, else 0)
+EXCITATION = 15     # the base excitation block (kernels.excitation: a_b(t), fixed or swept)
+BASE_ACCEL = EXCITATION + ex.ACCEL  # A    base acceleration amplitude      (m/s^2 peak)
+BASE_OMEGA = EXCITATION + ex.OMEGA  # w_b  base angular frequency (a sweep's start, rad/s)
+BASE_PHASE = EXCITATION + ex.PHASE  # phi_b base excitation phase at t = 0   (rad)
+N_PARAMS = EXCITATION + ex.SIZE
 
 PARAM_NAMES = ("mass", "damping", "k0", "k1", "g0", "g1", "h", "omega", "q0", "v0", "bound",
-               "q_scale", "v_scale", "base_accel", "base_omega", "participation", "base_phase",
-               "load_phase")
+               "q_scale", "v_scale", "participation", "load_phase") + ex.NAMES
 
 # The columns `prepare` divides by -m.
 FORCE_COLUMNS = (DAMPING, K0, K1, G0, G1, H)
@@ -102,10 +103,13 @@ def prepare(row, p, o, s):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4))
 def base_acceleration(t, p, o, s, fast):
-    """a_b(t) = A sin(w_b t + phi_b) (m/s^2): the clamps' acceleration at time t (s)."""
-    x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
+    """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation
+    block's own (kernels.excitation: fixed or swept frequency, constant or tabled level);
+    fast True (the lanes, which take fixed-frequency, fixed-level rows only):
+    A sin(w_b t + phi_b) with vecmath's fast_sin."""
     if fast is None:
-        return p[o + BASE_ACCEL * s] * math.sin(x)
+        return ex.acceleration(t, p, o + EXCITATION * s, s)
+    x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
     return p[o + BASE_ACCEL * s] * fast_sin(x)
 
 

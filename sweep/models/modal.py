@@ -27,6 +27,8 @@ import numpy as np
 import xarray as xr
 
 from ..schema import STANDARD_GRAVITY
+from . import excitation
+from .excitation import EXCITATION_NAMES
 
 # Eq.32 as printed (SI, P0 = 4 N).
 PAPER_LOAD = 4.0                      # N, the load Eq.32 was printed for
@@ -179,34 +181,61 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     out.update(base)
     out["base_phase"] = 0.0              # a stepped sweep's carried phases (continuation.py)
     out["load_phase"] = 0.0
-    if base["participation"] != 0.0:
-        out.update(base_response(base["base_accel"], base["base_omega"], c["omega_1"],
-                                 p["damping_ratio"]))
+    swept = p.get("base_sweep_start") is not None
+    level, omega_b = base["base_accel"], base["base_omega"]
+    if base["participation"] != 0.0 and not swept:
+        out.update(base_response(level, omega_b, c["omega_1"], p["damping_ratio"]))
+    if swept:                     # the scales of the sweep's largest level, lowest frequency
+        start, stop, rate = p["base_sweep_start"], p["base_sweep_stop"], p["base_sweep_rate"]
+        out["sweep_duration"] = excitation.sweep_duration(start, stop, rate)
+        levels = p.get("base_levels_g")
+        if levels is not None:
+            level = max(b[1] for b in levels) * STANDARD_GRAVITY
+        omega_b = 2.0 * np.pi * np.minimum(start, stop)
+    out["scale_forcing"] = base["participation"] * level     # (m/s^2, rad/s): state_scale's
+    out["scale_omega"] = omega_b
     out["q_scale"], out["v_scale"] = state_scale(
-        out["q0"], out["v0"], c["omega_1"], out["bound"],
-        base["participation"] * base["base_accel"], base["base_omega"])
+        out["q0"], out["v0"], c["omega_1"], out["bound"], out["scale_forcing"], omega_b)
     return out
 
 
 def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
-    """The kernel's base-excitation columns from p's base keys (by axis name, None if absent).
+    """The kernel's base-excitation columns from p's base keys (by axis name, None if absent):
+    participation Gamma = 4/pi and kernels.excitation's block (`excitation.block`).
 
-    base_accel: A (m/s^2), from base_acceleration (m/s^2) or base_acceleration_g times
-    STANDARD_GRAVITY; base_omega: 2 pi f (rad/s), from base_frequency (Hz) or
-    base_frequency_ratio times omega_1 (rad/s, the unloaded span's w1); participation: Gamma =
-    4/pi. All three 0.0 when p has no base level (no [base] table).
-    """
-    if p.get("base_acceleration") is not None:
-        accel = p["base_acceleration"]
-    elif p.get("base_acceleration_g") is not None:
-        accel = p["base_acceleration_g"] * STANDARD_GRAVITY
-    else:
-        return {"base_accel": 0.0, "base_omega": 0.0, "participation": 0.0}
+    Level: base_acceleration (m/s^2), base_acceleration_g times STANDARD_GRAVITY, or the table
+    base_levels_g ((Hz, g) breakpoints, log-log). Frequency: base_frequency (Hz),
+    base_frequency_ratio times omega_1 (rad/s, the unloaded span's w1), or a logarithmic sweep
+    base_sweep_start -> base_sweep_stop (Hz) at base_sweep_rate (octaves per minute), which
+    ends after its duration (`excitation.sweep_duration`). Every column 0 when p has no base
+    level (no [base] table)."""
+    levels = p.get("base_levels_g")
+    if p.get("base_acceleration") is None and p.get("base_acceleration_g") is None \
+            and levels is None:
+        return {"participation": 0.0, **excitation.block(0.0, 0.0)}
+    start = p.get("base_sweep_start")
+    if start is not None:
+        stop, rate = p["base_sweep_stop"], p["base_sweep_rate"]
+        omega = 2.0 * np.pi * start
+        lam = excitation.sweep_rate(start, stop, rate)
+        end = excitation.sweep_duration(start, stop, rate)
+        accel = 0.0 if levels is not None else _level(p)
+        return {"participation": PARTICIPATION,
+                **excitation.block(accel, omega, lam, end, levels)}
     if p.get("base_frequency") is not None:
         omega = 2.0 * np.pi * p["base_frequency"]
     else:
         omega = p["base_frequency_ratio"] * omega_1
-    return {"base_accel": accel, "base_omega": omega, "participation": PARTICIPATION}
+    accel = (excitation.table_level(levels, omega / (2.0 * np.pi)) if levels is not None
+             else _level(p))
+    return {"participation": PARTICIPATION, **excitation.block(accel, omega)}
+
+
+def _level(p: Mapping[str, Any]) -> Any:
+    """A constant base level (m/s^2) from base_acceleration or base_acceleration_g (g)."""
+    if p.get("base_acceleration") is not None:
+        return p["base_acceleration"]
+    return p["base_acceleration_g"] * STANDARD_GRAVITY
 
 
 def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> dict[str, Any]:
@@ -268,17 +297,14 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
         "k_sq": k ** 2,
         "omega": one_mode["omega"],
         "bound": one_mode["bound"],
-        "base_accel": one_mode["base_accel"],
-        "base_omega": one_mode["base_omega"],
         "participation": one_mode["participation"],
-        "base_phase": 0.0,
         "load_phase": 0.0,
+        **{name: one_mode[name] for name in EXCITATION_NAMES},
     }
     q_max = np.max(np.abs(np.broadcast_arrays(*[np.asarray(q, float) for q in q0])), axis=0)
     v_max = np.max(np.abs(np.broadcast_arrays(*[np.asarray(v, float) for v in v0])), axis=0)
     out["q_scale"], out["v_scale"] = state_scale(
-        q_max, v_max, w1, out["bound"], one_mode["participation"] * one_mode["base_accel"],
-        one_mode["base_omega"])
+        q_max, v_max, w1, out["bound"], one_mode["scale_forcing"], one_mode["scale_omega"])
     for n in range(n_modes):
         out[f"q0_{n + 1}"] = q0[n]
         out[f"v0_{n + 1}"] = v0[n]

@@ -1,0 +1,84 @@
+"""The base excitation signal a_b(t) (m/s^2), written once for every System (docs/model.md
+sec. 5 and 6).
+
+    a_b(t) = A(t) sin(phi(t))
+    phi(t) = phi_b + w_b t                          fixed frequency (RATE = 0)
+    phi(t) = phi_b + w_b (exp(lam t) - 1) / lam     logarithmic sweep from w_b at rate lam
+
+A logarithmic sweep from f_s to f_e at r octaves per minute has lam = s r ln 2 / 60 (1/s),
+s = +1 up, -1 down: its frequency is f(t) = f_s exp(lam t) and it lasts T = ln(f_e/f_s) / lam.
+
+The level A(t) is the constant ACCEL, or (SEGMENTS > 0) a table of segments in the log of
+the excitation frequency, u(t) = ln w(t) = LOG_OMEGA + lam t: on segment k, which starts at
+u = EDGE[k], ln A = LOG_LEVEL[k] + SLOPE[k] (u - EDGE[k]) (A in m/s^2). That is a table of
+(frequency, level) breakpoints interpolated log-log, read along the sweep whichever way it
+runs. After END (s; the sweep's end) the clamps stop: a_b = 0.
+
+The columns form one block, read as p[o + column * s] from its first column (the accessor of
+kernels.oscillator: o the block's first slot, s the stride), so each System places the block
+where it likes in its rows and calls `acceleration` on it. Units: t in s.
+"""
+
+import math
+
+import numba as nb
+
+# Columns of the excitation block, relative to its first column.
+ACCEL = 0           # A, the constant level (m/s^2 peak; read when SEGMENTS = 0)
+OMEGA = 1           # w_b, the frequency, a sweep's start frequency (rad/s)
+PHASE = 2           # phi_b, the phase at t = 0 (rad; a stepped sweep's carried phase)
+RATE = 3            # lam, the sweep rate (1/s): w(t) = w_b exp(lam t); 0 for a fixed frequency
+SEGMENTS = 4        # number of level segments (0: the constant ACCEL)
+END = 5             # with SEGMENTS > 0: a_b = 0 after this time (s)
+LOG_OMEGA = 6       # ln w_b (w_b in rad/s), with SEGMENTS > 0
+MAX_SEGMENTS = 8    # room for this many segments (a level table of up to 9 breakpoints)
+EDGE = 7                            # segment k starts at u = p[EDGE + k] (ln of rad/s)
+LOG_LEVEL = EDGE + MAX_SEGMENTS     # ln A there (A in m/s^2)
+SLOPE = LOG_LEVEL + MAX_SEGMENTS    # d ln A / d ln w on the segment (1)
+SIZE = SLOPE + MAX_SEGMENTS
+
+NAMES = (("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments",
+          "sweep_end", "log_base_omega")
+         + tuple(f"level_edge_{k}" for k in range(MAX_SEGMENTS))
+         + tuple(f"level_log_{k}" for k in range(MAX_SEGMENTS))
+         + tuple(f"level_slope_{k}" for k in range(MAX_SEGMENTS)))
+"""The block's column names, in order (sweep.models.modal.base_excitation gives them)."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def phase(t, p, o, s):
+    """phi(t) (rad) of the excitation block at p[o + column * s], at time t (s)."""
+    lam = p[o + RATE * s]
+    if lam == 0.0:
+        return p[o + OMEGA * s] * t + p[o + PHASE * s]
+    return p[o + OMEGA * s] * (math.expm1(lam * t) / lam) + p[o + PHASE * s]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def level(t, p, o, s):
+    """A(t) (m/s^2 peak) of the excitation block at p[o + column * s], at time t (s)."""
+    n = int(p[o + SEGMENTS * s])
+    if n == 0:
+        return p[o + ACCEL * s]
+    if t > p[o + END * s]:
+        return 0.0
+    u = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t
+    k = 0
+    while k + 1 < n and u >= p[o + (EDGE + k + 1) * s]:
+        k += 1
+    return math.exp(p[o + (LOG_LEVEL + k) * s]
+                    + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def acceleration(t, p, o, s):
+    """a_b(t) = A(t) sin(phi(t)) (m/s^2) of the excitation block at p[o + column * s], with
+    libm's sin (the scalar drivers; the lanes drivers take only fixed-frequency, fixed-level
+    rows and evaluate A sin(w_b t + phi_b) in their vector loops)."""
+    return level(t, p, o, s) * math.sin(phase(t, p, o, s))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def frequency(t, p, o, s):
+    """The excitation frequency f(t) (Hz) of the block at p[o + column * s] at time t (s)."""
+    return p[o + OMEGA * s] / (2.0 * math.pi) * math.exp(p[o + RATE * s] * t)

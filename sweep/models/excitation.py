@@ -1,0 +1,95 @@
+"""Base excitation of the clamps as the kernels take it (kernels.excitation's block of
+columns): a fixed frequency or a logarithmic sine sweep, a constant level or a table of
+(frequency, level) breakpoints interpolated log-log (docs/model.md secs. 5 and 6).
+
+A sweep from f_s to f_e (Hz) at r octaves per minute (down when f_e < f_s) has
+
+    lam = s r ln 2 / 60 (1/s), s = sign(ln(f_e / f_s)),   f(t) = f_s exp(lam t),
+    T = 60 |log2(f_e / f_s)| / r (s),   phi(t) = 2 pi f_s (exp(lam t) - 1) / lam.
+
+Every function works element-wise on floats, NumPy arrays or xarray DataArrays.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Sequence
+
+import numpy as np
+
+from ..schema import STANDARD_GRAVITY
+
+EXCITATION_NAMES: tuple[str, ...] = (
+    ("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments", "sweep_end",
+     "log_base_omega") + tuple(f"level_{what}_{k}" for what in ("edge", "log", "slope")
+                               for k in range(8)))
+"""kernels.excitation.NAMES, written here so that the models need not import Numba (a test
+checks that the two agree)."""
+
+MAX_BREAKPOINTS = 9
+"""Most breakpoints of a level table (kernels.excitation.MAX_SEGMENTS + 1)."""
+
+
+def sweep_rate(start: Any, stop: Any, rate: Any) -> Any:
+    """lam (1/s) of a logarithmic sweep from start to stop (Hz) at rate octaves per minute:
+    f(t) = start exp(lam t); negative for a down sweep."""
+    return np.sign(np.log(stop / start)) * rate * math.log(2.0) / 60.0
+
+
+def sweep_duration(start: Any, stop: Any, rate: Any) -> Any:
+    """T (s): how long a sweep from start to stop (Hz) at rate (octaves per minute) takes,
+    60 |log2(stop / start)| / rate."""
+    return 60.0 * np.abs(np.log2(stop / start)) / rate
+
+
+def sweep_frequency(t: Any, start: Any, stop: Any, rate: Any) -> Any:
+    """f(t) (Hz), the excitation frequency of the sweep at time t (s)."""
+    return start * np.exp(sweep_rate(start, stop, rate) * t)
+
+
+def sweep_phase(t: Any, start: Any, stop: Any, rate: Any) -> Any:
+    """phi(t) (rad) of the sweep at time t (s): 2 pi f_s (exp(lam t) - 1) / lam."""
+    lam = sweep_rate(start, stop, rate)
+    return 2.0 * np.pi * start * np.expm1(lam * t) / lam
+
+
+def table_level(levels_g: Sequence[Sequence[float]], frequency: Any) -> Any:
+    """The level (m/s^2 peak) of a table of (Hz, g) breakpoints at `frequency` (Hz),
+    interpolated log-log between breakpoints (a constant level, or a slope in dB/octave)."""
+    f = np.array([b[0] for b in levels_g], float)
+    g = np.array([b[1] for b in levels_g], float)
+    values = np.exp(np.interp(np.log(np.asarray(frequency, float)), np.log(f), np.log(g)))
+    if hasattr(frequency, "copy") and hasattr(frequency, "dims"):
+        return frequency.copy(data=values * STANDARD_GRAVITY)
+    return (values * STANDARD_GRAVITY)[()]
+
+
+def block(accel: Any, omega: Any, rate: Any = 0.0, end: Any = math.inf,
+          levels_g: Sequence[Sequence[float]] | None = None) -> dict[str, Any]:
+    """kernels.excitation's columns by name (its NAMES): constant level accel (m/s^2) or, with
+    a sweep and a table, the table's segments; omega the (start) angular frequency (rad/s);
+    rate lam (1/s, 0: fixed frequency); end: the sweep's end (s, after which a_b = 0).
+
+    A table with a fixed frequency is read here (accel = its level there); along a sweep the
+    kernel reads it (segments in ln w: edges ln(2 pi f_k), ln A_k, log-log slopes)."""
+    out: dict[str, Any] = {"base_accel": accel, "base_omega": omega, "base_phase": 0.0,
+                           "sweep_rate": rate, "level_segments": 0.0, "sweep_end": 0.0,
+                           "log_base_omega": 0.0}
+    for k in range(MAX_BREAKPOINTS - 1):
+        out[f"level_edge_{k}"] = out[f"level_log_{k}"] = out[f"level_slope_{k}"] = 0.0
+    if not np.any(np.asarray(rate) != 0.0):
+        return out
+    if levels_g is None:                  # one segment of slope 0: the level ends with the sweep
+        with np.errstate(divide="ignore"):
+            out.update(level_segments=1.0, sweep_end=end, log_base_omega=np.log(omega),
+                       level_log_0=np.log(accel))
+        return out
+    f = np.array([b[0] for b in levels_g], float)
+    log_a = np.log(np.array([b[1] for b in levels_g], float) * STANDARD_GRAVITY)
+    log_w = np.log(2.0 * np.pi * f)
+    out.update(level_segments=float(f.size - 1), sweep_end=end, log_base_omega=np.log(omega))
+    for k in range(f.size - 1):
+        out[f"level_edge_{k}"] = log_w[k]
+        out[f"level_log_{k}"] = log_a[k]
+        out[f"level_slope_{k}"] = (log_a[k + 1] - log_a[k]) / (log_w[k + 1] - log_w[k])
+    return out
