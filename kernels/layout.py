@@ -21,7 +21,11 @@ BASE = 14           # 1.0: the scene has base excitation (the forcing term and t
 CONSTANT_STIFFNESS = 15  # 1.0: no row has a time-varying stiffness (k1 = g1 = 0 everywhere: a
                     # constant or zero end load), so cos(W t) is compiled out
                     # (oscillator's `parametric` switch); 0.0, the default: rows may have one
-N_SETTINGS = 16
+SWEPT = 16          # 1.0: the base frequency is swept (kernels.excitation's RATE != 0): the
+                    # sweep's outputs (metrics.sweep_metrics) are computed; 0.0: none
+BANDS_PER_OCTAVE = 17   # N of the response envelope's 1/N-octave bands (swept scenes)
+FIRST_BAND = 18     # the envelope's first band k: centre 1000 x 2^(k/N) Hz (base-2 bands)
+N_SETTINGS = 19
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)
@@ -33,7 +37,9 @@ ACCELERATION = 5    # max |q'' + a_b| over the tail window (m/s^2): the absolute
                     # acceleration amplitude under base excitation; NaN without (BASE = 0)
 Q_END = 6           # q at the end of the run (m): where a stepped sweep's next point starts;
 V_END = 7           # q' there (m/s); both NaN where the point failed
-N_REALS = 8
+PEAK_FREQUENCY = 8  # swept scenes: the excitation frequency (Hz) when |q| had its largest
+                    # extremum; NaN otherwise
+N_REALS = 9
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -26,6 +26,8 @@ import math
 import numba as nb
 import numpy as np
 
+from . import excitation as ex
+
 # The state table lives in kernels/states.py (no Numba: the sweep layer reads it); the kernels
 # import it from here.
 from .states import (COMPLETED, DECAYED, DIVERGED, INVALID_INPUT, LONGITUDINAL_STATES,  # noqa: F401
@@ -181,3 +183,34 @@ def orbit_period(buf, n, t_tail, k):
                 return (last - buf[i, EXT_T]) / periods
             seen += 1
     return math.nan
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def sweep_metrics(p, o, s, buf, n, bands_per_octave, first_band, envelope):
+    """A swept point's outputs from its n extrema of q (buf) and its excitation block at
+    p[o + column * s] (kernels.excitation): returns the peak frequency (Hz), the excitation
+    frequency f(t) at the extremum of largest |q| (NaN with no extremum during the sweep), and
+    writes envelope[b] (m), the largest |q| at an extremum of q while f(t) lay in band
+    first_band + b of the base-2 1/N-octave bands, centres 1000 x 2^(k/N) Hz (N =
+    bands_per_octave), edges a factor 2^(1/2N) either side; NaN for a band with no extremum.
+    Extrema after the sweep's end (a run longer than the sweep) belong to no band."""
+    for b in range(envelope.shape[0]):
+        envelope[b] = math.nan
+    end = p[o + ex.END * s]
+    best = -1.0
+    t_best = math.nan
+    for i in range(n):
+        t = buf[i, EXT_T]
+        if t > end:
+            break
+        q = abs(buf[i, EXT_Q])
+        if q > best:
+            best = q
+            t_best = t
+        if envelope.shape[0] == 0:
+            continue
+        f = ex.frequency(t, p, o, s)
+        b = int(math.floor(bands_per_octave * math.log2(f / 1000.0) + 0.5) - first_band)
+        if 0 <= b < envelope.shape[0] and not envelope[b] >= q:
+            envelope[b] = q
+    return ex.frequency(t_best, p, o, s) if best >= 0.0 else math.nan

@@ -30,8 +30,8 @@ from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
 from .layout import (FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS, RHS_EVALS, RTOL,
-                     SETTLING, TAIL, TOL, T_END, WANT_SETTLING)
-from .transverse import classify_metrics
+                     SETTLING, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
+from .transverse import classify_metrics, swept_outputs
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -339,7 +339,7 @@ def at_rest(row, n_modes, t, y, band, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, n_modes, settings, reals, counts, series, modal, final, base):
+def solve_point(row, n_modes, settings, reals, counts, series, modal, final, envelope, base):
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
     mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
     parameters give INVALID_INPUT, NaN metrics."""
@@ -354,11 +354,15 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, bas
             modal[j] = math.nan
         for j in range(2 * n_modes):
             final[j] = math.nan
+        for j in range(envelope.shape[0]):
+            envelope[j] = math.nan
         return mt.INVALID_INPUT
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
                             settings[TOL], series, modal, base)
     resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
+    if settings[SWEPT] != 0.0:
+        state = swept_outputs(row, md.EXCITATION, 1, settings, acc, buf, state, reals, envelope)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for j in range(n_modes):
         modal[j] = math.nan if failed else modal[j]
@@ -397,6 +401,17 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
     failed: where a stepped sweep's next point starts). Releases the GIL (sweep.threads runs
     blocks on threads)."""
+    none = np.empty(0)
     for i in range(lo, hi):
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], base)
+                                modal[i], final[i], none, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_swept_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
+                      final, envelope, base):
+    """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
+    envelope of the midspan deflection: envelope (n, n_bands) (m; n_bands may be 0)."""
+    for i in range(lo, hi):
+        states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
+                                modal[i], final[i], envelope[i], base)

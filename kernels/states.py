@@ -12,7 +12,8 @@ UNSETTLED = 4
 DIVERGED = 5
 STEP_TOO_SMALL = 6
 MAX_STEPS = 7
-COMPLETED = 8         # longitudinal only: the span reached t_end (it has no settling to judge)
+COMPLETED = 8         # the run reached t_end, and it has no settling to judge (a longitudinal
+                      # span; a transverse span under a sine sweep)
 RUNNING = -1
 SECOND_PASS = -2      # internal: STEADY at rest away from zero, its settling time still to be found
                       # by transverse.settle_second_pass; never left in a result
@@ -24,3 +25,5 @@ STATE_MEANINGS = ("invalid_input", "decayed", "steady", "modulated", "unsettled"
 TRANSVERSE_STATES = (INVALID_INPUT, DECAYED, STEADY, MODULATED, UNSETTLED, DIVERGED,
                      STEP_TOO_SMALL, MAX_STEPS)
 LONGITUDINAL_STATES = (INVALID_INPUT, COMPLETED, DIVERGED, MAX_STEPS)
+SWEPT_STATES = (INVALID_INPUT, COMPLETED, DIVERGED, STEP_TOO_SMALL, MAX_STEPS)
+"""A transverse scene with a swept base frequency: a sweep never settles."""

@@ -26,11 +26,12 @@ from . import trajectory as tj
 from . import dop853
 from .dopri5 import MIN_RTOL, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
-from .layout import (ACCELERATION, AMPLITUDE, FAILURE_TIME, N_COUNTS, N_REALS, PEAK, PERIOD,
-                     Q_END, V_END,
+from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FIRST_BAND,
+                     N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
                      WANT_SETTLING)
-from .oscillator import BOUND, MASS, N_PARAMS, acceleration, prepare, stiffness
+from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepare,
+                         stiffness)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -215,17 +216,41 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, settings, reals, counts, series, parametric, base):
+def solve_point(row, settings, reals, counts, series, envelope, parametric, base):
     """Integrate the point of parameter row `row` and classify it. Never raises for bad
-    parameters: they give INVALID_INPUT."""
+    parameters: they give INVALID_INPUT. With settings[SWEPT] (a swept base frequency) the
+    sweep's outputs too (`swept_outputs`: peak frequency, envelope; the state COMPLETED)."""
     if not valid(row):
         reject_point(reals, counts, series)
+        for b in range(envelope.shape[0]):
+            envelope[b] = math.nan
         return mt.INVALID_INPUT
     p = np.empty(N_PARAMS)
     prepare(row, p, 0, 1)
     acc, buf = integrate(p, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
                          settings[TOL], series, parametric, base)
-    return classify(p, 0, 1, settings, acc, buf, reals, counts, parametric, base)
+    state = classify(p, 0, 1, settings, acc, buf, reals, counts, parametric, base)
+    if settings[SWEPT] != 0.0:
+        state = swept_outputs(p, EXCITATION, 1, settings, acc, buf, state, reals, envelope)
+    return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def swept_outputs(p, o, s, settings, acc, buf, state, reals, envelope):
+    """A swept point's state and outputs once `classify_metrics` has run: the peak frequency
+    (reals[PEAK_FREQUENCY], Hz) and the envelope (metrics.sweep_metrics; p[o + column * s]
+    its excitation block), NaN where the point failed; the state of a point that ran the whole
+    sweep is COMPLETED (a sweep has no settling to judge). Returns the state."""
+    failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
+    f_peak = mt.sweep_metrics(p, o, s, buf, int(acc[tj.N_EXT]), settings[BANDS_PER_OCTAVE],
+                              settings[FIRST_BAND], envelope)
+    if failed:
+        for b in range(envelope.shape[0]):
+            envelope[b] = math.nan
+        return state
+    reals[PEAK_FREQUENCY] = f_peak
+    reals[SETTLING] = math.nan
+    return mt.COMPLETED
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -239,6 +264,17 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, paramet
     settle_second_pass. base: oscillator's base-excitation switch, None or True (True when
     settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one).
     """
+    none = np.empty(0)
     for i in range(lo, hi):
-        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], parametric,
-                                base)
+        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], none,
+                                parametric, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_swept_block(params, settings, lo, hi, states, reals, counts, series, envelope,
+                      parametric, base):
+    """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
+    envelope: envelope (n, n_bands) (m; n_bands may be 0, `swept_outputs`)."""
+    for i in range(lo, hi):
+        states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i],
+                                envelope[i], parametric, base)

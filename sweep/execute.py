@@ -63,11 +63,16 @@ def _set_threads(threads: int) -> None:
     numba.set_num_threads(thread_count(threads))
 
 
-def transverse_outputs(n: int, n_samples: int) -> dict[str, np.ndarray]:
-    """Empty transverse outputs of n points, by name (the kernel's output arrays)."""
+def transverse_outputs(n: int, n_samples: int, n_bands: int = -1) -> dict[str, np.ndarray]:
+    """Empty transverse outputs of n points, by name (the kernel's output arrays); with
+    n_bands >= 0 (a swept base frequency) also envelope (n, n_bands), the response envelope
+    (m, kernels.metrics.sweep_metrics)."""
     from sweep.kernels import layout as tk
-    return {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
-            "counts": np.empty((n, tk.N_COUNTS), np.int64), "series": np.empty((n, n_samples))}
+    out = {"states": np.empty(n, np.int8), "reals": np.empty((n, tk.N_REALS)),
+           "counts": np.empty((n, tk.N_COUNTS), np.int64), "series": np.empty((n, n_samples))}
+    if n_bands >= 0:
+        out["envelope"] = np.empty((n, n_bands))
+    return out
 
 
 def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
@@ -81,41 +86,59 @@ def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
 
 
 def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, driver: str,
-                     threads: int = 0,
+                     n_bands: int = -1, per_point_end: bool = False, threads: int = 0,
                      on_block: Callable[[int, int, dict], None] | None = None,
                      stop: threading.Event | None = None) -> dict[str, np.ndarray]:
-    """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series).
+    """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series;
+    `transverse_outputs`). A swept base frequency (settings[SWEPT] = 1): n_bands the envelope's
+    bands, and per_point_end: each point ends with its own sweep (the rows' sweep_end column,
+    kernels.excitation.END) rather than at settings' T_END.
 
     on_block(lo, hi, outputs) hears of each block of rows as soon as it is final; with `stop`
     set the call returns early, with only the rows on_block reported solved."""
+    from sweep.kernels import oscillator as osc
+
     from .threads import solve_transverse
-    out = transverse_outputs(params.shape[0], n_samples)
+    out = transverse_outputs(params.shape[0], n_samples, n_bands)
     report = None if on_block is None else (lambda lo, hi: on_block(lo, hi, out))
     solve_transverse(params, settings, out["states"], out["reals"], out["counts"], out["series"],
-                     driver=driver, threads=threads, on_block=report, stop=stop)
+                     driver=driver, threads=threads, on_block=report, stop=stop,
+                     envelope=out.get("envelope"),
+                     durations=_ends(params, osc.EXCITATION) if per_point_end else None)
     return out
 
 
-def modes_outputs(n: int, n_samples: int, n_modes: int) -> dict[str, np.ndarray]:
+def _ends(params: np.ndarray, block: int) -> np.ndarray:
+    """Each row's sweep end (s): column kernels.excitation.END of the excitation block that
+    starts at column `block`."""
+    from sweep.kernels import excitation as ex
+    return np.ascontiguousarray(params[:, block + ex.END])
+
+
+def modes_outputs(n: int, n_samples: int, n_modes: int, n_bands: int = -1) -> dict[str, np.ndarray]:
     """Empty multi-mode outputs of n points: `transverse_outputs` plus modal (n, n_modes), each
     mode's tail amplitude (m), and final (n, 2 n_modes), the final state (m, m/s)."""
-    return {**transverse_outputs(n, n_samples), "modal": np.empty((n, n_modes)),
+    return {**transverse_outputs(n, n_samples, n_bands), "modal": np.empty((n, n_modes)),
             "final": np.empty((n, 2 * n_modes))}
 
 
 def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, n_modes: int,
-                driver: str = "lanes", threads: int = 0,
+                driver: str = "lanes", n_bands: int = -1, per_point_end: bool = False,
+                threads: int = 0,
                 on_block: Callable[[int, int, dict], None] | None = None,
                 stop: threading.Event | None = None) -> dict[str, np.ndarray]:
     """The multi-mode kernel (kernels.modal_driver) over `params` rows (kernels.modes columns
     for n_modes modes); outputs by name (`modes_outputs`); driver "lanes" or "scalar"
-    (threads.solve_modes); on_block and stop as `transverse_chunk`'s."""
+    (threads.solve_modes); n_bands, per_point_end, on_block and stop as `transverse_chunk`'s."""
+    from sweep.kernels import modes as md
+
     from .threads import solve_modes
-    out = modes_outputs(params.shape[0], n_samples, n_modes)
+    out = modes_outputs(params.shape[0], n_samples, n_modes, n_bands)
     report = None if on_block is None else (lambda lo, hi: on_block(lo, hi, out))
     solve_modes(params, n_modes, settings, out["states"], out["reals"], out["counts"],
-                out["series"], out["modal"], out["final"], driver=driver, threads=threads, on_block=report,
-                stop=stop)
+                out["series"], out["modal"], out["final"], driver=driver, threads=threads,
+                on_block=report, stop=stop, envelope=out.get("envelope"),
+                durations=_ends(params, md.EXCITATION) if per_point_end else None)
     return out
 
 
@@ -509,11 +532,11 @@ def chunk_template(chunk_fn: Callable[..., dict], args: tuple) -> dict[str, np.n
     """The arrays chunk_fn(rows, *args) makes for no rows: their names, dtypes and trailing
     shapes. A chunk of points lo..hi-1 must return exactly these with hi - lo rows."""
     if chunk_fn is transverse_chunk:
-        _, n_samples, _ = args
-        return transverse_outputs(0, n_samples)
+        n_samples, n_bands = args[1], (args[3] if len(args) > 3 else -1)
+        return transverse_outputs(0, n_samples, n_bands)
     if chunk_fn is modes_chunk:
-        _, n_samples, n_modes, _ = args
-        return modes_outputs(0, n_samples, n_modes)
+        n_samples, n_modes, n_bands = args[1], args[2], (args[4] if len(args) > 4 else -1)
+        return modes_outputs(0, n_samples, n_modes, n_bands)
     if chunk_fn is longitudinal_chunk:
         _, snapshot_times, n_hist, n_nodes = args
         return longitudinal_outputs(0, n_hist, np.asarray(snapshot_times).size, n_nodes)

@@ -33,6 +33,7 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params["paper_parametric"] = scene.get("model.paper_parametric")
     params["load_type"] = scene.get("load.type")
     params["divergence_bound"] = scene.get("metrics.divergence_bound")
+    params["base_levels_g"] = scene.get("base.levels_g")
     if params["load_type"] == "constant":      # no frequency axis: refused by load_scene
         params["frequency"] = None
     return params

@@ -69,6 +69,8 @@ def allowed(key: schema.Key) -> str:
     bounds = ", ".join(b for b in (low, high) if b)
     if key.kind == "floats":
         return "a list of numbers" + (f", each {bounds}" if bounds else "")
+    if key.kind == "pairs":
+        return "a list of [x, y] pairs, x increasing, both > 0"
     return bounds
 
 

@@ -9,6 +9,8 @@ Kinds of value:
     "bool"    true or false
     "str"     a string; `choices` lists the allowed values
     "floats"  a list of finite real numbers (may be empty), each within the bounds
+    "pairs"   a list of [x, y] pairs of finite positive numbers, x strictly increasing
+              (a table of breakpoints: ``base.levels_g``)
 A float key with ``sweepable=True`` may also appear under ``[axes]``, by its axis name.
 """
 
@@ -107,6 +109,17 @@ KEYS: tuple[Key, ...] = (
     Key("base", "frequency_ratio", "float", None, units="1", minimum=0.0, exclusive_min=True,
         long_name="base excitation frequency over the unloaded span's first natural frequency, "
                   "f/f1", axis="base_frequency_ratio"),
+    # a logarithmic sine sweep instead of a frequency: [base] sweep = {start, stop, rate}
+    Key("base", "sweep.start", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
+        long_name="logarithmic sine sweep: start frequency", axis="base_sweep_start"),
+    Key("base", "sweep.stop", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
+        long_name="logarithmic sine sweep: stop frequency (below start: a down sweep)",
+        axis="base_sweep_stop"),
+    Key("base", "sweep.rate", "float", None, units="min-1", minimum=0.0, exclusive_min=True,
+        long_name="logarithmic sine sweep: rate in octaves per minute", axis="base_sweep_rate"),
+    Key("base", "levels_g", "pairs", None, units=G_UNITS,
+        long_name="base level table instead of a constant level: (frequency in Hz, peak level "
+                  "in g) breakpoints, interpolated log-log"),
     # [initial]
     Key("initial", "displacement", "float", 0.0, units="m",
         long_name="initial midspan deflection q(0)", axis="initial_displacement"),
@@ -167,6 +180,14 @@ KEYS: tuple[Key, ...] = (
     Key("outputs", "absolute_acceleration", "bool", True,
         long_name="scenes with [base]: store the absolute midspan acceleration amplitude (m s-2 "
                   "and g) and the transmissibility"),
+    Key("outputs", "peak_frequency", "bool", True,
+        long_name="swept base frequency: store the excitation frequency at the peak response"),
+    Key("outputs", "envelope", "bool", False,
+        long_name="swept base frequency: store the response envelope, the largest |q| at the "
+                  "extrema of q in each 1/N-octave band of the excitation frequency"),
+    Key("outputs", "bands_per_octave", "int", 3, units="1", minimum=1, maximum=24,
+        long_name="swept base frequency: N of the envelope's 1/N-octave bands (3: third "
+                  "octaves)"),
     Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
     Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="time-series sample interval (default t_end/1000)"),
@@ -205,6 +226,9 @@ TOP_LEVEL: dict[str, str] = {"name": "a short name for the sweep",
 SECTIONS: tuple[str, ...] = tuple(dict.fromkeys(k.section for k in KEYS)) + ("axes",)
 
 BY_DOTTED: dict[str, Key] = {k.dotted: k for k in KEYS}
+TABLES: dict[str, str] = {"base.sweep": "sweep = { start = 5.0, stop = 100.0, rate = 2.0 } "
+                                        "(Hz, Hz, octaves per minute)"}
+"""Inline tables of keys (their keys are the schema's ``sweep.start`` ...) -> an example."""
 BY_AXIS: dict[str, Key] = {k.axis: k for k in KEYS if k.axis is not None}
 
 AXIS_SPACINGS: tuple[str, ...] = ("linear", "log")

@@ -71,9 +71,13 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                      reals: np.ndarray, counts: np.ndarray, series: np.ndarray, *,
                      driver: str = "lanes", threads: int = 0,
                      on_block: Callable[[int, int], None] | None = None,
-                     stop: threading.Event | None = None) -> None:
+                     stop: threading.Event | None = None,
+                     envelope: np.ndarray | None = None,
+                     durations: np.ndarray | None = None) -> None:
     """Solve every row of `params` (n, N_PARAMS) into the preallocated outputs (first axis n):
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
+    A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
+    for its response envelope and durations (n,), each point's end time (s; `swept_blocks`).
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
@@ -92,7 +96,16 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
     parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
-    if driver == "scalar":
+    swept = settings[tk.SWEPT] != 0.0
+    if swept:
+        if driver != "scalar":
+            raise ValueError("a swept base frequency takes driver 'scalar'")
+
+        def kernel(lo: int, hi: int) -> None:
+            for part, lo_, hi_ in swept_blocks(settings, durations, lo, hi):
+                tk.solve_swept_block(params, part, lo_, hi_, states, reals, counts, series,
+                                     envelope, parametric, base)
+    elif driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
             tk.solve_block(params, settings, lo, hi, states, reals, counts, series, parametric,
                            base)
@@ -112,19 +125,21 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         if on_block is not None:
             on_block(lo, hi)
 
-    run_blocks(solve_block, params.shape[0], threads, stop)
+    run_blocks(solve_block, params.shape[0], threads, stop, one_at_a_time=swept)
 
 
 def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
                 reals: np.ndarray, counts: np.ndarray, series: np.ndarray, modal: np.ndarray,
                 final: np.ndarray, *, driver: str = "lanes", threads: int = 0,
                 on_block: Callable[[int, int], None] | None = None,
-                stop: threading.Event | None = None) -> None:
+                stop: threading.Event | None = None, envelope: np.ndarray | None = None,
+                durations: np.ndarray | None = None) -> None:
     """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for n_modes
     modes in, the same outputs plus modal (n, n_modes), each mode's tail amplitude (m), and
     final (n, 2 n_modes), the final state (m, m/s).
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
-    (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off."""
+    (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off. A swept base
+    frequency takes the scalar driver, with envelope and durations as `solve_transverse`'s."""
     from sweep.kernels import layout as tk
     from sweep.kernels import metrics as mt
     from sweep.kernels import modal_driver
@@ -135,24 +150,53 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
     else:
         kernel = modal_driver
     base = True if settings[tk.BASE] != 0.0 else None
+    swept = settings[tk.SWEPT] != 0.0
+    if swept and driver != "scalar":
+        raise ValueError("a swept base frequency takes driver 'scalar'")
 
     def solve_block(lo: int, hi: int) -> None:
-        kernel.solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series,
-                           modal, final, base)
+        if swept:
+            for part, lo_, hi_ in swept_blocks(settings, durations, lo, hi):
+                modal_driver.solve_swept_block(params, n_modes, part, lo_, hi_, states, reals,
+                                               counts, series, modal, final, envelope, base)
+        else:
+            kernel.solve_block(params, n_modes, settings, lo, hi, states, reals, counts,
+                               series, modal, final, base)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             modal_driver.settle_second_pass(params[lo:hi], n_modes, settings, states[lo:hi],
                                             reals[lo:hi], counts[lo:hi], base)
         if on_block is not None:
             on_block(lo, hi)
 
-    run_blocks(solve_block, params.shape[0], threads, stop)
+    run_blocks(solve_block, params.shape[0], threads, stop, one_at_a_time=swept)
+
+
+def swept_blocks(settings: np.ndarray, durations: np.ndarray | None, lo: int,
+                 hi: int) -> list[tuple[np.ndarray, int, int]]:
+    """Rows lo..hi-1 as runs of equal end time: (settings with T_END that time, lo, hi) each.
+    durations: each row's end time (s); None: settings' own for every row."""
+    from sweep.kernels import layout as tk
+    if durations is None:
+        return [(settings, lo, hi)]
+    runs = []
+    start = lo
+    for i in range(lo + 1, hi + 1):
+        if i == hi or durations[i] != durations[start]:
+            part = settings.copy()
+            part[tk.T_END] = durations[start]
+            runs.append((part, start, i))
+            start = i
+    return runs
 
 
 def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
-               stop: threading.Event | None) -> None:
+               stop: threading.Event | None, one_at_a_time: bool = False) -> None:
     """Run solve_block(lo, hi) over blocks covering rows 0..n-1 on `threads` threads (0: all),
-    guided scheduling and timed blocks (module docstring); with `stop` set no new block starts."""
-    n_threads = max(1, min(thread_count(threads), -(-n // LANES_PER_THREAD)))
+    guided scheduling and timed blocks (module docstring); with `stop` set no new block starts.
+    one_at_a_time: every block one row, a thread for every row (points that each take long:
+    a sine sweep's)."""
+    per_thread = 1 if one_at_a_time else LANES_PER_THREAD
+    n_threads = max(1, min(thread_count(threads), -(-n // per_thread)))
     stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
     most = SOLO_BLOCK if n_threads == 1 else MAX_BLOCK
     start = 0
@@ -164,7 +208,7 @@ def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
         while not stop.is_set():
             with lock:
                 lo = start
-                hi = start = next_block(lo, n, n_threads, cap)
+                hi = start = lo + 1 if one_at_a_time else next_block(lo, n, n_threads, cap)
             if lo >= n:
                 return
             began = time.perf_counter()

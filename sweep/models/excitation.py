@@ -13,7 +13,7 @@ Every function works element-wise on floats, NumPy arrays or xarray DataArrays.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -93,3 +93,58 @@ def block(accel: Any, omega: Any, rate: Any = 0.0, end: Any = math.inf,
         out[f"level_log_{k}"] = log_a[k]
         out[f"level_slope_{k}"] = (log_a[k + 1] - log_a[k]) / (log_w[k + 1] - log_w[k])
     return out
+
+
+SWEEP_KEYS: tuple[str, str, str] = ("base.sweep.start", "base.sweep.stop", "base.sweep.rate")
+"""The keys of a logarithmic sweep ([base] sweep = {start, stop, rate})."""
+SWEEP_AXES: tuple[str, str, str] = ("base_sweep_start", "base_sweep_stop", "base_sweep_rate")
+
+
+def is_swept(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
+    """Whether a scene's base frequency is swept (any base.sweep key, as a key or an axis)."""
+    return any(values.get(d) is not None for d in SWEEP_KEYS) or any(a in axes
+                                                                      for a in SWEEP_AXES)
+
+
+def sweep_grid(values: Mapping[str, Any], axes: Mapping[str, Any]) -> tuple[Any, Any, Any]:
+    """(start, stop, rate) of a swept scene on the product grid of its sweep axes (arrays
+    that broadcast; scalars where not swept)."""
+    parts = [np.asarray(axes[a], float) if a in axes else np.asarray(values[d], float)
+             for d, a in zip(SWEEP_KEYS, SWEEP_AXES)]
+    shaped = np.ix_(*[np.atleast_1d(p) for p in parts])
+    return shaped[0], shaped[1], shaped[2]
+
+
+def longest_sweep(values: Mapping[str, Any], axes: Mapping[str, Any]) -> float:
+    """The longest sweep duration (s) of a swept scene's points."""
+    return float(np.max(sweep_duration(*sweep_grid(values, axes))))
+
+
+def end_time(values: Mapping[str, Any], axes: Mapping[str, Any]) -> float:
+    """The run's end time (s): solver.t_end, or for a swept scene that gives none, its
+    longest sweep (each point then ends with its own sweep)."""
+    t_end = values["solver.t_end"]
+    return float(t_end) if t_end is not None else longest_sweep(values, axes)
+
+
+BAND_REFERENCE = 1000.0
+"""Hz: the centre of band 0 of the base-2 fractional-octave bands, 1000 x 2^(k/N) Hz."""
+
+
+def band_index(frequency: Any, bands_per_octave: int) -> Any:
+    """k of the base-2 1/N-octave band that holds `frequency` (Hz): round(N log2(f / 1000)),
+    as kernels.metrics.sweep_metrics computes it."""
+    return np.floor(bands_per_octave * np.log2(np.asarray(frequency, float) / BAND_REFERENCE)
+                    + 0.5).astype(int)[()]
+
+
+def band_centres(first: int, count: int, bands_per_octave: int) -> np.ndarray:
+    """Centre frequencies (Hz) of bands first .. first + count - 1: 1000 x 2^(k/N)."""
+    return BAND_REFERENCE * 2.0 ** (np.arange(first, first + count) / bands_per_octave)
+
+
+def band_bounds(first: int, count: int, bands_per_octave: int) -> np.ndarray:
+    """(count, 2) lower and upper edges (Hz) of those bands: the centre / and x 2^(1/2N)."""
+    centres = band_centres(first, count, bands_per_octave)
+    half = 2.0 ** (0.5 / bands_per_octave)
+    return np.stack([centres / half, centres * half], axis=1)

@@ -75,6 +75,8 @@ from typing import Any
 
 import numpy as np
 
+from .excitation import SWEEP_KEYS, end_time, sweep_grid
+
 from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span counts
 
 from .. import schema
@@ -113,9 +115,11 @@ DEFAULT_FREQUENCY_RATIO = 1.0
 
 BASE_LEVEL_KEYS: tuple[str, str] = ("base.acceleration", "base.acceleration_g")
 BASE_FREQUENCY_KEYS: tuple[str, str] = ("base.frequency", "base.frequency_ratio")
-BASE_KEYS: tuple[str, ...] = BASE_LEVEL_KEYS + BASE_FREQUENCY_KEYS
-BASE_FIX = ("add a [base] table with acceleration or acceleration_g and frequency or "
-            "frequency_ratio")
+BASE_TABLE_KEY = "base.levels_g"
+BASE_KEYS: tuple[str, ...] = (BASE_LEVEL_KEYS + (BASE_TABLE_KEY,) + BASE_FREQUENCY_KEYS
+                              + SWEEP_KEYS)
+BASE_FIX = ("add a [base] table with acceleration, acceleration_g or levels_g and frequency, "
+            "frequency_ratio or sweep")
 """How to fix a base key or axis given without the rest of the base excitation."""
 PAIRS: tuple[tuple[str, str], ...] = (FREQUENCY_KEYS, BASE_LEVEL_KEYS, BASE_FREQUENCY_KEYS)
 """Either-or keys: two spellings of one quantity (as scalars or axes), never both."""
@@ -145,8 +149,8 @@ MAX_SAMPLES = 10_000_000
 def has_base(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
     """Whether a resolved scene (its values and axes) has base excitation: a base level is
     given, as a [base] key or an axis (a validated scene then has a base frequency too)."""
-    return any(values.get(d) is not None or schema.BY_DOTTED[d].axis in axes
-               for d in BASE_LEVEL_KEYS)
+    return values.get(BASE_TABLE_KEY) is not None or any(
+        values.get(d) is not None or schema.BY_DOTTED[d].axis in axes for d in BASE_LEVEL_KEYS)
 
 
 def model_kind(given: Mapping[str, Any]) -> str:
@@ -205,15 +209,87 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
     if given.get("model.coefficients") == "paper":
         _fail(where, "model.coefficients = 'paper' has no base excitation (Eq.32 as printed "
               "has no forcing term)", "use model.coefficients = 'consistent'")
-    for pair, what, example in ((BASE_LEVEL_KEYS, "a level", "acceleration_g = 0.5 (g) or "
-                                 "acceleration = 4.9 (m/s^2)"),
-                                (BASE_FREQUENCY_KEYS, "a frequency", "frequency = 20.0 (Hz) or "
-                                 "frequency_ratio = 1.0 (f/f1)")):
+    for pair, what, example in ((BASE_LEVEL_KEYS + (BASE_TABLE_KEY,), "a level",
+                                 "acceleration_g = 0.5 (g), acceleration = 4.9 (m/s^2) or "
+                                 "levels_g = [[5.0, 0.5], [100.0, 0.6]] (Hz, g)"),
+                                (BASE_FREQUENCY_KEYS + SWEEP_KEYS, "a frequency",
+                                 "frequency = 20.0 (Hz), frequency_ratio = 1.0 (f/f1) or "
+                                 "sweep = { start = 5.0, stop = 100.0, rate = 2.0 }")):
         if any(d in given or schema.BY_DOTTED[d].axis in axes for d in pair):
             continue
-        _fail(where, f"base excitation needs {what}: the scene gives neither "
-              f"{pair[0]} nor {pair[1]} (as a key or axis)",
+        _fail(where, f"base excitation needs {what}: the scene gives none of "
+              f"{', '.join(_spelling(d) for d in pair)} (as a key or axis)",
               BASE_FIX if not file_has_base else f"add {example} to the [base] table")
+    _check_sweep(given, axes)
+
+
+def _spelling(dotted: str) -> str:
+    """A base key as a scene writes it: base.sweep for its three keys."""
+    return "base.sweep" if dotted in SWEEP_KEYS else dotted
+
+
+def _present(dotted: str, given: dict[str, Any], axes: dict[str, np.ndarray]) -> bool:
+    axis = schema.BY_DOTTED[dotted].axis
+    return dotted in given or (axis is not None and axis in axes)
+
+
+def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of a sine sweep and a level table (docs/model.md sec. 6): a sweep has a start, a
+    stop and a rate (keys or axes) that differ, replaces base.frequency and
+    base.frequency_ratio, is solved by the scalar driver, has no settling time and is not a
+    stepped sweep; a level table replaces the constant level and covers every frequency the
+    scene's sweeps reach; the envelope outputs need a sweep."""
+    swept = [d for d in SWEEP_KEYS if _present(d, given, axes)]
+    table = given.get(BASE_TABLE_KEY)
+    if table is not None:
+        for dotted in BASE_LEVEL_KEYS:
+            if _present(dotted, given, axes):
+                _fail(f"scene keys '{dotted}' and '{BASE_TABLE_KEY}'", "give one level, not "
+                      "both (a constant level, or a table of breakpoints)",
+                      f"remove one of them: {_PAIR_UNITS['base.acceleration']}")
+    if not swept:
+        for dotted in ("outputs.envelope",):
+            if given.get(dotted):
+                _fail(f"scene key '{dotted}'", "needs a swept base frequency (the envelope is "
+                      "read against the sweep's frequency)", "add [base] sweep = { start = "
+                      "5.0, stop = 100.0, rate = 2.0 }, or remove the key")
+        return
+    where = "scene key 'base.sweep'"
+    missing = [d.rpartition(".")[2] for d in SWEEP_KEYS if d not in swept]
+    if missing:
+        _fail(where, f"needs start, stop and rate; missing {', '.join(missing)}",
+              "write sweep = { start = 5.0, stop = 100.0, rate = 2.0 } (Hz, Hz, octaves per "
+              "minute; as keys or axes base_sweep_start, base_sweep_stop, base_sweep_rate)")
+    for dotted in BASE_FREQUENCY_KEYS:
+        if _present(dotted, given, axes):
+            _fail(f"scene keys '{dotted}' and 'base.sweep'", "give one frequency, not both (a "
+                  "fixed frequency, or a sweep)", f"remove {dotted} or the sweep")
+    values = {d: given.get(d) for d in SWEEP_KEYS}
+    start, stop, _ = sweep_grid(values, axes)
+    if np.any(start == stop):
+        _fail(where, "start and stop are equal at some point: nothing to sweep",
+              "give different start and stop frequencies (stop below start sweeps down), or "
+              "use base.frequency for a fixed frequency")
+    if table is not None:
+        low, high = table[0][0], table[-1][0]
+        f_lo, f_hi = float(np.min(np.minimum(start, stop))), float(np.max(np.maximum(start, stop)))
+        if f_lo < low * (1 - 1e-12) or f_hi > high * (1 + 1e-12):
+            _fail(f"scene key '{BASE_TABLE_KEY}'", f"covers {low:g} to {high:g} Hz, but the "
+                  f"sweep reaches {f_lo:g} to {f_hi:g} Hz", "extend the table to every "
+                  "frequency the sweep reaches, or narrow the sweep")
+    if given.get("continuation.axis") is not None:
+        _fail("scene key 'continuation.axis'", "a continuous sweep ([base] sweep) carries its "
+              "state and phase itself; [continuation] steps a fixed frequency",
+              "remove [continuation], or use base.frequency with a frequency axis for a "
+              "stepped sweep")
+    if given.get("solver.driver") == "lanes":
+        _fail("scene key 'solver.driver'", "a swept base frequency is solved by the 'scalar' "
+              "driver only (the lanes' vector sine takes a fixed frequency)",
+              "remove solver.driver (a sweep takes 'scalar')")
+    if given.get("outputs.settling_time"):
+        _fail("scene key 'outputs.settling_time'", "a sweep has no settling time (its "
+              "excitation never stops changing)", "remove it: a swept scene stores "
+              "peak_amplitude, peak_frequency and, with outputs.envelope = true, the envelope")
 
 
 def check_pairs(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
@@ -345,9 +421,9 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
               "remove one of them: t_end is in seconds, transits in multiples of l/a")
 
 
-def _check_times(values: dict[str, Any]) -> None:
+def _check_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Transverse: intervals and steps must fit inside the simulated time."""
-    t_end = values["solver.t_end"]
+    t_end = end_time(values, axes)
     for dotted in ("outputs.sample_interval", "solver.max_step", "solver.first_step",
                    "solver.min_step"):
         value = values[dotted]
@@ -359,13 +435,15 @@ def _check_times(values: dict[str, Any]) -> None:
         _fail("scene key 'solver.min_step'",
               f"must be <= solver.max_step ({high!r} s), got {low!r} (every step would be "
               "below the smallest allowed)", "use a smaller min_step or a larger max_step")
-    _check_sample_count(values, "outputs.time_series")
+    _check_sample_count(values, "outputs.time_series", t_end)
 
 
-def _check_sample_count(values: dict[str, Any], wanted: str) -> None:
+def _check_sample_count(values: dict[str, Any], wanted: str, t_end: Any = None) -> None:
     """Refuse a sample interval that gives more than MAX_SAMPLES samples per point, when the
-    samples are asked for (``wanted``) and solver.t_end is known."""
-    t_end, interval = values["solver.t_end"], values["outputs.sample_interval"]
+    samples are asked for (``wanted``) and the end time (t_end, s; default solver.t_end) is
+    known."""
+    t_end = values["solver.t_end"] if t_end is None else t_end
+    interval = values["outputs.sample_interval"]
     if not values[wanted] or t_end is None or interval is None or t_end / interval <= MAX_SAMPLES:
         return
     _fail("scene key 'outputs.sample_interval'",
@@ -415,6 +493,8 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
     oscillator has no forcing term (the end load enters the stiffness only), so such a sweep
     stays at q = 0 everywhere: it would look like a result and say nothing. Base excitation
     with a level above zero somewhere drives the span from rest: no warning then."""
+    if values.get(BASE_TABLE_KEY) is not None:      # a table's levels are > 0
+        return
     if has_base(values, axes) and any(
             _extreme(values, axes, d, np.max) > 0.0 for d in BASE_LEVEL_KEYS
             if values[d] is not None or schema.BY_DOTTED[d].axis in axes):
@@ -547,8 +627,14 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
                          mentioned: set[str]) -> None:
     """solver.t_end 5 s, and the paper preset's initial.velocity without an initial condition."""
     _shared_defaults(values, mentioned)
-    if "solver.t_end" not in mentioned:
-        values["solver.t_end"] = DEFAULT_T_END
+    swept = any(d in mentioned for d in SWEEP_KEYS)
+    if "solver.t_end" not in mentioned and not swept:
+        values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps
+    if swept:            # no settling; the scalar driver; the peaks over the whole sweep
+        for dotted, value in (("outputs.settling_time", False), ("solver.driver", "scalar"),
+                              ("metrics.tail", 1.0)):
+            if dotted not in mentioned:
+                values[dotted] = value
     paper = values["model.coefficients"] == "paper"
     if paper and not ("initial.displacement" in mentioned or "initial.velocity" in mentioned):
         values["initial.velocity"] = PAPER_VELOCITY
@@ -567,7 +653,7 @@ def _check_transverse_resolved(values: dict[str, Any], axes: dict[str, np.ndarra
                                given: dict[str, Any]) -> None:
     """Finite coefficients, steps and samples within t_end, and the zero-solution warning."""
     _check_coefficients(values, axes)
-    _check_times(values)
+    _check_times(values, axes)
     _warn_zero_solution(values, axes, given)
 
 

@@ -26,7 +26,7 @@ from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, fla
 from ..runner import RunOptions, check_memory, placer, point_order, solve_chunked
 from ..scene import Scene
 from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
-from . import modal
+from . import excitation, modal
 
 KIND = "transverse"
 MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
@@ -81,6 +81,14 @@ _BASE_DERIVED = {
 }
 
 
+# Scenes with a swept base frequency (docs/model.md sec. 6).
+_SWEEP_DERIVED = {
+    "sweep_duration": ("s", "duration of the logarithmic sine sweep, 60 |log2(stop/start)| / "
+                            "rate"),
+}
+BAND_DIM = "band_frequency"    # the envelope's dimension: its bands' centre frequencies (Hz)
+
+
 @dataclass
 class KernelResult:
     """Flat per-point kernel outputs, in grid (C) order."""
@@ -90,6 +98,7 @@ class KernelResult:
     series: np.ndarray      # (n, n_samples) q samples (m); n_samples may be 0
     sample_times: np.ndarray
     modal: np.ndarray | None = None    # (n, N) each mode's tail amplitude (m); N >= 2 only
+    envelope: np.ndarray | None = None  # (n, n_bands) the response envelope (m); swept only
 
 
 def sample_times(t_end: float, dt: float) -> np.ndarray:
@@ -113,20 +122,36 @@ def settings_vector(scene: Scene) -> np.ndarray:
     atol = scene.get("solver.atol")
     s[tk.ATOL] = 0.0 if atol is None else atol
     s[tk.ATOL_SCALE] = ATOL_SCALE if atol is None else 0.0
-    s[tk.T_END] = scene.get("solver.t_end")
+    s[tk.T_END] = excitation.end_time(scene.values, scene.axes)
     s[tk.MAX_STEPS] = scene.get("solver.max_steps")
     s[tk.MAX_STEP] = scene.get("solver.max_step") or math.inf
     s[tk.FIRST_STEP] = scene.get("solver.first_step") or 0.0
     s[tk.TAIL] = scene.get("metrics.tail")
     s[tk.TOL] = scene.get("metrics.tolerance")
-    s[tk.SAMPLE_DT] = scene.get("outputs.sample_interval") or scene.get("solver.t_end") / 1000.0
+    s[tk.SAMPLE_DT] = scene.get("outputs.sample_interval") or s[tk.T_END] / 1000.0
     s[tk.WANT_SETTLING] = 1.0 if scene.get("outputs.settling_time") else 0.0
     s[tk.MIN_STEP] = scene.get("solver.min_step") or 0.0
     s[tk.CONTROLLER] = 1.0 if scene.get("solver.controller") == "pi" else 0.0
     s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
     if scene.has_base:                  # else 0.0: no forcing term compiled
         s[tk.BASE] = 1.0
+    if excitation.is_swept(scene.values, scene.axes):
+        s[tk.SWEPT] = 1.0
+        s[tk.BANDS_PER_OCTAVE], s[tk.FIRST_BAND] = scene.get("outputs.bands_per_octave"), 0.0
+        if scene.get("outputs.envelope"):
+            s[tk.FIRST_BAND] = envelope_bands(scene)[0]
     return s
+
+
+def envelope_bands(scene: Scene) -> tuple[int, int]:
+    """(first band k, number of bands) of a swept scene's envelope: the base-2 1/N-octave
+    bands, centres 1000 x 2^(k/N) Hz (N = outputs.bands_per_octave), that hold every
+    frequency its sweeps reach."""
+    start, stop, _ = excitation.sweep_grid(scene.values, scene.axes)
+    n = scene.get("outputs.bands_per_octave")
+    low = int(excitation.band_index(float(np.min(np.minimum(start, stop))), n))
+    high = int(excitation.band_index(float(np.max(np.maximum(start, stop))), n))
+    return low, high - low + 1
 
 
 def set_constant_stiffness(settings: np.ndarray, coeffs: dict[str, Any]) -> None:
@@ -171,7 +196,10 @@ class Inputs:
     n_modes scalars or axis parameters each (mode 1's from initial.displacement and
     initial.velocity, the others 0, unless the scene gives initial.modal_displacement or
     initial.modal_velocity); continuation, direction, jump_ratio: the stepped sweep's axis
-    (None: every point independent), its direction and its jump factor ([continuation]).
+    (None: every point independent), its direction and its jump factor ([continuation]);
+    swept: the base frequency is swept ([base] sweep); bands: (first band, count, bands per
+    octave) of its envelope (None: no envelope); per_point_end: every point ends with its own
+    sweep (no solver.t_end given).
     """
     coords: dict[str, xr.DataArray]
     dims: tuple[str, ...]
@@ -191,6 +219,9 @@ class Inputs:
     continuation: str | None = None
     direction: str = "up"
     jump_ratio: float = 1.5
+    swept: bool = False
+    bands: tuple[int, int, int] | None = None
+    per_point_end: bool = False
 
 
 def resolve(scene: Scene) -> Inputs:
@@ -202,6 +233,7 @@ def resolve(scene: Scene) -> Inputs:
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if "outputs.time_series" in wanted else np.empty(0))
     params = grid.parameters(scene, coords)
+    swept = excitation.is_swept(scene.values, scene.axes)
     n_modes = scene.get("model.modes")
     initial = []
     for listed, single in (("initial.modal_displacement", "initial_displacement"),
@@ -217,7 +249,10 @@ def resolve(scene: Scene) -> Inputs:
                   modal_q0=initial[0], modal_v0=initial[1],
                   continuation=scene.get("continuation.axis"),
                   direction=scene.get("continuation.direction"),
-                  jump_ratio=scene.get("continuation.jump_ratio"))
+                  jump_ratio=scene.get("continuation.jump_ratio"), swept=swept,
+                  bands=(envelope_bands(scene) + (scene.get("outputs.bands_per_octave"),)
+                         if swept and scene.get("outputs.envelope") else None),
+                  per_point_end=swept and scene.get("solver.t_end") is None)
 
 
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:
@@ -284,6 +319,10 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
     from .continuation import Carry
     dims, shape, params, n = inputs.dims, inputs.shape, inputs.params, inputs.n_modes
     n_samples = inputs.sample_times.size
+    # a swept base frequency: the envelope's bands and whether each point ends with its sweep
+    swept = (() if not inputs.swept else
+             ((inputs.bands[1] if inputs.bands else 0), inputs.per_point_end))
+    n_bands = swept[0] if swept else -1
     if n == 1:
         def rows_at(points: np.ndarray) -> np.ndarray:
             at = grid.point_values(params, dims, shape, points)
@@ -293,22 +332,22 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
             state=(osc.Q0, osc.V0), base_phase=osc.BASE_PHASE, load_phase=osc.LOAD_PHASE,
             base_omega=osc.BASE_OMEGA, load_omega=osc.OMEGA,
             final=lambda out: out["reals"][:, [tk.Q_END, tk.V_END]])
-        return _System(rows_at, transverse_chunk, (settings, n_samples, inputs.driver),
-                       lambda m: transverse_outputs(m, n_samples), carry)
+        return _System(rows_at, transverse_chunk, (settings, n_samples, inputs.driver) + swept,
+                       lambda m: transverse_outputs(m, n_samples, n_bands), carry)
 
     carry = None if inputs.continuation is None else Carry(
         state=tuple(range(md.N_FIXED, md.N_FIXED + 2 * n)), base_phase=md.BASE_PHASE,
         load_phase=md.LOAD_PHASE, base_omega=md.BASE_OMEGA, load_omega=md.OMEGA,
         final=lambda out: out["final"])
     return _System(lambda points: modal_rows(inputs, points), modes_chunk,
-                   (settings, n_samples, n, inputs.driver),
-                   lambda m: modes_outputs(m, n_samples, n), carry)
+                   (settings, n_samples, n, inputs.driver) + swept,
+                   lambda m: modes_outputs(m, n_samples, n, n_bands), carry)
 
 
 def _result(out: dict[str, np.ndarray], inputs: Inputs) -> KernelResult:
     """The KernelResult of a kernel's outputs by name."""
     return KernelResult(out["states"], out["reals"], out["counts"], out["series"],
-                        inputs.sample_times, out.get("modal"))
+                        inputs.sample_times, out.get("modal"), out.get("envelope"))
 
 
 def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], system: _System,
@@ -412,8 +451,52 @@ def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[in
     return {"modal_amplitude": amplitude, "modal_frequency": frequency}
 
 
-def state_attrs() -> dict[str, Any]:
-    """CF flag attributes of the transverse `state` variable."""
+def sweep_outputs(result: KernelResult, inputs: Inputs,
+                  coeffs: dict[str, Any]) -> dict[str, xr.DataArray]:
+    """The outputs of a swept base frequency (docs/model.md sec. 6): peak_frequency (Hz, the
+    excitation frequency at the largest |q|), the envelope (m, over the axes and BAND_DIM;
+    `band_coordinates`) and the sweep's duration (s); NaN where a point failed."""
+    dims, shape = inputs.dims, inputs.shape
+    out: dict[str, xr.DataArray] = {}
+    if "outputs.peak_frequency" in inputs.wanted:
+        out["peak_frequency"] = xr.DataArray(
+            result.reals[:, tk.PEAK_FREQUENCY].reshape(shape), dims=dims,
+            attrs={"units": "Hz", "long_name": "excitation frequency of the sweep when |q| had "
+                                               "its largest extremum"})
+    if inputs.bands is not None:
+        n = inputs.bands[2]
+        out["envelope"] = xr.DataArray(
+            result.envelope.reshape(shape + (result.envelope.shape[1],)), dims=dims + (BAND_DIM,),
+            attrs={"units": "m", "long_name": f"response envelope: the largest |q| at the "
+                   f"extrema of q while the sweep's frequency lay in the 1/{n}-octave band",
+                   "cell_methods": f"{BAND_DIM}: maximum"})
+    if "sweep_duration" in coeffs:
+        out["sweep_duration"] = derived(coeffs["sweep_duration"], inputs.coords)
+        out["sweep_duration"].attrs = dict(zip(("units", "long_name"),
+                                               _SWEEP_DERIVED["sweep_duration"]))
+    return out
+
+
+def band_coordinates(first: int, count: int, bands_per_octave: int) -> dict[str, xr.DataArray]:
+    """The envelope's coordinate: the bands' centre frequencies (Hz) on BAND_DIM, with CF cell
+    bounds (their edges) in BAND_DIM_bounds."""
+    from .excitation import band_bounds, band_centres
+    bounds_name = f"{BAND_DIM}_bounds"
+    centre = xr.DataArray(band_centres(first, count, bands_per_octave), dims=BAND_DIM, attrs={
+        "units": "Hz", "long_name": f"centre frequency of the base-2 1/{bands_per_octave}-octave "
+                                    "band, 1000 x 2^(k/N) Hz", "bounds": bounds_name})
+    edges = xr.DataArray(band_bounds(first, count, bands_per_octave), dims=(BAND_DIM, "nv"),
+                         attrs={"units": "Hz", "long_name": "band edges"})
+    return {BAND_DIM: centre, bounds_name: edges}
+
+
+def state_attrs(swept: bool = False) -> dict[str, Any]:
+    """CF flag attributes of the transverse `state` variable (`swept`: of a swept base
+    frequency, whose points complete their sweeps or fail)."""
+    if swept:
+        return {**flag_attrs(km.SWEPT_STATES), "long_name": "response state of the point",
+                "comment": "completed: the point ran its whole sweep (a sweep has no settling "
+                           "to judge); the failure states have NaN outputs"}
     return {
         **flag_attrs(km.TRANSVERSE_STATES),
         "long_name": "response state of the point",
@@ -431,7 +514,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     coords, dims, shape = inputs.coords, inputs.dims, inputs.shape
     short, method = METHODS[inputs.method]
     data: dict[str, xr.DataArray] = {}
-    data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims, attrs=state_attrs())
+    data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims,
+                                 attrs=state_attrs(inputs.swept))
     for name, (col, units, long_name, switch) in _REALS.items():
         if switch is None or switch in inputs.wanted:
             data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
@@ -449,9 +533,16 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     if result.modal is not None:
         data.update(modal_outputs(result.modal, dims, shape, coeffs, coords))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
-        data.update(base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
-                                 derived(coeffs["base_accel"], coords)))
+        outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
+                               derived(coeffs["base_accel"], coords))
+        if inputs.swept and inputs.params.get("base_levels_g") is not None:
+            del outputs["transmissibility"]         # no one level to divide by
+        data.update(outputs)
     all_coords: dict[str, Any] = dict(coords)
+    if inputs.swept:
+        data.update(sweep_outputs(result, inputs, coeffs))
+        if inputs.bands is not None:
+            all_coords.update(band_coordinates(*inputs.bands))
     if result.modal is not None:
         all_coords[MODE_DIM] = xr.DataArray(
             np.arange(1, result.modal.shape[1] + 1, dtype=np.int32), dims=MODE_DIM,

@@ -44,8 +44,10 @@ def _build(text: str, source: str, default_name: str,
     if isinstance(doc.get("axes"), dict):
         doc["axes"] = _flatten_axes(doc["axes"])
     file_has_base = "base" in doc
+    _flatten_tables(doc)
     applied = _parse_overrides(overrides)
     _apply_overrides(doc, applied)
+    _flatten_tables(doc)
     _check_top_level(doc)
     name = _check_name(doc.get("name", default_name))
     description = _check_description(doc.get("description", ""))
@@ -60,6 +62,25 @@ def _build(text: str, source: str, default_name: str,
     kind.check_resolved(values, axes, given)
     return Scene(name=name, description=description, values=values, axes=axes,
                  text=text, source=source, overrides=applied)
+
+
+def _flatten_tables(doc: dict[str, Any]) -> None:
+    """Write a section's inline tables of keys (``[base] sweep = {start, stop, rate}``) as the
+    schema's dotted names (``sweep.start``), in place; a table replaces the dotted keys it
+    had. A plain value where such a table belongs is refused in one line."""
+    for section, table in doc.items():
+        if not isinstance(table, dict) or section == "axes":
+            continue
+        for name in [n for n in table if f"{section}.{n}" in schema.TABLES]:
+            value = table.pop(name)
+            dotted = f"{section}.{name}"
+            if not isinstance(value, dict):
+                _fail(f"scene key '{dotted}'", f"must be a table, got {value!r}",
+                      f"write e.g. {schema.TABLES[dotted]}")
+            for old in [n for n in table if n.startswith(f"{name}.")]:
+                del table[old]
+            for sub, item in value.items():
+                table[f"{name}.{sub}"] = item
 
 
 def _check_run(given: dict[str, Any]) -> None:

@@ -128,6 +128,8 @@ def _check_value(where: str, key: schema.Key, raw: Any) -> Any:
     """A value of the key's kind, within its bounds and choices."""
     if key.kind == "floats":
         return _as_floats(where, key, raw)
+    if key.kind == "pairs":
+        return _as_pairs(where, key, raw)
     if isinstance(raw, (dict, list)):
         _fail(where, f"must be a single value, got {_show(raw)}", _container_fix(key, raw))
     if key.kind == "float":
@@ -157,6 +159,32 @@ def _as_floats(where: str, key: schema.Key, raw: Any) -> tuple[float, ...]:
                          f"got {_show(item)}", _HINTS.get(key.dotted) or _generic_hint(key))
         values.append(value)
     return tuple(values)
+
+
+def _as_pairs(where: str, key: schema.Key, raw: Any) -> tuple[tuple[float, float], ...]:
+    """A table of breakpoints: 2 to MAX_BREAKPOINTS [x, y] pairs of finite numbers > 0, x
+    strictly increasing (``base.levels_g``: x in Hz, y in g)."""
+    from ..models.excitation import MAX_BREAKPOINTS
+    fix = f"write e.g. {key.name} = [[5.0, 0.5], [100.0, 0.6]] (Hz, g)"
+    if not isinstance(raw, list) or not 2 <= len(raw) <= MAX_BREAKPOINTS:
+        _fail(where, f"must be a list of 2 to {MAX_BREAKPOINTS} [frequency, level] pairs, got "
+              f"{_show(raw)}", fix)
+    pairs = []
+    for number, item in enumerate(raw, start=1):
+        if not isinstance(item, list) or len(item) != 2:
+            _fail(where, f"item {number} must be a pair [frequency, level], got {_show(item)}",
+                  fix)
+        x = _as_float(where, item[0], fix, f"item {number}'s frequency ")
+        y = _as_float(where, item[1], fix, f"item {number}'s level ")
+        if not (x > 0.0 and y > 0.0):
+            _fail(where, f"item {number} must have a frequency and a level > 0 (a log-log "
+                  f"table), got {_show(item)}", fix)
+        if pairs and not x > pairs[-1][0]:
+            _fail(where, f"item {number}'s frequency {_show(x)} Hz must be above the one "
+                  f"before ({_show(pairs[-1][0])} Hz)", "list the breakpoints in order of "
+                  "increasing frequency, each frequency once")
+        pairs.append((x, y))
+    return tuple(pairs)
 
 
 def _container_fix(key: schema.Key, raw: Any) -> str:
