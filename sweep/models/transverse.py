@@ -470,6 +470,15 @@ def sweep_outputs(result: KernelResult, inputs: Inputs,
             attrs={"units": "m", "long_name": f"response envelope: the largest |q| at the "
                    f"extrema of q while the sweep's frequency lay in the 1/{n}-octave band",
                    "cell_methods": f"{BAND_DIM}: maximum"})
+        from .excitation import band_centres, table_level
+        centres = xr.DataArray(band_centres(*inputs.bands), dims=BAND_DIM)
+        levels = inputs.params.get("base_levels_g")
+        level = (table_level(levels, centres) if levels is not None
+                 else derived(coeffs["base_accel"], inputs.coords) * xr.ones_like(centres))
+        out["base_level_g"] = (level / STANDARD_GRAVITY).transpose(..., BAND_DIM)
+        out["base_level_g"].attrs = {
+            "units": G_UNITS, "long_name": f"base acceleration level at the band's centre "
+                                           f"frequency, in g ({STANDARD_GRAVITY:g} m s-2)"}
     if "sweep_duration" in coeffs:
         out["sweep_duration"] = derived(coeffs["sweep_duration"], inputs.coords)
         out["sweep_duration"].attrs = dict(zip(("units", "long_name"),
@@ -486,7 +495,7 @@ def band_coordinates(first: int, count: int, bands_per_octave: int) -> dict[str,
         "units": "Hz", "long_name": f"centre frequency of the base-2 1/{bands_per_octave}-octave "
                                     "band, 1000 x 2^(k/N) Hz", "bounds": bounds_name})
     edges = xr.DataArray(band_bounds(first, count, bands_per_octave), dims=(BAND_DIM, "nv"),
-                         attrs={"units": "Hz", "long_name": "band edges"})
+                         attrs={"units": "Hz", "long_name": centre.attrs["long_name"]})
     return {BAND_DIM: centre, bounds_name: edges}
 
 
