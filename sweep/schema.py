@@ -117,6 +117,9 @@ KEYS: tuple[Key, ...] = (
         axis="base_sweep_stop"),
     Key("base", "sweep.rate", "float", None, units="min-1", minimum=0.0, exclusive_min=True,
         long_name="logarithmic sine sweep: rate in octaves per minute", axis="base_sweep_rate"),
+    Key("base", "sweep.direction", "str", None, choices=("up", "down", "both"),
+        long_name="logarithmic sine sweep: from the lower of start and stop to the upper (up), "
+                  "back (down) or both (a direction dimension); default: from start to stop"),
     Key("base", "levels_g", "pairs", None, units=G_UNITS,
         long_name="base level table instead of a constant level: (frequency in Hz, peak level "
                   "in g) breakpoints, interpolated log-log"),

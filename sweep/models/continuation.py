@@ -170,8 +170,9 @@ def jump_attrs(axis_name: str, ratio: float) -> dict[str, object]:
                          f"in the sweep's direction (by more than a factor {ratio:g})"}
 
 
-def direction_coordinate(directions: list[str]) -> xr.DataArray:
+def direction_coordinate(directions: list[str], long_name: str = "direction of the stepped "
+                         "sweep along the continuation axis (up: increasing values)"
+                         ) -> xr.DataArray:
     """The `direction` coordinate of a result swept both ways."""
     return xr.DataArray(np.array(directions, dtype=object), dims=DIRECTION_DIM,
-                        attrs={"long_name": "direction of the stepped sweep along the "
-                                            "continuation axis (up: increasing values)"})
+                        attrs={"long_name": long_name})

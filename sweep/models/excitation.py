@@ -98,6 +98,8 @@ def block(accel: Any, omega: Any, rate: Any = 0.0, end: Any = math.inf,
 SWEEP_KEYS: tuple[str, str, str] = ("base.sweep.start", "base.sweep.stop", "base.sweep.rate")
 """The keys of a logarithmic sweep ([base] sweep = {start, stop, rate})."""
 SWEEP_AXES: tuple[str, str, str] = ("base_sweep_start", "base_sweep_stop", "base_sweep_rate")
+SWEEP_DIRECTION = "base.sweep.direction"
+"""Optional: up, down or both ways between start and stop (default: from start to stop)."""
 
 
 def is_swept(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:

@@ -75,7 +75,7 @@ from typing import Any
 
 import numpy as np
 
-from .excitation import SWEEP_KEYS, end_time, sweep_grid
+from .excitation import SWEEP_DIRECTION, SWEEP_KEYS, end_time, sweep_grid
 
 from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span counts
 
@@ -247,6 +247,9 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
                 _fail(f"scene keys '{dotted}' and '{BASE_TABLE_KEY}'", "give one level, not "
                       "both (a constant level, or a table of breakpoints)",
                       f"remove one of them: {_PAIR_UNITS['base.acceleration']}")
+    if not swept and given.get(SWEEP_DIRECTION) is not None:
+        _fail(f"scene key '{SWEEP_DIRECTION}'", "needs a sweep (start, stop and rate)",
+              "write sweep = { start = 5.0, stop = 100.0, rate = 2.0, direction = 'both' }")
     if not swept:
         for dotted in ("outputs.envelope",):
             if given.get(dotted):

@@ -199,7 +199,8 @@ class Inputs:
     (None: every point independent), its direction and its jump factor ([continuation]);
     swept: the base frequency is swept ([base] sweep); bands: (first band, count, bands per
     octave) of its envelope (None: no envelope); per_point_end: every point ends with its own
-    sweep (no solver.t_end given).
+    sweep (no solver.t_end given); sweep_direction: base.sweep.direction (None: from start to
+    stop).
     """
     coords: dict[str, xr.DataArray]
     dims: tuple[str, ...]
@@ -222,6 +223,7 @@ class Inputs:
     swept: bool = False
     bands: tuple[int, int, int] | None = None
     per_point_end: bool = False
+    sweep_direction: str | None = None
 
 
 def resolve(scene: Scene) -> Inputs:
@@ -252,7 +254,8 @@ def resolve(scene: Scene) -> Inputs:
                   jump_ratio=scene.get("continuation.jump_ratio"), swept=swept,
                   bands=(envelope_bands(scene) + (scene.get("outputs.bands_per_octave"),)
                          if swept and scene.get("outputs.envelope") else None),
-                  per_point_end=swept and scene.get("solver.t_end") is None)
+                  per_point_end=swept and scene.get("solver.t_end") is None,
+                  sweep_direction=scene.get("base.sweep.direction"))
 
 
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:
@@ -273,9 +276,53 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     started = time.perf_counter()
     if inputs.continuation is not None:
         return _run_stepped(inputs, options, coeffs, system, settings, started)
+    if inputs.sweep_direction is not None:
+        return _run_directed(inputs, options, coeffs, settings, started)
     out = solve_chunked(options, system.chunk_fn, system.rows_at, system.args,
                         system.outputs(n_points))
     return assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
+
+
+def _run_directed(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any],
+                  settings: np.ndarray, started: float) -> xr.Dataset:
+    """A sweep with base.sweep.direction: up (from the lower of start and stop to the upper),
+    down, or both, solved as one grid of twice the points (the down sweeps after the up
+    sweeps: one chunk store, one dask graph), the two halves on a `direction` dimension."""
+    from . import continuation as ct
+    directions = ["up", "down"] if inputs.sweep_direction == "both" else [inputs.sweep_direction]
+    systems = [_system(oriented(inputs, d), settings) for d in directions]
+    n = int(np.prod(inputs.shape, dtype=np.int64))
+
+    def rows_at(points: np.ndarray) -> np.ndarray:
+        rows = np.empty((points.size, systems[0].rows_at(points[:0]).shape[1]))
+        for k, system in enumerate(systems):
+            mine = points // n == k
+            if np.any(mine):
+                rows[mine] = system.rows_at(points[mine] % n)
+        return rows
+
+    out = solve_chunked(options, systems[0].chunk_fn, rows_at, systems[0].args,
+                        systems[0].outputs(n * len(directions)))
+    elapsed = time.perf_counter() - started
+    results = [assemble(oriented(inputs, d), coeffs,
+                        _result({k: v[i * n:(i + 1) * n] for k, v in out.items()}, inputs),
+                        elapsed) for i, d in enumerate(directions)]
+    if len(results) == 1:
+        return results[0]
+    ds = _both_directions(results, inputs.dims, directions)
+    return ds.assign_coords({ct.DIRECTION_DIM: ct.direction_coordinate(
+        directions, "direction of the sine sweep (up: increasing frequency)")})
+
+
+def oriented(inputs: Inputs, direction: str) -> Inputs:
+    """`inputs` with its sweep running up (from the lower of start and stop to the upper) or
+    down."""
+    import dataclasses
+    start, stop = inputs.params["base_sweep_start"], inputs.params["base_sweep_stop"]
+    low, high = np.minimum(start, stop), np.maximum(start, stop)
+    first, last = (low, high) if direction == "up" else (high, low)
+    return dataclasses.replace(inputs, params={**inputs.params, "base_sweep_start": first,
+                                               "base_sweep_stop": last})
 
 
 @dataclass(frozen=True)
@@ -401,7 +448,8 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...],
     `direction` dimension, the rest (closed forms of the parameters) once."""
     from . import continuation as ct
     first = results[0]
-    solved = {"state", "jump", "modal_amplitude", *_REALS, *_COUNTS, *BASE_OUTPUTS}
+    solved = {"state", "jump", "modal_amplitude", "peak_frequency", "envelope", *_REALS,
+              *_COUNTS, *BASE_OUTPUTS}
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
     ds = first.drop_vars(per_point).merge(stacked)
