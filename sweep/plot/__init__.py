@@ -19,6 +19,12 @@ What `plot` draws, by the result's content:
 - a stepped sweep ([continuation]): amplitude (and the absolute acceleration in g under base
   excitation) against the stepped axis, one curve per value of one other axis, stepped up solid
   and down dashed, the jumps marked by triangles (`plot_branches`);
+- a continuous sine sweep ([base] sweep = {start, stop, rate}): peak_amplitude and
+  peak_frequency over the axes like amplitude; with its envelope stored (outputs.envelope) the
+  response envelope against the excitation frequency on log-log axes, one line per point of
+  the one swept axis, each point's peak starred and its f1 dotted, the base level in g on a
+  right axis (`plot_envelope`), and a map of the envelope over that axis and the bands (log
+  frequency axis);
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
   histories (`plot_histories`); with swept axes also the peak end displacement and the
   dynamic amplification over them.
@@ -57,6 +63,7 @@ The package, split like xarray's plot/ by what is drawn:
     maps.py      two swept axes (plot_map, plot_state_map)
     series.py    stored histories (plot_time_series, plot_snapshots, plot_histories)
     branches.py  a stepped sweep: up and down against the stepped axis, the jumps (plot_branches)
+    envelope.py  a continuous sine sweep: the response envelope over frequency (plot_envelope)
     figures.py   which figures a result gets, and writing them (plot, save)
 """
 
@@ -65,6 +72,7 @@ from __future__ import annotations
 # _HATCHES, _edges and _select_tag are private; tests/test_plot.py reaches them here.
 from .figures import Figures, _select_tag, plot, save, why_not_drawn  # noqa: F401
 from .branches import plot_branches
+from .envelope import plot_envelope
 from .labels import footer, label
 from .line import plot_line
 from .maps import _HATCHES, FLOOR, plot_map, plot_state_map  # noqa: F401
@@ -75,6 +83,7 @@ from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
            "check_result", "load_result", "parse_select", "plot", "plot_branches",
+           "plot_envelope",
            "plot_histories",
            "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
            "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]

@@ -22,13 +22,14 @@ from matplotlib.figure import Figure
 
 from ..errors import UserError
 from ..files import write_temporary
-from .labels import _add_footer
+from .labels import _add_footer, _title
 from .branches import plot_branches, stepped_axis
+from .envelope import BAND_DIM, plot_envelope
 from .line import plot_line
 from .maps import plot_map, plot_state_map
-from .result import _time_dim, check_result, select_points, swept_axes
+from .result import _scene, _time_dim, check_result, select_points, swept_axes
 from .series import _snapshot_fields, plot_histories, plot_snapshots, plot_time_series
-from .style import _plain_ticks, _state_meaning, _unit
+from .style import _log_ticks, _plain_ticks, _state_meaning, _unit
 
 _log = logging.getLogger(__package__)     # "sweep.plot", the one logger of the figures
 
@@ -65,7 +66,10 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     """Every figure that fits the result, keyed by name (the file name `save` gives it).
 
     Transverse: 'amplitude' and 'settling_time' (lines over one swept axis, maps over two),
-    and 'absolute_acceleration_g' under base excitation,
+    and 'absolute_acceleration_g' under base excitation; a continuous sine sweep also
+    'peak_amplitude' and 'peak_frequency' over the axes, and with its envelope stored
+    'envelope' (against the excitation frequency, zero or one swept axis) and 'envelope_map'
+    (one swept axis x the bands);
     'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
     swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
@@ -88,6 +92,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
         scalars = ["amplitude", "settling_time"]
         if "absolute_acceleration_g" in ds:        # base excitation (docs/model.md sec. 5)
             scalars.insert(1, "absolute_acceleration_g")
+        if _is_swept(ds):                          # a continuous sine sweep: its peak first
+            scalars[:0] = ["peak_amplitude", "peak_frequency"]
     if len(axes) == 2:
         scalars.append("state")
     for var in scalars:
@@ -107,6 +113,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             figures[var] = plot_line(ds, var).figure
         else:
             figures[var] = plot_map(ds, var).figure
+    if "envelope" in ds:
+        _envelope_figures(ds, axes, figures)
     if "displacement" in ds and _time_dim(ds["displacement"]) is not None:
         figures["time_series"] = plot_time_series(ds)
     if _snapshot_fields(ds):
@@ -118,6 +126,40 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             _plain_ticks(ax)
         _add_footer(fig, ds)
     return figures
+
+
+def _is_swept(ds: xr.Dataset) -> bool:
+    """A continuous sine sweep's result ([base] sweep = {start, stop, rate})."""
+    if "peak_frequency" in ds or "envelope" in ds:
+        return True
+    base = _scene(ds).get("base", {})
+    return isinstance(base, dict) and isinstance(base.get("sweep"), dict)
+
+
+def _envelope_figures(ds: xr.Dataset, axes: list[str], figures: Figures) -> None:
+    """A sweep's 'envelope' (lines against the excitation frequency, `plot_envelope`; zero or
+    one swept axis) and 'envelope_map' (its one swept axis x the bands, log frequency axis)."""
+    title = ds.attrs.get("title", "result")
+    names = ["envelope"] + (["envelope_map"] if len(axes) == 1 else [])
+    reason = why_not_drawn(ds["envelope"])
+    if reason is None and len(axes) > 1:
+        example = " ".join(f"--select {d}={float(ds[d].values[0]):g}" for d in axes[1:])
+        reason = (f"{len(axes)} swept axes ({', '.join(axes)}): select values of all but the "
+                  f"first to draw it, e.g. {example}")
+    if reason is None and ds.sizes[BAND_DIM] < 2:
+        names = ["envelope"]
+    for name in names:
+        if reason is not None:
+            figures.skipped[name] = reason
+            _log.info("%s: %s: no figure (%s)", title, name, reason)
+        elif name == "envelope":
+            figures[name] = plot_envelope(ds)
+        else:
+            ax = plot_map(ds, "envelope", x=BAND_DIM, y=axes[0], xscale="log")
+            ax.set_xlabel(f"excitation frequency [{ds[BAND_DIM].attrs.get('units', 'Hz')}]")
+            ax.set_title(_title(ds, "response envelope"), fontsize="medium")
+            _log_ticks(ax, "x")
+            figures[name] = ax.figure
 
 
 def _stepped_figures(ds: xr.Dataset, select: Mapping[str, Any] | None) -> Figures:

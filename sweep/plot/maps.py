@@ -33,8 +33,13 @@ _HATCHES = {"modulated": "\\\\\\", "unsettled": "///", "diverged": "xxx",
             "step_size_too_small": "...", "max_steps_reached": "+++", "invalid_input": "---"}
 
 
-def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str) -> tuple[str, str]:
+def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str,
+              var: str | None = None) -> tuple[str, str]:
+    """The map's x and y: the swept axes, and the dimensions `var` lies over beyond them (a
+    sweep's envelope bands, `band_frequency`), with more than one value; exactly two."""
     axes = swept_axes(ds)
+    if var is not None and var in ds:
+        axes += [d for d in ds[var].dims if d not in ds["state"].dims and ds.sizes[d] > 1]
     if len(axes) != 2:
         raise UserError(f"{who} needs exactly two swept axes; this result has {len(axes)} "
                         f"({', '.join(axes) or 'none'})" + (": use plot_line" if len(axes) == 1
@@ -50,13 +55,30 @@ def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str) -> tuple[s
     return x, y
 
 
-def _mesh(ax: Axes, ds: xr.Dataset, x: str, y: str, values: np.ndarray, **kwargs: Any):
+def _scale(ax: Axes, which: str, values: np.ndarray, scale: str | None) -> None:
+    """The x or y scale: `scale` when given ("linear", "log"), else log for a log-spaced
+    coordinate. A log scale needs positive values (UserError otherwise)."""
+    if scale is None:
+        scale = "log" if _is_log_spaced(values) else "linear"
+    if scale not in ("linear", "log"):
+        raise UserError(f"{which}scale '{scale}': use 'linear' or 'log'")
+    if scale == "log" and not np.all(np.asarray(values, float) > 0):
+        raise UserError(f"{which}scale 'log': the {which} axis has values <= 0")
+    (ax.set_xscale if which == "x" else ax.set_yscale)(scale)
+
+
+def _mesh(ax: Axes, ds: xr.Dataset, x: str, y: str, values: np.ndarray,
+          xscale: str | None = None, yscale: str | None = None, **kwargs: Any):
     xv, yv = _coord(ds, x), _coord(ds, y)
-    mesh = ax.pcolormesh(_edges(xv), _edges(yv), values, shading="flat", **kwargs)
-    if _is_log_spaced(xv):
-        ax.set_xscale("log")
-    if _is_log_spaced(yv):
-        ax.set_yscale("log")
+    xe, ye = _edges(xv), _edges(yv)
+    # A log axis gets geometric cell edges even when the centres are not log-spaced.
+    if xscale == "log" and not _is_log_spaced(xv) and np.all(xv > 0):
+        xe = np.exp(_edges(np.log(xv)))
+    if yscale == "log" and not _is_log_spaced(yv) and np.all(yv > 0):
+        ye = np.exp(_edges(np.log(yv)))
+    mesh = ax.pcolormesh(xe, ye, values, shading="flat", **kwargs)
+    _scale(ax, "x", xv, xscale)
+    _scale(ax, "y", yv, yscale)
     ax.set_xlabel(label(ds[x], _unit(ds[x])[1]))
     ax.set_ylabel(label(ds[y], _unit(ds[y])[1]))
     return mesh
@@ -70,10 +92,16 @@ def _mark_states(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
     """Mark the cells whose state is not a good one; returns the legend handles. A small grid
     (at most 100 cells) gets a marker per cell; a denser one gets each state's region hatched
     and outlined in the state's colour along the cell edges, so the colour under it shows."""
-    state = ds["state"].transpose(y, x).values
+    points = ds["state"].values              # the counts are of points, not of cells
+    state = ds["state"]
+    for dim in (x, y):                       # a map over a dimension beyond the swept axes
+        if dim not in state.dims:            # (envelope bands): a point's state on its row
+            state = state.expand_dims({dim: ds.sizes[dim]})
+    state = state.transpose(y, x).values
     styles = [s for s in state_styles(ds["state"]) if s[3] is not None and (state == s[0]).any()]
     if state.size > _MARKER_CELLS:
-        return [_hatch_region(ax, ds, x, y, state == value, meaning, colour)
+        return [_hatch_region(ax, ds, x, y, state == value, meaning, colour,
+                              int((points == value).sum()))
                 for value, meaning, colour, _marker in styles]
     xx, yy = np.meshgrid(_coord(ds, x), _coord(ds, y))
     # Markers fit in their cells: at most 60 % of the smaller cell side (and 30 pt^2).
@@ -88,13 +116,14 @@ def _mark_states(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
                    linewidths=edge, zorder=4)
         handles.append(Line2D([], [], ls="none", marker=marker, color=colour,
                               markeredgecolor="k", markeredgewidth=0.6,
-                              label=_state_label(meaning, int(mask.sum()))))
+                              label=_state_label(meaning, int((points == value).sum()))))
     return handles
 
 
 def _hatch_region(ax: Axes, ds: xr.Dataset, x: str, y: str, mask: np.ndarray, meaning: str,
-                  colour: str) -> Patch:
-    """Hatch and outline the cells of `mask` (rows: y); its legend handle."""
+                  colour: str, count: int | None = None) -> Patch:
+    """Hatch and outline the cells of `mask` (rows: y); its legend handle, counting `count`
+    points (default: the cells of `mask`)."""
     def doubled(edges: np.ndarray) -> np.ndarray:
         # Two samples per cell just inside its edges: contouring the 0/1 mask at 0.5 then
         # crosses exactly on the cell edges (also on a log-spaced axis).
@@ -112,7 +141,7 @@ def _hatch_region(ax: Axes, ds: xr.Dataset, x: str, y: str, mask: np.ndarray, me
                path_effects=[patheffects.Stroke(linewidth=2.3, foreground="k"),
                              patheffects.Normal()])
     return Patch(facecolor="none", edgecolor=colour, hatch=hatch, linewidth=1.1,
-                 label=_state_label(meaning, int(mask.sum())))
+                 label=_state_label(meaning, int(mask.sum()) if count is None else count))
 
 
 def _overlays(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
@@ -127,7 +156,8 @@ def _overlays(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
 def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
              y: str | None = None, select: Mapping[str, Any] | None = None,
              ax: Axes | None = None, add_colorbar: bool = True, add_legend: bool = True,
-             mark_states: bool = True, overlays: bool = True, **kwargs: Any) -> Axes:
+             mark_states: bool = True, overlays: bool = True, xscale: str | None = None,
+             yscale: str | None = None, **kwargs: Any) -> Axes:
     """A pcolormesh map of `var` over the two swept axes (x: the second, y: the first, as
     xarray draws a 2-D DataArray; or name them). A variable spanning more than two decades gets
     a log colour scale; cells with no value (NaN) are grey. Displacements are in mm; on a log
@@ -136,11 +166,14 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
     six decades, the rest in the lowest colour). Points in a state that is not a good one
     (modulated, unsettled, diverged, failures) are marked: a marker per cell on small grids,
     hatched and outlined regions on dense ones (`_MARKER_CELLS`). The closed-form curves the
-    axes allow are drawn in white (sweep/plot/overlays.py). Extra keyword arguments go to
-    `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
+    axes allow are drawn in white (sweep/plot/overlays.py). A variable over one swept axis and
+    a dimension of its own (a sweep's `envelope` over `band_frequency`, Hz) is mapped over the
+    two; a point's state marks its whole row. `xscale`, `yscale`: "linear" or "log" (None: log
+    for a log-spaced coordinate, such as the envelope's band centres). Extra keyword arguments
+    go to `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
     """
     ds = select_points(ds, select)
-    x, y = _map_axes(ds, x, y, "plot_map")
+    x, y = _map_axes(ds, x, y, "plot_map", var)
     if var not in ds:
         raise UserError(f"plot_map: the result has no variable '{var}'")
     ax = ax if ax is not None else _new_axes((7.0, 6.0))
@@ -170,7 +203,7 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
         padded = _padded_range(values.compressed())
         if padded is not None:
             kwargs["vmin"], kwargs["vmax"] = padded
-    mesh = _mesh(ax, ds, x, y, values, cmap=cmap, **kwargs)
+    mesh = _mesh(ax, ds, x, y, values, xscale, yscale, cmap=cmap, **kwargs)
     ax.set_facecolor(_NAN_COLOUR)
     if values.mask.any():
         handles.append(Patch(facecolor=_NAN_COLOUR, edgecolor="0.5", label="no value (NaN)"))

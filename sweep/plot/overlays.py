@@ -161,18 +161,21 @@ def _paper_fig5_points(ax: Axes, ds: xr.Dataset, dim: str, var: str, factor: flo
 
 def _base_resonance(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
     """The linear resonance of a base-excited map: f = f1 over the other axis (a
-    base_frequency axis, when f1 depends on that axis alone) or f/f1 = 1; its legend handle."""
+    base_frequency axis, or a sweep's envelope bands `band_frequency`, when f1 depends on the
+    other axis alone) or f/f1 = 1; its legend handle."""
     style = dict(color="w", lw=1.4, ls=(0, (1, 1.5)), zorder=3, path_effects=_OUTLINE)
     if "base_frequency_ratio" in (x, y):
         (ax.axvline if x == "base_frequency_ratio" else ax.axhline)(1.0, **style)
-    elif "base_frequency" in (x, y) and "natural_frequency" in ds:
-        other = y if x == "base_frequency" else x
+    elif ("base_frequency" in (x, y) or "band_frequency" in (x, y)) \
+            and "natural_frequency" in ds:
+        freq = "base_frequency" if "base_frequency" in (x, y) else "band_frequency"
+        other = y if x == freq else x
         f1 = ds["natural_frequency"]
         if not _depends_only_on(f1, [other]) or other not in f1.dims:
             return []
         pos = _coord(ds, other)
         values = np.asarray(f1.transpose(other).values, float)
-        px, py = (values, pos) if x == "base_frequency" else (pos, values)
+        px, py = (values, pos) if x == freq else (pos, values)
         ax.plot(px, py, **style)
     else:
         return []
@@ -272,6 +275,10 @@ def _base_text(ds: xr.Dataset, get: Callable[[str, str], Any]) -> str | None:
         return None
     level_g, level = get("base", "acceleration_g"), get("base", "acceleration")
     freq, ratio = get("base", "frequency"), get("base", "frequency_ratio")
+    sweep = doc.get("base", {}).get("sweep") if isinstance(doc.get("base"), dict) else None
+    if isinstance(sweep, dict) or any(str(a).startswith("base_sweep_") for a in doc.get(
+            "axes", {})):
+        return _sweep_text(ds, sweep if isinstance(sweep, dict) else {}, level_g, level)
     text = "base sine"
     if level_g is not None:
         text += f" {float(level_g):.4g} g"
@@ -281,6 +288,45 @@ def _base_text(ds: xr.Dataset, get: Callable[[str, str], Any]) -> str | None:
         text += f" at {float(freq):.4g} Hz"
     elif ratio is not None:
         text += f" at f/f1 = {float(ratio):.4g}"
+    return text
+
+
+def _number(value: Any) -> float | None:
+    ok = isinstance(value, (int, float, np.number)) and not isinstance(value, bool)
+    return float(value) if ok and math.isfinite(float(value)) else None
+
+
+def _sweep_text(ds: xr.Dataset, sweep: dict, level_g: Any, level: Any) -> str:
+    """'base sine sweep 20-60 Hz at 4 oct/min, 0.2-0.4 g (levels_g table)'; the swept parts
+    left out (they are on the axes)."""
+    def part(key: str) -> float | None:
+        axis = f"base_sweep_{key}"
+        if axis in ds.coords:
+            return _number(ds[axis].values.item()) if ds[axis].ndim == 0 else None
+        if axis in _scene(ds).get("axes", {}):
+            return None
+        return _number(sweep.get(key))
+
+    start, stop, rate = part("start"), part("stop"), part("rate")
+    text = "base sine sweep"
+    if start is not None and stop is not None:
+        text += f" {start:.4g}-{stop:.4g} Hz"
+    elif start is not None or stop is not None:
+        text += f" {'from' if start is not None else 'to'} {(start or stop):.4g} Hz"
+    if rate is not None:
+        text += f" at {rate:.4g} oct/min"
+    table = _scene(ds).get("base", {}).get("levels_g")
+    levels = [_number(p[1]) for p in table if isinstance(p, (list, tuple)) and len(p) == 2] \
+        if isinstance(table, list) else []
+    levels = [v for v in levels if v is not None]
+    if levels:
+        low, high = min(levels), max(levels)
+        shown = f"{low:.4g} g" if low == high else f"{low:.4g}-{high:.4g} g"
+        text += f", {shown} (levels_g table)"
+    elif _number(level_g) is not None:
+        text += f", {float(level_g):.4g} g"
+    elif _number(level) is not None:
+        text += f", {float(level):.4g} m/s^2"
     return text
 
 

@@ -46,7 +46,12 @@ _SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
 _OVER_AXES = ("amplitude", "settling_time", "peak_end_displacement", "dynamic_amplification",
               "load_ratio", "natural_frequency", "transit_time", "static_end_displacement",
               "peak_fixed_end_force", "force_amplification", "damping_ratio",
-              "absolute_acceleration_g", "transmissibility")
+              "absolute_acceleration_g", "transmissibility", "peak_amplitude",
+              "peak_frequency", "sweep_duration")
+# A continuous sine sweep's envelope and input level: over (some of) the swept axes and
+# BAND_DIM, the centres of its 1/N-octave bands (Hz), with CF bounds (BAND_DIM, nv).
+BAND_DIM = "band_frequency"
+_OVER_BANDS = ("envelope", "base_level_g")
 _HISTORIES = ("displacement", "end_displacement", "fixed_end_force")
 _SNAPSHOTS = tuple(f"snapshot_{f}{s}" for f in ("displacement", "force", "velocity")
                    for s in ("", "_ratio"))
@@ -271,10 +276,52 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
                                  f", not over ({want})")
         for dim in expected:
             _check_axis(ds, dim, where, unique=False)
+    _check_bands(ds, axes, where)
     for key in ("title", "model_kind", "coefficients", "scene"):
         if key in ds.attrs and not isinstance(ds.attrs[key], str):
             raise _refuse(where, f"attribute '{key}' is not text")
     _check_scene(ds, where)
+
+
+def _check_bands(ds: xr.Dataset, axes: list[str], where: str) -> None:
+    """A sweep's envelope (over every swept axis and BAND_DIM) and base level (over BAND_DIM
+    and some of the axes): numbers, a band axis of distinct positive frequencies, and band
+    bounds, when the axis names them, of two finite edges around each centre."""
+    present = [name for name in _OVER_BANDS if name in ds]
+    if not present:
+        return
+    for name in present:
+        da = ds[name]
+        if da.dtype.kind not in "iuf":
+            raise _refuse(where, f"variable '{name}' holds {da.dtype}, not numbers")
+        others = [d for d in da.dims if d != BAND_DIM]
+        want = axes if name == "envelope" else [d for d in axes if d in others]
+        if BAND_DIM not in da.dims or sorted(others) != sorted(want) \
+                or len(others) != len(set(others)):
+            shown = ", ".join(axes + [BAND_DIM]) if name == "envelope" else \
+                f"{BAND_DIM} and some of ({', '.join(axes)})"
+            raise _refuse(where, f"variable '{name}' lies over ({', '.join(map(str, da.dims))})"
+                                 f", not over ({shown})")
+    _check_axis(ds, BAND_DIM, where, unique=True)
+    centres = np.asarray(ds[BAND_DIM].values, dtype=float)
+    if np.any(centres <= 0):
+        raise _refuse(where, f"coordinate '{BAND_DIM}' has values <= 0 "
+                             f"({_values_text(centres)}), not band frequencies")
+    bounds = ds[BAND_DIM].attrs.get("bounds")
+    if bounds is None:
+        return
+    if not isinstance(bounds, str) or bounds not in ds.variables:
+        raise _refuse(where, f"coordinate '{BAND_DIM}' names bounds {_short(repr(bounds))}, "
+                             "which the result does not hold")
+    b = ds[bounds]
+    if b.ndim != 2 or b.dims[0] != BAND_DIM or b.shape[1] != 2 or b.dtype.kind not in "iuf":
+        raise _refuse(where, f"bounds '{_short(bounds)}' hold {b.dtype} over "
+                             f"({', '.join(map(str, b.dims))}), not two edges per band")
+    v = np.asarray(b.values, dtype=float)
+    if not (np.all(np.isfinite(v)) and np.all(v[:, 0] <= centres) and np.all(centres <= v[:, 1])
+            and np.all(v > 0)):
+        raise _refuse(where, f"bounds '{_short(bounds)}' are not finite positive edges around "
+                             f"each band's centre")
 
 
 def _check_scene(ds: xr.Dataset, where: str) -> None:

@@ -7,12 +7,15 @@ the prefix their largest value calls for; a level in g reads as g; anything else
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 import numpy as np
 import xarray as xr
 from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.ticker import ScalarFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter, ScalarFormatter
 
 from ..schema import G_UNITS
 
@@ -120,6 +123,30 @@ def _plain_ticks(ax: Axes) -> None:
         if isinstance(formatter, ScalarFormatter):
             formatter.set_useOffset(False)
             formatter.set_scientific(False)
+
+
+def _log_ticks(ax: Axes, which: str) -> None:
+    """Plain numbers on a log axis ('20', '50', not '2 x 10^1'); over less than about two
+    decades the 2 and 5 of each decade are labelled too (within one decade also the 3, within
+    0.7 decades every digit)."""
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    low, high = (ax.get_xlim() if which == "x" else ax.get_ylim())
+    if not (low > 0 and high > low):
+        return
+    decades = math.log10(high / low)
+    plain = FuncFormatter(lambda v, _pos: f"{v:g}")
+    axis.set_major_locator(LogLocator(base=10.0))
+    axis.set_major_formatter(plain)
+    subs = (tuple(np.arange(2.0, 10.0)) if decades < 0.7 else (2.0, 3.0, 5.0) if decades < 1.2
+            else (2.0, 5.0) if decades < 2.2 else ())
+    axis.set_minor_locator(LogLocator(base=10.0, subs=tuple(np.arange(2.0, 10.0))))
+    if subs:
+        def minor(v: float, _pos: Any) -> str:
+            mantissa = v / 10.0 ** math.floor(math.log10(v) + 1e-9)
+            return f"{v:g}" if any(math.isclose(mantissa, s, rel_tol=1e-6) for s in subs) else ""
+        axis.set_minor_formatter(FuncFormatter(minor))
+    else:
+        axis.set_minor_formatter(NullFormatter())
 
 
 def _padded_range(values: np.ndarray) -> tuple[float, float] | None:
