@@ -136,6 +136,10 @@ DEFAULT_T_END = 5.0
 DEFAULT_TRANSITS = 8.0
 """solver.transits of a longitudinal scene that gives neither solver.t_end nor transits."""
 
+SWEEP_MAX_STEPS = 20_000_000
+"""solver.max_steps of a swept scene that gives none: a 130 s sweep to 100 Hz takes up to ~1e6
+RK45 steps at rtol = 1e-8 (about 50 per cycle of a short span's f1), 10x that at 1e-10."""
+
 LONGITUDINAL_AXES: tuple[str, ...] = ("length", "load_amplitude", "youngs_modulus", "density",
                                       "area")
 """The axes a longitudinal scene can sweep (the parameters of the wave problem)."""
@@ -635,7 +639,7 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
         values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps
     if swept:            # no settling; the scalar driver; the peaks over the whole sweep
         for dotted, value in (("outputs.settling_time", False), ("solver.driver", "scalar"),
-                              ("metrics.tail", 1.0)):
+                              ("metrics.tail", 1.0), ("solver.max_steps", SWEEP_MAX_STEPS)):
             if dotted not in mentioned:
                 values[dotted] = value
     paper = values["model.coefficients"] == "paper"
