@@ -294,7 +294,7 @@ def _check_bands(ds: xr.Dataset, axes: list[str], where: str) -> None:
         da = ds[name]
         if da.dtype.kind not in "iuf":
             raise _refuse(where, f"variable '{name}' holds {da.dtype}, not numbers")
-        others = [d for d in da.dims if d != BAND_DIM]
+        others = [d for d in da.dims if d not in (BAND_DIM, DIRECTION_DIM)]
         want = axes if name == "envelope" else [d for d in axes if d in others]
         if BAND_DIM not in da.dims or sorted(others) != sorted(want) \
                 or len(others) != len(set(others)):
