@@ -201,3 +201,143 @@ def test_sweep_plot_writes_the_envelope_png(result, tmp_path, capsys):
         assert f"swept-{key}.png" in names, names
     assert (out / "swept-envelope.png").stat().st_size > 1000
     assert "swept-envelope.png" in capsys.readouterr().out
+
+
+# ------------------------------------------------------------------ a sweep run up and down
+
+BOTH_WAYS = """
+name = "plot-both-ways"
+[cable]
+damping_ratio = 0.02
+[load]
+amplitude = 0.0
+[base]
+acceleration_g = 0.5
+sweep = {start = 20.0, stop = 60.0, rate = 8.0, direction = "both"}
+[outputs]
+envelope = true
+[axes]
+length = [0.4, 0.5]
+"""
+
+
+@pytest.fixture(scope="module")
+def both_ways(tmp_path_factory):
+    """One tiny real sweep run both ways (a `direction` dimension), written and read back."""
+    path = tmp_path_factory.mktemp("both") / "both.nc"
+    sweep.run(sweep.load_scene_text(BOTH_WAYS), output=path, progress=False)
+    ds = splot.load_result(path)
+    assert list(ds["direction"].values) == ["up", "down"]
+    assert ds["peak_amplitude"].dims == ("direction", "length")
+    return ds, path
+
+
+def _with_directions(ds: xr.Dataset, down_factor: float = 0.5) -> xr.Dataset:
+    """A hand-made result with a `direction` dimension: the down values `down_factor` x up."""
+    solved = ["state", "envelope", "peak_amplitude", "peak_frequency"]
+    up, down = ds[solved], ds[solved].copy(deep=True)
+    down["envelope"] = down["envelope"] * down_factor
+    down["peak_amplitude"] = down["peak_amplitude"] * down_factor
+    both = xr.concat([up, down], dim=xr.DataArray(["up", "down"], dims="direction"))
+    out = ds.drop_vars(solved).assign(**{v: both[v] for v in solved})
+    for v in solved:
+        out[v].attrs = ds[v].attrs
+    return out
+
+
+def test_sweep_plot_draws_every_figure_of_a_sweep_run_both_ways(both_ways, tmp_path, capsys):
+    _, path = both_ways
+    out = tmp_path / "figs"
+    assert main(["plot", str(path), "-o", str(out)]) == 0
+    names = {p.name for p in out.iterdir()}
+    expected = {"peak_amplitude", "peak_frequency", "amplitude", "absolute_acceleration_g",
+                "envelope", "envelope_map-up", "envelope_map-down"}
+    assert {f"both-{key}.png" for key in expected} <= names, names
+    assert "envelope_map" not in {n[len("both-"):-len(".png")] for n in names}
+    assert all((out / n).stat().st_size > 1000 for n in names)
+    assert "Traceback" not in capsys.readouterr().err
+
+
+def test_the_envelope_of_a_sweep_run_both_ways_has_an_up_and_a_down_line_per_point(both_ways):
+    ds, _ = both_ways
+    fig = plot_envelope(ds)
+    lines = _envelope_lines(fig)
+    assert len(lines) == 2 * ds.sizes["length"]
+    for i, length in enumerate(ds["length"].values):
+        mine = [line for line in lines if line.get_label().startswith(f"length = {length:g} m")]
+        assert sorted(line.get_linestyle() for line in mine) == ["-", "--"]
+        assert len({line.get_color() for line in mine}) == 1       # one colour per point
+        for line in mine:
+            way = "up" if line.get_linestyle() == "-" else "down"
+            np.testing.assert_allclose(
+                line.get_ydata(), ds["envelope"].sel(direction=way).isel(length=i).values * 1e3)
+    texts = _legend_texts(fig)
+    # The legend names each point once and the line styles once, not every line.
+    assert texts.count("swept up") == 1 and texts.count("swept down") == 1
+    assert [t for t in texts if t.startswith("length")] == ["length = 0.4 m", "length = 0.5 m"]
+    assert any("peak of the up sweep" in t for t in texts)
+    assert any("peak of the down sweep" in t for t in texts)
+    stars = np.concatenate([np.asarray(c.get_offsets()) for c in fig.axes[0].collections
+                            if len(c.get_offsets())])
+    expected = np.column_stack([ds["peak_frequency"].values.ravel(),
+                                ds["peak_amplitude"].values.ravel() * 1e3])
+    np.testing.assert_allclose(sorted(map(tuple, stars)), sorted(map(tuple, expected)))
+    assert "up and down" in fig.axes[0].get_title()
+
+
+def test_the_peak_lines_of_a_sweep_run_both_ways_overlay_up_and_down(both_ways):
+    ds, _ = both_ways
+    figures = splot.plot(ds)
+    for var in ("peak_amplitude", "peak_frequency", "amplitude"):
+        ax = figures[var].axes[0]
+        by_way = {line.get_gid(): line for line in ax.get_lines()
+                  if str(line.get_gid()).startswith("direction-")}
+        assert set(by_way) == {"direction-up", "direction-down"}, var
+        assert by_way["direction-up"].get_linestyle() == "-"
+        assert by_way["direction-down"].get_linestyle() == "--"
+        factor = 1e3 if var != "peak_frequency" else 1.0
+        for way in ("up", "down"):
+            np.testing.assert_allclose(by_way[f"direction-{way}"].get_ydata(),
+                                       ds[var].sel(direction=way).values * factor)
+        texts = _legend_texts(figures[var])
+        assert "swept up" in texts and "swept down" in texts
+    assert "Hz" in figures["peak_frequency"].axes[0].get_ylabel()
+    assert "mm" in figures["peak_amplitude"].axes[0].get_ylabel()
+    assert any("swept up and down" in t.get_text() for t in figures["peak_amplitude"].texts)
+
+
+def test_maps_of_a_sweep_run_both_ways_are_drawn_per_direction_on_one_scale():
+    ds = _with_directions(_hand_made(3), down_factor=0.25)
+    splot.check_result(ds)
+    figures = splot.plot(ds)
+    assert {"envelope", "envelope_map-up", "envelope_map-down"} <= set(figures)
+    assert "envelope_map" not in figures
+    up, down = (figures[f"envelope_map-{w}"].axes[0] for w in ("up", "down"))
+    assert up.collections[0].get_clim() == down.collections[0].get_clim()
+    assert "swept up" in up.get_title() and "swept down" in down.get_title()
+    with pytest.raises(UserError, match="direction"):
+        splot.plot_map(ds, "envelope", x="band_frequency", y="length")
+    # Two swept axes: every map (amplitude-like and state) once per direction.
+    two = xr.concat([ds, ds], dim=xr.DataArray([1.0, 2.0], dims="base_sweep_rate",
+                                               attrs={"units": "min-1"}))
+    for name in ("band_frequency", "band_frequency_bounds", "base_level_g",
+                 "natural_frequency"):
+        two[name] = ds[name]
+    two = two.transpose("direction", "length", "base_sweep_rate", ...)
+    two["state"][1, 0, 1] = 5                                      # one down sweep diverged
+    splot.check_result(two)
+    figures = splot.plot(two)
+    for name in ("peak_amplitude", "state"):      # (peak_frequency: one value, no figure)
+        assert {f"{name}-up", f"{name}-down"} <= set(figures), (name, set(figures))
+    assert "envelope" not in figures and "select" in figures.skipped["envelope"]
+
+
+def test_failed_sweeps_of_one_direction_are_left_out_and_counted():
+    ds = _with_directions(_hand_made(2))
+    ds["state"].loc[{"direction": "down"}] = np.array([8, 5], np.int8)   # 0.6 m down diverged
+    fig = plot_envelope(ds)
+    assert len(_envelope_lines(fig)) == 3
+    assert any("left out: 1 of 4 sweeps" in t and "diverged 1" in t for t in _legend_texts(fig))
+    line = splot.plot_line(ds, "peak_amplitude")
+    assert any(t.startswith("diverged (1)") for t in
+               [t.get_text() for t in line.get_legend().get_texts()])

@@ -25,6 +25,10 @@ What `plot` draws, by the result's content:
   the one swept axis, each point's peak starred and its f1 dotted, the base level in g on a
   right axis (`plot_envelope`), and a map of the envelope over that axis and the bands (log
   frequency axis);
+- a continuous sine sweep run both ways ([base] sweep.direction = "both", a `direction`
+  dimension): up and down overlaid on every line (up solid, down dashed) and on the envelope
+  (each point in its colour, both directions' peaks starred), and each map drawn once per
+  direction (NAME-up, NAME-down) on one colour scale;
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
   histories (`plot_histories`); with swept axes also the peak end displacement and the
   dynamic amplification over them.

@@ -20,13 +20,15 @@ from matplotlib.lines import Line2D
 
 from ..errors import UserError
 from .labels import _point_text, _title
-from .result import select_points, swept_axes
+from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import _legend, _log_ticks, _new_axes, state_styles
 
 BAND_DIM = "band_frequency"          # the envelope's dimension (sweep.models.transverse.BAND_DIM)
 _LEVEL_COLOUR = "0.55"               # the base level on the right axis
 _F1_STYLE = dict(ls=(0, (2, 2)), lw=1.0, alpha=0.9, zorder=1)
 _PEAK_STYLE = dict(marker="*", s=110, edgecolors="k", linewidths=0.6, zorder=5)
+# A sweep run both ways (a `direction` dimension): up solid, filled; down dashed, hollow.
+_WAYS = {"up": dict(ls="-", lw=1.6, filled=True), "down": dict(ls="--", lw=1.3, filled=False)}
 
 
 def _good_states(state: xr.DataArray) -> set[int]:
@@ -84,6 +86,11 @@ def plot_envelope(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     state is not a good one (a sweep's `completed`) are not drawn, and the legend says how many
     were left out and why.
 
+    A sweep run both ways (a `direction` dimension, [base] sweep.direction = "both") gets the
+    up and down envelope of each point overlaid in the point's colour, up solid with filled
+    markers, down dashed with hollow ones, and each direction's peak starred (up filled, down
+    hollow); the legend names the points once and says once which line style is which.
+
     `select`: {axis: value} fixes the other swept axes, as for `plot_line`. `ax`: draw into
     these Axes (else a new Figure). Returns the Figure. Raises UserError without `envelope`, or
     with more than one swept axis left.
@@ -103,45 +110,67 @@ def plot_envelope(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     fig = ax.figure
     freq = np.asarray(ds[BAND_DIM].values, dtype=float)
     edges = _band_edges(ds)
-    env = ds["envelope"]
     points = [ds.isel({dim: i}) for i in range(ds.sizes[dim])] if dim else [ds]
     good = _good_states(ds["state"])
     colours = [f"C{i % 10}" for i in range(len(points))]
+    ways = ([str(d) for d in ds[DIRECTION_DIM].values] if DIRECTION_DIM in ds["state"].dims
+            else [None])
     handles: list = []
     left_out: dict[str, int] = {}
     drawn: list[tuple[xr.Dataset, str]] = []
+    peaks: list[tuple[xr.Dataset, str, str | None]] = []
     for point, colour in zip(points, colours):
-        value = int(point["state"].values)
-        if value not in good:
-            meaning = _meaning(ds["state"], value)
-            left_out[meaning] = left_out.get(meaning, 0) + 1
-            continue
-        y = _positive(point["envelope"].transpose(BAND_DIM).values) * 1e3
         text = _point_text(point, [dim]) if dim else str(ds.attrs.get("title", "envelope"))
-        line, = ax.plot(freq, y, color=colour, lw=1.6, marker="o", ms=3.5, zorder=3,
-                        label=text, gid="envelope")
-        handles.append(line)
-        drawn.append((point, colour))
+        first = None
+        for way in ways:
+            part = point if way is None else point.sel({DIRECTION_DIM: way})
+            value = int(part["state"].values)
+            if value not in good:
+                meaning = _meaning(ds["state"], value)
+                left_out[meaning] = left_out.get(meaning, 0) + 1
+                continue
+            y = _positive(part["envelope"].transpose(BAND_DIM).values) * 1e3
+            style = _WAYS.get(way, _WAYS["up"])
+            line, = ax.plot(freq, y, color=colour, lw=style["lw"], ls=style["ls"], marker="o",
+                            ms=3.5, mfc=colour if style["filled"] else "white", mec=colour,
+                            zorder=3, label=text if way is None else f"{text}, swept {way}",
+                            gid="envelope")
+            peaks.append((part, colour, way))
+            if first is None:
+                first = line
+                drawn.append((part, colour))
+        if first is not None:
+            handles.append(first if ways == [None] else
+                           Line2D([], [], color=colour, lw=2.0, label=text))
+    if ways != [None] and drawn:
+        handles += [Line2D([], [], color="0.3", marker="o", ms=3.5, mfc="white" if not
+                           _WAYS.get(w, _WAYS["up"])["filled"] else "0.3", mec="0.3",
+                           ls=_WAYS.get(w, _WAYS["up"])["ls"], label=f"swept {w}")
+                    for w in ways]
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlim(float(edges[0, 0]), float(edges[-1, 1]))
-    peaks = _draw_peaks(ax, drawn, edges)
+    stars = _draw_peaks(ax, peaks, edges)
     f1 = _draw_natural_frequencies(ax, drawn, edges)
-    handles += peaks + f1
+    handles += stars + f1
     level = _draw_level(ax, ds, dim, drawn, edges)
     handles += level
     if left_out:
         total = sum(left_out.values())
         why = ", ".join(f"{m} {n}" for m, n in sorted(left_out.items()))
-        handles.append(Line2D([], [], ls="none", label=f"left out: {total} of {len(points)} "
-                              f"point{'s' if len(points) != 1 else ''} not completed ({why})"))
+        runs = (f"{len(points)} point{'s' if len(points) != 1 else ''}" if ways == [None] else
+                f"{len(points) * len(ways)} sweeps ({len(points)} point"
+                f"{'s' if len(points) != 1 else ''} x {len(ways)} directions)")
+        handles.append(Line2D([], [], ls="none", label=f"left out: {total} of {runs} not "
+                              f"completed ({why})"))
     if not drawn:
         ax.text(0.5, 0.5, "no completed point: nothing to draw", transform=ax.transAxes,
                 ha="center", va="center", color="0.3")
     ax.set_xlabel(f"excitation frequency [{ds[BAND_DIM].attrs.get('units', 'Hz')}]")
     ax.set_ylabel("envelope, max |q| [mm]")
     n = _bands_per_octave(freq)
-    ax.set_title(_title(ds, f"response envelope{f' in 1/{n}-octave bands' if n else ''}"),
+    both = f", swept {' and '.join(ways)}" if ways != [None] else ""
+    ax.set_title(_title(ds, f"response envelope{f' in 1/{n}-octave bands' if n else ''}{both}"),
                  fontsize="medium")
     ax.grid(True, which="major", color="0.88", zorder=0)
     ax.grid(True, which="minor", color="0.95", zorder=0)
@@ -164,20 +193,35 @@ def _in_range(value: float, edges: np.ndarray) -> bool:
     return math.isfinite(value) and edges[0, 0] <= value <= edges[-1, 1]
 
 
-def _draw_peaks(ax: Axes, drawn: list[tuple[xr.Dataset, str]], edges: np.ndarray) -> list:
-    """A star at each drawn point's (peak_frequency, peak_amplitude); the legend handle."""
-    shown = False
-    for point, colour in drawn:
+def _draw_peaks(ax: Axes, drawn: list[tuple[xr.Dataset, str, str | None]],
+                edges: np.ndarray) -> list:
+    """A star at each drawn run's (peak_frequency, peak_amplitude), in its point's colour:
+    filled, or hollow for the down sweep of a sweep run both ways; the legend handles (one,
+    or one per direction)."""
+    shown: list[str | None] = []
+    for point, colour, way in drawn:
         if "peak_frequency" not in point or "peak_amplitude" not in point:
             continue
         f, q = float(point["peak_frequency"].values), float(point["peak_amplitude"].values)
         if _in_range(f, edges) and math.isfinite(q) and q > 0:
-            ax.scatter([f], [q * 1e3], color=colour, **_PEAK_STYLE)
-            shown = True
-    if not shown:
-        return []
-    return [Line2D([], [], ls="none", marker="*", ms=10, color="0.6", markeredgecolor="k",
-                   markeredgewidth=0.6, label="peak: max |q| of the run at its frequency")]
+            filled = _WAYS.get(way, _WAYS["up"])["filled"]
+            style = dict(_PEAK_STYLE, edgecolors="k" if filled else colour,
+                         linewidths=0.6 if filled else 1.3)
+            ax.scatter([f], [q * 1e3], color=colour if filled else "white", **style)
+            if way not in shown:
+                shown.append(way)
+    if shown == [None]:
+        return [Line2D([], [], ls="none", marker="*", ms=10, color="0.6", markeredgecolor="k",
+                       markeredgewidth=0.6, label="peak: max |q| of the run at its frequency")]
+    handles = []
+    for way in (w for w in _WAYS if w in shown):
+        filled = _WAYS[way]["filled"]
+        handles.append(Line2D([], [], ls="none", marker="*", ms=10,
+                              color="0.6" if filled else "white",
+                              markeredgecolor="k" if filled else "0.4",
+                              markeredgewidth=0.6 if filled else 1.2,
+                              label=f"peak of the {way} sweep: max |q| at its frequency"))
+    return handles
 
 
 def _draw_natural_frequencies(ax: Axes, drawn: list[tuple[xr.Dataset, str]],

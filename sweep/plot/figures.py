@@ -27,7 +27,8 @@ from .branches import plot_branches, stepped_axis
 from .envelope import BAND_DIM, plot_envelope
 from .line import plot_line
 from .maps import plot_map, plot_state_map
-from .result import _scene, _time_dim, check_result, select_points, swept_axes
+from .result import (DIRECTION_DIM, _scene, _time_dim, check_result, select_points,
+                     swept_axes)
 from .series import _snapshot_fields, plot_histories, plot_snapshots, plot_time_series
 from .style import _log_ticks, _plain_ticks, _state_meaning, _unit
 
@@ -70,6 +71,9 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     'peak_amplitude' and 'peak_frequency' over the axes, and with its envelope stored
     'envelope' (against the excitation frequency, zero or one swept axis) and 'envelope_map'
     (one swept axis x the bands);
+    a continuous sine sweep run both ways ([base] sweep.direction = "both": a `direction`
+    dimension) gets its up and down overlaid on the lines and the envelope, and each map twice,
+    'NAME-up' and 'NAME-down', on one colour scale;
     'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
     swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
@@ -100,19 +104,20 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
         if var not in ds or len(axes) not in (1, 2):
             continue
         if var == "state":
-            reason = (f"every point is {_state_meaning(ds.isel({a: 0 for a in axes}))}"
+            reason = (f"every point is "
+                      f"{_state_meaning(ds.isel({a: 0 for a in ds['state'].dims}))}"
                       if np.unique(ds["state"].values).size == 1 else None)
         else:
             reason = why_not_drawn(ds[var])
         if reason is not None:
             figures.skipped[var] = reason
             _log.info("%s: %s: no figure (%s)", ds.attrs.get("title", "result"), var, reason)
-        elif var == "state":
-            figures[var] = plot_state_map(ds).figure
-        elif len(axes) == 1:
+        elif len(axes) == 1 and var != "state":
             figures[var] = plot_line(ds, var).figure
         else:
-            figures[var] = plot_map(ds, var).figure
+            for key, way in _ways(ds, var):
+                figures[key] = (plot_state_map(ds, direction=way) if var == "state"
+                                else plot_map(ds, var, direction=way)).figure
     if "envelope" in ds:
         _envelope_figures(ds, axes, figures)
     if "displacement" in ds and _time_dim(ds["displacement"]) is not None:
@@ -126,6 +131,16 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             _plain_ticks(ax)
         _add_footer(fig, ds)
     return figures
+
+
+def _ways(ds: xr.Dataset, name: str) -> list[tuple[str, str | None]]:
+    """The maps of `name`: one, (name, None); or, for a sweep run both ways (a `direction`
+    dimension), one per direction, (name-up, 'up'), (name-down, 'down'). Two files rather than
+    one drawing: each map keeps the layout (colour bar, state marks, overlays) of a map swept
+    one way, and `plot_map` gives both one colour scale, so they compare colour for colour."""
+    if DIRECTION_DIM not in ds["state"].dims:
+        return [(name, None)]
+    return [(f"{name}-{way}", str(way)) for way in ds[DIRECTION_DIM].values]
 
 
 def _is_swept(ds: xr.Dataset) -> bool:
@@ -155,11 +170,14 @@ def _envelope_figures(ds: xr.Dataset, axes: list[str], figures: Figures) -> None
         elif name == "envelope":
             figures[name] = plot_envelope(ds)
         else:
-            ax = plot_map(ds, "envelope", x=BAND_DIM, y=axes[0], xscale="log")
-            ax.set_xlabel(f"excitation frequency [{ds[BAND_DIM].attrs.get('units', 'Hz')}]")
-            ax.set_title(_title(ds, "response envelope"), fontsize="medium")
-            _log_ticks(ax, "x")
-            figures[name] = ax.figure
+            for key, way in _ways(ds, name):
+                ax = plot_map(ds, "envelope", x=BAND_DIM, y=axes[0], xscale="log",
+                              direction=way)
+                ax.set_xlabel(f"excitation frequency [{ds[BAND_DIM].attrs.get('units', 'Hz')}]")
+                ax.set_title(_title(ds, "response envelope" + (f", swept {way}" if way else "")),
+                             fontsize="medium")
+                _log_ticks(ax, "x")
+                figures[key] = ax.figure
 
 
 def _stepped_figures(ds: xr.Dataset, select: Mapping[str, Any] | None) -> Figures:

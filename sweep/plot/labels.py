@@ -11,7 +11,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from .overlays import overlays_for
-from .result import _TIME_DIMS, _scene, _setting
+from .result import _TIME_DIMS, DIRECTION_DIM, _scene, _setting
 from .style import _fmt, _is_displacement
 
 _MAX_LABEL = 60
@@ -53,7 +53,7 @@ def _scene_axes(ds: xr.Dataset) -> list[str]:
     doc = _scene(ds)
     return list(doc.get("axes", {})) if doc else [c for c in ds.coords
                                                  if c not in (*_TIME_DIMS, "snapshot_time",
-                                                              "position")]
+                                                              "position", DIRECTION_DIM)]
 
 
 def footer(ds: xr.Dataset) -> str:

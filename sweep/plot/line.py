@@ -1,4 +1,5 @@
-"""One swept axis: a quantity against it, markers coloured by state (`plot_line`)."""
+"""One swept axis: a quantity against it, markers coloured by state (`plot_line`); a sine
+sweep run both ways (a `direction` dimension): up and down overlaid (`_plot_directions`)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from matplotlib.lines import Line2D
 from ..errors import UserError
 from .labels import _title, label
 from .overlays import overlays_for
-from .result import select_points, swept_axes
+from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import (_is_log_spaced, _legend, _new_axes, _padded_range, _plain_ticks, _unit,
                     _wide_range, state_styles)
 
@@ -26,7 +27,12 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
     Displacements are in mm; near-constant data get a +-5 % range around their value (not a
     range of round-off); no axis uses an offset. On the paper's Fig 5 case the paper's own
     amplitudes are marked ("paper Fig 5"). Extra keyword arguments go to `Axes.scatter`.
-    Returns the Axes."""
+
+    A result with a `direction` dimension (a continuous sine sweep run both ways, [base]
+    sweep.direction = "both") gets the up and down values overlaid instead: up solid with
+    filled markers, down dashed with hollow ones, in one colour (legend "swept up" / "swept
+    down"); points in a state that is not a good one are marked with their state's map marker.
+    Extra keyword arguments then go to `Axes.plot`. Returns the Axes."""
     ds = select_points(ds, select)
     axes = swept_axes(ds)
     if len(axes) != 1:
@@ -37,6 +43,8 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
     if var not in ds:
         raise UserError(f"plot_line: the result has no variable '{var}'")
     ax = ax if ax is not None else _new_axes()
+    if DIRECTION_DIM in ds["state"].dims:
+        return _plot_directions(ds, dim, var, ax, add_legend, **kwargs)
     xfactor, xunits = _unit(ds[dim])
     x = ds[dim].values.astype(float) * xfactor
     y = ds[var].values.astype(float)
@@ -88,4 +96,77 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
     _plain_ticks(ax)
     if add_legend:
         _legend(ax, handles, "state")
+    return ax
+
+
+_DIRECTION_STYLE = {"up": dict(ls="-", filled=True), "down": dict(ls="--", filled=False)}
+
+
+def _plot_directions(ds: xr.Dataset, dim: str, var: str, ax: Axes, add_legend: bool,
+                     **kwargs: Any) -> Axes:
+    """`var` against `dim` for each value of `direction` ('up', 'down'), overlaid in one colour:
+    up solid with filled markers, down dashed with hollow ones (as `plot_branches` draws a
+    stepped sweep). Points whose state is not a good one get their state's map marker over
+    them; points with no value (NaN) a hollow triangle on the bottom edge."""
+    xfactor, xunits = _unit(ds[dim])
+    x = ds[dim].values.astype(float) * xfactor
+    da = ds[var].broadcast_like(ds["state"]).transpose(DIRECTION_DIM, dim)
+    y_all = da.values.astype(float)
+    state_all = ds["state"].transpose(DIRECTION_DIM, dim).values
+    factor, units = _unit(ds[var], y_all)
+    directions = [str(d) for d in ds[DIRECTION_DIM].values]
+    colour = "C0"
+    handles = []
+    marked: dict[tuple[int, str, str, str], int] = {}
+    nan_any = False
+    for i, direction in enumerate(directions):
+        style = _DIRECTION_STYLE.get(direction, dict(ls=":", filled=True))
+        y = y_all[i] * factor
+        ax.plot(x, y, ls=style["ls"], color=colour, marker="o", ms=4.5, lw=1.3,
+                mfc=colour if style["filled"] else "white", mec=colour, zorder=2,
+                label=f"swept {direction}", gid=f"direction-{direction}", **kwargs)
+        handles.append(Line2D([], [], ls=style["ls"], color=colour, marker="o", ms=4.5,
+                              mfc=colour if style["filled"] else "white", mec=colour,
+                              label=f"swept {direction}"))
+        for value, meaning, s_colour, marker in state_styles(ds["state"]):
+            mask = state_all[i] == value
+            if marker is None or not mask.any():
+                continue
+            marked[(value, meaning, s_colour, marker)] = marked.get(
+                (value, meaning, s_colour, marker), 0) + int(mask.sum())
+            good = mask & np.isfinite(y)
+            if good.any():
+                ax.scatter(x[good], y[good], marker=marker, s=60, color=s_colour,
+                           edgecolors="k", linewidths=0.6, zorder=4)
+        bad = ~np.isfinite(y)
+        if bad.any():
+            nan_any = True
+            ax.scatter(x[bad], np.zeros(bad.sum()), marker="v", facecolors="none",
+                       edgecolors=colour, linewidths=1.2, s=36, zorder=3, clip_on=False,
+                       transform=ax.get_xaxis_transform())
+    for (_value, meaning, s_colour, marker), count in sorted(marked.items()):
+        handles.append(Line2D([], [], ls="none", marker=marker, color=s_colour,
+                              markeredgecolor="k", markeredgewidth=0.6,
+                              label=f"{meaning} ({count})"))
+    if nan_any:
+        handles.append(Line2D([], [], ls="none", marker="v", markerfacecolor="none",
+                              markeredgecolor="0.3", label="no value (NaN)"))
+    for draw in overlays_for(ds, "line"):         # buckling length, paper Fig 5 (overlays.py)
+        handles += draw(ax, ds, dim, var, factor, units, 36)
+    if _wide_range(y_all):
+        ax.set_yscale("log")
+    else:
+        padded = _padded_range(y_all * factor)
+        if padded is not None:
+            ax.set_ylim(*padded)
+    if _is_log_spaced(x):
+        ax.set_xscale("log")
+    ax.set_xlabel(label(ds[dim], xunits))
+    ax.set_ylabel(label(ds[var], units))
+    ways = " and ".join(directions)
+    ax.set_title(_title(ds, f"swept {ways}"), fontsize="medium")
+    ax.grid(True, color="0.92", zorder=0)
+    _plain_ticks(ax)
+    if add_legend:
+        _legend(ax, handles)
     return ax

@@ -17,7 +17,7 @@ from matplotlib.patches import Patch
 from ..errors import UserError
 from .labels import _title, label
 from .overlays import overlays_for
-from .result import select_points, swept_axes
+from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import (_coord, _edges, _is_displacement, _is_log_spaced, _legend, _new_axes,
                     _padded_range, _plain_ticks, _unit, _wide_range, state_styles)
 
@@ -53,6 +53,23 @@ def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str,
     if {x, y} != set(axes):
         raise UserError(f"{who}: x and y must be the swept axes {axes[0]} and {axes[1]}")
     return x, y
+
+
+def _one_direction(ds: xr.Dataset, direction: str | None, who: str) -> xr.Dataset:
+    """`ds` at one value of its `direction` dimension (a sweep run up and down); `ds` itself
+    when it has none. UserError for a missing or unknown direction."""
+    if DIRECTION_DIM not in ds.dims:
+        if direction is not None:
+            raise UserError(f"{who}: direction={direction!r}, but the result was swept one way "
+                            "(no 'direction' dimension)")
+        return ds
+    values = [str(v) for v in ds[DIRECTION_DIM].values]
+    if direction is None and len(values) == 1:
+        direction = values[0]
+    if direction not in values:
+        raise UserError(f"{who}: the result was swept {' and '.join(values)}: pick one map, "
+                        f"direction={values[0]!r} (one of {', '.join(map(repr, values))})")
+    return ds.sel({DIRECTION_DIM: direction})
 
 
 def _scale(ax: Axes, which: str, values: np.ndarray, scale: str | None) -> None:
@@ -157,7 +174,7 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
              y: str | None = None, select: Mapping[str, Any] | None = None,
              ax: Axes | None = None, add_colorbar: bool = True, add_legend: bool = True,
              mark_states: bool = True, overlays: bool = True, xscale: str | None = None,
-             yscale: str | None = None, **kwargs: Any) -> Axes:
+             yscale: str | None = None, direction: str | None = None, **kwargs: Any) -> Axes:
     """A pcolormesh map of `var` over the two swept axes (x: the second, y: the first, as
     xarray draws a 2-D DataArray; or name them). A variable spanning more than two decades gets
     a log colour scale; cells with no value (NaN) are grey. Displacements are in mm; on a log
@@ -170,23 +187,30 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
     a dimension of its own (a sweep's `envelope` over `band_frequency`, Hz) is mapped over the
     two; a point's state marks its whole row. `xscale`, `yscale`: "linear" or "log" (None: log
     for a log-spaced coordinate, such as the envelope's band centres). Extra keyword arguments
-    go to `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...). Returns the Axes.
+    go to `Axes.pcolormesh` (cmap, norm, vmin, vmax, ...).
+
+    `direction`: for a result swept both ways (a `direction` dimension, 'up' and 'down'), the
+    one drawn; its colour scale spans both, so that the up and down maps compare colour for
+    colour. Returns the Axes.
     """
     ds = select_points(ds, select)
     x, y = _map_axes(ds, x, y, "plot_map", var)
     if var not in ds:
         raise UserError(f"plot_map: the result has no variable '{var}'")
+    both = ds[var]                             # the colour scale: over every direction
+    ds = _one_direction(ds, direction, "plot_map")
     ax = ax if ax is not None else _new_axes((7.0, 6.0))
     da = ds[var].transpose(y, x) if ds[var].ndim == 2 else ds[var].broadcast_like(
         ds["state"]).transpose(y, x)
-    factor, units = _unit(ds[var], da.values)
+    factor, units = _unit(both, both.values)
     values = np.ma.masked_invalid(da.values.astype(float) * factor)
+    scale = np.ma.masked_invalid(np.asarray(both.values, dtype=float) * factor).compressed()
     extend = "neither"
     handles = []
     cmap = kwargs.pop("cmap", "viridis")
     user_scale = "norm" in kwargs or "vmin" in kwargs or "vmax" in kwargs
-    if not user_scale and _wide_range(values.compressed()):
-        top, low = float(values.max()), float(values.min())
+    if not user_scale and _wide_range(scale):
+        top, low = float(scale.max()), float(scale.min())
         if _is_displacement(ds[var]):
             floor = FLOOR * top
             cmap = mpl_colormaps[cmap] if isinstance(cmap, str) else cmap
@@ -197,10 +221,13 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
                                      label=f"no response, < {floor:.2g} {units} ({below})"))
         else:
             floor = top * 10.0 ** -_DECADES
-        extend = "min" if low < floor else "neither"
+        shown = values.compressed()
+        extend = "min" if shown.size and float(shown.min()) < floor else "neither"
         kwargs["norm"] = mcolors.LogNorm(vmin=max(low, floor), vmax=top, clip=False)
     elif not user_scale:
-        padded = _padded_range(values.compressed())
+        padded = _padded_range(scale)
+        if padded is None and DIRECTION_DIM in both.dims and scale.size:
+            kwargs["vmin"], kwargs["vmax"] = float(scale.min()), float(scale.max())
         if padded is not None:
             kwargs["vmin"], kwargs["vmax"] = padded
     mesh = _mesh(ax, ds, x, y, values, xscale, yscale, cmap=cmap, **kwargs)
@@ -217,20 +244,29 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
     if add_colorbar:
         bar = ax.figure.colorbar(mesh, ax=ax, label=label(ds[var], units), extend=extend)
         _plain_ticks(bar.ax)
-    ax.set_title(_title(ds, str(var)), fontsize="medium")
+    ax.set_title(_title(ds, str(var) + _swept(ds)), fontsize="medium")
     _plain_ticks(ax)
     if add_legend:
         _legend(ax, handles)
     return ax
 
 
+def _swept(ds: xr.Dataset) -> str:
+    """', swept up' for one direction of a sweep run both ways; '' otherwise."""
+    if DIRECTION_DIM in ds.coords and ds[DIRECTION_DIM].ndim == 0:
+        return f", swept {ds[DIRECTION_DIM].values}"
+    return ""
+
+
 def plot_state_map(ds: xr.Dataset, *, x: str | None = None, y: str | None = None,
                    select: Mapping[str, Any] | None = None, ax: Axes | None = None,
-                   add_legend: bool = True, overlays: bool = True, **kwargs: Any) -> Axes:
+                   add_legend: bool = True, overlays: bool = True,
+                   direction: str | None = None, **kwargs: Any) -> Axes:
     """A map of `state` over the two swept axes, one fixed colour per flag meaning, with the
-    closed-form overlays of `plot_map`. Returns the Axes."""
+    closed-form overlays of `plot_map`; `direction` as for `plot_map`. Returns the Axes."""
     ds = select_points(ds, select)
     x, y = _map_axes(ds, x, y, "plot_state_map")
+    ds = _one_direction(ds, direction, "plot_state_map")
     ax = ax if ax is not None else _new_axes((7.0, 6.0))
     styles = state_styles(ds["state"])
     values = [s[0] for s in styles]
@@ -247,7 +283,7 @@ def plot_state_map(ds: xr.Dataset, *, x: str | None = None, y: str | None = None
         handles += _overlays(ax, ds, x, y)
         ax.set_xlim(*lims[0])
         ax.set_ylim(*lims[1])
-    ax.set_title(_title(ds, "state"), fontsize="medium")
+    ax.set_title(_title(ds, "state" + _swept(ds)), fontsize="medium")
     _plain_ticks(ax)
     if add_legend:
         _legend(ax, handles)

@@ -297,7 +297,8 @@ def _number(value: Any) -> float | None:
 
 
 def _sweep_text(ds: xr.Dataset, sweep: dict, level_g: Any, level: Any) -> str:
-    """'base sine sweep 20-60 Hz at 4 oct/min, 0.2-0.4 g (levels_g table)'; the swept parts
+    """'base sine sweep 20-60 Hz at 4 oct/min, 0.2-0.4 g (levels_g table)' (with ', swept up
+    and down' or ', swept down' after the rate when sweep.direction says so); the swept parts
     left out (they are on the axes)."""
     def part(key: str) -> float | None:
         axis = f"base_sweep_{key}"
@@ -315,6 +316,9 @@ def _sweep_text(ds: xr.Dataset, sweep: dict, level_g: Any, level: Any) -> str:
         text += f" {'from' if start is not None else 'to'} {(start or stop):.4g} Hz"
     if rate is not None:
         text += f" at {rate:.4g} oct/min"
+    way = sweep.get("direction")
+    if way in ("up", "down", "both"):
+        text += ", swept up and down" if way == "both" else f", swept {way}"
     table = _scene(ds).get("base", {}).get("levels_g")
     levels = [_number(p[1]) for p in table if isinstance(p, (list, tuple)) and len(p) == 2] \
         if isinstance(table, list) else []
