@@ -142,6 +142,43 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, n_mode
     return out
 
 
+def stepped_chunk(lines: np.ndarray, kernel: Callable[..., dict], kernel_args: tuple,
+                  dwells: int, orders: tuple, carry: Any, dwell: float, threads: int = 0,
+                  on_block: Callable[[int, int, dict], None] | None = None,
+                  stop: threading.Event | None = None) -> dict[str, np.ndarray]:
+    """Stepped sweeps ([continuation], sweep/models/continuation.py) of whole lines: each row
+    of `lines` is one line of `dwells` dwells in one direction, its direction's index into
+    `orders` (the visiting orders of the dwells, continuation.dwell_order) in column 0, then
+    the dwells' kernel rows one after another. Each line is swept through its dwells by
+    `kernel` (transverse_chunk or modes_chunk, with kernel_args), the state and phases carried
+    as `carry` says, dwell: the dwell time (s); the lines share `threads`. Returns the kernel's
+    outputs with a dwell axis after the first: (lines, dwells, ...). A line is the unit of a
+    chunk (a dask task, a stored chunk): its dwells depend on each other."""
+    from .models import continuation as ct
+    m = lines.shape[0]
+    rows = lines[:, 1:].reshape(m * dwells, -1)
+    template = chunk_template(kernel, kernel_args)
+    out = {k: np.empty((m, dwells) + v.shape[1:], v.dtype) for k, v in template.items()}
+    direction = lines[:, 0].astype(int)
+    line_points = np.arange(m * dwells).reshape(m, dwells)
+    flat = {k: np.empty((m * dwells,) + v.shape[1:], v.dtype) for k, v in template.items()}
+    groups = [(line_points[direction == d], np.asarray(order), flat)
+              for d, order in enumerate(orders) if np.any(direction == d)]
+    ct.solve_lines(rows, groups, carry, dwell, lambda batch: kernel(batch, *kernel_args,
+                                                                    threads=1),
+                   workers=_thread_count(threads))
+    for k, v in flat.items():
+        out[k][:] = v.reshape((m, dwells) + v.shape[1:])
+    if on_block is not None:
+        on_block(0, m, out)
+    return out
+
+
+def _thread_count(threads: int) -> int:
+    from .threads import thread_count
+    return thread_count(threads)
+
+
 def longitudinal_chunk(params: np.ndarray, settings: np.ndarray, snapshot_times: np.ndarray,
                        n_hist: int, n_nodes: int, threads: int = 0) -> dict[str, np.ndarray]:
     """Central-difference kernel over `params` rows; outputs by name."""
@@ -537,6 +574,10 @@ def chunk_template(chunk_fn: Callable[..., dict], args: tuple) -> dict[str, np.n
     if chunk_fn is modes_chunk:
         n_samples, n_modes, n_bands = args[1], args[2], (args[4] if len(args) > 4 else -1)
         return modes_outputs(0, n_samples, n_modes, n_bands)
+    if chunk_fn is stepped_chunk:
+        kernel, kernel_args, dwells = args[0], args[1], args[2]
+        return {k: np.empty((0, dwells) + v.shape[1:], v.dtype)
+                for k, v in chunk_template(kernel, kernel_args).items()}
     if chunk_fn is longitudinal_chunk:
         _, snapshot_times, n_hist, n_nodes = args
         return longitudinal_outputs(0, n_hist, np.asarray(snapshot_times).size, n_nodes)

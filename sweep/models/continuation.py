@@ -49,15 +49,24 @@ class Carry:
 
     state: the columns of the initial state (q's then q''s, m and m/s); base_phase,
     load_phase: the phase offsets (rad) of the base excitation and of the end load;
-    base_omega, load_omega: their angular frequencies (rad/s); final: a function of a
-    kernel call's outputs giving the final state of each point, (n, len(state)).
+    base_omega, load_omega: their angular frequencies (rad/s); final: where a kernel call's
+    outputs hold each point's final state, (n, len(state)): "reals" (the one-mode kernel's
+    Q_END and V_END columns) or "final" (the multi-mode kernel's own output). Plain data, so
+    that a dask worker can take it.
     """
     state: tuple[int, ...]
     base_phase: int
     load_phase: int
     base_omega: int
     load_omega: int
-    final: Callable[[dict[str, np.ndarray]], np.ndarray]
+    final: str
+
+    def final_state(self, out: dict[str, np.ndarray]) -> np.ndarray:
+        """Each point's final state (n, len(state)) in a kernel call's outputs."""
+        if self.final == "reals":
+            from sweep.kernels import layout as tk
+            return out["reals"][:, [tk.Q_END, tk.V_END]]
+        return out["final"]
 
 
 def dwell_order(values: np.ndarray, direction: str) -> np.ndarray:
@@ -92,11 +101,23 @@ def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int,
     results do not depend on its share or on the number of threads."""
     n_points = rows.shape[0]
     lines = np.moveaxis(np.arange(n_points).reshape(shape), axis, -1).reshape(-1, shape[axis])
+    solve_lines(rows, [(lines, order, out) for order, out in zip(orders, outputs)], carry,
+                dwell, solve, advance, workers)
+    return outputs
+
+
+def solve_lines(rows: np.ndarray, groups: list[tuple[np.ndarray, np.ndarray, dict]],
+                carry: Carry, dwell: float, solve: Callable[[np.ndarray], dict],
+                advance: Callable[[int], None] | None = None, workers: int = 1) -> None:
+    """`solve_continued`'s work: each group (lines, order, outputs) is a set of lines (point
+    indices into `rows`, one line a row, its dwells along it) swept in `order`, filling
+    `outputs` at those points. The groups' lines are cut into tasks that the threads share."""
+    n_lines = sum(g[0].shape[0] for g in groups)
     # shares of at least one lanes group each: fewer lines than that a call leaves lanes idle,
     # and two such calls side by side took longer than one thread doing both (measured)
-    per_direction = max(1, min(lines.shape[0] // MIN_SHARE, -(-workers // len(orders))))
-    tasks = [(order, lines[i::per_direction], out) for order, out in zip(orders, outputs)
-             for i in range(per_direction)]
+    per_group = max(1, min(n_lines // (MIN_SHARE * len(groups)), -(-workers // len(groups))))
+    tasks = [(order, lines[i::per_group], out) for lines, order, out in groups
+             for i in range(per_group) if lines[i::per_group].shape[0]]
 
     def run(task) -> None:
         order, share, out = task
@@ -105,12 +126,11 @@ def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int,
     if workers <= 1 or len(tasks) == 1:
         for task in tasks:
             run(task)
-        return outputs
+        return
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(min(workers, len(tasks)), thread_name_prefix="cable-sweep") as pool:
         for future in [pool.submit(run, task) for task in tasks]:
             future.result()
-    return outputs
 
 
 def _sweep_lines(rows: np.ndarray, lines: np.ndarray, order: np.ndarray, carry: Carry,
@@ -132,7 +152,7 @@ def _sweep_lines(rows: np.ndarray, lines: np.ndarray, order: np.ndarray, carry: 
         for name, values in out.items():
             outputs[name][points] = values
         failed = np.isin(out["states"], FAILED)
-        state = np.where(failed[:, None], start, carry.final(out))
+        state = np.where(failed[:, None], start, carry.final_state(out))
         phase_b = np.where(failed, 0.0, _wrap(phase_b + batch[:, carry.base_omega] * dwell))
         phase_w = np.where(failed, 0.0, _wrap(phase_w + batch[:, carry.load_omega] * dwell))
         if advance is not None:

@@ -368,8 +368,8 @@ def _check_modes(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
 
 def _check_continuation(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of a stepped sweep ([continuation]): its axis is one of the scene's axes with more
-    than one value, and the other continuation keys need it; the time series and the resumable
-    (chunked, dask) runs are not offered along a continued axis."""
+    than one value, and the other continuation keys need it; the time series is not offered
+    along a continued axis (every dwell restarts the clock)."""
     axis = given.get("continuation.axis")
     if axis is None:
         for dotted in ("continuation.direction", "continuation.jump_ratio"):
@@ -391,9 +391,6 @@ def _check_continuation(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
         _fail("scene key 'outputs.time_series'", "not stored for a stepped sweep "
               "([continuation]): every step restarts the clock", "remove it, or remove "
               "[continuation] to store q(t) of independent points")
-    if given.get("run.backend", "threads") != "threads":
-        _fail("scene key 'run.backend'", "a stepped sweep ([continuation]) runs in-process: "
-              "its steps are solved in order", "use run.backend = 'threads'")
 
 
 def _check_paper_cable(given: dict[str, Any]) -> None:

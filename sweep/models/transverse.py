@@ -378,14 +378,14 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
         carry = None if inputs.continuation is None else Carry(
             state=(osc.Q0, osc.V0), base_phase=osc.BASE_PHASE, load_phase=osc.LOAD_PHASE,
             base_omega=osc.BASE_OMEGA, load_omega=osc.OMEGA,
-            final=lambda out: out["reals"][:, [tk.Q_END, tk.V_END]])
+            final="reals")
         return _System(rows_at, transverse_chunk, (settings, n_samples, inputs.driver) + swept,
                        lambda m: transverse_outputs(m, n_samples, n_bands), carry)
 
     carry = None if inputs.continuation is None else Carry(
         state=tuple(range(md.N_FIXED, md.N_FIXED + 2 * n)), base_phase=md.BASE_PHASE,
         load_phase=md.LOAD_PHASE, base_omega=md.BASE_OMEGA, load_omega=md.OMEGA,
-        final=lambda out: out["final"])
+        final="final")
     return _System(lambda points: modal_rows(inputs, points), modes_chunk,
                    (settings, n_samples, n, inputs.driver) + swept,
                    lambda m: modes_outputs(m, n_samples, n, n_bands), carry)
@@ -400,30 +400,53 @@ def _result(out: dict[str, np.ndarray], inputs: Inputs) -> KernelResult:
 def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], system: _System,
                  settings: np.ndarray, started: float) -> xr.Dataset:
     """A stepped sweep along inputs.continuation (sweep/models/continuation.py): each
-    direction's Dataset, with its `jump` flags; both directions on a `direction` dimension."""
-    from ..errors import UserError
-    from ..execute import Progress
+    direction's Dataset, with its `jump` flags; both directions on a `direction` dimension.
+
+    A line (one direction, one combination of the other axes' values, all its dwells) is the
+    unit of work the runner chunks (`execute.stepped_chunk`): the threads share a chunk's
+    lines, a dask task takes a chunk of lines, the chunk store keeps finished lines to resume
+    from. Without an output file every line is one chunk: no thread waits between chunks."""
+    import dataclasses
+
+    from ..execute import stepped_chunk
     from ..threads import thread_count
     from . import continuation as ct
-    if options.resume:
-        raise UserError("--resume: a stepped sweep ([continuation]) is solved in order and "
-                        "keeps no chunks to resume from; run it again without --resume")
     dims, shape = inputs.dims, inputs.shape
     n_points = int(np.prod(shape, dtype=np.int64))
     axis = dims.index(inputs.continuation)
+    dwells = shape[axis]
     values = inputs.coords[inputs.continuation].values
     directions = ["up", "down"] if inputs.direction == "both" else [inputs.direction]
-    rows = system.rows_at(np.arange(n_points))
-    orders = [ct.dwell_order(values, direction) for direction in directions]
-    progress = Progress(n_points * len(directions), 0, options.progress)
-    try:
-        outs = ct.solve_continued(
-            rows, shape, axis, orders, system.carry, float(settings[tk.T_END]),
-            lambda batch: system.chunk_fn(batch, *system.args, threads=1),
-            [system.outputs(n_points) for _ in directions], progress.advance,
-            workers=thread_count(options.threads))
-    finally:
-        progress.close()
+    orders = tuple(ct.dwell_order(values, direction) for direction in directions)
+    lines = np.moveaxis(np.arange(n_points).reshape(shape), axis, -1).reshape(-1, dwells)
+    n_lines = lines.shape[0]
+
+    def line_rows(points: np.ndarray) -> np.ndarray:
+        """Rows of lines `points` (direction index x n_lines + line): the direction, then
+        the kernel rows of the line's dwells in the axis's order."""
+        rows = system.rows_at(lines[points % n_lines].reshape(-1))
+        rows = rows.reshape(points.size, -1)
+        return np.ascontiguousarray(np.hstack([(points // n_lines)[:, None].astype(float),
+                                               rows]))
+
+    args = (system.chunk_fn, system.args, dwells, orders, system.carry,
+            float(settings[tk.T_END]))
+    total = n_lines * len(directions)
+    workers = thread_count(options.threads)
+    if options.chunk_size is None:
+        chunk = total if options.output is None else max(ct.MIN_SHARE * workers, -(-total // 4))
+        options = dataclasses.replace(options, chunk_size=min(chunk, total))
+    template = system.outputs(0)
+    out = solve_chunked(options, stepped_chunk, line_rows, args,
+                        {k: np.empty((total, dwells) + v.shape[1:], v.dtype)
+                         for k, v in template.items()})
+    outs = []
+    for d in range(len(directions)):
+        grid_out = {k: np.empty((n_points,) + v.shape[1:], v.dtype) for k, v in template.items()}
+        for k, v in out.items():
+            grid_out[k][lines.reshape(-1)] = v[d * n_lines:(d + 1) * n_lines].reshape(
+                (n_lines * dwells,) + v.shape[2:])
+        outs.append(grid_out)
     results = []
     for order, out in zip(orders, outs):
         ds = assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
