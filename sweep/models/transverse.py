@@ -565,8 +565,8 @@ def band_coordinates(first: int, count: int, bands_per_octave: int) -> dict[str,
     centre = xr.DataArray(band_centres(first, count, bands_per_octave), dims=BAND_DIM, attrs={
         "units": "Hz", "long_name": f"centre frequency of the base-2 1/{bands_per_octave}-octave "
                                     "band, 1000 x 2^(k/N) Hz", "bounds": bounds_name})
-    edges = xr.DataArray(band_bounds(first, count, bands_per_octave), dims=(BAND_DIM, "nv"),
-                         attrs={"units": "Hz", "long_name": centre.attrs["long_name"]})
+    # CF 7.1: a bounds variable takes its parent's units and long name (xarray writes none)
+    edges = xr.DataArray(band_bounds(first, count, bands_per_octave), dims=(BAND_DIM, "nv"))
     return {BAND_DIM: centre, bounds_name: edges}
 
 
