@@ -282,6 +282,7 @@ def test_cli_plot_bad_options_are_one_line(results, tmp_path, args, message):
      ("amplitude", "settling_time", "time_series")),
     ("length_frequency_map.py", "length_frequency_map", ("amplitude", "settling_time", "state")),
     ("stepped_sine.py", "stepped_sine", ("amplitude", "absolute_acceleration_g")),
+    ("qualification_sweep.py", "qualification_sweep", ("envelope", "peak_amplitude")),
 ])
 def test_examples_run_on_a_reduced_grid(tmp_path, script, stem, keys):
     env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
