@@ -45,8 +45,8 @@ name = "no-base"
 [initial]
 displacement = 1e-4
 """
-FIX = ("add a [base] table with acceleration or acceleration_g and frequency or "
-       "frequency_ratio")
+FIX = ("add a [base] table with acceleration, acceleration_g or levels_g and frequency, "
+       "frequency_ratio or sweep")
 
 
 def refused(text: str, overrides: dict | None = None) -> str:
@@ -85,11 +85,11 @@ def test_a_base_table_without_frequency_or_level_names_the_key_and_the_fix():
     message = refused(BASE.replace("frequency = 20.0", ""))
     assert message.startswith("scene key 'base.acceleration_g': base excitation needs a "
                               "frequency"), message
-    assert "base.frequency nor base.frequency_ratio" in message
-    assert "add frequency = 20.0 (Hz) or frequency_ratio = 1.0 (f/f1) to the [base]" in message
+    assert "none of base.frequency, base.frequency_ratio, base.sweep" in message
+    assert "add frequency = 20.0 (Hz), frequency_ratio = 1.0 (f/f1) or sweep = { start = 5.0, stop = 100.0, rate = 2.0 } to the [base]" in message
     message = refused(BASE.replace("acceleration_g = 0.5", ""))
     assert message.startswith("scene key 'base.frequency': base excitation needs a level")
-    assert "base.acceleration nor base.acceleration_g" in message
+    assert "none of base.acceleration, base.acceleration_g, base.levels_g" in message
     message = refused("[base]\n")
     assert message.startswith("scene section '[base]': base excitation needs a level"), message
 

@@ -222,7 +222,7 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
         if any(d in given or schema.BY_DOTTED[d].axis in axes for d in pair):
             continue
         _fail(where, f"base excitation needs {what}: the scene gives none of "
-              f"{', '.join(_spelling(d) for d in pair)} (as a key or axis)",
+              f"{', '.join(dict.fromkeys(_spelling(d) for d in pair))} (as a key or axis)",
               BASE_FIX if not file_has_base else f"add {example} to the [base] table")
     _check_sweep(given, axes)
 
