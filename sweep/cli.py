@@ -104,13 +104,14 @@ def _parser() -> argparse.ArgumentParser:
 
 def _summary(ds, seconds: float) -> str:
     import numpy as np
-    flags = ds["state"].attrs          # CF flag_values / flag_meanings (not 0..n-1 for every kind)
-    values = ds["state"].values.ravel()
+    name = "state" if "state" in ds else "stability"    # a stability-only result has no state
+    flags = ds[name].attrs          # CF flag_values / flag_meanings (not 0..n-1 for every kind)
+    values = ds[name].values.ravel()
     counts = [(int(np.count_nonzero(values == v)), m)
               for v, m in zip(np.atleast_1d(flags["flag_values"]), flags["flag_meanings"].split())]
     states = ", ".join(f"{c} {m}" for c, m in counts if c)
     n = int(ds.attrs["n_points"])
-    ways = " x 2 directions (up, down)" if "direction" in ds["state"].dims else ""
+    ways = " x 2 directions (up, down)" if "direction" in ds[name].dims else ""
     return (f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'}{ways} in {seconds:.2f} s "
             f"({states})")
 

@@ -191,6 +191,10 @@ KEYS: tuple[Key, ...] = (
     Key("outputs", "bands_per_octave", "int", 3, units="1", minimum=1, maximum=24,
         long_name="swept base frequency: N of the envelope's 1/N-octave bands (3: third "
                   "octaves)"),
+    Key("outputs", "stability", "bool", False,
+        long_name="transverse, harmonic load: Floquet multiplier, growth rate and stability of "
+                  "the straight span, from one load period (with the time-domain outputs off, "
+                  "nothing else is integrated)"),
     Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
     Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="time-series sample interval (default t_end/1000)"),

@@ -334,6 +334,7 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                       f"remove the {axis} axis, or use load.type = 'harmonic'")
     _check_modes(given, axes)
     _check_continuation(given, axes)
+    _check_stability(given)
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:
@@ -341,6 +342,17 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
         _check_paper_cable(given)
+
+
+def _check_stability(given: dict[str, Any]) -> None:
+    """outputs.stability needs a period: a harmonic end load (docs/model.md sec. 8)."""
+    if not given.get("outputs.stability"):
+        return
+    if given.get("load.type") == "constant":
+        _fail("scene key 'outputs.stability'", "needs a harmonic end load (Floquet multipliers "
+              "over its period); a constant load has none: its straight span is unstable above "
+              "the buckling load, which every result holds (buckling_load, load_ratio)",
+              "use load.type = 'harmonic', or remove outputs.stability")
 
 
 def _check_modes(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
@@ -410,6 +422,9 @@ def _check_paper_cable(given: dict[str, Any]) -> None:
 
 def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of a longitudinal scene: a constant load, its parameters only, one end time."""
+    if given.get("outputs.stability"):
+        _fail("scene key 'outputs.stability'", "only for model.kind = 'transverse' (Floquet "
+              "multipliers of the span's transverse modes)", "remove it")
     load_type = given.get("load.type", LONGITUDINAL_LOAD)
     if load_type != LONGITUDINAL_LOAD:
         _fail("scene key 'load.type'",
@@ -498,6 +513,8 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
     stays at q = 0 everywhere: it would look like a result and say nothing. Base excitation
     with a level above zero somewhere drives the span from rest: no warning then."""
     if values.get(BASE_TABLE_KEY) is not None:      # a table's levels are > 0
+        return
+    if values.get("outputs.stability"):             # its multipliers say what a seed would do
         return
     if has_base(values, axes) and any(
             _extreme(values, axes, d, np.max) > 0.0 for d in BASE_LEVEL_KEYS

@@ -258,10 +258,63 @@ def resolve(scene: Scene) -> Inputs:
                   sweep_direction=scene.get("base.sweep.direction"))
 
 
+TIME_DOMAIN_OUTPUTS = ("outputs.amplitude", "outputs.peak_amplitude", "outputs.settling_time",
+                       "outputs.response_period", "outputs.solver_stats", "outputs.time_series")
+"""Outputs that need the time-domain run (with base excitation also the absolute acceleration,
+with a sweep its peak frequency and envelope)."""
+
+
+def time_domain(inputs: Inputs) -> bool:
+    """Whether the scene asks for anything the time-domain run gives (else, with
+    outputs.stability, only the monodromy is computed)."""
+    wanted = set(TIME_DOMAIN_OUTPUTS)
+    if inputs.has_base:
+        wanted.add("outputs.absolute_acceleration")
+    if inputs.swept:
+        wanted |= {"outputs.peak_frequency", "outputs.envelope"}
+    return bool(wanted & inputs.wanted)
+
+
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     """The transverse sweep of `scene` as a Dataset, run as `options` say: the model's entry
     point (sweep.models.model_for)."""
     inputs = resolve(scene)
+    if "outputs.stability" not in inputs.wanted:
+        return _run_time_domain(inputs, options)
+    from .stability import stability_outputs
+    started = time.perf_counter()
+    coeffs = modal.oscillator(inputs.params)
+    stable = stability_outputs(coeffs, inputs.dims, inputs.shape, inputs.n_modes,
+                               options.threads)
+    if not time_domain(inputs):
+        if inputs.continuation is not None:
+            from ..errors import UserError
+            raise UserError("scene key 'continuation.axis': a stepped sweep needs a time-domain "
+                            "output (outputs.amplitude, ...), and this scene asks only for "
+                            "outputs.stability; remove [continuation] or turn an output on")
+        return stability_dataset(inputs, coeffs, stable, time.perf_counter() - started)
+    ds = _run_time_domain(inputs, options)
+    return ds.assign(stable)
+
+
+def stability_dataset(inputs: Inputs, coeffs: dict[str, Any], stable: dict[str, xr.DataArray],
+                      elapsed: float) -> xr.Dataset:
+    """The Dataset of a stability-only scene: the Floquet outputs and the closed forms."""
+    data = dict(stable)
+    for name, (units, long_name) in _DERIVED.items():
+        if name in coeffs and name not in inputs.coords:
+            data[name] = derived(coeffs[name], inputs.coords)
+            data[name].attrs = {"units": units, "long_name": long_name}
+    system = ("transverse modal oscillator" if inputs.n_modes == 1 else
+              f"transverse Galerkin model, {inputs.n_modes} modes")
+    attrs = global_attrs(inputs.origin, inputs.shape, elapsed,
+                         f"{system} linearised about q = 0, Floquet multipliers over one load "
+                         f"period (fixed-step DOP853 eighth order)")
+    return xr.Dataset(data, coords=dict(inputs.coords), attrs=attrs)
+
+
+def _run_time_domain(inputs: Inputs, options: RunOptions) -> xr.Dataset:
+    """The time-domain run of a transverse scene (every point integrated over [0, t_end])."""
     shape = inputs.shape
     settings = inputs.settings.copy()
     n_points = int(np.prod(shape, dtype=np.int64))
