@@ -29,6 +29,16 @@ What `plot` draws, by the result's content:
   dimension): up and down overlaid on every line (up solid, down dashed) and on the envelope
   (each point in its colour, both directions' peaks starred), and each map drawn once per
   direction (NAME-up, NAME-down) on one colour scale;
+- a stability result (outputs.stability; with the time-domain outputs off it has no `state`
+  and `stability`'s flags stand in for it): over two swept axes the Ince-Strutt chart
+  ('stability', `plot_stability_chart`): the unstable points coloured by the Floquet growth
+  rate (1/s), the stable ones light grey, invalid ones marked, the damped boundary (growth
+  rate 0) outlined, the tongues m = 1, 2, 3, ... named at W/w1 = 2/m, and over W/w1 x P0/Pcr
+  (a load_amplitude axis is drawn as P0/Pcr when `load_ratio` lies over it alone) the
+  first-order boundaries of the undamped principal and second Mathieu zones; over one axis the
+  growth rate against it with its zero line (`plot_growth_rate`); with the time-domain map
+  too, that map with the Floquet boundary over it ('stability_over_amplitude',
+  `plot_stability_over_map`, "Floquet: unstable inside");
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
   histories (`plot_histories`); with swept axes also the peak end displacement and the
   dynamic amplification over them.
@@ -54,7 +64,8 @@ More than two swept axes: `select={"dim": value, ...}` picks the values of the o
 value must be one of the axis's coordinates); `save` writes the selection into the file names
 (RESULT-DIM=VALUE-FIGURE.png), so that two selections do not overwrite each other. Labels read
 `long_name` and `units` from the Dataset. Like xarray's plotting functions, the single-panel
-ones take `ax=None` and return the Axes, and pass extra keyword arguments to matplotlib.
+ones take `ax=None` and return the Axes, and pass extra keyword arguments to matplotlib
+(the stability figures, stability.py, take `ax=None` and return their Figure).
 Figures are made with the object-oriented API (`matplotlib.figure.Figure`): no pyplot, no
 display and no backend choice are needed, and none is forced on the caller.
 
@@ -67,6 +78,7 @@ The package, split like xarray's plot/ by what is drawn:
     maps.py      two swept axes (plot_map, plot_state_map)
     series.py    stored histories (plot_time_series, plot_snapshots, plot_histories)
     branches.py  a stepped sweep: up and down against the stepped axis, the jumps (plot_branches)
+    stability.py Floquet stability: the Ince-Strutt chart, the growth rate, the boundary over a map
     envelope.py  a continuous sine sweep: the response envelope over frequency (plot_envelope)
     figures.py   which figures a result gets, and writing them (plot, save)
 """
@@ -83,11 +95,13 @@ from .maps import _HATCHES, FLOOR, plot_map, plot_state_map  # noqa: F401
 from .overlays import PAPER_FIG5_AMPLITUDES
 from .result import check_result, load_result, parse_select, select_points, swept_axes
 from .series import plot_histories, plot_snapshots, plot_time_series
+from .stability import plot_growth_rate, plot_stability_chart, plot_stability_over_map
 from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
            "check_result", "load_result", "parse_select", "plot", "plot_branches",
-           "plot_envelope",
+           "plot_envelope", "plot_growth_rate",
            "plot_histories",
            "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
+           "plot_stability_chart", "plot_stability_over_map",
            "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]

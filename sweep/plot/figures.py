@@ -29,6 +29,8 @@ from .line import plot_line
 from .maps import plot_map, plot_state_map
 from .result import (DIRECTION_DIM, _scene, _time_dim, check_result, select_points,
                      swept_axes)
+from .stability import (floquet_boundary_in_range, plot_growth_rate, plot_stability_chart,
+                        plot_stability_over_map)
 from .series import _snapshot_fields, plot_histories, plot_snapshots, plot_time_series
 from .style import _log_ticks, _plain_ticks, _state_meaning, _unit
 
@@ -74,7 +76,11 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     a continuous sine sweep run both ways ([base] sweep.direction = "both": a `direction`
     dimension) gets its up and down overlaid on the lines and the envelope, and each map twice,
     'NAME-up' and 'NAME-down', on one colour scale;
-    'state' (map, two axes), 'time_series' (when stored). Longitudinal: 'snapshots',
+    'state' (map, two axes), 'time_series' (when stored); with outputs.stability
+    'stability' (the Floquet Ince-Strutt chart over two axes, the growth rate against one) and,
+    when the time-domain map exists too, 'stability_over_amplitude' (the amplitude map with the
+    Floquet boundary over it); a stability-only result (no `state`) gets 'stability' alone.
+    Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
     swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
     settling times of an undamped run, all 0 s; a state map with one state) gets no figure:
@@ -118,6 +124,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             for key, way in _ways(ds, var):
                 figures[key] = (plot_state_map(ds, direction=way) if var == "state"
                                 else plot_map(ds, var, direction=way)).figure
+    if "growth_rate" in ds:
+        _stability_figures(ds, axes, figures)
     if "envelope" in ds:
         _envelope_figures(ds, axes, figures)
     if "displacement" in ds and _time_dim(ds["displacement"]) is not None:
@@ -178,6 +186,36 @@ def _envelope_figures(ds: xr.Dataset, axes: list[str], figures: Figures) -> None
                              fontsize="medium")
                 _log_ticks(ax, "x")
                 figures[key] = ax.figure
+
+
+def _stability_figures(ds: xr.Dataset, axes: list[str], figures: Figures) -> None:
+    """A stability result's 'stability' (the Ince-Strutt chart over two swept axes, the growth
+    rate against one) and, when the result also has a time-domain map over the same axes,
+    'stability_over_amplitude' (that map with the Floquet boundary over it)."""
+    title = ds.attrs.get("title", "result")
+    names = ["stability"] + (["stability_over_amplitude"]
+                             if len(axes) == 2 and "state" in ds.data_vars else [])
+    reason = why_not_drawn(ds["growth_rate"])
+    if reason is None and len(axes) not in (1, 2):
+        reason = "no swept axis with more than one value"
+    if reason is None and sorted(ds["growth_rate"].dims) != sorted(axes):
+        reason = (f"growth_rate lies over ({', '.join(ds['growth_rate'].dims)}), not over the "
+                  f"swept axes ({', '.join(axes)})")
+    for name in names:
+        why = reason
+        if why is None and name == "stability_over_amplitude":
+            if DIRECTION_DIM in ds["state"].dims:
+                why = "the time-domain maps were swept both ways; see the 'stability' chart"
+            elif not floquet_boundary_in_range(ds):
+                why = "the growth rate does not change sign: no Floquet boundary to draw"
+        if why is not None:
+            figures.skipped[name] = why
+            _log.info("%s: %s: no figure (%s)", title, name, why)
+        elif name == "stability":
+            figures[name] = (plot_growth_rate(ds) if len(axes) == 1
+                             else plot_stability_chart(ds))
+        else:
+            figures[name] = plot_stability_over_map(ds)
 
 
 def _stepped_figures(ds: xr.Dataset, select: Mapping[str, Any] | None) -> Figures:

@@ -111,6 +111,13 @@ def footer(ds: xr.Dataset) -> str:
     zeta = get("cable", "damping_ratio")
     if zeta is not None:
         parts.append(f"damping ratio {num(zeta)}")
+    if "state" not in ds.data_vars and "growth_rate" in ds.data_vars:
+        # Stability only (no time-domain run): no initial state, end time, solver or metrics.
+        modes = doc.get("model", {}).get("modes", 1)
+        parts.append("Floquet multipliers of the straight span linearised about q = 0, one "
+                     "load period per point" + (f", {modes} modes" if isinstance(modes, int)
+                                                and modes > 1 else ""))
+        return "Load case: " + "; ".join(parts)
     q0, v0 = get("initial", "displacement"), get("initial", "velocity")
     start = [t for t in ((None if q0 is None else f"q(0) = {_fmt(float(q0), 'm')}"),
                          (None if v0 is None else f"q'(0) = {num(v0)} m/s")) if t]

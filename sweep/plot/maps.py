@@ -174,7 +174,8 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
              y: str | None = None, select: Mapping[str, Any] | None = None,
              ax: Axes | None = None, add_colorbar: bool = True, add_legend: bool = True,
              mark_states: bool = True, overlays: bool = True, xscale: str | None = None,
-             yscale: str | None = None, direction: str | None = None, **kwargs: Any) -> Axes:
+             yscale: str | None = None, direction: str | None = None,
+             extra_handles: list | None = None, **kwargs: Any) -> Axes:
     """A pcolormesh map of `var` over the two swept axes (x: the second, y: the first, as
     xarray draws a 2-D DataArray; or name them). A variable spanning more than two decades gets
     a log colour scale; cells with no value (NaN) are grey. Displacements are in mm; on a log
@@ -191,7 +192,8 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
 
     `direction`: for a result swept both ways (a `direction` dimension, 'up' and 'down'), the
     one drawn; its colour scale spans both, so that the up and down maps compare colour for
-    colour. Returns the Axes.
+    colour. `extra_handles`: legend entries of what the caller draws over the map (the Floquet
+    boundary of stability.plot_stability_over_map). Returns the Axes.
     """
     ds = select_points(ds, select)
     x, y = _map_axes(ds, x, y, "plot_map", var)
@@ -247,7 +249,7 @@ def plot_map(ds: xr.Dataset, var: str = "amplitude", *, x: str | None = None,
     ax.set_title(_title(ds, str(var) + _swept(ds)), fontsize="medium")
     _plain_ticks(ax)
     if add_legend:
-        _legend(ax, handles)
+        _legend(ax, handles + list(extra_handles or ()))
     return ax
 
 
@@ -261,9 +263,11 @@ def _swept(ds: xr.Dataset) -> str:
 def plot_state_map(ds: xr.Dataset, *, x: str | None = None, y: str | None = None,
                    select: Mapping[str, Any] | None = None, ax: Axes | None = None,
                    add_legend: bool = True, overlays: bool = True,
-                   direction: str | None = None, **kwargs: Any) -> Axes:
+                   direction: str | None = None, extra_handles: list | None = None,
+                   **kwargs: Any) -> Axes:
     """A map of `state` over the two swept axes, one fixed colour per flag meaning, with the
-    closed-form overlays of `plot_map`; `direction` as for `plot_map`. Returns the Axes."""
+    closed-form overlays of `plot_map`; `direction` and `extra_handles` as for `plot_map`.
+    Returns the Axes."""
     ds = select_points(ds, select)
     x, y = _map_axes(ds, x, y, "plot_state_map")
     ds = _one_direction(ds, direction, "plot_state_map")
@@ -286,5 +290,5 @@ def plot_state_map(ds: xr.Dataset, *, x: str | None = None, y: str | None = None
     ax.set_title(_title(ds, "state" + _swept(ds)), fontsize="medium")
     _plain_ticks(ax)
     if add_legend:
-        _legend(ax, handles)
+        _legend(ax, handles + list(extra_handles or ()))
     return ax

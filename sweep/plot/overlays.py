@@ -10,6 +10,8 @@ coefficients, the load), so a figure calls every function its kind lists:
 - transverse, maps: under base excitation the linear resonance f = f1 (docs/model.md sec. 5),
   the buckling length, and the principal parametric resonance zone W = 2 w1 sqrt(1 +- mu),
   mu = P0/(2 Pcr), dotted where damping suppresses it, mu < 2 zeta (docs/model.md sec. 2);
+- transverse, stability chart (stability.py) over W/w1 x P0/Pcr: the first-order boundaries of
+  the undamped principal and second Mathieu zones ("first-order boundaries (undamped)");
 - transverse, time series: the paper's +-A of each Fig 5 span;
 - transverse, footer: the base excitation ('base sine 1 g at 20 Hz');
 - longitudinal, end histories of a single point: d'Alembert's peaks 2 P0 l/EA and 2 P0
@@ -18,6 +20,7 @@ coefficients, the load), so a figure calls every function its kind lists:
 The signatures, by figure:
     "line"         f(ax, ds, dim, var, factor, units, size) -> legend handles
     "map"          f(ax, ds, x, y) -> legend handles
+    "stability"    f(ax, ds, x, y) -> legend handles
     "time_series"  f(ax, ds, point, var, factor, units) -> None   (one panel)
     "histories"    f(ax, ds, points, name, factor) -> None        (one quantity)
     "footer"       f(ds, get) -> text or None                     (get: the scene value getter)
@@ -31,6 +34,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 import xarray as xr
+from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 
@@ -334,6 +338,51 @@ def _sweep_text(ds: xr.Dataset, sweep: dict, level_g: Any, level: Any) -> str:
     return text
 
 
+MATHIEU_LABEL = "first-order boundaries (undamped)"
+_MATHIEU_STYLE = dict(color="k", lw=1.2, ls=(0, (5, 2.5)), zorder=5,
+                      path_effects=[patheffects.Stroke(linewidth=2.6, foreground="w"),
+                                    patheffects.Normal()])
+
+
+def mathieu_boundaries(mu: np.ndarray) -> dict[str, np.ndarray]:
+    """W/w1 of the first-order boundaries of the undamped Mathieu zones at mu = P0/Pcr, from
+    a = 4/r^2, s = 2 mu/r^2 (r = W/w1): the principal zone a = 1 -+ s, r = 2 sqrt(1 -+ mu/2);
+    the second zone a = 4 - s^2/12 and a = 4 + 5 s^2/12, each a quadratic in r^2 solved at
+    every mu: r^2 = (1 + sqrt(1 + mu^2/3))/2 and r^2 = (1 + sqrt(1 - 5 mu^2/3))/2 (the root
+    near r = 1; NaN where there is none, mu > sqrt(3/5), far beyond first order)."""
+    mu = np.asarray(mu, float)
+    with np.errstate(invalid="ignore"):
+        return {"principal_low": 2.0 * np.sqrt(1.0 - 0.5 * mu),
+                "principal_high": 2.0 * np.sqrt(1.0 + 0.5 * mu),
+                "second_high": np.sqrt(0.5 * (1.0 + np.sqrt(1.0 + mu ** 2 / 3.0))),
+                "second_low": np.sqrt(0.5 * (1.0 + np.sqrt(1.0 - 5.0 * mu ** 2 / 3.0)))}
+
+
+def _mathieu_zones(ax: Axes, ds: xr.Dataset, x: str, y: str) -> list:
+    """A stability chart over W/w1 x P0/Pcr (a load_ratio axis, or load_amplitude with one
+    buckling load): the first-order boundaries of the undamped principal and second zones
+    (`mathieu_boundaries`), black dashes; nothing over other axes."""
+    freq, other = (x, y) if x == "frequency_ratio" else (y, x)
+    if freq != "frequency_ratio":
+        return []
+    if other == "load_ratio":
+        to_mu = 1.0
+    elif other == "load_amplitude" and "buckling_load" in ds and ds["buckling_load"].ndim == 0 \
+            and float(ds["buckling_load"].values) > 0:
+        to_mu = 1.0 / float(ds["buckling_load"].values)
+    else:
+        return []
+    raw = np.asarray(ds[other].values, float)
+    shown = _coord(ds, other)
+    factor = float(shown[-1] / raw[-1]) if raw[-1] else 1.0
+    load = np.linspace(raw.min(), raw.max(), 400)
+    zones = mathieu_boundaries(load * to_mu)
+    for name, r in zones.items():
+        px, py = (r, load * factor) if x == freq else (load * factor, r)
+        ax.plot(px, py, gid=f"mathieu-{name}", **_MATHIEU_STYLE)
+    return [Line2D([], [], label=MATHIEU_LABEL, **_MATHIEU_STYLE)]
+
+
 # ---------------------------------------------------------------------------------- longitudinal
 
 def _exact_peaks(ax: Axes, ds: xr.Dataset, points: list[xr.Dataset], name: str,
@@ -354,6 +403,7 @@ def _exact_peaks(ax: Axes, ds: xr.Dataset, points: list[xr.Dataset], name: str,
 OVERLAYS: dict[str, dict[str, tuple[Callable[..., Any], ...]]] = {
     "transverse": {"line": (_buckling_line, _paper_fig5_points),
                    "map": (_base_resonance, _buckling_map, _resonance_zone),
+                   "stability": (_mathieu_zones,),
                    "time_series": (_paper_fig5_bands,),
                    "footer": (_base_text,)},
     "longitudinal": {"histories": (_exact_peaks,)},

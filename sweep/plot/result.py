@@ -47,7 +47,11 @@ _OVER_AXES = ("amplitude", "settling_time", "peak_end_displacement", "dynamic_am
               "load_ratio", "natural_frequency", "transit_time", "static_end_displacement",
               "peak_fixed_end_force", "force_amplification", "damping_ratio",
               "absolute_acceleration_g", "transmissibility", "peak_amplitude",
-              "peak_frequency", "sweep_duration")
+              "peak_frequency", "sweep_duration", "floquet_multiplier", "growth_rate",
+              "floquet_mode")
+# A stability result's flags (outputs.stability): CF flags like `state`'s, over the swept axes.
+# With the time-domain outputs off a result has no `state`: `stability` stands in for it.
+STABILITY = "stability"
 # A continuous sine sweep's envelope and input level: over (some of) the swept axes and
 # BAND_DIM, the centres of its 1/N-octave bands (Hz), with CF bounds (BAND_DIM, nv).
 BAND_DIM = "band_frequency"
@@ -122,7 +126,8 @@ def load_result(path: str | os.PathLike) -> xr.Dataset:
             raise _unreadable(where, exc) from exc
     missing = [what for what, ok in (("no 'cable_sweep_version' attribute",
                                       "cable_sweep_version" in ds.attrs),
-                                     ("no 'state' variable", "state" in ds.data_vars)) if not ok]
+                                     ("no 'state' variable", flags_variable(ds) is not None))
+               if not ok]
     if missing:
         raise UserError(f"{where}: not a cable-sweep result ({' and '.join(missing)}); "
                         "give a file written by 'sweep run ... -o FILE.nc'")
@@ -220,36 +225,64 @@ def _check_directions(ds: xr.Dataset, where: str) -> None:
                              "'up' and 'down', each once")
 
 
+def flags_variable(ds: xr.Dataset) -> str | None:
+    """The variable whose dimensions are the result's swept axes and whose CF flags say how
+    each point went: `state`; for a stability-only result (outputs.stability with the
+    time-domain outputs off: `growth_rate` and `stability`, no `state`) `stability`; None for
+    neither."""
+    if "state" in ds.data_vars:
+        return "state"
+    if STABILITY in ds.data_vars and "growth_rate" in ds.data_vars:
+        return STABILITY
+    return None
+
+
+def _check_flags(state: xr.DataArray, name: str, where: str) -> None:
+    """Integer CF flags: flag_values and flag_meanings that pair up, values among them."""
+    if state.dtype.kind not in "iu":
+        raise _refuse(where, f"variable '{name}' holds {state.dtype}, not integer "
+                             f"{name} flags")
+    flags = np.asarray(state.attrs.get("flag_values", []))
+    meanings = str(state.attrs.get("flag_meanings", "")).split()
+    if flags.ndim != 1 or flags.dtype.kind not in "iu" or not 1 <= flags.size <= _MAX_FLAGS:
+        raise _refuse(where, f"{name}'s flag_values are {_short(repr(flags))}, not 1 to "
+                             f"{_MAX_FLAGS} integers")
+    if len(meanings) != flags.size or len(set(meanings)) != len(meanings):
+        raise _refuse(where, f"{name} has {flags.size} flag_values but {len(meanings)} "
+                             f"flag_meanings ({len(set(meanings))} distinct): they must pair up")
+    if np.unique(flags).size != flags.size:
+        raise _refuse(where, f"{name}'s flag_values ({_short(repr(flags.tolist()))}) repeat a "
+                             "value")
+    if any(len(m) > 64 for m in meanings):
+        raise _refuse(where, f"{name} has a flag meaning longer than 64 characters")
+    odd = np.setdiff1d(np.unique(state.values), flags)
+    if odd.size:
+        raise _refuse(where, f"{name} holds values that are not among its flag_values "
+                             f"({_short(repr(odd.tolist()))})")
+
+
 def check_result(ds: xr.Dataset, where: str = "the result") -> None:
     """Refuse (UserError, one line naming `where`) a Dataset the figures cannot be drawn from
     faithfully: attributes beyond a result's sizes, a `state` that is not integer flags with
     matching `flag_values` / `flag_meanings`, swept axes without finite, distinct coordinate
     values or with none, plotted variables that are not numbers or lie over other dimensions,
-    a `scene` attribute that is not a scene of this result's model. `plot` calls it; so does
-    `load_result`."""
+    a `scene` attribute that is not a scene of this result's model. A stability-only result
+    (`growth_rate` and `stability`, no `state`: outputs.stability with the time-domain outputs
+    off) is checked with `stability` in state's place; a result with both has both checked,
+    over the same axes. `plot` calls it; so does `load_result`."""
     _check_attrs(ds, where)
-    if "state" not in ds.data_vars:
+    name = flags_variable(ds)
+    if name is None:
         raise _refuse(where, "no 'state' variable")
-    state = ds["state"]
-    if state.dtype.kind not in "iu":
-        raise _refuse(where, f"variable 'state' holds {state.dtype}, not integer state flags")
-    flags = np.asarray(state.attrs.get("flag_values", []))
-    meanings = str(state.attrs.get("flag_meanings", "")).split()
-    if flags.ndim != 1 or flags.dtype.kind not in "iu" or not 1 <= flags.size <= _MAX_FLAGS:
-        raise _refuse(where, f"state's flag_values are {_short(repr(flags))}, not 1 to "
-                             f"{_MAX_FLAGS} integers")
-    if len(meanings) != flags.size or len(set(meanings)) != len(meanings):
-        raise _refuse(where, f"state has {flags.size} flag_values but {len(meanings)} "
-                             f"flag_meanings ({len(set(meanings))} distinct): they must pair up")
-    if np.unique(flags).size != flags.size:
-        raise _refuse(where, f"state's flag_values ({_short(repr(flags.tolist()))}) repeat a "
-                             "value")
-    if any(len(m) > 64 for m in meanings):
-        raise _refuse(where, "state has a flag meaning longer than 64 characters")
-    odd = np.setdiff1d(np.unique(state.values), flags)
-    if odd.size:
-        raise _refuse(where, f"state holds values that are not among its flag_values "
-                             f"({_short(repr(odd.tolist()))})")
+    state = ds[name]
+    _check_flags(state, name, where)
+    if name == "state" and STABILITY in ds.data_vars:   # both kinds: the stability flags too
+        _check_flags(ds[STABILITY], STABILITY, where)
+        over = [d for d in state.dims if d != DIRECTION_DIM]
+        if sorted(ds[STABILITY].dims) != sorted(over):
+            raise _refuse(where, f"variable '{STABILITY}' lies over "
+                                 f"({', '.join(map(str, ds[STABILITY].dims))}), not over "
+                                 f"({', '.join(over)})")
     axes = [d for d in state.dims if d != DIRECTION_DIM]
     for dim in axes:
         _check_axis(ds, dim, where, unique=True)
@@ -387,9 +420,10 @@ def _values_text(values: np.ndarray) -> str:
 
 
 def swept_axes(ds: xr.Dataset) -> list[str]:
-    """The result's swept axes with more than one value, in scene order (the dims of state; a
-    stepped sweep's `direction` is not one)."""
-    return [d for d in ds["state"].dims if ds.sizes[d] > 1 and d != DIRECTION_DIM]
+    """The result's swept axes with more than one value, in scene order (the dims of state, of
+    `stability` in a stability-only result; a stepped sweep's `direction` is not one)."""
+    return [d for d in ds[flags_variable(ds) or "state"].dims
+            if ds.sizes[d] > 1 and d != DIRECTION_DIM]
 
 
 def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr.Dataset:
@@ -399,9 +433,10 @@ def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr
     A value must be one of the axis's coordinate values (to 1e-6 relative). Raises UserError
     for an unknown axis, a value not on the axis, or more than two remaining swept axes.
     """
-    if "state" not in ds.data_vars:
+    name = flags_variable(ds)
+    if name is None:
         raise UserError("not a cable-sweep result: no 'state' variable")
-    axes = [d for d in ds["state"].dims if d != DIRECTION_DIM]
+    axes = [d for d in ds[name].dims if d != DIRECTION_DIM]
     for dim, value in (select or {}).items():
         shown = f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
         if dim not in axes:
