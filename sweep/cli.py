@@ -3,6 +3,7 @@
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
+    sweep design RESULT.nc [--min-frequency HZ] [--max-amplitude M] [--quantity NAME] [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -93,6 +94,20 @@ def _parser() -> argparse.ArgumentParser:
     modes.add_argument("--threads", type=int, default=None, metavar="N",
                        help="worker threads (default: all)")
     modes.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    design = sub.add_parser("design", help="the largest span between clamps meeting the "
+                                           "criteria, from a result with a length axis")
+    design.add_argument("result", metavar="RESULT.nc",
+                        help="a netCDF file written by 'sweep run' with a length axis")
+    design.add_argument("--min-frequency", type=float, default=None, metavar="HZ",
+                        help="first natural frequency at least this (Hz)")
+    design.add_argument("--max-amplitude", type=float, default=None, metavar="M",
+                        help="response at most this (m): peak_amplitude of a swept result, "
+                             "else amplitude, or --quantity")
+    design.add_argument("--quantity", default=None, metavar="NAME",
+                        help="the variable (in m) --max-amplitude limits")
+    design.add_argument("-o", "--output", metavar="OUT.nc",
+                        help="netCDF file to write the spans to (atomically)")
+    design.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     sub.add_parser("scenes", help="list the built-in scenes")
     keys = sub.add_parser("keys", help="every scene key: type, default, units, allowed values")
     keys.add_argument("which", nargs="?", default=None, metavar="SECTION | KEY",
@@ -209,6 +224,26 @@ def _modes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _design(args: argparse.Namespace) -> int:
+    from .design import max_span, table
+    from .io import check_output_path, write_netcdf
+    from .plot import load_result
+    if args.min_frequency is None and args.max_amplitude is None:
+        raise UserError("design: no criterion given (give --min-frequency HZ and/or "
+                        "--max-amplitude M)")
+    if args.output is not None:
+        check_output_path(args.output, args.overwrite)   # before any work, in one line
+    ds = load_result(args.result)
+    result = max_span(ds, min_frequency=args.min_frequency, max_amplitude=args.max_amplitude,
+                      quantity=args.quantity)
+    print(f"{result.attrs['title']} ({result.attrs['criteria']})")
+    print(table(result))
+    if args.output is not None:
+        write_netcdf(result, args.output, overwrite=args.overwrite)
+        print(f"-> {args.output}")
+    return 0
+
+
 def _scenes() -> int:
     from .scene import builtin_scenes
     scenes = builtin_scenes()
@@ -280,6 +315,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _plot(args)
         if args.command == "keys":
             return _keys(args)
+        if args.command == "design":
+            return _design(args)
         if args.command == "modes":
             from .execute import terminate_raises
             with terminate_raises():

@@ -1,0 +1,315 @@
+"""The clamp-spacing question (docs/model.md sec. 9): the largest span between clamps that
+meets a harness's criteria under the load case of a result.
+
+`max_span(ds, min_frequency=..., max_amplitude=...)` walks a result's `length` axis upwards
+and, for every combination of its other swept axes, returns the largest span before the first
+grid length that fails, interpolated between that length and the last passing one on the
+margin of the criterion that binds. A length fails when
+
+* ``min_frequency``: its first natural frequency `natural_frequency` (Hz) is below the limit;
+* ``max_amplitude``: its response (`peak_amplitude` of a swept result, one with
+  `peak_frequency`; else `amplitude`; or the variable named by ``quantity``, m) is above the
+  limit, or is missing (NaN);
+* ``state``: its `state` is a failure (invalid_input, diverged, step_size_too_small,
+  max_steps_reached);
+* ``stability``: where the result has `stability`, the straight span is unstable there
+  (`growth_rate` > 0, or a flag other than stable).
+
+A stepped or swept result's `direction` (up, down) counts at its worst: the quantity's maximum
+over direction, and a length fails on a state or stability failure of either direction.
+
+Interpolation between the last passing grid length l_a and the first failing one l_b:
+frequency in log f against log l (f1 ~ l^-2 unloaded, so the frequency criterion alone is
+exact), amplitude linearly in l of (quantity - limit), stability linearly in l of growth_rate;
+a state failure (which has no margin) and a missing value give l_a. When several criteria fail
+at l_b the smallest of their spans binds. No analysis is run: the span is only as good as the
+grid (a finer `length` axis near the answer refines it).
+"""
+
+from __future__ import annotations
+
+import datetime
+import math
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from .errors import UserError
+
+LENGTH = "length"
+DIRECTION = "direction"
+STATE_FAILURES = ("invalid_input", "diverged", "step_size_too_small", "max_steps_reached")
+"""`state` flag meanings that fail a length."""
+CRITERIA = ("min_frequency", "max_amplitude", "state", "stability")
+"""The criteria in the order they are named when the shortest span fails several."""
+LIMITED_BY = CRITERIA + ("grid",)
+
+
+def _number(value: Any, flag: str, example: str) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise UserError(f"{flag} {value!r}: not a number (give e.g. {flag} {example})") from None
+    if not (math.isfinite(x) and x > 0.0):
+        raise UserError(f"{flag} {x:g}: must be a positive finite number, e.g. {flag} "
+                        f"{example}")
+    return x
+
+
+def _flags(var: xr.DataArray) -> dict[int, str]:
+    values = np.atleast_1d(var.attrs.get("flag_values", [])).tolist()
+    meanings = str(var.attrs.get("flag_meanings", "")).split()
+    return {int(v): m for v, m in zip(values, meanings)}
+
+
+def _default_quantity(ds: xr.Dataset) -> str:
+    return "peak_amplitude" if "peak_frequency" in ds else "amplitude"
+
+
+def _length_quantities(ds: xr.Dataset, axes: tuple[str, ...]) -> list[str]:
+    """Variables with units m over the swept axes only: what --quantity may name."""
+    return sorted(str(n) for n, v in ds.data_vars.items()
+                  if v.attrs.get("units") == "m" and LENGTH in v.dims
+                  and set(v.dims) <= set(axes))
+
+
+def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
+           quantity: str | None) -> tuple[tuple[str, ...], str | None]:
+    """Refuse (one-line UserError) what max_span cannot answer; the swept axes and the
+    quantity the amplitude criterion reads (None without one)."""
+    if not isinstance(ds, xr.Dataset):
+        raise UserError(f"max_span: needs a result (an xarray Dataset), got "
+                        f"{type(ds).__name__}")
+    if min_frequency is None and max_amplitude is None:
+        raise UserError("design: no criterion given (give --min-frequency HZ and/or "
+                        "--max-amplitude M)")
+    template = "state" if "state" in ds else "stability" if "stability" in ds else None
+    if template is None:
+        raise UserError("design: the result has neither 'state' nor 'stability' (give a "
+                        "result written by 'sweep run ... -o FILE.nc')")
+    axes = tuple(str(d) for d in ds[template].dims)
+    if LENGTH not in axes or LENGTH not in ds.coords:
+        have = ", ".join(a for a in axes if a != DIRECTION) or "none"
+        raise UserError(f"design: the result has no 'length' axis (its axes: {have}); run the "
+                        "scene with one, e.g. --set 'axes.length={start=0.1, stop=0.6, num=11}'")
+    lengths = np.asarray(ds[LENGTH].values, float)
+    if not (np.all(np.isfinite(lengths)) and np.all(lengths > 0)):
+        raise UserError("design: the result's 'length' axis holds values that are not "
+                        "positive finite lengths (m); give a result written by 'sweep run'")
+    if min_frequency is not None and "natural_frequency" not in ds:
+        raise UserError("design: --min-frequency needs the variable 'natural_frequency' (Hz), "
+                        "which this result lacks (a transverse result has it)")
+    if quantity is not None and max_amplitude is None:
+        raise UserError(f"design: --quantity {quantity}: is the response --max-amplitude "
+                        "limits; give --max-amplitude M too")
+    if max_amplitude is None:
+        return axes, None
+    name = _default_quantity(ds) if quantity is None else str(quantity)
+    choices = ", ".join(_length_quantities(ds, axes)) or "none"
+    if name not in ds.data_vars:
+        how = "--quantity" if quantity is not None else "the default quantity"
+        raise UserError(f"design: {how} '{name}': no such variable in the result (variables "
+                        f"in m over its length axis: {choices}; give --quantity NAME)")
+    units = ds[name].attrs.get("units")
+    if units != "m":
+        raise UserError(f"design: --max-amplitude limits '{name}', whose units are "
+                        f"{units!r}, not 'm' (give --quantity NAME of one in m: {choices})")
+    extra = [d for d in ds[name].dims if d not in axes]
+    if extra:
+        raise UserError(f"design: quantity '{name}' lies over {', '.join(map(str, extra))}, "
+                        f"not a swept axis (give --quantity NAME of one over the axes only: "
+                        f"{choices})")
+    return axes, name
+
+
+def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
+    """`var` as a float array shaped like `like`, length last."""
+    return np.asarray(var.broadcast_like(like).transpose(*like.dims).values, float)
+
+
+def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
+             max_amplitude: float | None = None, quantity: str | None = None) -> xr.Dataset:
+    """The largest span between clamps (m) that meets the criteria, per combination of the
+    result's other swept axes.
+
+    Parameters
+    ----------
+    ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis (m).
+    min_frequency : Hz; a length passes when `natural_frequency` >= min_frequency.
+    max_amplitude : m; a length passes when the response <= max_amplitude. The response is
+        `quantity` (a variable in m over the swept axes), by default `peak_amplitude` for a
+        swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
+        (largest) value over `direction` counts.
+    quantity : the variable `max_amplitude` limits (needs max_amplitude).
+
+    Every length must also have a `state` that is not a failure (invalid_input, diverged,
+    step_size_too_small, max_steps_reached on either direction) and, where the result has
+    `stability`, be stable (growth_rate <= 0).
+
+    Returns
+    -------
+    A Dataset over the result's axes other than `length` and `direction` (their coordinates
+    kept) with `max_span` (m): the largest length before the first failing grid length,
+    interpolated between the last passing and the first failing one on the binding
+    criterion's margin (module docstring); the longest grid length when none fails; NaN when
+    the shortest already fails. `limited_by` (strings): the binding criterion,
+    "min_frequency", "max_amplitude", "state" or "stability" ("grid" when no length fails;
+    with a NaN max_span the criterion the shortest span fails). Attributes: `criteria`, the
+    source result's `title`.
+
+    Raises UserError (one line) without a criterion, without a `length` axis, for an unknown
+    quantity or one whose units are not m, a non-positive limit.
+    """
+    fmin = None if min_frequency is None else _number(min_frequency, "--min-frequency", "100")
+    amax = None if max_amplitude is None else _number(max_amplitude, "--max-amplitude", "0.002")
+    axes, qname = _check(ds, fmin, amax, quantity)
+    ds = ds.sortby(LENGTH)
+    others = tuple(a for a in axes if a not in (LENGTH, DIRECTION))
+    template_name = "state" if "state" in ds else "stability"
+    like = ds[template_name].isel({DIRECTION: 0}, drop=True) if DIRECTION in axes \
+        else ds[template_name]
+    like = like.transpose(*others, LENGTH)
+    shape = like.shape
+    lengths = np.asarray(ds[LENGTH].values, float)
+
+    def worst(var: xr.DataArray, how: str) -> xr.DataArray:
+        if DIRECTION in var.dims:
+            # skipna=False: a missing direction is not a pass
+            return getattr(var, how)(DIRECTION, skipna=False)
+        return var
+
+    # margins: >= 0 passes (NaN fails), per criterion; the value interpolated on, and how
+    margins: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
+    if fmin is not None:
+        f = _broadcast(worst(ds["natural_frequency"], "min"), like)
+        margins["min_frequency"] = (f - fmin, f, "log")
+    if qname is not None:
+        q = _broadcast(worst(ds[qname], "max"), like)
+        margins["max_amplitude"] = (amax - q, q - amax, "linear")
+    if "state" in ds:
+        meanings = _flags(ds["state"])
+        bad = [v for v, m in meanings.items() if m in STATE_FAILURES]
+        failed = worst(ds["state"].isin(bad), "max")
+        ok = np.where(_broadcast(failed, like) > 0, -1.0, 0.0)
+        margins["state"] = (ok, np.full(shape, np.nan), "none")
+    if "stability" in ds:
+        meanings = _flags(ds["stability"])
+        bad = [v for v, m in meanings.items() if m != "stable"]
+        failed = _broadcast(worst(ds["stability"].isin(bad), "max"), like) > 0
+        if "growth_rate" in ds:
+            g = _broadcast(worst(ds["growth_rate"], "max"), like)
+            failed |= ~(g <= 0.0)
+        else:
+            g = np.full(shape, np.nan)
+        margins["stability"] = (np.where(failed, -1.0, 0.0), g, "linear")
+
+    flat = {k: (m.reshape(-1, shape[-1]), v.reshape(-1, shape[-1]), how)
+            for k, (m, v, how) in margins.items()}
+    n = int(np.prod(shape[:-1], dtype=int))
+    spans = np.full(n, np.nan)
+    limited = np.empty(n, dtype=object)
+    for i in range(n):
+        passes = np.ones(shape[-1], bool)
+        for m, _, _ in flat.values():
+            passes &= m[i] >= 0.0                # NaN margin: fails
+        if passes.all():
+            spans[i], limited[i] = lengths[-1], "grid"
+            continue
+        b = int(np.argmin(passes))               # the first failing length
+        failing = [k for k in CRITERIA if k in flat and not flat[k][0][i, b] >= 0.0]
+        if b == 0:
+            spans[i], limited[i] = np.nan, failing[0]
+            continue
+        a = b - 1
+        best = (math.inf, "")
+        for k in failing:
+            _, v, how = flat[k]
+            span = _interpolate(lengths[a], lengths[b], v[i, a], v[i, b],
+                                fmin if k == "min_frequency" else 0.0, how)
+            if span < best[0]:
+                best = (span, k)
+        spans[i], limited[i] = best
+    out_shape = shape[:-1]
+    coords = {d: _coordinate(ds, d) for d in others}
+    title = str(ds.attrs.get("title", ""))
+    criteria = "; ".join(
+        ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
+        + ([f"{qname} <= {amax:g} m"] if qname is not None else [])
+        + (["state not in (" + ", ".join(STATE_FAILURES) + ")"] if "state" in ds else [])
+        + (["growth_rate <= 0 (stable)"] if "stability" in ds else []))
+    from .version import package_version
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    result = xr.Dataset(
+        {"max_span": xr.DataArray(spans.reshape(out_shape), dims=others, attrs={
+            "units": "m",
+            "long_name": "largest span between clamps meeting the criteria, every shorter "
+                         "grid span passing (interpolated between grid lengths)",
+            "comment": "NaN: the shortest grid length already fails (limited_by says which "
+                       "criterion)"}),
+         "limited_by": xr.DataArray(limited.reshape(out_shape).astype(str).astype(object),
+                                    dims=others, attrs={
+             "long_name": "criterion binding max_span: " + ", ".join(LIMITED_BY),
+             "comment": "grid: no grid length fails (max_span is the longest grid length, "
+                        "the true one may be longer); with a NaN max_span, the criterion "
+                        "the shortest grid length fails"})},
+        coords=coords,
+        attrs={"title": f"maximum span: {title}" if title else "maximum span",
+               "Conventions": "CF-1.11",
+               "source": f"cable-sweep {package_version()}: sweep.design.max_span of a result",
+               "history": f"{now} max_span by cable-sweep {package_version()} from result "
+                          f"'{title}' ({criteria})",
+               "source_title": title,
+               "criteria": criteria,
+               "length_grid": f"{lengths.size} lengths, {lengths[0]:g} to {lengths[-1]:g} m"})
+    return result
+
+
+def _interpolate(la: float, lb: float, va: float, vb: float, limit: float, how: str) -> float:
+    """Where, between the passing la and failing lb, the criterion's value crosses its limit:
+    `log` (log v against log l), `linear` (v - limit linear in l); la where it cannot be
+    found (no margin, a missing value, no crossing)."""
+    if how == "none" or not (np.isfinite(va) and np.isfinite(vb)):
+        return float(la)
+    if how == "log":
+        if not (va > 0 and vb > 0 and limit > 0) or va == vb:
+            return float(la)
+        t = (math.log(limit) - math.log(va)) / (math.log(vb) - math.log(va))
+        t = min(max(t, 0.0), 1.0)
+        return float(math.exp(math.log(la) + t * (math.log(lb) - math.log(la))))
+    if vb == va:
+        return float(la)
+    t = (limit - va) / (vb - va)
+    t = min(max(t, 0.0), 1.0)
+    return float(la + t * (lb - la))
+
+
+def _coordinate(ds: xr.Dataset, dim: str) -> xr.DataArray:
+    """The coordinate of `dim` with its attributes (less `bounds`, whose variable stays
+    behind, so the output names nothing it lacks)."""
+    if dim in ds.coords:
+        c = ds[dim]
+        attrs = {k: v for k, v in c.attrs.items() if k != "bounds"}
+        return xr.DataArray(c.values, dims=(dim,), attrs=attrs)
+    return xr.DataArray(np.arange(ds.sizes[dim]), dims=(dim,),
+                        attrs={"long_name": f"index along {dim}", "units": "1"})
+
+
+def table(result: xr.Dataset) -> str:
+    """A short text table of `max_span`: one line per combination of the other axes, their
+    values, max_span in mm and limited_by."""
+    span = result["max_span"]
+    dims = list(span.dims)
+    head = [*dims, "max_span_mm", "limited_by"]
+    rows = []
+    for index in np.ndindex(*span.shape):
+        values = [f"{result[d].values[i]:g}" if np.asarray(result[d].values).dtype.kind in "fiu"
+                  else str(result[d].values[i]) for d, i in zip(dims, index)]
+        s = float(span.values[index])
+        by = str(result["limited_by"].values[index])
+        rows.append([*values, f"{s * 1e3:.2f}" if np.isfinite(s) else "nan",
+                     by if np.isfinite(s) else f"{by} (shortest span fails)"])
+    widths = [max(len(r[j]) for r in [head, *rows]) for j in range(len(head))]
+    lines = ["  ".join(c.rjust(w) if j < len(head) - 1 else c
+                       for j, (c, w) in enumerate(zip(r, widths))) for r in [head, *rows]]
+    return "\n".join(lines)

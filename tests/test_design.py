@@ -1,0 +1,256 @@
+"""The clamp-spacing question (docs/model.md sec. 9, sweep/design.py): the largest span meeting
+a frequency and a deflection criterion, against closed forms computed here from the cable data,
+not from the result's own derived values."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from scipy.optimize import brentq
+
+import sweep
+from sweep.cli import main
+from sweep.design import max_span
+
+# Table 1 cable, bending moment of the solid round 6 mm^2 section.
+E, RHO, AREA, INERTIA, ZETA = 1.1e11, 8900.0, 6e-6, 2.865e-12, 0.02
+G = 9.80665
+LEVEL_G = 0.001            # g: tiny, so the membrane-free span responds linearly
+BASE_FREQUENCY = 30.0      # Hz
+
+SCENE = """
+name = "{name}"
+description = "design test"
+[model]
+kind = "transverse"
+coefficients = "consistent"
+membrane = {membrane}
+modes = 1
+[cable]
+youngs_modulus = 1.1e11
+density = 8900.0
+area = 6e-6
+inertia = 2.865e-12
+damping_ratio = 0.02
+{cable}
+[load]
+amplitude = 0.0
+[base]
+{base}
+[initial]
+displacement = 0.0
+velocity = 0.0
+[axes]
+{axes}
+[solver]
+{solver}
+"""
+
+
+def f1(length: float) -> float:
+    """First natural frequency (Hz) of the unloaded span, docs/model.md sec. 9."""
+    return math.pi * math.sqrt(E * INERTIA / (RHO * AREA)) / (2.0 * length ** 2)
+
+
+def l_max_frequency(f_min: float) -> float:
+    return math.sqrt(math.pi * math.sqrt(E * INERTIA / (RHO * AREA)) / (2.0 * f_min))
+
+
+def linear_amplitude(length: float) -> float:
+    """(4/pi) A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2), m."""
+    w1, w = 2 * math.pi * f1(length), 2 * math.pi * BASE_FREQUENCY
+    return (4 / math.pi) * LEVEL_G * G / math.sqrt((w1 ** 2 - w ** 2) ** 2
+                                                   + (2 * ZETA * w1 * w) ** 2)
+
+
+def _run(tmp: Path, name: str, *, membrane: float = 0.0, cable: str = "",
+         base: str = f"acceleration_g = {LEVEL_G}\nfrequency = {BASE_FREQUENCY}",
+         axes: str, solver: str = "t_end = 5.0", output: bool = True) -> tuple[xr.Dataset, Path]:
+    path = tmp / f"{name}.toml"
+    path.write_text(SCENE.format(name=name, membrane=membrane, cable=cable, base=base,
+                                 axes=axes, solver=solver))
+    out = tmp / f"{name}.nc"
+    ds = sweep.run(sweep.load_scene(str(path)), output=out if output else None, progress=False)
+    return ds, out
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("design")
+    coarse = _run(tmp, "coarse", axes="length = {start = 0.1, stop = 0.6, num = 11}",
+                  solver="t_end = 0.5")
+    # lengths from 0.1 m up to the 30 Hz resonance (0.357 m), every 5 mm
+    linear = _run(tmp, "linear", axes="length = {start = 0.1, stop = 0.34, num = 49}")
+    swept = _run(tmp, "swept", membrane=0.375,
+                 base='acceleration_g = 0.5\n'
+                      'sweep = {start = 20.0, stop = 60.0, rate = 16.0, direction = "both"}',
+                 axes="length = {start = 0.2, stop = 0.35, num = 4}", solver="")
+    no_length = _run(tmp, "nolength", cable="length = 0.3", base=f"acceleration_g = {LEVEL_G}",
+                     axes="base_frequency = [20.0, 30.0]", solver="t_end = 0.5")
+    return {"coarse": coarse, "linear": linear, "swept": swept, "no_length": no_length}
+
+
+def test_frequency_criterion_alone_is_the_closed_form(results):
+    ds, _ = results["coarse"]
+    out = max_span(ds, min_frequency=100.0)
+    exact = l_max_frequency(100.0)
+    assert 0.1 < exact < 0.6
+    got = float(out["max_span"])
+    assert abs(got / exact - 1) < 1e-6, (got, exact)      # log f vs log l: exact for l^-2
+    assert str(out["limited_by"].values) == "min_frequency"
+    assert out["max_span"].attrs["units"] == "m"
+    assert "natural_frequency >= 100 Hz" in out.attrs["criteria"]
+    assert "coarse" in out.attrs["title"]
+    # a limit below every grid frequency: every span passes, the grid binds
+    grid = max_span(ds, min_frequency=1.0)
+    assert float(grid["max_span"]) == pytest.approx(0.6)
+    assert str(grid["limited_by"].values) == "grid"
+    # above every grid frequency: the shortest span fails already
+    none = max_span(ds, min_frequency=f1(0.1) * 1.01)
+    assert np.isnan(float(none["max_span"]))
+    assert str(none["limited_by"].values) == "min_frequency"
+
+
+def _amplitude_reference(limit: float) -> float:
+    l_res = math.sqrt(math.pi * math.sqrt(E * INERTIA / (RHO * AREA))
+                      / (2 * BASE_FREQUENCY))
+    return brentq(lambda length: linear_amplitude(length) - limit, 0.1, l_res, xtol=1e-12)
+
+
+@pytest.mark.parametrize("limit", [2e-8, 1e-7, 5e-7])
+def test_amplitude_criterion_on_a_linear_span_is_the_closed_form(results, limit):
+    ds, _ = results["linear"]
+    out = max_span(ds, max_amplitude=limit)
+    exact = _amplitude_reference(limit)
+    got = float(out["max_span"])
+    assert abs(got / exact - 1) < 0.02, (got, exact)
+    assert abs(got / exact - 1) < 2e-3, (got, exact)      # 5 mm grid: far better than 2 %
+    assert str(out["limited_by"].values) == "max_amplitude"
+    assert "amplitude <= " in out.attrs["criteria"]
+
+
+def test_both_criteria_the_smaller_span_binds(results):
+    ds, _ = results["linear"]
+    f_span = l_max_frequency(100.0)
+    a_small, a_large = _amplitude_reference(2e-8), _amplitude_reference(5e-7)
+    assert a_small < f_span < a_large
+    out = max_span(ds, min_frequency=100.0, max_amplitude=5e-7)
+    assert float(out["max_span"]) == pytest.approx(f_span, rel=1e-6)
+    assert str(out["limited_by"].values) == "min_frequency"
+    out = max_span(ds, min_frequency=100.0, max_amplitude=2e-8)
+    assert float(out["max_span"]) == pytest.approx(a_small, rel=2e-3)
+    assert str(out["limited_by"].values) == "max_amplitude"
+
+
+def test_a_swept_result_uses_peak_amplitude_over_its_worst_direction(results):
+    ds, _ = results["swept"]
+    assert "peak_frequency" in ds and "direction" in ds["peak_amplitude"].dims
+    worst = ds["peak_amplitude"].max("direction").values
+    lengths = ds["length"].values
+    assert np.all(np.diff(worst) > 0), worst          # the response grows with the span here
+    # a limit the 3rd length's better direction passes and its worse one fails: the worse binds
+    best = ds["peak_amplitude"].min("direction").values
+    assert best[2] < worst[2] and worst[1] < best[2], (best, worst)
+    limit = 0.5 * (best[2] + worst[2])
+    expected = lengths[1] + (limit - worst[1]) / (worst[2] - worst[1]) * (lengths[2] - lengths[1])
+    out = max_span(ds, max_amplitude=limit)
+    assert float(out["max_span"]) == pytest.approx(expected, rel=1e-9)
+    assert float(out["max_span"]) < lengths[2]         # the better direction alone: beyond
+    assert str(out["limited_by"].values) == "max_amplitude"
+    assert "peak_amplitude <= " in out.attrs["criteria"]
+    assert "direction" not in out.dims
+
+
+def test_other_axes_are_kept(results):
+    ds, _ = results["coarse"]
+    two = xr.concat([ds, ds], dim=xr.DataArray([0.01, 0.02], dims="damping_ratio",
+                                               attrs={"units": "1", "long_name": "damping"}))
+    two["natural_frequency"] = ds["natural_frequency"]         # over length only: broadcast
+    out = max_span(two, min_frequency=100.0)
+    assert out["max_span"].dims == ("damping_ratio",)
+    assert out["damping_ratio"].attrs["units"] == "1"
+    np.testing.assert_allclose(out["max_span"].values, l_max_frequency(100.0), rtol=1e-6)
+
+
+def test_a_failed_state_ends_the_walk(results):
+    ds, _ = results["coarse"]
+    bad = ds.copy(deep=True)
+    state = bad["state"].values
+    meanings = bad["state"].attrs["flag_meanings"].split()
+    values = list(np.atleast_1d(bad["state"].attrs["flag_values"]))
+    state[2] = values[meanings.index("diverged")]
+    out = max_span(bad, min_frequency=100.0)
+    assert float(out["max_span"]) == pytest.approx(float(ds["length"][1]))
+    assert str(out["limited_by"].values) == "state"
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    ({}, "no criterion"),
+    ({"max_amplitude": 1e-3, "quantity": "nonesuch"}, "nonesuch"),
+    ({"max_amplitude": 1e-3, "quantity": "natural_frequency"}, "units"),
+    ({"min_frequency": -5.0}, "positive"),
+    ({"quantity": "amplitude"}, "--max-amplitude"),
+])
+def test_bad_criteria_are_one_line(results, kwargs, fragment):
+    ds, _ = results["coarse"]
+    with pytest.raises(sweep.UserError, match=fragment) as info:
+        max_span(ds, **kwargs)
+    assert "\n" not in str(info.value)
+
+
+def test_a_result_without_length_is_refused(results):
+    ds, _ = results["no_length"]
+    with pytest.raises(sweep.UserError, match="length") as info:
+        max_span(ds, min_frequency=100.0)
+    assert "\n" not in str(info.value)
+
+
+def test_cli_design_writes_a_cf_clean_file(results, tmp_path, capsys):
+    from test_cf import cf_problems
+    _, path = results["coarse"]
+    out = tmp_path / "out.nc"
+    assert main(["design", str(path), "--min-frequency", "100", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "max_span_mm" in text and "min_frequency" in text
+    assert f"{l_max_frequency(100.0) * 1e3:.2f}" in text
+    assert cf_problems(out) == []
+    back = xr.open_dataset(out)
+    assert back["max_span"].attrs["units"] == "m"
+    assert float(back["max_span"]) == pytest.approx(l_max_frequency(100.0), rel=1e-6)
+    assert str(back["limited_by"].values) == "min_frequency"
+    back.close()
+
+
+def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, capsys):
+    from test_cf import cf_problems
+    ds, _ = results["coarse"]
+    two = xr.concat([ds, ds], dim=xr.DataArray([0.01, 0.02], dims="damping_ratio",
+                                               attrs={"units": "1", "long_name": "damping"}))
+    src = tmp_path / "two.nc"
+    two.to_netcdf(src)
+    out = tmp_path / "out2.nc"
+    assert main(["design", str(src), "--min-frequency", "100", "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert sum("min_frequency" in line for line in lines[1:]) == 2
+    assert cf_problems(out) == []
+
+
+@pytest.mark.parametrize("which, flags, fragment", [
+    ("coarse", [], "no criterion"),
+    ("no_length", ["--min-frequency", "100"], "length"),
+    ("coarse", ["--max-amplitude", "1e-3", "--quantity", "nonesuch"], "nonesuch"),
+    ("coarse", ["--min-frequency", "abc"], "invalid float"),
+])
+def test_cli_design_bad_input_is_one_line_exit_2(results, which, flags, fragment, capsys):
+    _, path = results[which]
+    try:
+        code = main(["design", str(path), *flags])
+    except SystemExit as exc:                     # argparse's own errors
+        code = exc.code
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert fragment in err and len(err.splitlines()) == 1, err
