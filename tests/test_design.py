@@ -254,3 +254,23 @@ def test_cli_design_bad_input_is_one_line_exit_2(results, which, flags, fragment
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert fragment in err and len(err.splitlines()) == 1, err
+
+
+def test_an_unstable_span_ends_the_walk_at_the_growth_rate_zero():
+    # principal parametric resonance (W = 2 w1) under a fixed 0.5 N end load: the load ratio
+    # P0/Pcr grows as l^2, so long spans are unstable, short ones stable
+    scene = sweep.load_scene("harness-stability", overrides={
+        "axes.length": {"start": 0.2, "stop": 0.8, "num": 13},
+        "axes.frequency_ratio": [2.0], "axes.load_amplitude": [0.5]})
+    ds = sweep.run(scene, progress=False)
+    g = ds["growth_rate"].squeeze().values
+    lengths = ds["length"].values
+    b = int(np.argmax(g > 0))
+    assert b > 0 and np.all(g[:b] <= 0) and np.all(g[b:] > 0), g
+    out = max_span(ds, min_frequency=1.0)
+    got = float(out["max_span"].squeeze())
+    assert lengths[b - 1] < got < lengths[b]
+    assert got == pytest.approx(lengths[b - 1] - g[b - 1] * (lengths[b] - lengths[b - 1])
+                                / (g[b] - g[b - 1]), rel=1e-9)
+    assert str(out["limited_by"].squeeze().values) == "stability"
+    assert out["max_span"].dims == ("frequency_ratio", "load_amplitude")
