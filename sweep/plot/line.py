@@ -49,7 +49,6 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
     x = ds[dim].values.astype(float) * xfactor
     y = ds[var].values.astype(float)
     state = ds["state"].values
-    log_y = _wide_range(y)
     factor, units = _unit(ds[var], y)
     ax.plot(x, y * factor, color="0.7", lw=1.0, zorder=1)
     handles = []
@@ -76,12 +75,22 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
                                                   if np.isfinite(y).any() else 0.0)]),
                       updatey=False)
     ax.autoscale_view()
+    return _finish_axes(ax, ds, dim, var, x, y, factor, units, xunits, handles, nan_any,
+                        kwargs["s"], _title(ds), add_legend, "state")
+
+
+def _finish_axes(ax: Axes, ds: xr.Dataset, dim: str, var: str, x: np.ndarray, y: np.ndarray,
+                 factor: float, units: str, xunits: str, handles: list, nan_any: bool,
+                 size: float, title: str, add_legend: bool, *legend_args: Any) -> Axes:
+    """What every line plot ends with: the NaN legend entry, the kind's overlays (buckling
+    length, paper Fig 5: overlays.py), a log y axis for data over decades (else a padded
+    range), a log x axis for a log-spaced axis, labels with units, title, grid, legend."""
     if nan_any:
         handles.append(Line2D([], [], ls="none", marker="v", markerfacecolor="none",
                               markeredgecolor="0.3", label="no value (NaN)"))
-    for draw in overlays_for(ds, "line"):         # buckling length, paper Fig 5 (overlays.py)
-        handles += draw(ax, ds, dim, var, factor, units, kwargs["s"])
-    if log_y:
+    for draw in overlays_for(ds, "line"):
+        handles += draw(ax, ds, dim, var, factor, units, size)
+    if _wide_range(y):
         ax.set_yscale("log")
     else:
         padded = _padded_range(y * factor)
@@ -91,11 +100,11 @@ def plot_line(ds: xr.Dataset, var: str = "amplitude", *, select: Mapping[str, An
         ax.set_xscale("log")
     ax.set_xlabel(label(ds[dim], xunits))
     ax.set_ylabel(label(ds[var], units))
-    ax.set_title(_title(ds), fontsize="medium")
+    ax.set_title(title, fontsize="medium")
     ax.grid(True, color="0.92", zorder=0)
     _plain_ticks(ax)
     if add_legend:
-        _legend(ax, handles, "state")
+        _legend(ax, handles, *legend_args)
     return ax
 
 
@@ -148,25 +157,6 @@ def _plot_directions(ds: xr.Dataset, dim: str, var: str, ax: Axes, add_legend: b
         handles.append(Line2D([], [], ls="none", marker=marker, color=s_colour,
                               markeredgecolor="k", markeredgewidth=0.6,
                               label=f"{meaning} ({count})"))
-    if nan_any:
-        handles.append(Line2D([], [], ls="none", marker="v", markerfacecolor="none",
-                              markeredgecolor="0.3", label="no value (NaN)"))
-    for draw in overlays_for(ds, "line"):         # buckling length, paper Fig 5 (overlays.py)
-        handles += draw(ax, ds, dim, var, factor, units, 36)
-    if _wide_range(y_all):
-        ax.set_yscale("log")
-    else:
-        padded = _padded_range(y_all * factor)
-        if padded is not None:
-            ax.set_ylim(*padded)
-    if _is_log_spaced(x):
-        ax.set_xscale("log")
-    ax.set_xlabel(label(ds[dim], xunits))
-    ax.set_ylabel(label(ds[var], units))
     ways = " and ".join(directions)
-    ax.set_title(_title(ds, f"swept {ways}"), fontsize="medium")
-    ax.grid(True, color="0.92", zorder=0)
-    _plain_ticks(ax)
-    if add_legend:
-        _legend(ax, handles)
-    return ax
+    return _finish_axes(ax, ds, dim, var, x, y_all, factor, units, xunits, handles, nan_any, 36,
+                        _title(ds, f"swept {ways}"), add_legend)
