@@ -173,37 +173,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     shape = like.shape
     lengths = np.asarray(ds[LENGTH].values, float)
 
-    def worst(var: xr.DataArray, how: str) -> xr.DataArray:
-        if DIRECTION in var.dims:
-            # skipna=False: a missing direction is not a pass
-            return getattr(var, how)(DIRECTION, skipna=False)
-        return var
-
-    # margins: >= 0 passes (NaN fails), per criterion; the value interpolated on, and how
-    margins: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
-    if fmin is not None:
-        f = _broadcast(worst(ds["natural_frequency"], "min"), like)
-        margins["min_frequency"] = (f - fmin, f, "log")
-    if qname is not None:
-        q = _broadcast(worst(ds[qname], "max"), like)
-        margins["max_amplitude"] = (amax - q, q - amax, "linear")
-    if "state" in ds:
-        meanings = _flags(ds["state"])
-        bad = [v for v, m in meanings.items() if m in STATE_FAILURES]
-        failed = worst(ds["state"].isin(bad), "max")
-        ok = np.where(_broadcast(failed, like) > 0, -1.0, 0.0)
-        margins["state"] = (ok, np.full(shape, np.nan), "none")
-    if "stability" in ds:
-        meanings = _flags(ds["stability"])
-        bad = [v for v, m in meanings.items() if m != "stable"]
-        failed = _broadcast(worst(ds["stability"].isin(bad), "max"), like) > 0
-        if "growth_rate" in ds:
-            g = _broadcast(worst(ds["growth_rate"], "max"), like)
-            failed |= ~(g <= 0.0)
-        else:
-            g = np.full(shape, np.nan)
-        margins["stability"] = (np.where(failed, -1.0, 0.0), g, "linear")
-
+    margins = _margins(ds, fmin, amax, qname, like)
     flat = {k: (m.reshape(-1, shape[-1]), v.reshape(-1, shape[-1]), how)
             for k, (m, v, how) in margins.items()}
     n = int(np.prod(shape[:-1], dtype=int))
@@ -263,6 +233,45 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                "criteria": criteria,
                "length_grid": f"{lengths.size} lengths, {lengths[0]:g} to {lengths[-1]:g} m"})
     return result
+
+
+def _worst(var: xr.DataArray, how: str) -> xr.DataArray:
+    if DIRECTION in var.dims:
+        # skipna=False: a missing direction is not a pass
+        return getattr(var, how)(DIRECTION, skipna=False)
+    return var
+
+
+def _margins(ds: xr.Dataset, fmin: float | None, amax: float | None, qname: str | None,
+             like: xr.DataArray) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
+    """The pass/fail logic max_span and refine_span share: per criterion, its margin (>= 0
+    passes, NaN fails), the value interpolated on, and how (`_interpolate`), each an array
+    shaped like `like` (the flags over the axes less direction, length last)."""
+    shape = like.shape
+    margins: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
+    if fmin is not None:
+        f = _broadcast(_worst(ds["natural_frequency"], "min"), like)
+        margins["min_frequency"] = (f - fmin, f, "log")
+    if qname is not None:
+        q = _broadcast(_worst(ds[qname], "max"), like)
+        margins["max_amplitude"] = (amax - q, q - amax, "linear")
+    if "state" in ds:
+        meanings = _flags(ds["state"])
+        bad = [v for v, m in meanings.items() if m in STATE_FAILURES]
+        failed = _worst(ds["state"].isin(bad), "max")
+        ok = np.where(_broadcast(failed, like) > 0, -1.0, 0.0)
+        margins["state"] = (ok, np.full(shape, np.nan), "none")
+    if "stability" in ds:
+        meanings = _flags(ds["stability"])
+        bad = [v for v, m in meanings.items() if m != "stable"]
+        failed = _broadcast(_worst(ds["stability"].isin(bad), "max"), like) > 0
+        if "growth_rate" in ds:
+            g = _broadcast(_worst(ds["growth_rate"], "max"), like)
+            failed |= ~(g <= 0.0)
+        else:
+            g = np.full(shape, np.nan)
+        margins["stability"] = (np.where(failed, -1.0, 0.0), g, "linear")
+    return margins
 
 
 def _interpolate(la: float, lb: float, va: float, vb: float, limit: float, how: str) -> float:
