@@ -3,7 +3,8 @@
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
-    sweep design RESULT.nc [--min-frequency HZ] [--max-amplitude M] [--quantity NAME] [-o OUT.nc]
+    sweep design RESULT.nc [--min-frequency HZ] [--max-amplitude M] [--quantity NAME]
+                 [--refine [--tolerance M]] [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -105,6 +106,12 @@ def _parser() -> argparse.ArgumentParser:
                              "else amplitude, or --quantity")
     design.add_argument("--quantity", default=None, metavar="NAME",
                         help="the variable (in m) --max-amplitude limits")
+    design.add_argument("--refine", action="store_true",
+                        help="refine each bracketed span by bisecting on length with runs of "
+                             "the result's scene (the frequency criterion needs none)")
+    design.add_argument("--tolerance", type=float, default=None, metavar="M",
+                        help="--refine: bisect until the bracket is below this (m, default "
+                             "0.001)")
     design.add_argument("-o", "--output", metavar="OUT.nc",
                         help="netCDF file to write the spans to (atomically)")
     design.add_argument("--overwrite", action="store_true", help="replace an existing output file")
@@ -225,19 +232,30 @@ def _modes(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from .design import max_span, table
+    from .design import max_span, refine_span, table
     from .io import check_output_path, write_netcdf
     from .plot import load_result
     if args.min_frequency is None and args.max_amplitude is None:
         raise UserError("design: no criterion given (give --min-frequency HZ and/or "
                         "--max-amplitude M)")
+    if args.tolerance is not None and not args.refine:
+        raise UserError(f"design: --tolerance {args.tolerance:g} is the bracket --refine "
+                        "bisects to; give --refine too")
     if args.output is not None:
         check_output_path(args.output, args.overwrite)   # before any work, in one line
     ds = load_result(args.result)
-    result = max_span(ds, min_frequency=args.min_frequency, max_amplitude=args.max_amplitude,
-                      quantity=args.quantity)
+    criteria = dict(min_frequency=args.min_frequency, max_amplitude=args.max_amplitude,
+                    quantity=args.quantity)
+    if args.refine:
+        result = refine_span(ds, **criteria,
+                             tolerance=1e-3 if args.tolerance is None else args.tolerance)
+    else:
+        result = max_span(ds, **criteria)
     print(f"{result.attrs['title']} ({result.attrs['criteria']})")
     print(table(result))
+    if args.refine:
+        print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
+              f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
     if args.output is not None:
         write_netcdf(result, args.output, overwrite=args.overwrite)
         print(f"-> {args.output}")

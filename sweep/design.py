@@ -322,3 +322,137 @@ def table(result: xr.Dataset) -> str:
     lines = ["  ".join(c.rjust(w) if j < len(head) - 1 else c
                        for j, (c, w) in enumerate(zip(r, widths))) for r in [head, *rows]]
     return "\n".join(lines)
+
+
+def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
+                max_amplitude: float | None = None, quantity: str | None = None,
+                tolerance: float = 1e-3) -> xr.Dataset:
+    """`max_span` refined beyond the grid by bisecting on length with the engine itself.
+
+    For every combination of the result's other axes whose grid max_span is bracketed (a
+    passing grid length l_a and the first failing one l_b; not "grid", not NaN), the scene
+    stored in the result (`attrs["scene"]`) is run again at one trial length (`axes.length` a
+    one-value axis, every other axis fixed to the combination's value as a one-element list;
+    a stepped result's continuation axis is kept whole and the combination's value read off
+    it), the same criteria (`_margins`) are evaluated on that one-length result, and the
+    bracket is halved until it is below `tolerance` (m). max_span is then the bracket's
+    passing end (conservative: within `tolerance` below the true span), limited_by the
+    criterion its failing end fails.
+
+    The frequency criterion needs no run: natural_frequency is the closed form
+    f1 ~ l^-2 of the unloaded span, so interpolating log f against log l between the grid
+    lengths is exact; where only it fails at l_b the span is that interpolation (no run; with
+    only min_frequency the refinement costs no run at all). Where another criterion fails at
+    l_b too and the frequency span l_f lies inside the bracket, one run at l_f decides:
+    passing, the span is l_f; failing, the bisection runs on [l_a, l_f].
+
+    Returns max_span's Dataset with the refined spans; attributes `refine_runs` (engine runs
+    made), `refine_tolerance` (m) and `refinement` (how). Raises UserError (one line) as
+    max_span, for a result without its scene, a non-positive tolerance, an axis the stored
+    scene lacks, and a stepped result stepped along length (its branch depends on the path).
+    """
+    from .run import run
+    from .scene import load_scene_text
+
+    tol = _number(tolerance, "--tolerance", "0.001")
+    grid = max_span(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
+                    quantity=quantity)
+    fmin = None if min_frequency is None else float(min_frequency)
+    amax = None if max_amplitude is None else float(max_amplitude)
+    axes, qname = _check(ds, fmin, amax, quantity)
+    text = ds.attrs.get("scene")
+    if not isinstance(text, str) or not text.strip():
+        raise UserError("design --refine: the result has no 'scene' attribute to run again "
+                        "(give a result written by 'sweep run ... -o FILE.nc')")
+    scene_axes = set(load_scene_text(text, source="the result's scene").axes)
+    stepped = ds.attrs.get("continuation_axis")
+    stepped = stepped if isinstance(stepped, str) and stepped in ds.dims else None
+    if stepped == LENGTH:
+        raise UserError("design --refine: the result is stepped along length (its branch "
+                        "depends on the path); refine on a finer length axis instead")
+    ds = ds.sortby(LENGTH)
+    others = tuple(a for a in axes if a not in (LENGTH, DIRECTION))
+    missing = [a for a in others if a not in scene_axes or a not in ds.coords]
+    if missing:
+        raise UserError(f"design --refine: axis {', '.join(missing)} is not an axis of the "
+                        "result's stored scene, so it cannot be run again (refine the result "
+                        "'sweep run' wrote)")
+    lengths = np.asarray(ds[LENGTH].values, float)
+    nonfrequency = [k for k in CRITERIA if k != "min_frequency"]
+    runs = 0
+
+    def fails(point: dict[str, Any], length: float) -> list[str]:
+        """The non-frequency criteria the engine's one-length run at `length` fails."""
+        nonlocal runs
+        overrides: dict[str, Any] = {f"axes.{LENGTH}": [float(length)]}
+        for a, v in point.items():
+            if a != stepped:
+                overrides[f"axes.{a}"] = [v.item() if hasattr(v, "item") else v]
+        one = run(load_scene_text(text, source="the result's scene", overrides=overrides),
+                  progress=False)
+        runs += 1
+        if stepped is not None:
+            one = one.sel({stepped: [point[stepped]]})
+        name = "state" if "state" in one else "stability"
+        like = one[name].isel({DIRECTION: 0}, drop=True) if DIRECTION in one[name].dims \
+            else one[name]
+        like = like.transpose(*[a for a in others if a in like.dims], LENGTH)
+        margins = _margins(one, None, amax, qname, like)
+        return [k for k in nonfrequency if k in margins
+                and not np.all(margins[k][0] >= 0.0)]
+
+    spans = grid["max_span"].values.copy().reshape(-1)
+    limited = grid["limited_by"].values.copy().reshape(-1)
+    shape = grid["max_span"].shape
+    for flat_i, index in enumerate(np.ndindex(*shape)):
+        if limited[flat_i] == "grid" or not np.isfinite(spans[flat_i]):
+            continue
+        point = {a: ds[a].values[i] for a, i in zip(others, index)}
+        sub = ds.sel({a: v for a, v in point.items()}) if point else ds
+        sub = sub.expand_dims({a: [v] for a, v in point.items()}) if point else sub
+        like_name = "state" if "state" in sub else "stability"
+        like = sub[like_name].isel({DIRECTION: 0}, drop=True) \
+            if DIRECTION in sub[like_name].dims else sub[like_name]
+        like = like.transpose(*others, LENGTH)
+        margins = {k: (m.reshape(-1), v.reshape(-1), how)
+                   for k, (m, v, how) in _margins(sub, fmin, amax, qname, like).items()}
+        passes = np.logical_and.reduce([m >= 0.0 for m, _, _ in margins.values()])
+        b = int(np.argmin(passes))
+        a = b - 1
+        lo, hi = float(lengths[a]), float(lengths[b])
+        failing = [k for k in CRITERIA if k in margins and not margins[k][0][b] >= 0.0]
+        l_f = math.inf
+        if "min_frequency" in failing:
+            f = margins["min_frequency"][1]
+            l_f = _interpolate(lo, hi, f[a], f[b], fmin, "log")
+        others_fail = [k for k in failing if k != "min_frequency"]
+        if not others_fail:                      # the frequency alone: exact, no run
+            spans[flat_i], limited[flat_i] = l_f, "min_frequency"
+            continue
+        by = others_fail[0]
+        if lo < l_f < hi:
+            at_f = fails(point, l_f)
+            if not at_f:
+                spans[flat_i], limited[flat_i] = l_f, "min_frequency"
+                continue
+            hi, by = l_f, at_f[0]
+        while hi - lo > tol:
+            mid = 0.5 * (lo + hi)
+            at_mid = fails(point, mid)
+            if at_mid:
+                hi, by = mid, at_mid[0]
+            else:
+                lo = mid
+        spans[flat_i], limited[flat_i] = lo, by
+    grid["max_span"].values = spans.reshape(shape)
+    grid["limited_by"].values = limited.reshape(shape)
+    grid["max_span"].attrs["long_name"] = ("largest span between clamps meeting the criteria, "
+                                           "refined by bisection with the engine")
+    grid.attrs["refine_runs"] = np.int32(runs)
+    grid.attrs["refine_tolerance"] = float(tol)
+    grid.attrs["refinement"] = (
+        f"bisection on length with engine runs of the result's scene until the bracket is "
+        f"below {tol:g} m, max_span its passing end (conservative); min_frequency by "
+        f"log f vs log l interpolation, exact for the unloaded f1 ~ l^-2, no run")
+    grid.attrs["history"] += f"; refined by bisection ({runs} engine runs, tolerance {tol:g} m)"
+    return grid

@@ -14,7 +14,7 @@ from scipy.optimize import brentq
 
 import sweep
 from sweep.cli import main
-from sweep.design import max_span
+from sweep.design import max_span, refine_span
 
 # Table 1 cable, bending moment of the solid round 6 mm^2 section.
 E, RHO, AREA, INERTIA, ZETA = 1.1e11, 8900.0, 6e-6, 2.865e-12, 0.02
@@ -274,3 +274,74 @@ def test_an_unstable_span_ends_the_walk_at_the_growth_rate_zero():
                                 / (g[b] - g[b - 1]), rel=1e-9)
     assert str(out["limited_by"].squeeze().values) == "stability"
     assert out["max_span"].dims == ("frequency_ratio", "load_amplitude")
+
+
+# --refine: bisection on length with the engine, against the same closed forms
+
+
+def _coarse_linear(results) -> xr.Dataset:
+    """The linear span's result on a 40 mm grid (every 8th length): its grid answer is off by
+    up to ~2.5 %, so the refinement has something to do."""
+    ds, _ = results["linear"]
+    return ds.isel(length=slice(0, None, 8))
+
+
+@pytest.mark.parametrize("limit", [2e-8, 1e-7, 5e-7])
+def test_refine_amplitude_is_the_closed_form_with_log2_runs(results, limit):
+    ds = _coarse_linear(results)
+    exact = _amplitude_reference(limit)
+    grid = float(max_span(ds, max_amplitude=limit)["max_span"])
+    tol = 1e-4
+    out = refine_span(ds, max_amplitude=limit, tolerance=tol)
+    got = float(out["max_span"])
+    assert abs(got / exact - 1) < 2e-3, (got, exact)
+    assert exact - tol - 1e-6 < got <= exact + 1e-6, (got, exact)   # the passing end
+    assert abs(got / exact - 1) < abs(grid / exact - 1)
+    assert str(out["limited_by"].values) == "max_amplitude"
+    bracket = 0.04                                   # one grid step
+    expected = math.ceil(math.log2(bracket / tol))
+    assert abs(int(out.attrs["refine_runs"]) - expected) <= 1, out.attrs["refine_runs"]
+    assert out.attrs["refine_tolerance"] == tol
+
+
+def test_refine_frequency_alone_costs_no_run(results):
+    ds = _coarse_linear(results)
+    out = refine_span(ds, min_frequency=100.0)
+    assert abs(float(out["max_span"]) / l_max_frequency(100.0) - 1) < 1e-3
+    assert int(out.attrs["refine_runs"]) == 0
+    assert str(out["limited_by"].values) == "min_frequency"
+
+
+def test_refine_both_criteria_the_smaller_binds(results):
+    ds = _coarse_linear(results)
+    out = refine_span(ds, min_frequency=100.0, max_amplitude=2e-8, tolerance=1e-4)
+    assert float(out["max_span"]) == pytest.approx(_amplitude_reference(2e-8), rel=2e-3)
+    assert str(out["limited_by"].values) == "max_amplitude"
+    out = refine_span(ds, min_frequency=100.0, max_amplitude=5e-7, tolerance=1e-4)
+    assert float(out["max_span"]) == pytest.approx(l_max_frequency(100.0), rel=1e-6)
+    assert str(out["limited_by"].values) == "min_frequency"
+
+
+def test_refine_bad_tolerance_is_one_line(results):
+    ds = _coarse_linear(results)
+    with pytest.raises(sweep.UserError, match="positive") as info:
+        refine_span(ds, max_amplitude=1e-7, tolerance=0.0)
+    assert "\n" not in str(info.value)
+
+
+def test_cli_design_refine_prints_and_writes(results, tmp_path, capsys):
+    from test_cf import cf_problems
+    src = tmp_path / "coarse-linear.nc"
+    _coarse_linear(results).to_netcdf(src)
+    out = tmp_path / "refined.nc"
+    assert main(["design", str(src), "--max-amplitude", "1e-7", "--refine",
+                 "--tolerance", "1e-4", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "max_amplitude" in text and "engine runs" in text
+    assert cf_problems(out) == []
+    back = xr.open_dataset(out)
+    assert float(back["max_span"]) == pytest.approx(_amplitude_reference(1e-7), rel=2e-3)
+    assert int(back.attrs["refine_runs"]) > 0
+    back.close()
+    assert main(["design", str(src), "--max-amplitude", "1e-7", "--tolerance", "1e-4"]) == 2
+    assert "--refine" in capsys.readouterr().err
