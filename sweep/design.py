@@ -229,6 +229,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                "source": f"cable-sweep {package_version()}: sweep.design.max_span of a result",
                "history": f"{now} max_span by cable-sweep {package_version()} from result "
                           f"'{title}' ({criteria})",
+               "cable_sweep_version": package_version(),
                "source_title": title,
                "criteria": criteria,
                "length_grid": f"{lengths.size} lengths, {lengths[0]:g} to {lengths[-1]:g} m"})

@@ -345,3 +345,52 @@ def test_cli_design_refine_prints_and_writes(results, tmp_path, capsys):
     back.close()
     assert main(["design", str(src), "--max-amplitude", "1e-7", "--tolerance", "1e-4"]) == 2
     assert "--refine" in capsys.readouterr().err
+
+
+# the design chart: sweep plot of a design result
+
+
+def test_cli_plot_of_a_design_result_writes_the_chart(results, tmp_path, capsys):
+    _, path = results["coarse"]
+    design = tmp_path / "design.nc"
+    assert main(["design", str(path), "--min-frequency", "100", "-o", str(design)]) == 0
+    figs = tmp_path / "figs"
+    assert main(["plot", str(design), "-o", str(figs)]) == 0
+    out = capsys.readouterr().out
+    png = figs / "design-max_span.png"
+    assert png.exists() and png.stat().st_size > 0, out
+    assert str(png) in out
+
+
+def test_plot_design_over_one_axis_names_the_criteria(results, tmp_path):
+    from sweep.plot import load_result, plot, plot_design
+    ds, _ = results["coarse"]
+    two = xr.concat([ds, ds], dim=xr.DataArray([0.01, 0.02], dims="damping_ratio",
+                                               attrs={"units": "1", "long_name": "damping"}))
+    design = max_span(two, min_frequency=100.0)
+    design["limited_by"].values[1] = "state"       # two criteria: two legend entries
+    path = tmp_path / "two-design.nc"
+    design.to_netcdf(path)
+    back = load_result(path)
+    fig = plot_design(back)
+    ax = fig.axes[0]
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("min_frequency" in t for t in texts) and any("state" in t for t in texts)
+    assert "mm" in ax.get_ylabel()
+    assert list(plot(back)) == ["max_span"]
+    one = plot(back, {"damping_ratio": 0.02})
+    assert list(one) == ["max_span"]
+    with pytest.raises(sweep.UserError, match="not one of"):
+        plot(back, {"damping_ratio": 0.5})
+
+
+def test_a_design_result_with_a_bad_criterion_is_refused(results, tmp_path):
+    from sweep.plot import load_result
+    ds, _ = results["coarse"]
+    design = max_span(ds, min_frequency=100.0)
+    design["limited_by"] = design["limited_by"].copy(data=np.array("nonesuch", dtype=object))
+    path = tmp_path / "bad-design.nc"
+    design.to_netcdf(path)
+    with pytest.raises(sweep.UserError, match="nonesuch") as info:
+        load_result(path)
+    assert "\n" not in str(info.value)

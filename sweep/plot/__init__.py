@@ -78,6 +78,7 @@ The package, split like xarray's plot/ by what is drawn:
     maps.py      two swept axes (plot_map, plot_state_map)
     series.py    stored histories (plot_time_series, plot_snapshots, plot_histories)
     branches.py  a stepped sweep: up and down against the stepped axis, the jumps (plot_branches)
+    design.py    a 'sweep design' result: max_span against its axis, by criterion (plot_design)
     stability.py Floquet stability: the Ince-Strutt chart, the growth rate, the boundary over a map
     envelope.py  a continuous sine sweep: the response envelope over frequency (plot_envelope)
     figures.py   which figures a result gets, and writing them (plot, save)
@@ -88,6 +89,7 @@ from __future__ import annotations
 # _HATCHES, _edges and _select_tag are private; tests/test_plot.py reaches them here.
 from .figures import Figures, _select_tag, plot, save, why_not_drawn  # noqa: F401
 from .branches import plot_branches
+from .design import plot_design
 from .envelope import plot_envelope
 from .labels import footer, label
 from .line import plot_line
@@ -100,6 +102,7 @@ from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
            "check_result", "load_result", "parse_select", "plot", "plot_branches",
+           "plot_design",
            "plot_envelope", "plot_growth_rate",
            "plot_histories",
            "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",

@@ -24,10 +24,12 @@ from ..errors import UserError
 from ..files import write_temporary
 from .labels import _add_footer, _title
 from .branches import plot_branches, stepped_axis
+from .design import plot_design
 from .envelope import BAND_DIM, plot_envelope
 from .line import plot_line
 from .maps import plot_map, plot_state_map
-from .result import (DIRECTION_DIM, _scene, _time_dim, check_result, select_points,
+from .result import (DIRECTION_DIM, _scene, _time_dim, check_result, is_design_result,
+                     select_points,
                      swept_axes)
 from .stability import (floquet_boundary_in_range, plot_growth_rate, plot_stability_chart,
                         plot_stability_over_map)
@@ -90,6 +92,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     Raises UserError (one line) for a Dataset the figures cannot be drawn from faithfully
     (`check_result`), before drawing anything.
     """
+    if is_design_result(ds):                   # 'sweep design -o': the design chart alone
+        return _design_figures(ds, select)
     check_result(ds)
     if stepped_axis(ds) is not None:
         return _stepped_figures(ds, select)
@@ -139,6 +143,22 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             _plain_ticks(ax)
         _add_footer(fig, ds)
     return figures
+
+
+def _design_figures(ds: xr.Dataset, select: Mapping[str, Any] | None) -> Figures:
+    """A design result's one figure, 'max_span' (`plot_design`), over the one axis `select`
+    leaves (each selected value must be one of its axis's coordinates)."""
+    for dim, value in (select or {}).items():
+        if dim not in ds["max_span"].dims:
+            raise UserError(f"--select {dim}={value:g}: the design result has no axis '{dim}' "
+                            f"(its axes: {', '.join(map(str, ds['max_span'].dims)) or 'none'})")
+        values = np.asarray(ds[dim].values, float)
+        hit = np.flatnonzero(np.isclose(values, float(value), rtol=1e-9, atol=0.0))
+        if hit.size == 0:
+            raise UserError(f"--select {dim}={value:g}: not one of its values "
+                            f"({', '.join(f'{v:g}' for v in values)})")
+        ds = ds.isel({dim: int(hit[0])})
+    return Figures({"max_span": plot_design(ds)}, select=select)
 
 
 def _ways(ds: xr.Dataset, name: str) -> list[tuple[str, str | None]]:

@@ -126,13 +126,46 @@ def load_result(path: str | os.PathLike) -> xr.Dataset:
             raise _unreadable(where, exc) from exc
     missing = [what for what, ok in (("no 'cable_sweep_version' attribute",
                                       "cable_sweep_version" in ds.attrs),
-                                     ("no 'state' variable", flags_variable(ds) is not None))
+                                     ("no 'state' variable", flags_variable(ds) is not None
+                                      or is_design_result(ds)))
                if not ok]
     if missing:
         raise UserError(f"{where}: not a cable-sweep result ({' and '.join(missing)}); "
                         "give a file written by 'sweep run ... -o FILE.nc'")
-    check_result(ds, where)
+    if is_design_result(ds):
+        check_design_result(ds, where)
+    else:
+        check_result(ds, where)
     return ds
+
+
+_DESIGN_LIMITS = ("min_frequency", "max_amplitude", "state", "stability", "grid")
+"""sweep.design.LIMITED_BY (not imported: the figures do not depend on the design layer)."""
+
+
+def is_design_result(ds: xr.Dataset) -> bool:
+    """A file written by 'sweep design -o': `max_span` and `limited_by`, no flags variable."""
+    return ("max_span" in ds.data_vars and "limited_by" in ds.data_vars
+            and flags_variable(ds) is None)
+
+
+def check_design_result(ds: xr.Dataset, where: str = "the design result") -> None:
+    """Refuse (UserError, one line) a design result the chart cannot show faithfully:
+    attributes beyond a result's sizes, a `max_span` that is not numbers in m, a `limited_by`
+    over other axes or naming no criterion, axes without finite, distinct coordinates."""
+    _check_attrs(ds, where)
+    span, by = ds["max_span"], ds["limited_by"]
+    if span.dtype.kind not in "iuf" or span.attrs.get("units") != "m":
+        raise _refuse(where, f"variable 'max_span' holds {span.dtype} in "
+                             f"{span.attrs.get('units')!r}, not numbers in 'm'")
+    if by.dims != span.dims:
+        raise _refuse(where, f"'limited_by' lies over {by.dims}, 'max_span' over {span.dims}")
+    odd = sorted({str(v) for v in np.asarray(by.values).ravel()} - set(_DESIGN_LIMITS))
+    if odd:
+        raise _refuse(where, f"'limited_by' holds {_short(', '.join(odd))}, not one of "
+                             f"{', '.join(_DESIGN_LIMITS)}")
+    for dim in span.dims:
+        _check_axis(ds, dim, where, unique=True)
 
 
 def _unreadable(where: str, exc: BaseException) -> UserError:

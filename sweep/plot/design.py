@@ -1,0 +1,100 @@
+"""The design chart of a 'sweep design' result (sweep/design.py): max_span against the one
+axis the result has left, each point coloured by the criterion that binds it; a result with
+no axis left gets a single bar with its value written on it."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from ..errors import UserError
+from .labels import label
+from .result import check_design_result
+from .style import _coord, _is_log_spaced, _legend, _new_axes, _plain_ticks, _unit
+
+CRITERION_STYLES = {
+    "min_frequency": ("C0", "o", "first natural frequency (min_frequency)"),
+    "max_amplitude": ("C3", "s", "response amplitude (max_amplitude)"),
+    "state": ("C1", "X", "run failed (state)"),
+    "stability": ("C4", "D", "parametric instability (stability)"),
+    "grid": ("0.5", "^", "none within the grid (grid: longest length)"),
+}
+"""limited_by -> (colour, marker, legend text)."""
+
+
+def _scale(spans: np.ndarray) -> tuple[float, str]:
+    finite = spans[np.isfinite(spans)]
+    return (1e3, "mm") if finite.size == 0 or np.nanmax(np.abs(finite)) < 1.0 else (1.0, "m")
+
+
+def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Figure:
+    """max_span (mm below 1 m, else m) of a design result: over one axis a line with markers
+    coloured by `limited_by` and a legend naming the criteria; over none a single bar with the
+    value annotated. A NaN span (the shortest grid length fails) is marked at the bottom of
+    the axes. Extra keyword arguments go to `Axes.plot` (or `Axes.bar`). Returns the Figure.
+    Raises UserError (one line) for a result over more than one axis (select one value of the
+    others first) or one the chart cannot show (`check_design_result`)."""
+    check_design_result(ds)
+    span, by = ds["max_span"], ds["limited_by"]
+    if span.ndim > 1:
+        raise UserError(f"plot_design: max_span lies over {', '.join(map(str, span.dims))}; "
+                        "select one value of all but one axis (e.g. --select "
+                        f"{span.dims[1]}={float(ds[span.dims[1]].values[0]):g})")
+    ax = _new_axes() if ax is None else ax
+    values = np.asarray(span.values, float).reshape(-1)
+    factor, units = _scale(values)
+    ylabel = f"largest span between clamps [{units}]"
+    title = str(ds.attrs.get("title", "maximum span"))
+    criteria = str(ds.attrs.get("criteria", ""))
+    if span.ndim == 0:
+        v, b = float(values[0]), str(by.values)
+        colour, _, text = CRITERION_STYLES.get(b, ("0.3", "o", b))
+        height = v * factor if np.isfinite(v) else 0.0
+        ax.bar([0], [height], color=colour, width=0.5, **kwargs)
+        note = (f"{v * factor:.4g} {units}\nlimited by {b}" if np.isfinite(v)
+                else f"none: the shortest length\nfails {b}")
+        ax.annotate(note, (0, height), xytext=(0, 4), textcoords="offset points",
+                    ha="center", va="bottom")
+        ax.set_xticks([0], ["max_span"])
+        ax.set_xlim(-1, 1)
+        ax.set_ylim(0, max(height, 1e-12) * 1.25)
+    else:
+        dim = span.dims[0]
+        x = _coord(ds, dim)
+        ax.plot(x, values * factor, color="0.6", lw=1.2, zorder=1, **kwargs)
+        handles = []
+        bys = np.asarray(by.values).astype(str)
+        finite = values[np.isfinite(values)]
+        floor = float(np.min(finite)) * factor * 0.95 if finite.size else 0.0
+        for name in [n for n in CRITERION_STYLES if n in set(bys)] + \
+                sorted(set(bys) - set(CRITERION_STYLES)):
+            colour, marker, text = CRITERION_STYLES.get(name, ("0.3", "o", name))
+            where = bys == name
+            ok = where & np.isfinite(values)
+            if ok.any():
+                ax.scatter(x[ok], values[ok] * factor, color=colour, marker=marker, s=40,
+                           zorder=2)
+            if (where & ~np.isfinite(values)).any():
+                ax.scatter(x[where & ~np.isfinite(values)],
+                           np.full(int((where & ~np.isfinite(values)).sum()), floor),
+                           color=colour, marker="v", s=40, zorder=2)
+                text += "; v: shortest length fails"
+            handles.append(Line2D([], [], color=colour, marker=marker, ls="", label=text))
+        ax.set_xlabel(label(ds[dim], units=_unit(ds[dim])[1]))
+        if _is_log_spaced(x):
+            ax.set_xscale("log")
+        _legend(ax, handles, title="limited by")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title if not criteria else f"{title}\n{criteria}", fontsize="small")
+    refine = ds.attrs.get("refine_runs")
+    if refine is not None:
+        ax.text(0.99, 0.01, f"refined: {int(refine)} runs, tolerance "
+                f"{float(ds.attrs.get('refine_tolerance', np.nan)):g} m",
+                transform=ax.transAxes, ha="right", va="bottom", fontsize="x-small")
+    _plain_ticks(ax)
+    return ax.figure
