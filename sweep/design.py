@@ -22,8 +22,16 @@ Interpolation between the last passing grid length l_a and the first failing one
 frequency in log f against log l (f1 ~ l^-2 unloaded, so the frequency criterion alone is
 exact), amplitude linearly in l of (quantity - limit), stability linearly in l of growth_rate;
 a state failure (which has no margin) and a missing value give l_a. When several criteria fail
-at l_b the smallest of their spans binds. No analysis is run: the span is only as good as the
-grid (a finer `length` axis near the answer refines it).
+at l_b the smallest of their spans binds. max_span runs no analysis: its span is only as good
+as the grid.
+
+`refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
+bracketed span it bisects on length with one-length engine runs of the result's stored scene,
+the other axes fixed to the combination's values, evaluating the same criteria (`_margins`,
+shared with max_span) until the bracket is below the tolerance (1 mm by default), and reports
+the bracket's passing end (conservative). The frequency criterion needs no run (log f against
+log l is exact for the unloaded f1 ~ l^-2), so a frequency-only refinement costs none; the
+runs made are counted in the attribute `refine_runs`.
 """
 
 from __future__ import annotations
