@@ -394,3 +394,59 @@ def test_a_design_result_with_a_bad_criterion_is_refused(results, tmp_path):
     with pytest.raises(sweep.UserError, match="nonesuch") as info:
         load_result(path)
     assert "\n" not in str(info.value)
+
+
+def test_refine_a_swept_result_tightens_the_grid_bracket(results):
+    ds, _ = results["swept"]
+    worst = ds["peak_amplitude"].max("direction").values
+    lengths = ds["length"].values
+    limit = 0.5 * (worst[1] + worst[2])
+    out = refine_span(ds, max_amplitude=limit, tolerance=1e-3)
+    got = float(out["max_span"])
+    assert lengths[1] <= got < lengths[2]
+    assert str(out["limited_by"].values) == "max_amplitude"
+    assert int(out.attrs["refine_runs"]) == math.ceil(math.log2((lengths[2] - lengths[1])
+                                                                / 1e-3))
+    # the engine at the refined span passes and a tolerance beyond it fails
+    again = sweep.load_scene_text(ds.attrs["scene"], overrides={"axes.length": [got]})
+    assert float(sweep.run(again, progress=False)["peak_amplitude"].max()) <= limit
+    again = sweep.load_scene_text(ds.attrs["scene"], overrides={"axes.length": [got + 1e-3]})
+    assert float(sweep.run(again, progress=False)["peak_amplitude"].max()) > limit
+
+
+def test_refine_a_stepped_result_keeps_its_stepped_axis_whole():
+    scene = sweep.load_scene("harness-stepped-sine", overrides={
+        "axes.base_frequency_ratio": {"start": 0.9, "stop": 1.1, "num": 3},
+        "model.modes": 1, "solver.t_end": 1.0})
+    ds = sweep.run(scene, progress=False)
+    assert ds.attrs["continuation_axis"] == "base_frequency_ratio"
+    worst = ds["amplitude"].max("direction")
+    limit = float(worst.isel(length=1).max()) * 1.05
+    grid = max_span(ds, max_amplitude=limit)
+    out = refine_span(ds, max_amplitude=limit, tolerance=2e-3)
+    assert out["max_span"].dims == ("base_frequency_ratio",)
+    refined = out["limited_by"].values == "max_amplitude"
+    assert refined.any() and int(out.attrs["refine_runs"]) > 0
+    lengths = ds["length"].values
+    for g, r in zip(grid["max_span"].values[refined], out["max_span"].values[refined]):
+        below = lengths[lengths <= g].max()
+        assert below <= r < lengths[lengths > below].min()
+    np.testing.assert_array_equal(out["max_span"].values[~refined],
+                                  grid["max_span"].values[~refined])
+
+
+def test_refine_the_stability_criterion():
+    scene = sweep.load_scene("harness-stability", overrides={
+        "axes.length": {"start": 0.2, "stop": 0.8, "num": 13},
+        "axes.frequency_ratio": [2.0], "axes.load_amplitude": [0.5]})
+    ds = sweep.run(scene, progress=False)
+    lengths = ds["length"].values
+    out = refine_span(ds, min_frequency=1.0, tolerance=1e-3)
+    got = float(out["max_span"].squeeze())
+    b = int(np.argmax(ds["growth_rate"].squeeze().values > 0))
+    assert lengths[b - 1] <= got < lengths[b]
+    assert str(out["limited_by"].squeeze().values) == "stability"
+    assert 0 < int(out.attrs["refine_runs"]) <= 6
+    # the growth rate's zero, which max_span interpolates linearly, within the bracket
+    assert got == pytest.approx(float(max_span(ds, min_frequency=1.0)["max_span"].squeeze()),
+                                abs=5e-3)
