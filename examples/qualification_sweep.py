@@ -20,6 +20,7 @@ import sweep
 import sweep.design
 from sweep.plot import plot, save
 
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--small", action="store_true", help="a reduced sweep, as CI runs it")
@@ -59,6 +60,7 @@ def main() -> None:
           f"{refined['limited_by'].item()}")
     for figure in save(plot(ds), out, prefix="qualification_sweep-"):
         print(figure)
+
 
 if __name__ == "__main__":
     main()
