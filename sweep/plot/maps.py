@@ -46,9 +46,15 @@ def _map_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str,
                                                             else ""))
     if x is None and y is None:
         y, x = axes                      # xarray's convention: rows (first dim) on y
-    elif x is None:
+    return _pair(axes, x, y, who)
+
+
+def _pair(axes: list[str], x: str | None, y: str | None, who: str) -> tuple[str, str]:
+    """(x, y) over the two `axes`, the one not given being the other; UserError unless they
+    are the two axes."""
+    if x is None:
         x = next(d for d in axes if d != y)
-    elif y is None:
+    if y is None:
         y = next(d for d in axes if d != x)
     if {x, y} != set(axes):
         raise UserError(f"{who}: x and y must be the swept axes {axes[0]} and {axes[1]}")

@@ -26,7 +26,8 @@ from matplotlib.patches import Patch
 
 from ..errors import UserError
 from .labels import _title, label
-from .maps import _MARKER_CELLS, _hatch_region, _map_axes, _mesh, plot_map, plot_state_map
+from .maps import (_MARKER_CELLS, _hatch_region, _map_axes, _mesh, _pair, plot_map,
+                   plot_state_map)
 from .overlays import overlays_for
 from .result import STABILITY, select_points, swept_axes
 from .style import (STATE_STYLES, _coord, _is_log_spaced, _legend, _new_axes, _plain_ticks,
@@ -88,13 +89,7 @@ def _chart_axes(ds: xr.Dataset, x: str | None, y: str | None, who: str) -> tuple
     y = "load_amplitude" if y == "load_ratio" else y
     if x is None and y is None:
         x = next((a for a in _FREQUENCY_AXES if a in axes), axes[1])
-    if x is None:
-        x = next(d for d in axes if d != y)
-    if y is None:
-        y = next(d for d in axes if d != x)
-    if {x, y} != set(axes):
-        raise UserError(f"{who}: x and y must be the swept axes {axes[0]} and {axes[1]}")
-    return x, y
+    return _pair(axes, x, y, who)
 
 
 def _as_load_ratio(ds: xr.Dataset, dim: str) -> xr.Dataset | None:
