@@ -155,28 +155,22 @@ def stepped_chunk(lines: np.ndarray, kernel: Callable[..., dict], kernel_args: t
     outputs with a dwell axis after the first: (lines, dwells, ...). A line is the unit of a
     chunk (a dask task, a stored chunk): its dwells depend on each other."""
     from .models import continuation as ct
+    from .threads import thread_count
     m = lines.shape[0]
     rows = lines[:, 1:].reshape(m * dwells, -1)
-    template = chunk_template(kernel, kernel_args)
-    out = {k: np.empty((m, dwells) + v.shape[1:], v.dtype) for k, v in template.items()}
+    flat = {k: np.empty((m * dwells,) + v.shape[1:], v.dtype)
+            for k, v in chunk_template(kernel, kernel_args).items()}
     direction = lines[:, 0].astype(int)
     line_points = np.arange(m * dwells).reshape(m, dwells)
-    flat = {k: np.empty((m * dwells,) + v.shape[1:], v.dtype) for k, v in template.items()}
     groups = [(line_points[direction == d], np.asarray(order), flat)
               for d, order in enumerate(orders) if np.any(direction == d)]
     ct.solve_lines(rows, groups, carry, dwell, lambda batch: kernel(batch, *kernel_args,
                                                                     threads=1),
-                   workers=_thread_count(threads))
-    for k, v in flat.items():
-        out[k][:] = v.reshape((m, dwells) + v.shape[1:])
+                   workers=thread_count(threads))
+    out = {k: v.reshape((m, dwells) + v.shape[1:]) for k, v in flat.items()}
     if on_block is not None:
         on_block(0, m, out)
     return out
-
-
-def _thread_count(threads: int) -> int:
-    from .threads import thread_count
-    return thread_count(threads)
 
 
 def longitudinal_chunk(params: np.ndarray, settings: np.ndarray, snapshot_times: np.ndarray,

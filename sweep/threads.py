@@ -77,7 +77,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     """Solve every row of `params` (n, N_PARAMS) into the preallocated outputs (first axis n):
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
     A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
-    for its response envelope and durations (n,), each point's end time (s; `swept_blocks`).
+    for its response envelope and durations (n,), each point's end time (s; `swept_settings`).
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
@@ -102,9 +102,9 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
             raise ValueError("a swept base frequency takes driver 'scalar'")
 
         def kernel(lo: int, hi: int) -> None:
-            for part, lo_, hi_ in swept_blocks(settings, durations, lo, hi):
-                tk.solve_swept_block(params, part, lo_, hi_, states, reals, counts, series,
-                                     envelope, parametric, base)
+            for i in range(lo, hi):
+                tk.solve_swept_block(params, swept_settings(settings, durations, i), i, i + 1,
+                                     states, reals, counts, series, envelope, parametric, base)
     elif driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
             tk.solve_block(params, settings, lo, hi, states, reals, counts, series, parametric,
@@ -156,9 +156,11 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
 
     def solve_block(lo: int, hi: int) -> None:
         if swept:
-            for part, lo_, hi_ in swept_blocks(settings, durations, lo, hi):
-                modal_driver.solve_swept_block(params, n_modes, part, lo_, hi_, states, reals,
-                                               counts, series, modal, final, envelope, base)
+            for i in range(lo, hi):
+                modal_driver.solve_swept_block(params, n_modes,
+                                               swept_settings(settings, durations, i), i, i + 1,
+                                               states, reals, counts, series, modal, final,
+                                               envelope, base)
         else:
             kernel.solve_block(params, n_modes, settings, lo, hi, states, reals, counts,
                                series, modal, final, base)
@@ -171,22 +173,15 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
     run_blocks(solve_block, params.shape[0], threads, stop, one_at_a_time=swept)
 
 
-def swept_blocks(settings: np.ndarray, durations: np.ndarray | None, lo: int,
-                 hi: int) -> list[tuple[np.ndarray, int, int]]:
-    """Rows lo..hi-1 as runs of equal end time: (settings with T_END that time, lo, hi) each.
-    durations: each row's end time (s); None: settings' own for every row."""
+def swept_settings(settings: np.ndarray, durations: np.ndarray | None, i: int) -> np.ndarray:
+    """The settings row i of a swept scene runs with: T_END its own end time durations[i]
+    (s), or settings as they are (durations None: every row ends at settings' T_END)."""
     from sweep.kernels import layout as tk
     if durations is None:
-        return [(settings, lo, hi)]
-    runs = []
-    start = lo
-    for i in range(lo + 1, hi + 1):
-        if i == hi or durations[i] != durations[start]:
-            part = settings.copy()
-            part[tk.T_END] = durations[start]
-            runs.append((part, start, i))
-            start = i
-    return runs
+        return settings
+    own = settings.copy()
+    own[tk.T_END] = durations[i]
+    return own
 
 
 def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
