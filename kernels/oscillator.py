@@ -102,9 +102,9 @@ def prepare(row, p, o, s):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _swept_base(t, p, o, s):
-    """kernels.excitation's a_b(t) of the row's block: a call of its own, so that inlining
-    `base_acceleration` into a vector loop copies no more than the fixed-frequency sine."""
+def _excitation_signal(t, p, o, s):
+    """kernels.excitation's a_b(t) of the row's block (fixed or swept): a call of its own, so
+    that inlining `base_acceleration` into a vector loop copies no more than its sine."""
     return ex.acceleration(t, p, o + EXCITATION * s, s)
 
 
@@ -115,7 +115,7 @@ def base_acceleration(t, p, o, s, fast):
     fast True (the lanes, which take fixed-frequency, fixed-level rows only):
     A sin(w_b t + phi_b) with vecmath's fast_sin."""
     if fast is None:
-        return _swept_base(t, p, o, s)
+        return _excitation_signal(t, p, o, s)
     x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
     return p[o + BASE_ACCEL * s] * fast_sin(x)
 

@@ -178,9 +178,8 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
                    omega=0.0)
     out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"], p["length"])
     base = base_excitation(p, c["omega_1"])
-    out.update(base)
-    out["base_phase"] = 0.0              # a stepped sweep's carried phases (continuation.py)
-    out["load_phase"] = 0.0
+    out.update(base)                     # its base_phase 0: a stepped sweep carries the phases
+    out["load_phase"] = 0.0              # (continuation.py)
     swept = p.get("base_sweep_start") is not None
     level, omega_b = base["base_accel"], base["base_omega"]
     if base["participation"] != 0.0 and not swept:

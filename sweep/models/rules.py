@@ -202,7 +202,7 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
     the table."""
     named = [(f"axis '{schema.BY_DOTTED[d].axis}'" if schema.BY_DOTTED[d].axis in axes
               else f"scene key '{d}'")
-             for d in BASE_KEYS if d in given or schema.BY_DOTTED[d].axis in axes]
+             for d in BASE_KEYS if _present(d, given, axes)]
     if not named and not has_table:
         return
     where = named[0] if named else "scene section '[base]'"
@@ -219,7 +219,7 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
                                 (BASE_FREQUENCY_KEYS + SWEEP_KEYS, "a frequency",
                                  "frequency = 20.0 (Hz), frequency_ratio = 1.0 (f/f1) or "
                                  "sweep = { start = 5.0, stop = 100.0, rate = 2.0 }")):
-        if any(d in given or schema.BY_DOTTED[d].axis in axes for d in pair):
+        if any(_present(d, given, axes) for d in pair):
             continue
         _fail(where, f"base excitation needs {what}: the scene gives none of "
               f"{', '.join(dict.fromkeys(_spelling(d) for d in pair))} (as a key or axis)",
@@ -233,6 +233,7 @@ def _spelling(dotted: str) -> str:
 
 
 def _present(dotted: str, given: dict[str, Any], axes: dict[str, np.ndarray]) -> bool:
+    """Whether the scene gives key `dotted`, as a key or as its axis."""
     axis = schema.BY_DOTTED[dotted].axis
     return dotted in given or (axis is not None and axis in axes)
 
@@ -303,7 +304,7 @@ def check_pairs(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Refuse both keys of an either-or pair (PAIRS), as scalars (given: dotted key -> value)
     or axes (axis name -> values)."""
     for pair in PAIRS:
-        present = [d for d in pair if d in given or schema.BY_DOTTED[d].axis in axes]
+        present = [d for d in pair if _present(d, given, axes)]
         if len(present) == 2:
             _fail(f"scene keys '{pair[0]}' and '{pair[1]}'", "give one, not both (as keys or "
                   f"axes {', '.join(schema.BY_DOTTED[d].axis or d for d in pair)})",

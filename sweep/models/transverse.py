@@ -279,11 +279,11 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     """The transverse sweep of `scene` as a Dataset, run as `options` say: the model's entry
     point (sweep.models.model_for)."""
     inputs = resolve(scene)
+    coeffs = modal.oscillator(inputs.params)   # derived quantities, on the axes they need
     if "outputs.stability" not in inputs.wanted:
-        return _run_time_domain(inputs, options)
+        return _run_time_domain(inputs, coeffs, options)
     from .stability import stability_outputs
     started = time.perf_counter()
-    coeffs = modal.oscillator(inputs.params)
     stable = stability_outputs(coeffs, inputs.dims, inputs.shape, inputs.n_modes,
                                options.threads)
     if not time_domain(inputs):
@@ -293,18 +293,26 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
                             "output (outputs.amplitude, ...), and this scene asks only for "
                             "outputs.stability; remove [continuation] or turn an output on")
         return stability_dataset(inputs, coeffs, stable, time.perf_counter() - started)
-    ds = _run_time_domain(inputs, options)
+    ds = _run_time_domain(inputs, coeffs, options)
     return ds.assign(stable)
+
+
+def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
+                      table: dict[str, tuple[str, str]]) -> dict[str, xr.DataArray]:
+    """The closed forms of `table` (name -> (units, long_name)) that `coeffs` holds, each on
+    the axes it depends on; none that is itself an axis (its coordinate holds it)."""
+    out = {}
+    for name, (units, long_name) in table.items():
+        if name in coeffs and name not in coords:
+            out[name] = derived(coeffs[name], coords)
+            out[name].attrs = {"units": units, "long_name": long_name}
+    return out
 
 
 def stability_dataset(inputs: Inputs, coeffs: dict[str, Any], stable: dict[str, xr.DataArray],
                       elapsed: float) -> xr.Dataset:
     """The Dataset of a stability-only scene: the Floquet outputs and the closed forms."""
-    data = dict(stable)
-    for name, (units, long_name) in _DERIVED.items():
-        if name in coeffs and name not in inputs.coords:
-            data[name] = derived(coeffs[name], inputs.coords)
-            data[name].attrs = {"units": units, "long_name": long_name}
+    data = {**stable, **derived_variables(coeffs, inputs.coords, _DERIVED)}
     system = ("transverse modal oscillator" if inputs.n_modes == 1 else
               f"transverse Galerkin model, {inputs.n_modes} modes")
     attrs = global_attrs(inputs.origin, inputs.shape, elapsed,
@@ -313,8 +321,10 @@ def stability_dataset(inputs: Inputs, coeffs: dict[str, Any], stable: dict[str, 
     return xr.Dataset(data, coords=dict(inputs.coords), attrs=attrs)
 
 
-def _run_time_domain(inputs: Inputs, options: RunOptions) -> xr.Dataset:
-    """The time-domain run of a transverse scene (every point integrated over [0, t_end])."""
+def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
+                     options: RunOptions) -> xr.Dataset:
+    """The time-domain run of a transverse scene (every point integrated over [0, t_end]);
+    coeffs: modal.oscillator of its parameters."""
     shape = inputs.shape
     settings = inputs.settings.copy()
     n_points = int(np.prod(shape, dtype=np.int64))
@@ -323,7 +333,6 @@ def _run_time_domain(inputs: Inputs, options: RunOptions) -> xr.Dataset:
     check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size
                                            + (inputs.n_modes if inputs.n_modes > 1 else 0)))
                  + 40, "metrics and time series")
-    coeffs = modal.oscillator(inputs.params)   # derived quantities, on the axes they need
     set_constant_stiffness(settings, coeffs)
     system = _system(inputs, settings)
     started = time.perf_counter()
@@ -341,7 +350,6 @@ def _run_directed(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any],
     """A sweep with base.sweep.direction: up (from the lower of start and stop to the upper),
     down, or both, solved as one grid of twice the points (the down sweeps after the up
     sweeps: one chunk store, one dask graph), the two halves on a `direction` dimension."""
-    from . import continuation as ct
     directions = ["up", "down"] if inputs.sweep_direction == "both" else [inputs.sweep_direction]
     systems = [_system(oriented(inputs, d), settings) for d in directions]
     n = int(np.prod(inputs.shape, dtype=np.int64))
@@ -362,9 +370,8 @@ def _run_directed(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any],
                         elapsed) for i, d in enumerate(directions)]
     if len(results) == 1:
         return results[0]
-    ds = _both_directions(results, inputs.dims, directions)
-    return ds.assign_coords({ct.DIRECTION_DIM: ct.direction_coordinate(
-        directions, "direction of the sine sweep (up: increasing frequency)")})
+    return _both_directions(results, inputs.dims, directions,
+                            "direction of the sine sweep (up: increasing frequency)")
 
 
 def oriented(inputs: Inputs, direction: str) -> Inputs:
@@ -518,10 +525,11 @@ def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], sy
     return ds
 
 
-def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...],
-                     directions: list[str]) -> xr.Dataset:
-    """The up and down Datasets of a stepped sweep as one, what the kernel solved on a leading
-    `direction` dimension, the rest (closed forms of the parameters) once."""
+def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...], directions: list[str],
+                     long_name: str | None = None) -> xr.Dataset:
+    """The up and down Datasets of a sweep as one, what the kernel solved on a leading
+    `direction` dimension, the rest (closed forms of the parameters) once; long_name: the
+    direction coordinate's (default: a stepped sweep's)."""
     from . import continuation as ct
     first = results[0]
     solved = {"state", "jump", "modal_amplitude", "peak_frequency", "envelope", *_REALS,
@@ -529,7 +537,9 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...],
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
     ds = first.drop_vars(per_point).merge(stacked)
-    ds = ds.assign_coords({ct.DIRECTION_DIM: ct.direction_coordinate(directions)})
+    ds = ds.assign_coords({ct.DIRECTION_DIM: ct.direction_coordinate(directions)
+                           if long_name is None else
+                           ct.direction_coordinate(directions, long_name)})
     for name in per_point:
         ds[name] = ds[name].transpose(ct.DIRECTION_DIM, *first[name].dims)
         ds[name].attrs = first[name].attrs
@@ -603,10 +613,7 @@ def sweep_outputs(result: KernelResult, inputs: Inputs,
         out["base_level_g"].attrs = {
             "units": G_UNITS, "long_name": f"base acceleration level at the band's centre "
                                            f"frequency, in g ({STANDARD_GRAVITY:g} m s-2)"}
-    if "sweep_duration" in coeffs:
-        out["sweep_duration"] = derived(coeffs["sweep_duration"], inputs.coords)
-        out["sweep_duration"].attrs = dict(zip(("units", "long_name"),
-                                               _SWEEP_DERIVED["sweep_duration"]))
+    out.update(derived_variables(coeffs, inputs.coords, _SWEEP_DERIVED))
     return out
 
 
@@ -658,11 +665,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
             data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
                                       attrs={"units": "1",
                                              "long_name": long_name.format(method=short)})
-    for name, (units, long_name) in (_DERIVED | (_BASE_DERIVED if inputs.has_base else {})
-                                     ).items():
-        if name in coeffs and name not in coords:
-            data[name] = derived(coeffs[name], coords)
-            data[name].attrs = {"units": units, "long_name": long_name}
+    data.update(derived_variables(coeffs, coords,
+                                  _DERIVED | (_BASE_DERIVED if inputs.has_base else {})))
     if result.modal is not None:
         data.update(modal_outputs(result.modal, dims, shape, coeffs, coords))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
