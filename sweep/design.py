@@ -43,12 +43,15 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from sweep.kernels import states as km
+
 from .errors import UserError
 
 LENGTH = "length"
 DIRECTION = "direction"
-STATE_FAILURES = ("invalid_input", "diverged", "step_size_too_small", "max_steps_reached")
-"""`state` flag meanings that fail a length."""
+STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVERGED,
+                                                      km.STEP_TOO_SMALL, km.MAX_STEPS))
+"""`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
 CRITERIA = ("min_frequency", "max_amplitude", "state", "stability")
 """The criteria in the order they are named when the shortest span fails several."""
 LIMITED_BY = CRITERIA + ("grid",)
