@@ -279,6 +279,8 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     """The transverse sweep of `scene` as a Dataset, run as `options` say: the model's entry
     point (sweep.models.model_for)."""
     inputs = resolve(scene)
+    if "outputs.stability" not in inputs.wanted or time_domain(inputs):
+        _check_time_domain_memory(inputs)      # before anything is computed over the grid
     coeffs = modal.oscillator(inputs.params)   # derived quantities, on the axes they need
     if "outputs.stability" not in inputs.wanted:
         return _run_time_domain(inputs, coeffs, options)
@@ -321,6 +323,16 @@ def stability_dataset(inputs: Inputs, coeffs: dict[str, Any], stable: dict[str, 
     return xr.Dataset(data, coords=dict(inputs.coords), attrs=attrs)
 
 
+def _check_time_domain_memory(inputs: Inputs) -> None:
+    """Refuse, before any work, a grid whose time-domain outputs (and their Dataset copies),
+    solve order and derived quantities would not fit in memory: the parameter rows are built
+    chunk by chunk and never held for the whole grid."""
+    n_points = int(np.prod(inputs.shape, dtype=np.int64))
+    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size
+                                           + (inputs.n_modes if inputs.n_modes > 1 else 0)))
+                 + 40, "metrics and time series")
+
+
 def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
                      options: RunOptions) -> xr.Dataset:
     """The time-domain run of a transverse scene (every point integrated over [0, t_end]);
@@ -328,11 +340,6 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
     shape = inputs.shape
     settings = inputs.settings.copy()
     n_points = int(np.prod(shape, dtype=np.int64))
-    # Outputs (and their Dataset copies), the solve order and a few derived quantities: the
-    # parameter rows are built chunk by chunk and never held for the whole grid.
-    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size
-                                           + (inputs.n_modes if inputs.n_modes > 1 else 0)))
-                 + 40, "metrics and time series")
     set_constant_stiffness(settings, coeffs)
     system = _system(inputs, settings)
     started = time.perf_counter()
