@@ -46,6 +46,8 @@ import xarray as xr
 from sweep.kernels import states as km
 
 from .errors import UserError
+from .scene.points import POINT_DIM
+from .schema import BY_AXIS
 
 LENGTH = "length"
 DIRECTION = "direction"
@@ -213,6 +215,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         spans[i], limited[i] = best
     out_shape = shape[:-1]
     coords = {d: _coordinate(ds, d) for d in others}
+    if POINT_DIM in others:                      # each parameter set's [points] values
+        coords.update({c: _coordinate(ds, c) for c in ds.coords
+                       if c != POINT_DIM and ds[c].dims == (POINT_DIM,)})
     title = str(ds.attrs.get("title", ""))
     criteria = "; ".join(
         ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
@@ -311,21 +316,24 @@ def _coordinate(ds: xr.Dataset, dim: str) -> xr.DataArray:
     if dim in ds.coords:
         c = ds[dim]
         attrs = {k: v for k, v in c.attrs.items() if k != "bounds"}
-        return xr.DataArray(c.values, dims=(dim,), attrs=attrs)
+        return xr.DataArray(c.values, dims=c.dims, attrs=attrs)
     return xr.DataArray(np.arange(ds.sizes[dim]), dims=(dim,),
                         attrs={"long_name": f"index along {dim}", "units": "1"})
 
 
 def table(result: xr.Dataset) -> str:
     """A short text table of `max_span`: one line per combination of the other axes, their
-    values, max_span in mm and limited_by."""
+    values (a parameter set's [points] values too), max_span in mm and limited_by."""
     span = result["max_span"]
     dims = list(span.dims)
-    head = [*dims, "max_span_mm", "limited_by"]
+    on_points = [c for c in result.coords if c != POINT_DIM and result[c].dims == (POINT_DIM,)]
+    columns = [(d, d) for d in dims] + [(c, POINT_DIM) for c in on_points]
+    head = [c for c, _ in columns] + ["max_span_mm", "limited_by"]
     rows = []
     for index in np.ndindex(*span.shape):
-        values = [f"{result[d].values[i]:g}" if np.asarray(result[d].values).dtype.kind in "fiu"
-                  else str(result[d].values[i]) for d, i in zip(dims, index)]
+        at = dict(zip(dims, index))
+        values = [f"{result[c].values[at[d]]:g}" if np.asarray(result[c].values).dtype.kind
+                  in "fiu" else str(result[c].values[at[d]]) for c, d in columns]
         s = float(span.values[index])
         by = str(result["limited_by"].values[index])
         rows.append([*values, f"{s * 1e3:.2f}" if np.isfinite(s) else "nan",
@@ -376,7 +384,8 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     if not isinstance(text, str) or not text.strip():
         raise UserError("design --refine: the result has no 'scene' attribute to run again "
                         "(give a result written by 'sweep run ... -o FILE.nc')")
-    scene_axes = set(load_scene_text(text, source="the result's scene").axes)
+    stored = load_scene_text(text, source="the result's scene")
+    scene_axes = set(stored.axes) | ({POINT_DIM} if stored.points else set())
     stepped = ds.attrs.get("continuation_axis")
     stepped = stepped if isinstance(stepped, str) and stepped in ds.dims else None
     if stepped == LENGTH:
@@ -398,7 +407,10 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         nonlocal runs
         overrides: dict[str, Any] = {f"axes.{LENGTH}": [float(length)]}
         for a, v in point.items():
-            if a != stepped:
+            if a == POINT_DIM:               # the parameter set's values, as scalars
+                overrides.update({BY_AXIS[k].dotted: float(values[int(v)])
+                                  for k, values in stored.points.items()})
+            elif a != stepped:
                 overrides[f"axes.{a}"] = [v.item() if hasattr(v, "item") else v]
         one = run(load_scene_text(text, source="the result's scene", overrides=overrides),
                   progress=False)

@@ -9,17 +9,38 @@ import xarray as xr
 
 from .models.rules import default_inertia
 from .scene import Scene
+from .scene.points import POINT_DIM
 from .schema import BY_AXIS
 
 
 def coordinates(scene: Scene) -> dict[str, xr.DataArray]:
-    """One 1-D coordinate per axis, in scene order, with units and long_name."""
+    """The grid's coordinates, with units and long_name: with [points], first the `point`
+    dimension (0, 1, ...) and one coordinate on it per [points] key (its values, so
+    ``ds.length`` gives each point's length); then one 1-D coordinate per axis, in scene
+    order. `dimensions` picks the dimension coordinates out."""
     coords = {}
+    if scene.points:
+        count = len(next(iter(scene.points.values())))
+        names = ", ".join(scene.points)
+        coords[POINT_DIM] = xr.DataArray(
+            np.arange(count, dtype=np.int32), dims=POINT_DIM,
+            attrs={"units": "1", "long_name": f"parameter set (entry of the scene's [points]: "
+                                              f"{names})"})
+        for name, values in scene.points.items():
+            key = BY_AXIS[name]
+            coords[name] = xr.DataArray(np.asarray(values, dtype=float), dims=POINT_DIM,
+                                        attrs={"units": key.units, "long_name": key.long_name})
     for name, values in scene.axes.items():
         key = BY_AXIS[name]
         coords[name] = xr.DataArray(np.asarray(values, dtype=float), dims=name,
                                     attrs={"units": key.units, "long_name": key.long_name})
     return coords
+
+
+def dimensions(coords: dict[str, xr.DataArray]) -> tuple[str, ...]:
+    """The grid's dimensions, in order: the names of `coords` that are dimension coordinates
+    (the point dimension and the axes, not the [points] values on it)."""
+    return tuple(name for name, c in coords.items() if c.dims == (name,))
 
 
 def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:

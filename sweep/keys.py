@@ -91,9 +91,10 @@ def _select(which: str | None) -> list[schema.Key]:
         return [schema.BY_DOTTED[which]]
     keys = [k for k in schema.KEYS if k.section == which]
     if not keys:
-        sections = ", ".join(s for s in schema.SECTIONS if s != "axes")
+        sections = ", ".join(s for s in schema.SECTIONS if s not in schema.SWEPT_SECTIONS)
         raise UserError(f"keys: no scene section or dotted key '{which}' (sections: {sections}, "
-                        "axes; or a dotted key such as solver.rtol; or leave it out for all keys)")
+                        "axes, points; or a dotted key such as solver.rtol; or leave it out for "
+                        "all keys)")
     return keys
 
 
@@ -101,6 +102,8 @@ def text(which: str | None = None) -> str:
     """The reference as plain text, one block per key; `which` is a section or a dotted key."""
     if which == "axes":
         return _axes_text() + "\n"
+    if which == "points":
+        return _points_text() + "\n"
     lines: list[str] = []
     if which is None:
         for name, meaning in schema.TOP_LEVEL.items():
@@ -119,7 +122,7 @@ def text(which: str | None = None) -> str:
         lines += textwrap.wrap(help_text(key), 96, initial_indent="    ",
                                subsequent_indent="    ") + [""]
     if which is None:
-        lines += [_axes_text(), ""]
+        lines += [_axes_text(), "", _points_text(), ""]
     return "\n".join(lines)
 
 
@@ -130,6 +133,20 @@ def _axes_text() -> str:
                f"axis name: {names}")
     return "\n".join([f"[axes] NAME = [v1, v2, ...] or {{start, stop, num, spacing = {spacings}}}",
                       *textwrap.wrap(meaning, 96, initial_indent="    ", subsequent_indent="    ")])
+
+
+_POINTS_MEANING = ("zipped parameter sets: equal-length lists of sweepable keys (named as under "
+                   "[axes]), entry i of every list being parameter set i, the result's `point` "
+                   "dimension (coordinate 0, 1, ...; each key's values ride on it as a "
+                   "coordinate, e.g. ds.length). Points combine with [axes] as a product: every "
+                   "point is solved at every axis combination. A key is under [axes] or "
+                   "[points], not both; values need not be ordered or distinct.")
+
+
+def _points_text() -> str:
+    return "\n".join(["[points] NAME = [v1, v2, ...]  (every NAME the same number of values)",
+                      *textwrap.wrap(_POINTS_MEANING.replace("`", ""), 96,
+                                     initial_indent="    ", subsequent_indent="    ")])
 
 
 def _cell(value: str) -> str:
@@ -166,4 +183,8 @@ def markdown() -> str:
             "(default linear). The result has one dimension per axis, in the order the axes are",
             "written. NAME is the key's axis name:", ""]
     out += [f"- `{axis}`: `{key.dotted}`" for axis, key in schema.BY_AXIS.items()]
+    out += ["", "## [points]", "", "`NAME = [v1, v2, ...]`: " + _POINTS_MEANING,
+            "", "    [points]                       # three harness segments",
+            "    length = [0.30, 0.45, 0.30]    # m", "    area = [6e-6, 4e-6, 3e-6]      # m^2",
+            "    inertia = [2.865e-12, 1.3e-12, 0.7e-12]   # m^4"]
     return "\n".join(out) + "\n"

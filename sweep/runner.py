@@ -151,11 +151,16 @@ def placer(outputs: dict[str, np.ndarray], order: np.ndarray) -> Callable[[int, 
 
 
 def run_fingerprint(scene: Scene) -> str:
-    """What decides a run's results: every scene value but the run.* keys, and the axes."""
+    """What decides a run's results: every scene value but the run.* keys, the axes and the
+    [points] (in order: their order is the point dimension's)."""
     from .execute import fingerprint
     values = {k: v for k, v in scene.values.items() if not k.startswith("run.")}
     axes = {k: [float(x) for x in v] for k, v in scene.axes.items()}
-    return fingerprint(sorted(values.items()), sorted(axes.items()), package_version())
+    if not scene.points:
+        return fingerprint(sorted(values.items()), sorted(axes.items()), package_version())
+    points = {k: [float(x) for x in v] for k, v in scene.points.items()}
+    return fingerprint(sorted(values.items()), sorted(axes.items()), package_version(),
+                       list(points.items()))
 
 
 def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],

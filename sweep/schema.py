@@ -230,7 +230,9 @@ KEYS: tuple[Key, ...] = (
 TOP_LEVEL: dict[str, str] = {"name": "a short name for the sweep",
                              "description": "one line saying what the sweep is for"}
 
-SECTIONS: tuple[str, ...] = tuple(dict.fromkeys(k.section for k in KEYS)) + ("axes",)
+SECTIONS: tuple[str, ...] = tuple(dict.fromkeys(k.section for k in KEYS)) + ("axes", "points")
+"""Every section a scene may have: those of the keys, then [axes] and [points] (swept values)."""
+SWEPT_SECTIONS: tuple[str, ...] = ("axes", "points")
 
 BY_DOTTED: dict[str, Key] = {k.dotted: k for k in KEYS}
 TABLES: dict[str, str] = {"base.sweep": "sweep = { start = 5.0, stop = 100.0, rate = 2.0 } "

@@ -18,6 +18,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..schema import STANDARD_GRAVITY
+from .swept import Swept
 
 EXCITATION_NAMES: tuple[str, ...] = (
     ("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments", "sweep_end",
@@ -109,11 +110,12 @@ def is_swept(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
 
 
 def sweep_grid(values: Mapping[str, Any], axes: Mapping[str, Any]) -> tuple[Any, Any, Any]:
-    """(start, stop, rate) of a swept scene on the product grid of its sweep axes (arrays
-    that broadcast; scalars where not swept)."""
-    parts = [np.asarray(axes[a], float) if a in axes else np.asarray(values[d], float)
-             for d, a in zip(SWEEP_KEYS, SWEEP_AXES)]
-    shaped = np.ix_(*[np.atleast_1d(p) for p in parts])
+    """(start, stop, rate) of a swept scene over the combinations it solves (arrays that
+    broadcast): the product of its sweep axes, [points] zipped on one dimension (`axes` a
+    `Swept`; a plain mapping is all axes); scalars where not swept."""
+    swept = axes if isinstance(axes, Swept) else Swept(axes)
+    fixed = {a: values[d] for d, a in zip(SWEEP_KEYS, SWEEP_AXES)}
+    shaped = swept.product(SWEEP_AXES, fixed)
     return shaped[0], shaped[1], shaped[2]
 
 

@@ -66,7 +66,7 @@ class Inputs:
 def resolve(scene: Scene) -> Inputs:
     """The Inputs of a longitudinal scene: the only place this model reads it."""
     coords = grid.coordinates(scene)
-    dims = tuple(coords)
+    dims = grid.dimensions(coords)
     times = scene.get("outputs.snapshot_times")
     return Inputs(coords=coords, dims=dims, shape=tuple(coords[d].size for d in dims),
                   params=grid.parameters(scene, coords),

@@ -66,7 +66,6 @@ the scene pipeline but its messages.
 
 from __future__ import annotations
 
-import itertools
 import math
 import warnings
 from collections.abc import Callable, Mapping
@@ -76,6 +75,7 @@ from typing import Any
 import numpy as np
 
 from .excitation import SWEEP_DIRECTION, SWEEP_KEYS, end_time, sweep_grid
+from .swept import Swept
 
 from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span counts
 
@@ -594,10 +594,10 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     speed): computed with the run's own formulas (sweep.models.oscillator,
     sweep.models.wave.wave_parameters) at every corner of the grid (each axis at its first
     and last value). Each coefficient is a product of powers of the parameters (or a sum of
-    same-signed ones), so its largest and smallest magnitudes lie at corners."""
+    same-signed ones), so its largest and smallest magnitudes lie at corners. [points]
+    entries are combinations of their own: every entry is a corner (`Swept.corners`)."""
     kind = values["model.kind"]
-    corners = list(itertools.product(*([float(a[0]), float(a[-1])] for a in axes.values())))
-    columns = dict(zip(axes, np.array(corners, dtype=np.float64).T)) if axes else {}
+    columns = (axes if isinstance(axes, Swept) else Swept(axes)).corners()
     params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
                               for name, key in schema.BY_AXIS.items()}
     if params["inertia"] is None:
@@ -625,8 +625,9 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
         if value is None or key.section not in ("cable", "model", "load", "base"):
             continue
         value = float(np.atleast_1d(value)[corner % np.size(value)])
-        where = (f"axis '{axis}' at {value!r}" if axis in axes
-                 else f"scene key '{key.dotted}' = {value!r}")
+        where = (f"scene key '{key.dotted}' = {value!r}" if axis not in axes
+                 else f"[points] '{axis}' entry {value!r}" if axis in getattr(axes, "zipped", ())
+                 else f"axis '{axis}' at {value!r}")
         inputs.append((not (value == 0 or _PLAUSIBLE[0] <= abs(value) <= _PLAUSIBLE[1]), where))
     named = [w for odd, w in inputs if odd] or [w for _, w in inputs]
     _fail(", ".join(named),

@@ -122,7 +122,7 @@ def settings_vector(scene: Scene) -> np.ndarray:
     atol = scene.get("solver.atol")
     s[tk.ATOL] = 0.0 if atol is None else atol
     s[tk.ATOL_SCALE] = ATOL_SCALE if atol is None else 0.0
-    s[tk.T_END] = excitation.end_time(scene.values, scene.axes)
+    s[tk.T_END] = excitation.end_time(scene.values, scene.swept)
     s[tk.MAX_STEPS] = scene.get("solver.max_steps")
     s[tk.MAX_STEP] = scene.get("solver.max_step") or math.inf
     s[tk.FIRST_STEP] = scene.get("solver.first_step") or 0.0
@@ -135,7 +135,7 @@ def settings_vector(scene: Scene) -> np.ndarray:
     s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
     if scene.has_base:                  # else 0.0: no forcing term compiled
         s[tk.BASE] = 1.0
-    if excitation.is_swept(scene.values, scene.axes):
+    if excitation.is_swept(scene.values, scene.swept):
         s[tk.SWEPT] = 1.0
         s[tk.BANDS_PER_OCTAVE], s[tk.FIRST_BAND] = scene.get("outputs.bands_per_octave"), 0.0
         if scene.get("outputs.envelope"):
@@ -147,7 +147,7 @@ def envelope_bands(scene: Scene) -> tuple[int, int]:
     """(first band k, number of bands) of a swept scene's envelope: the base-2 1/N-octave
     bands, centres 1000 x 2^(k/N) Hz (N = outputs.bands_per_octave), that hold every
     frequency its sweeps reach."""
-    start, stop, _ = excitation.sweep_grid(scene.values, scene.axes)
+    start, stop, _ = excitation.sweep_grid(scene.values, scene.swept)
     n = scene.get("outputs.bands_per_octave")
     low = int(excitation.band_index(float(np.min(np.minimum(start, stop))), n))
     high = int(excitation.band_index(float(np.max(np.maximum(start, stop))), n))
@@ -229,13 +229,13 @@ class Inputs:
 def resolve(scene: Scene) -> Inputs:
     """The Inputs of a transverse scene: the only place this model reads it."""
     coords = grid.coordinates(scene)
-    dims = tuple(coords)
+    dims = grid.dimensions(coords)
     settings = settings_vector(scene)
     wanted = frozenset(k for k in scene.values if k.startswith("outputs.") and scene.get(k) is True)
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if "outputs.time_series" in wanted else np.empty(0))
     params = grid.parameters(scene, coords)
-    swept = excitation.is_swept(scene.values, scene.axes)
+    swept = excitation.is_swept(scene.values, scene.swept)
     n_modes = scene.get("model.modes")
     initial = []
     for listed, single in (("initial.modal_displacement", "initial_displacement"),

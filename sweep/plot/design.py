@@ -4,6 +4,7 @@ no axis left gets a single bar with its value written on it."""
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
 import numpy as np
@@ -13,7 +14,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..errors import UserError
-from .labels import label
+from .labels import POINT_DIM, label, point_ticks
 from .result import check_design_result
 from .style import _coord, _is_log_spaced, _legend, _new_axes, _plain_ticks, _unit
 
@@ -86,10 +87,13 @@ def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Fig
                 text += "; v: shortest length fails"
             handles.append(Line2D([], [], color=colour, marker=marker, ls="", label=text))
         ax.set_xlabel(label(ds[dim], units=_unit(ds[dim])[1]))
-        if _is_log_spaced(x):
+        if dim == POINT_DIM:
+            point_ticks(ax, ds, "x")
+        elif _is_log_spaced(x):
             ax.set_xscale("log")
         _legend(ax, handles, title="limited by")
     ax.set_ylabel(ylabel)
+    criteria = "\n".join(textwrap.wrap(criteria, 90))
     ax.set_title(title if not criteria else f"{title}\n{criteria}", fontsize="small")
     refine = ds.attrs.get("refine_runs")
     if refine is not None:

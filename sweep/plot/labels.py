@@ -30,6 +30,34 @@ def label(da: xr.DataArray, units: str | None = None) -> str:
     return f"{name} [{units}]" if units and units != "1" else name
 
 
+POINT_DIM = "point"               # the dimension of a scene's [points] (sweep/scene/points.py)
+
+
+def point_ticks(ax: Any, ds: xr.Dataset, which: str) -> None:
+    """On the `which` ("x" or "y") axis of the point dimension: a tick per parameter set,
+    labelled with its [points] values (the coordinates on that dimension), and the axis
+    label naming them with their units."""
+    if POINT_DIM not in ds.dims:
+        return
+    on = [c for c in ds.coords if c != POINT_DIM and ds[c].dims == (POINT_DIM,)]
+    index = [int(i) for i in ds[POINT_DIM].values]
+
+    def text(j: int) -> str:
+        values = [f"{float(ds[c].values[j]):.3g}" for c in on]
+        return f"{index[j]}\n" + ", ".join(values) if values else str(index[j])
+    names = ", ".join(f"{c} [{ds[c].attrs['units']}]" if ds[c].attrs.get("units", "1") != "1"
+                      else c for c in on)
+    title = f"parameter set ({names})" if names else "parameter set"
+    if which == "x":
+        ax.set_xticks(index, [text(j) for j in range(len(index))], fontsize="small")
+        ax.set_xlabel(title)
+    else:
+        ax.set_yticks(index, [text(j).replace("\n", ": ") for j in range(len(index))],
+                      fontsize="small")
+        ax.set_ylabel(title)
+    ax.minorticks_off()
+
+
 def _point_text(ds: xr.Dataset, dims: Iterable[str]) -> str:
     def one(d: str) -> str:
         factor, units = (1e3, "mm") if _is_displacement(ds[d]) else (1.0, ds[d].attrs.get("units"))

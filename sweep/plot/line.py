@@ -11,7 +11,7 @@ from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 
 from ..errors import UserError
-from .labels import _title, label
+from .labels import POINT_DIM, _title, label, point_ticks
 from .overlays import overlays_for
 from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import (_is_log_spaced, _legend, _new_axes, _padded_range, _plain_ticks, _unit,
@@ -103,6 +103,8 @@ def _finish_axes(ax: Axes, ds: xr.Dataset, dim: str, var: str, x: np.ndarray, y:
     ax.set_title(title, fontsize="medium")
     ax.grid(True, color="0.92", zorder=0)
     _plain_ticks(ax)
+    if dim == POINT_DIM:
+        point_ticks(ax, ds, "x")
     if add_legend:
         _legend(ax, handles, *legend_args)
     return ax

@@ -15,7 +15,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from ..errors import UserError
-from .labels import _title, label
+from .labels import POINT_DIM, _title, label, point_ticks
 from .overlays import overlays_for
 from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import (_coord, _edges, _is_displacement, _is_log_spaced, _legend, _new_axes,
@@ -104,6 +104,9 @@ def _mesh(ax: Axes, ds: xr.Dataset, x: str, y: str, values: np.ndarray,
     _scale(ax, "y", yv, yscale)
     ax.set_xlabel(label(ds[x], _unit(ds[x])[1]))
     ax.set_ylabel(label(ds[y], _unit(ds[y])[1]))
+    for which, dim in (("x", x), ("y", y)):
+        if dim == POINT_DIM:
+            point_ticks(ax, ds, which)
     return mesh
 
 

@@ -55,8 +55,10 @@ def _axis_or_none(entry: str) -> str | None:
     return key.axis if key is not None else None
 
 
-def _axis_name(entry: str) -> str:
-    """The axis an ``[axes]`` entry names; refuse unknown and non-sweepable names."""
+def _axis_name(entry: str, where: str | None = None) -> str:
+    """The axis an ``[axes]`` entry names; refuse unknown and non-sweepable names (`where`
+    names the entry in the message; default ``axis 'ENTRY'``)."""
+    where = where or f"axis '{entry}'"
     axis = _axis_or_none(entry)
     if axis is not None:
         return axis
@@ -66,11 +68,11 @@ def _axis_name(entry: str) -> str:
     if key is None and same_name and all(k.axis is None for k in same_name):
         key = same_name[0]
     if key is not None:
-        _fail(f"axis '{entry}'", f"'{key.dotted}' cannot be swept",
+        _fail(where, f"'{key.dotted}' cannot be swept",
               f"sweepable: {sweepable}; set {key.dotted} as a single value in [{key.section}]")
     candidates = [*schema.BY_AXIS, *(k.dotted for k in schema.BY_AXIS.values())]
     guess = _close(entry, candidates) or next((k.axis for k in same_name if k.axis), None)
-    _fail(f"axis '{entry}'", "unknown axis",
+    _fail(where, "unknown axis",
           _suggestion(guess, f"use one of the sweepable axes; sweepable: {sweepable}"))
 
 

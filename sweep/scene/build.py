@@ -13,10 +13,12 @@ import numpy as np
 
 from .. import models, schema
 from ..models import rules
+from ..models.swept import Swept
 from .axes import _check_axes, _flatten_axes
 from .document import Scene
 from .messages import _fail
 from .overrides import _apply_overrides, _parse_overrides
+from .points import _check_points
 from .reading import _parse_toml, _read_scene
 from .values import _check_description, _check_name, _check_sections, _check_top_level
 
@@ -41,8 +43,9 @@ def _build(text: str, source: str, default_name: str,
            overrides: Mapping[str, Any] | None) -> Scene:
     """Parse, override, validate and resolve a scene."""
     doc = _parse_toml(text, source)
-    if isinstance(doc.get("axes"), dict):
-        doc["axes"] = _flatten_axes(doc["axes"])
+    for section in schema.SWEPT_SECTIONS:
+        if isinstance(doc.get(section), dict):
+            doc[section] = _flatten_axes(doc[section])
     file_has_base = "base" in doc
     _flatten_tables(doc)
     applied = _parse_overrides(overrides)
@@ -53,15 +56,26 @@ def _build(text: str, source: str, default_name: str,
     description = _check_description(doc.get("description", ""))
     given = _check_sections(doc)
     axes = _check_axes(doc.get("axes", {}))
-    rules.check_base(given, axes, "base" in doc, file_has_base)
+    points = _check_points(doc.get("points", {}), axes)
+    swept = Swept(axes, points)         # what the rules see: every key that varies
+    rules.check_base(given, swept, "base" in doc, file_has_base)
     kind = models.rules_for(rules.model_kind(given))
-    kind.check(given, axes)
+    _check_continued(given, points)
+    kind.check(given, swept)
     _check_run(given)
-    rules.check_pairs(given, axes)
-    values = _resolve(given, axes, kind)
-    kind.check_resolved(values, axes, given)
+    rules.check_pairs(given, swept)
+    values = _resolve(given, swept, kind)
+    kind.check_resolved(values, swept, given)
     return Scene(name=name, description=description, values=values, axes=axes,
-                 text=text, source=source, overrides=applied)
+                 text=text, source=source, overrides=applied, points=points)
+
+
+def _check_continued(given: dict[str, Any], points: dict[str, np.ndarray]) -> None:
+    """A stepped sweep steps along an axis: its points are ordered values, [points] are not."""
+    axis = given.get("continuation.axis")
+    if axis in points:
+        _fail("scene key 'continuation.axis'", f"'{axis}' is a [points] entry; a stepped sweep "
+              "steps along an ordered axis", f"move {axis} from [points] to [axes]")
 
 
 def _flatten_tables(doc: dict[str, Any]) -> None:
@@ -69,7 +83,7 @@ def _flatten_tables(doc: dict[str, Any]) -> None:
     schema's dotted names (``sweep.start``), in place; a table replaces the dotted keys it
     had. A plain value where such a table belongs is refused in one line."""
     for section, table in doc.items():
-        if not isinstance(table, dict) or section == "axes":
+        if not isinstance(table, dict) or section in schema.SWEPT_SECTIONS:
             continue
         for name in [n for n in table if f"{section}.{n}" in schema.TABLES]:
             value = table.pop(name)
@@ -95,7 +109,7 @@ def _check_run(given: dict[str, Any]) -> None:
 def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray],
              kind: rules.Rules) -> dict[str, Any]:
     """Every dotted key -> value: given, else the default (the schema's, then those of the
-    model kind's rules); None for swept keys."""
+    model kind's rules); None for swept keys (axes and [points])."""
     swept = {schema.BY_AXIS[a].dotted for a in axes}
     values = {k.dotted: None if k.dotted in swept else given.get(k.dotted, k.default)
               for k in schema.KEYS}

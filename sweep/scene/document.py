@@ -10,9 +10,12 @@ import numpy as np
 
 from .. import schema
 from ..models.rules import has_base
+from ..models.swept import Swept
 
-_VALUE_SECTIONS: tuple[str, ...] = tuple(s for s in schema.SECTIONS if s != "axes")
-"""The sections that hold keys with values: every section but [axes], in schema order."""
+_VALUE_SECTIONS: tuple[str, ...] = tuple(s for s in schema.SECTIONS
+                                         if s not in schema.SWEPT_SECTIONS)
+"""The sections that hold keys with values: every section but [axes] and [points], in schema
+order."""
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 
 
@@ -25,10 +28,12 @@ class Scene:
         key (``outputs.snapshot_times``) holds a tuple of floats, or None.
     axes: axis name -> 1-D read-only float64 array, in scene order ([axes] table order,
         then axes added by overrides).
+    points: axis name -> 1-D read-only float64 array, one common length: the [points]
+        entries (zipped parameter sets, the result's ``point`` dimension); empty without.
     text: the TOML text as read; source: the built-in name or the path given;
     overrides: the overrides applied, with parsed values.
 
-    Two scenes are equal when their name, description, values and axes are equal
+    Two scenes are equal when their name, description, values, axes and points are equal
     (text, source and overrides are not compared).
     """
 
@@ -39,11 +44,17 @@ class Scene:
     text: str = field(repr=False)
     source: str
     overrides: dict[str, Any] = field(default_factory=dict)
+    points: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def swept(self) -> Swept:
+        """Every key that varies over the run -> its values: the axes and the [points]."""
+        return Swept(self.axes, self.points)
 
     @property
     def has_base(self) -> bool:
         """Whether the scene has base excitation of the clamps (a [base] level and frequency)."""
-        return has_base(self.values, self.axes)
+        return has_base(self.values, self.swept)
 
     def get(self, dotted: str) -> Any:
         """The resolved value of a dotted key, e.g. ``scene.get("solver.rtol")``.
@@ -59,12 +70,15 @@ class Scene:
                 and self.description == other.description
                 and self.values == other.values
                 and list(self.axes) == list(other.axes)
-                and all(np.array_equal(self.axes[a], other.axes[a]) for a in self.axes))
+                and all(np.array_equal(self.axes[a], other.axes[a]) for a in self.axes)
+                and list(self.points) == list(other.points)
+                and all(np.array_equal(self.points[a], other.points[a]) for a in self.points))
 
     __hash__ = None  # type: ignore[assignment]
 
     def to_toml(self) -> str:
-        """The resolved scene as TOML: every section, defaults included, axes as lists.
+        """The resolved scene as TOML: every section, defaults included, axes and points as
+        lists.
 
         None-valued keys are left out; a "floats" value is written as a list. `load_scene_text`
         of the result gives an equal Scene.
@@ -80,6 +94,9 @@ class Scene:
         if self.axes:
             lines.extend(["", "[axes]"])
             lines.extend(f"{_toml_key(a)} = {_toml_array(v)}" for a, v in self.axes.items())
+        if self.points:
+            lines.extend(["", "[points]"])
+            lines.extend(f"{_toml_key(a)} = {_toml_array(v)}" for a, v in self.points.items())
         return "\n".join(lines) + "\n"
 
     def _section_lines(self, section: str) -> list[str]:

@@ -1,7 +1,9 @@
 """``--set KEY=VALUE`` overrides: parsed as TOML values and written into the parsed document
 before validation.
 
-An override that sets a sweepable key as a scalar removes that key's axis; an override of one
+An override that sets a sweepable key as a scalar removes that key's axis (or [points]
+entry), one that sets an axis removes the key's [points] entry and the other way round
+(``--set points.length=[0.3, 0.5]``); an override of one
 key of an either-or pair (`sweep.models.rules.PAIRS`: the load frequency, the base level, the
 base frequency; as a scalar or an axis) removes its partner, and one of the end-time keys
 (solver.t_end, solver.transits) the other; so ``--set`` can always replace what the scene file
@@ -98,8 +100,9 @@ def _pair_target(dotted: str, pair: tuple[str, str]) -> str | None:
     """The key of an either-or `pair` an override sets (as scalar or axis), or None."""
     if dotted in pair:
         return dotted
-    if dotted.startswith("axes."):
-        axis = _axis_or_none(dotted[len("axes."):])
+    section, _, name = dotted.partition(".")
+    if section in schema.SWEPT_SECTIONS:
+        axis = _axis_or_none(name)
         if axis is not None and schema.BY_AXIS[axis].dotted in pair:
             return schema.BY_AXIS[axis].dotted
     return None
@@ -111,8 +114,8 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
         section, _, name = dotted.partition(".")
         if not name:
             doc[dotted] = value
-        elif section == "axes":
-            _override_axis(doc, name, value)
+        elif section in schema.SWEPT_SECTIONS:
+            _override_axis(doc, name, value, section)
         else:
             _override_scalar(doc, section, name, value)
 
@@ -125,14 +128,17 @@ def _override_table(doc: dict[str, Any], section: str) -> dict[str, Any]:
     return table
 
 
-def _override_axis(doc: dict[str, Any], name: str, value: Any) -> None:
-    """Set or replace an axis (keeping its place); drop the other key of its either-or pair
-    (load or base frequency, base level)."""
-    axes = _override_table(doc, "axes")
+def _override_axis(doc: dict[str, Any], name: str, value: Any, section: str = "axes") -> None:
+    """Set or replace an axis or a [points] entry (`section`; keeping its place); drop the
+    same key from the other section, and the other key of its either-or pair (load or base
+    frequency, base level)."""
+    axes = _override_table(doc, section)
     axis = _axis_or_none(name)
     if axis is None:
         axes[name] = value
         return
+    other = next(s for s in schema.SWEPT_SECTIONS if s != section)
+    _drop_axis(doc, axis, (other,))
     _drop_frequency_partner(doc, schema.BY_AXIS[axis].dotted)
     replaced = {(axis if _axis_or_none(k) == axis else k): v for k, v in axes.items()}
     replaced[axis] = value
@@ -153,12 +159,14 @@ def _override_scalar(doc: dict[str, Any], section: str, name: str, value: Any) -
         _drop_frequency_partner(doc, key.dotted)
 
 
-def _drop_axis(doc: dict[str, Any], axis: str) -> None:
-    """Remove every ``[axes]`` entry that names ``axis``."""
-    axes = doc.get("axes")
-    if isinstance(axes, dict):
-        for entry in [k for k in axes if _axis_or_none(k) == axis]:
-            del axes[entry]
+def _drop_axis(doc: dict[str, Any], axis: str,
+               sections: tuple[str, ...] = schema.SWEPT_SECTIONS) -> None:
+    """Remove every ``[axes]`` and ``[points]`` entry (of `sections`) that names ``axis``."""
+    for section in sections:
+        table = doc.get(section)
+        if isinstance(table, dict):
+            for entry in [k for k in table if _axis_or_none(k) == axis]:
+                del table[entry]
 
 
 def _drop_frequency_partner(doc: dict[str, Any], dotted: str) -> None:
