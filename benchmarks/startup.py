@@ -9,6 +9,8 @@ interpreter (sys.executable), stdout and stderr captured:
 2. `python -c "import sweep"`: the package import (NumPy, xarray, the scene schema).
 3. `python -c "import sweep, sweep.kernels.transverse"`: the same plus numba and the kernel modules
    (the kernels are compiled or loaded from the cache at their first call, not at import).
+3b. `python -m sweep.cli --help` and `python -m sweep.cli scenes`: commands that need neither
+   NumPy, xarray nor Numba.
 4. cold: `python -m sweep.cli run paper-fig5 -o TMP/out.nc --overwrite` with NUMBA_CACHE_DIR
    set to a fresh, empty temporary directory, so every kernel is JIT-compiled (--cold-repeats
    times, default 1, each with its own empty directory).
@@ -123,7 +125,9 @@ def main() -> None:
         out = str(Path(tmp) / "out.nc")
         refs = [("bare interpreter", [py, "-c", "pass"]),
                 ("import sweep", [py, "-c", "import sweep"]),
-                ("import sweep + kernels (numba)", [py, "-c", "import sweep, sweep.kernels.transverse"])]
+                ("import sweep + kernels (numba)", [py, "-c", "import sweep, sweep.kernels.transverse"]),
+                ("sweep --help", [py, "-m", "sweep.cli", "--help"]),
+                ("sweep scenes", [py, "-m", "sweep.cli", "scenes"])]
         for name, cmd in refs:
             timed(cmd, env, tmp)                                 # untimed: warm the file cache
             walls = [timed(cmd, env, tmp)[0] for _ in range(args.repeats)]

@@ -14,7 +14,6 @@ the backend, the chunking or the number of workers: each point depends on its ow
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import inspect
 import os
@@ -655,6 +654,7 @@ def _quiet_dask() -> Iterator[None]:
 def _connect(scheduler: str | None, workers: int) -> tuple[Any, Any]:
     """A dask Client of the scheduler at `scheduler`, or of a LocalCluster of `workers`
     single-threaded worker processes on this machine (0: one per core); and that cluster."""
+    import asyncio                                   # the dask path only
     import logging
 
     from dask.distributed import Client, LocalCluster
@@ -686,6 +686,7 @@ def _handshake(address: str) -> None:
     CONNECT_SECONDS: dask's own connect waits for the handshake without bound, so a listener
     that accepts and never answers would hang the Client forever. On a thread of its own, with
     its own event loop (the caller may be running one, as in Jupyter)."""
+    import asyncio                                   # the dask path only
     from distributed.comm import connect
     from distributed.security import Security
     outcome: list = []
@@ -714,6 +715,7 @@ def _handshake(address: str) -> None:
 
 def _close(client: Any, cluster: Any) -> None:
     """Close what _connect opened, whatever state the cluster is in, quietly."""
+    import asyncio                                   # the dask path only
     for thing in (client, cluster):
         if thing is not None:
             with contextlib.suppress(Exception, asyncio.CancelledError):
@@ -747,6 +749,7 @@ def _run_tasks(client, chunk_fn, rows_for, args, todo, keeper, place, stop, temp
                where: str) -> None:
     """Submit the chunks `todo` to `client`'s cluster, and place and keep their checked
     results as they come, watching for Ctrl-C (`stop`) and a failing cluster."""
+    import asyncio                                   # the dask path only
     from dask.distributed import wait
     pending = iter(todo)
     futures: dict = {}
@@ -796,6 +799,7 @@ def _run_tasks(client, chunk_fn, rows_for, args, todo, keeper, place, stop, temp
 
 def _threads(client: Any, where: str) -> int:
     """The number of worker threads `client`'s cluster has now."""
+    import asyncio                                   # the dask path only
     try:
         return sum(client.nthreads().values())
     except (Exception, asyncio.CancelledError) as exc:
@@ -804,6 +808,7 @@ def _threads(client: Any, where: str) -> int:
 
 def _result(fut: Any, lo: int, hi: int, where: str, stop: threading.Event) -> Any:
     """A finished task's result, or ClusterFailed saying why there is none."""
+    import asyncio                                   # the dask path only
     from dask.distributed import KilledWorker
     try:
         return fut.result()

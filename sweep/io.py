@@ -9,12 +9,14 @@ import re
 import stat
 import tempfile
 from pathlib import Path
-
-import xarray as xr
+from typing import TYPE_CHECKING
 
 from .errors import UserError
 from .files import free_bytes, fsync_directory, mib
 from .store import store_path
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 
 def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:

@@ -9,21 +9,34 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import xarray as xr
 
 from . import models
 from .errors import UserError
 from .io import check_output_path, remove_stale_temporaries, write_netcdf
 from .scene import Scene
 
+if TYPE_CHECKING:
+    import xarray as xr
+
 # Kept importable from here (benchmarks and scripts use them): the transverse model's kernel
-# entry points and the runner's point order and resource checks.
-from .models.transverse import (ATOL_SCALE, KernelResult, sample_times,  # noqa: F401,E402
-                                settings_vector, solve_points)
-from .runner import (available_memory, check_disk, check_memory, grid_order,  # noqa: F401,E402
-                     point_order, run_options)
+# entry points and the runner's point order and resource checks. Imported on first use
+# (PEP 562), so that `import sweep` (and `sweep --help`, `sweep scenes`) loads neither xarray
+# nor numba.
+_REEXPORTED = {name: "sweep.models.transverse" for name in
+               ("ATOL_SCALE", "KernelResult", "sample_times", "settings_vector", "solve_points")}
+_REEXPORTED.update({name: "sweep.runner" for name in
+                    ("available_memory", "check_disk", "check_memory", "grid_order",
+                     "point_order", "run_options")})
+
+
+def __getattr__(name: str) -> Any:
+    if name in _REEXPORTED:
+        import importlib
+        return getattr(importlib.import_module(_REEXPORTED[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: bool = False,
@@ -43,6 +56,9 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     """
     if not isinstance(scene, Scene):
         raise UserError(f"sweep.run: expected a Scene from sweep.load_scene, got {type(scene).__name__}")
+    from .lazydask import defer
+    defer()                                       # no dask import unless the run uses dask
+    from .runner import run_options
     if output is not None:
         check_output_path(output, overwrite)
     if progress is None:

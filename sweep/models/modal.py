@@ -21,10 +21,14 @@ Two coefficient sets (docs/model.md sec. 2):
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
+
+import sys
 
 import numpy as np
-import xarray as xr
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 from ..schema import STANDARD_GRAVITY
 from . import excitation
@@ -113,8 +117,8 @@ def escape_barrier(k: Any, g: Any, h: Any, length: Any) -> Any:
         q2 = (-g - np.sqrt(g * g - 4.0 * h * k)) / (2.0 * h)
         q_b = np.sqrt(q2)
         valid = (h < 0) & (k > 0) & (np.pi * q_b / length <= MAX_SLOPE)
-        if any(isinstance(v, xr.DataArray) for v in (k, g, h, length)):
-            return xr.where(valid, q_b, np.nan)
+        if any(_is_dataarray(v) for v in (k, g, h, length)):
+            return sys.modules["xarray"].where(valid, q_b, np.nan)
         return np.where(valid, q_b, np.nan)[()]
 
 
@@ -134,7 +138,7 @@ def state_scale(q0: Any, v0: Any, omega: Any, bound: Any, forcing: Any = 0.0,
     with np.errstate(divide="ignore", invalid="ignore"):
         driven = np.abs(forcing) / np.maximum(omega * omega, base_omega * base_omega)
     scale = np.maximum(np.maximum(np.abs(q0), np.abs(v0) / omega), driven)
-    scale = xr.where(scale > 0, scale, bound) if isinstance(scale, xr.DataArray) \
+    scale = sys.modules["xarray"].where(scale > 0, scale, bound) if _is_dataarray(scale) \
         else np.where(scale > 0, scale, bound)[()]
     return scale, omega * scale
 
@@ -265,7 +269,7 @@ def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> d
 
 def _finite_or_nan(value: Any) -> Any:
     """value with its infinities (and NaNs) as NaN: a float, array or DataArray."""
-    if isinstance(value, xr.DataArray):
+    if _is_dataarray(value):
         return value.where(np.isfinite(value))
     return np.where(np.isfinite(value), value, np.nan)[()]
 
@@ -310,9 +314,17 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
     return out
 
 
+def _is_dataarray(value: Any) -> bool:
+    """Whether `value` is an xarray.DataArray, without importing xarray (the scene rules use
+    these functions on plain floats; a DataArray exists only once xarray is imported)."""
+    xr = sys.modules.get("xarray")
+    return xr is not None and isinstance(value, xr.DataArray)
+
+
 def modal_frequencies(natural_frequency: Any, n_modes: int) -> xr.DataArray:
     """n^2 f1 (Hz) for n = 1..n_modes on a dimension `mode`: the linear natural frequencies of
     the unloaded span's modes (w_n = n^2 w1), natural_frequency being f1 (Hz, a float or a
     DataArray over some axes)."""
+    import xarray as xr
     n = xr.DataArray(np.arange(1, n_modes + 1), dims="mode")
     return (n * n * natural_frequency).astype(float)

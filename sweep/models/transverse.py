@@ -426,7 +426,6 @@ def modal_rows(inputs: Inputs, points: np.ndarray) -> np.ndarray:
 def _system(inputs: Inputs, settings: np.ndarray) -> _System:
     """How the runner drives the System of `inputs`: the one-mode oscillator (model.modes = 1)
     or the N-mode model (`modal_rows`)."""
-    from sweep.kernels import modes as md
     from sweep.kernels import oscillator as osc
 
     from ..execute import modes_chunk, modes_outputs, transverse_chunk, transverse_outputs
@@ -449,6 +448,7 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
         return _System(rows_at, transverse_chunk, (settings, n_samples, inputs.driver) + swept,
                        lambda m: transverse_outputs(m, n_samples, n_bands), carry)
 
+    from sweep.kernels import modes as md      # the N-mode System: only when it runs
     carry = None if inputs.continuation is None else Carry(
         state=tuple(range(md.N_FIXED, md.N_FIXED + 2 * n)), base_phase=md.BASE_PHASE,
         load_phase=md.LOAD_PHASE, base_omega=md.BASE_OMEGA, load_omega=md.OMEGA,

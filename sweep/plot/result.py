@@ -83,6 +83,8 @@ def load_result(path: str | os.PathLike) -> xr.Dataset:
     an unreadable (truncated, corrupted) file, and for a netCDF that is not a cable-sweep
     result or contradicts itself (`check_result`).
     """
+    from ..lazydask import defer
+    defer()                                       # reading a file needs no dask
     raw = os.fspath(path)
     where = f"result '{raw}'"
     p = Path(raw)

@@ -32,18 +32,37 @@ The package, one job a module (each re-exported name below keeps working from he
 
 from __future__ import annotations
 
-from ..models.rules import (BASE_FIX, BASE_FREQUENCY_KEYS, BASE_KEYS,  # noqa: F401
-                            BASE_LEVEL_KEYS, DEFAULT_FREQUENCY_RATIO, DEFAULT_T_END,
-                            DEFAULT_TRANSITS, END_TIME_KEYS, FREQUENCY_KEYS, LEVEL_LIMIT,
-                            LONGITUDINAL_AXES, LONGITUDINAL_LOAD, MAX_SAMPLES, PAIRS,
-                            PAPER_CABLE, PAPER_FIXED_AXES, PAPER_VELOCITY, default_inertia,
-                            has_base)
-from .axes import LOG_DIGITS, MAX_AXIS_POINTS, RANGE_KEYS, linear_range, log_range  # noqa: F401
-from .build import load_scene, load_scene_text
-from .document import Scene
-from .overrides import parse_override
-from .reading import MAX_SCENE_BYTES, _scenes_dir, builtin_scenes  # noqa: F401
-from .values import MAX_INT  # noqa: F401
+from typing import Any
+
+# Every name below is imported from its module on first use (PEP 562): `sweep scenes` reads the
+# built-in scenes without NumPy. name -> the module that defines it.
+_NAMES: dict[str, str] = {
+    **{name: "sweep.models.rules" for name in (
+        "BASE_FIX", "BASE_FREQUENCY_KEYS", "BASE_KEYS", "BASE_LEVEL_KEYS",
+        "DEFAULT_FREQUENCY_RATIO", "DEFAULT_T_END", "DEFAULT_TRANSITS", "END_TIME_KEYS",
+        "FREQUENCY_KEYS", "LEVEL_LIMIT", "LONGITUDINAL_AXES", "LONGITUDINAL_LOAD", "MAX_SAMPLES",
+        "PAIRS", "PAPER_CABLE", "PAPER_FIXED_AXES", "PAPER_VELOCITY", "default_inertia",
+        "has_base")},
+    **{name: "sweep.scene.axes" for name in (
+        "LOG_DIGITS", "MAX_AXIS_POINTS", "RANGE_KEYS", "linear_range", "log_range")},
+    "load_scene": "sweep.scene.build", "load_scene_text": "sweep.scene.build",
+    "Scene": "sweep.scene.document", "parse_override": "sweep.scene.overrides",
+    "MAX_SCENE_BYTES": "sweep.scene.reading", "_scenes_dir": "sweep.scene.reading",
+    "builtin_scenes": "sweep.scene.reading", "MAX_INT": "sweep.scene.values",
+}
 
 __all__ = ["Scene", "builtin_scenes", "has_base", "linear_range", "load_scene",
            "load_scene_text", "log_range", "parse_override"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _NAMES:
+        import importlib
+        value = getattr(importlib.import_module(_NAMES[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_NAMES))
