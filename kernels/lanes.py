@@ -140,11 +140,11 @@ def _prepare(W, settings, n_run):
     before t_end, within max_steps, and far above the minimum step (10 ulps of t or
     solver.min_step), so SciPy's clamp and failure cannot apply. Other lanes get W_FLAG = 1."""
     L = LANES
-    t_end = settings[T_END]
     max_step = settings[MAX_STEP]
     max_steps = settings[MAX_STEPS]
     min_user = settings[MIN_STEP]
     for j in range(n_run):
+        t_end = W[tj.T_FINAL * L + j]         # the lane's own end (solver.stop_when_steady)
         t = W[tj.T * L + j]
         h_abs = W[tj.H_ABS * L + j]
         fresh = W[tj.REJECTED_NOW * L + j] == 0.0
@@ -280,7 +280,6 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     LLVM vectorising it.
     """
     L = LANES
-    t_tail = settings[T_END] * (1.0 - settings[TAIL])
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
@@ -289,6 +288,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     n_extrema = 0
     n_near = 0
     for j in range(n_run):
+        t_tail = W[tj.T_TAIL * L + j]         # the lane's own tail window start
         h = W[W_H * L + j]
         active = h > 0.0
         err = W[W_ERR * L + j]
@@ -344,12 +344,11 @@ def _observe_acceleration(W, settings, n_run):
     a loop of its own so that `_finish` stays vectorised and scenes without base excitation
     do not pay for it."""
     L = LANES
-    t_tail = settings[T_END] * (1.0 - settings[TAIL])
     for j in range(n_run):
         done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
                 & (W[W_FLAG * L + j] == ORDINARY))
         tj.observe_acceleration(W, j, L, W[tj.T * L + j],
-                                W[tj.FV * L + j] + W[W_AB * L + j], t_tail, done)
+                                W[tj.FV * L + j] + W[W_AB * L + j], W[tj.T_TAIL * L + j], done)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

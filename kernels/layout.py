@@ -25,7 +25,12 @@ SWEPT = 16          # 1.0: the base frequency is swept (kernels.excitation's RAT
                     # sweep's outputs (metrics.sweep_metrics) are computed; 0.0: none
 BANDS_PER_OCTAVE = 17   # N of the response envelope's 1/N-octave bands (swept scenes)
 FIRST_BAND = 18     # the envelope's first band k: centre 1000 x 2^(k/N) Hz (base-2 bands)
-N_SETTINGS = 19
+STOP_STEADY = 19    # 1.0: a point whose response is steady (or has decayed) ends early, its
+                    # tail window moved to the STEADY_PERIODS periods after it was found so
+                    # (metrics.steady_period); 0.0, the default: every point runs to t_end
+STEADY_PERIODS = 20  # M: the periods the steadiness test spans and the moved tail window holds
+STEADY_TOL = 21     # eps: the test's tolerance on the extrema, relative to the amplitude
+N_SETTINGS = 22
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)
@@ -39,7 +44,9 @@ Q_END = 6           # q at the end of the run (m): where a stepped sweep's next 
 V_END = 7           # q' there (m/s); both NaN where the point failed
 PEAK_FREQUENCY = 8  # swept scenes: the excitation frequency (Hz) when |q| had its largest
                     # extremum; NaN otherwise
-N_REALS = 9
+STOP_TIME = 9       # with STOP_STEADY: when a point found steady ended (s, before t_end); NaN
+                    # for a point that ran to t_end
+N_REALS = 10
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -214,3 +214,71 @@ def sweep_metrics(p, o, s, buf, n, bands_per_octave, first_band, envelope):
         if 0 <= b < envelope.shape[0] and not envelope[b] >= q:
             envelope[b] = q
     return ex.frequency(t_best, p, o, s) if best >= 0.0 else math.nan
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _lag_holds(buf, n, m, k, bound):
+    """Whether the last 2 (m + 1) k extrema buf[n - 2 (m + 1) k : n] repeat with a lag of k
+    maxima (2k entries: maxima and minima alternate): every one within `bound` (m) of the
+    latest of its class (its position mod 2k), and each class's drift still to come, if its
+    approach to that level is geometric, within `bound` too: d r / (1 - r), d its newest
+    difference, r the mean ratio of its successive differences over the window (classes
+    whose differences change sign wander within round-off: no drift)."""
+    lag = 2 * k
+    last = n - 1
+    for c in range(lag):
+        level = buf[last - c, EXT_Q]
+        newest = 0.0
+        oldest = 0.0
+        one_way = True
+        for r in range(1, m + 1):
+            q = buf[last - c - lag * r, EXT_Q]
+            if abs(q - level) > bound:
+                return False
+            d = buf[last - c - lag * (r - 1), EXT_Q] - q
+            if r == 1:
+                newest = d
+            elif (d > 0.0) != (newest > 0.0) or d == 0.0:
+                one_way = False
+            oldest = d
+        if one_way and newest != 0.0 and m > 1:
+            ratio = abs(newest / oldest) ** (1.0 / (m - 1))
+            if not ratio < 1.0:
+                return False
+            if abs(newest) * ratio / (1.0 - ratio) > bound:
+                return False
+    return True
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def steady_period(buf, n, m, eps, peak):
+    """The early stop's test (solver.stop_when_steady), at a maximum of q (buf[n - 1]): the
+    response period (s) when the response is steady or has decayed, else 0.0.
+
+    Over the last m + 1 periods, of k maxima each (k = 1 .. MAX_ORDER: a response with
+    several maxima a period, superharmonic or period-k): A is the largest |q| of their
+    extrema (m). Decayed: A <= eps x peak (the run's max |q| so far). Steady: the extrema
+    repeat with a lag of k maxima to within eps x A, the drift still to come included
+    (`_lag_holds`). The smallest k that holds gives the period, over the window's m periods.
+    A beating or quasi-periodic response keeps its extrema apart at every lag and never
+    passes; a transient passes only once the rest of its approach is below eps x A."""
+    if n < 1 or buf[n - 1, EXT_KIND] != MAXIMUM:
+        return 0.0
+    amp = 0.0
+    scanned = 0
+    for k in range(1, MAX_ORDER + 1):
+        need = 2 * (m + 1) * k
+        if n < need:
+            return 0.0
+        for j in range(scanned, need):        # the window grows with k: scan the new part
+            kind = buf[n - 1 - j, EXT_KIND]
+            if (kind == MAXIMUM) != (j % 2 == 0):
+                return 0.0                    # maxima and minima do not alternate here
+            amp = max(amp, abs(buf[n - 1 - j, EXT_Q]))
+        scanned = need
+        period = (buf[n - 1, EXT_T] - buf[n - 1 - 2 * k * m, EXT_T]) / m
+        if amp <= eps * peak:
+            return period                     # decayed
+        if _lag_holds(buf, n, m, k, eps * amp):
+            return period
+    return 0.0

@@ -28,7 +28,8 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR
                      dense_coefficients, dense_root, dense_value, initial_step, pi_log2_err,
                      pi_step_factor, step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
-                     MIN_STEP, RTOL, SAMPLE_DT, TAIL, T_END)
+                     MIN_STEP, RTOL, SAMPLE_DT, STEADY_PERIODS, STEADY_TOL, STOP_STEADY, TAIL,
+                     T_END)
 from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
 from .stages import InlineWhereTrue
 from .vecmath import log2_fast
@@ -64,7 +65,10 @@ ACC_2 = 26          # q'' + a_b at the end of the step before (m/s^2; NaN before
 T_2 = 27            # ... its time (s)
 ACC_STEP = 28       # the accepted-step count when ACC_1 was sampled (its samples are consecutive
                     # steps' ends only if the next sample comes one step later)
-N_SLOTS = 29
+T_TAIL = 29         # this trajectory's tail window start (s): t_end (1 - tail), or, once found
+                    # steady (settings STOP_STEADY), the maximum where it was found so
+T_FINAL = 30        # this trajectory's end time (s): t_end, or the moved tail window's end
+N_SLOTS = 31
 
 # The PI controller's memory before the first accepted step: pi_log2_err(PI_MIN_ERR_PREV),
 # computed once here (the same arithmetic in Python) rather than compiled into `start`.
@@ -173,6 +177,8 @@ def begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, bou
     acc[ACC_2] = math.nan
     acc[T_2] = math.nan
     acc[ACC_STEP] = 0.0
+    acc[T_TAIL] = t_tail
+    acc[T_FINAL] = t_end
     if not abs(q) <= bound:
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = 0.0
@@ -185,7 +191,7 @@ def next_attempt(settings, acc):
     if acc[STATUS] != mt.RUNNING:
         return 0.0
     t = acc[T]
-    t_end = settings[T_END]
+    t_end = acc[T_FINAL]
     if t >= t_end:
         return 0.0
     min_step = max(10.0 * abs(np.nextafter(t, math.inf) - t), settings[MIN_STEP])
@@ -382,7 +388,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     t_new = acc[T_NEW]
     q_old = acc[Q]
     v_old = acc[V]
-    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    t_tail = acc[T_TAIL]
     bound = p[o + BOUND * s]
 
     if not (abs(q_new) <= bound and math.isfinite(v_new)):
@@ -422,6 +428,9 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qe))
             acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qe)
             acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qe)
+        if (settings[STOP_STEADY] != 0.0 and kind == mt.MAXIMUM
+                and acc[T_FINAL] == settings[T_END]):
+            t_tail = _stop_when_steady(settings, acc, buf, te, qe, t_tail)
 
     if t < t_tail <= t_new:
         if not have_qc:
@@ -459,6 +468,27 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     acc[V] = v_new
     acc[FQ] = K[K.shape[0] - 1, 0]
     acc[FV] = K[K.shape[0] - 1, 1]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _stop_when_steady(settings, acc, buf, te, qe, t_tail):
+    """At a maximum of q at te (s, q = qe m), with settings[STOP_STEADY]: if the extrema say
+    the response is steady or has decayed (`metrics.steady_period`), move the trajectory's
+    tail window to start here and end M periods later (M = settings[STEADY_PERIODS]), where
+    the trajectory then ends, when that is before its end time: the tail's metrics restart
+    from this maximum. Returns the tail window's start (s)."""
+    period = mt.steady_period(buf, int(acc[N_EXT]), int(settings[STEADY_PERIODS]),
+                              settings[STEADY_TOL], acc[PEAK])
+    end = te + settings[STEADY_PERIODS] * period
+    if not (period > 0.0 and end < acc[T_FINAL]):
+        return t_tail
+    acc[T_TAIL] = te
+    acc[T_FINAL] = end
+    acc[TAIL_AMP] = abs(qe)
+    acc[TAIL_QMIN] = qe
+    acc[TAIL_QMAX] = qe
+    acc[ACC_AMP] = 0.0
+    return te
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

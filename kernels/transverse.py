@@ -28,8 +28,8 @@ from .dopri5 import MIN_RTOL, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
 from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FIRST_BAND,
                      N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
-                     METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, T_END, TAIL, TOL,
-                     WANT_SETTLING)
+                     METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, STOP_TIME, T_END,
+                     TAIL, TOL, WANT_SETTLING)
 from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepare,
                          stiffness)
 
@@ -126,7 +126,10 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
     reals[V_END] = acc[tj.V]
     want_settling = settings[WANT_SETTLING] != 0.0
     tol = settings[TOL]
-    t_tail = settings[T_END] * (1.0 - settings[TAIL])
+    t_tail = acc[tj.T_TAIL]          # t_end (1 - tail), or where the point was found steady
+    t_end = acc[tj.T_FINAL]
+    if t_end < settings[T_END]:
+        reals[STOP_TIME] = t_end
     tail_amp = acc[tj.TAIL_AMP]
     peak = acc[tj.PEAK]
     n_ext = int(acc[tj.N_EXT])
@@ -155,7 +158,7 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
             if want_settling:
                 reals[SETTLING] = t_settle
             return mt.STEADY
-        if mt.tail_trend(buf, n_ext, t_tail, settings[T_END]):
+        if mt.tail_trend(buf, n_ext, t_tail, t_end):
             return mt.UNSETTLED
         return mt.MODULATED
     if acc[tj.TAIL_QMAX] - acc[tj.TAIL_QMIN] <= band and resting:

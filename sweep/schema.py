@@ -167,6 +167,19 @@ KEYS: tuple[Key, ...] = (
         long_name="smallest step allowed before a point fails (default: SciPy's 10 ulps of t)"),
     Key("solver", "first_step", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="first step (default: SciPy's initial-step selection)"),
+    Key("solver", "stop_when_steady", "bool", False,
+        long_name="end a point early once its response is steady or has decayed: at a maximum "
+                  "where the last steady_periods + 1 maxima and minima lie within "
+                  "steady_tolerance x the amplitude of their last level, drift still to come "
+                  "included; the tail window then becomes the steady_periods periods after "
+                  "it (stop_time says when each point ended)"),
+    Key("solver", "steady_periods", "int", 10, units="1", minimum=2, maximum=1000,
+        long_name="with stop_when_steady: the periods the steadiness test spans and the moved "
+                  "tail window holds"),
+    Key("solver", "steady_tolerance", "float", 1e-4, units="1", minimum=0.0,
+        exclusive_min=True, maximum=0.01,
+        long_name="with stop_when_steady: the test's tolerance on the extrema, relative to the "
+                  "amplitude (a decayed point: to the peak)"),
     # [metrics]
     Key("metrics", "tail", "float", 0.5, units="1", minimum=0.0, exclusive_min=True,
         maximum=1.0, long_name="tail window as a fraction of t_end"),

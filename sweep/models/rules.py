@@ -336,6 +336,7 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
     _check_modes(given, axes)
     _check_continuation(given, axes)
     _check_stability(given)
+    _check_steady_stop(given, axes)
     if given.get("model.coefficients") == "paper":
         for axis in axes:
             if axis in PAPER_FIXED_AXES:
@@ -343,6 +344,27 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
         _check_paper_cable(given)
+
+
+def _check_steady_stop(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """solver.stop_when_steady (kernels/metrics.py `steady_period`): for the one-mode System at a
+    fixed excitation frequency, each point solved on its own; its two settings need it."""
+    if not given.get("solver.stop_when_steady"):
+        for dotted in ("solver.steady_periods", "solver.steady_tolerance"):
+            if dotted in given and given[dotted] != schema.BY_DOTTED[dotted].default:
+                _fail(f"scene key '{dotted}'", "needs solver.stop_when_steady = true",
+                      "add solver.stop_when_steady = true, or remove the key")
+        return
+    where = "scene key 'solver.stop_when_steady'"
+    if given.get("model.modes", 1) > 1:
+        _fail(where, "is built for one mode (model.modes = 1): the modal amplitudes of several "
+              "modes are not moved with the tail window", "remove it, or set model.modes = 1")
+    if given.get("continuation.axis") is not None:
+        _fail(where, "not for a stepped sweep ([continuation]): each dwell carries its end "
+              "state to the next", "remove it, or remove [continuation]")
+    if any(_present(d, given, axes) for d in SWEEP_KEYS):
+        _fail(where, "a swept base frequency is never steady", "remove it, or use a fixed "
+              "base.frequency")
 
 
 def _check_stability(given: dict[str, Any]) -> None:

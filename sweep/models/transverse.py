@@ -47,6 +47,10 @@ _REALS = {
                         "outputs.response_period"),
     "failure_time": (tk.FAILURE_TIME, "s", "time at which a diverged or failed point stopped",
                      None),
+    "stop_time": (tk.STOP_TIME, "s", "time at which a point found steady or decayed ended, its "
+                  "tail window the solver.steady_periods periods before it "
+                  "(solver.stop_when_steady); NaN: the point ran to t_end",
+                  "solver.stop_when_steady"),
 }
 _COUNTS = {
     "n_steps": (tk.STEPS, "accepted {method} steps"),
@@ -135,6 +139,10 @@ def settings_vector(scene: Scene) -> np.ndarray:
     s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
     if scene.has_base:                  # else 0.0: no forcing term compiled
         s[tk.BASE] = 1.0
+    if scene.get("solver.stop_when_steady"):
+        s[tk.STOP_STEADY] = 1.0
+        s[tk.STEADY_PERIODS] = scene.get("solver.steady_periods")
+        s[tk.STEADY_TOL] = scene.get("solver.steady_tolerance")
     if excitation.is_swept(scene.values, scene.swept):
         s[tk.SWEPT] = 1.0
         s[tk.BANDS_PER_OCTAVE], s[tk.FIRST_BAND] = scene.get("outputs.bands_per_octave"), 0.0
@@ -231,7 +239,9 @@ def resolve(scene: Scene) -> Inputs:
     coords = grid.coordinates(scene)
     dims = grid.dimensions(coords)
     settings = settings_vector(scene)
-    wanted = frozenset(k for k in scene.values if k.startswith("outputs.") and scene.get(k) is True)
+    wanted = frozenset(k for k in scene.values if (k.startswith("outputs.")
+                                                    or k == "solver.stop_when_steady")
+                       and scene.get(k) is True)
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
              if "outputs.time_series" in wanted else np.empty(0))
     params = grid.parameters(scene, coords)
