@@ -97,7 +97,12 @@ def test_damaged_and_foreign_chunks_are_recomputed_in_one_line(tmp_path, whole):
     chunks[0].write_bytes(b"")                                        # empty
     chunks[1].write_bytes(chunks[1].read_bytes()[:300])              # truncated
     raw = bytearray(chunks[2].read_bytes())
-    raw[len(raw) // 2] ^= 0x01                                        # one flipped bit
+    with np.load(chunks[2]) as data:                # one flipped bit, inside an array's data
+        payload = max((data[k] for k in data.files if not k.startswith("__")),
+                      key=lambda a: a.nbytes).tobytes()
+    at = bytes(raw).find(payload)
+    assert at > 0
+    raw[at + len(payload) // 2] ^= 0x01
     chunks[2].write_bytes(bytes(raw))
     chunks[3].write_bytes(chunks[4].read_bytes())                    # another range's
     with np.load(chunks[5]) as data:                                 # another run's
