@@ -44,8 +44,7 @@ from . import stages
 from . import trajectory as tj
 from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
-from .layout import (MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, T_END, TAIL, TOL,
-                     WANT_SETTLING)
+from .layout import MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root

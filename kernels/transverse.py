@@ -29,7 +29,7 @@ from .layout import *  # noqa: F401,F403  (settings and output layouts, re-expor
 from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FIRST_BAND,
                      N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
                      METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, STOP_TIME, T_END,
-                     TAIL, TOL, WANT_SETTLING)
+                     TOL, WANT_SETTLING)
 from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepare,
                          stiffness)
 

@@ -113,7 +113,7 @@ def sweep_grid(values: Mapping[str, Any], axes: Mapping[str, Any]) -> tuple[Any,
     """(start, stop, rate) of a swept scene over the combinations it solves (arrays that
     broadcast): the product of its sweep axes, [points] zipped on one dimension (`axes` a
     `Swept`; a plain mapping is all axes); scalars where not swept."""
-    swept = axes if isinstance(axes, Swept) else Swept(axes)
+    swept = Swept.of(axes)
     fixed = {a: values[d] for d, a in zip(SWEEP_KEYS, SWEEP_AXES)}
     shaped = swept.product(SWEEP_AXES, fixed)
     return shaped[0], shaped[1], shaped[2]

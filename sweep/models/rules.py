@@ -346,14 +346,22 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
         _check_paper_cable(given)
 
 
+def _refuse_without(given: dict[str, Any], dependents: tuple[str, ...], problem: str,
+                    fix: str) -> None:
+    """Refuse any of `dependents` given with a value other than its default, when the key they
+    depend on is absent (a default is accepted: a resolved scene writes every key out)."""
+    for dotted in dependents:
+        if dotted in given and given[dotted] != schema.BY_DOTTED[dotted].default:
+            _fail(f"scene key '{dotted}'", problem, fix)
+
+
 def _check_steady_stop(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """solver.stop_when_steady (kernels/metrics.py `steady_period`): for the one-mode System at a
     fixed excitation frequency, each point solved on its own; its two settings need it."""
     if not given.get("solver.stop_when_steady"):
-        for dotted in ("solver.steady_periods", "solver.steady_tolerance"):
-            if dotted in given and given[dotted] != schema.BY_DOTTED[dotted].default:
-                _fail(f"scene key '{dotted}'", "needs solver.stop_when_steady = true",
-                      "add solver.stop_when_steady = true, or remove the key")
+        _refuse_without(given, ("solver.steady_periods", "solver.steady_tolerance"),
+                        "needs solver.stop_when_steady = true",
+                        "add solver.stop_when_steady = true, or remove the key")
         return
     where = "scene key 'solver.stop_when_steady'"
     if given.get("model.modes", 1) > 1:
@@ -407,12 +415,10 @@ def _check_continuation(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     along a continued axis (every dwell restarts the clock)."""
     axis = given.get("continuation.axis")
     if axis is None:
-        for dotted in ("continuation.direction", "continuation.jump_ratio"):
-            # a default value is accepted (a resolved scene writes every key out)
-            if dotted in given and given[dotted] != schema.BY_DOTTED[dotted].default:
-                _fail(f"scene key '{dotted}'", "needs continuation.axis (the axis to step "
-                      "along)", "add continuation.axis = NAME, one of the scene's axes, or "
-                      "remove the key")
+        _refuse_without(given, ("continuation.direction", "continuation.jump_ratio"),
+                        "needs continuation.axis (the axis to step along)",
+                        "add continuation.axis = NAME, one of the scene's axes, or remove the "
+                        "key")
         return
     if axis not in axes:
         named = ", ".join(axes) if axes else "none"
@@ -619,7 +625,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     same-signed ones), so its largest and smallest magnitudes lie at corners. [points]
     entries are combinations of their own: every entry is a corner (`Swept.corners`)."""
     kind = values["model.kind"]
-    columns = (axes if isinstance(axes, Swept) else Swept(axes)).corners()
+    columns = Swept.of(axes).corners()
     params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
                               for name, key in schema.BY_AXIS.items()}
     if params["inertia"] is None:

@@ -30,6 +30,11 @@ class Swept(dict):
         self.update(points)
         self.zipped: frozenset[str] = frozenset(points)
 
+    @classmethod
+    def of(cls, axes: Mapping[str, np.ndarray]) -> "Swept":
+        """`axes` itself when it is a Swept, else a Swept of axes alone (no [points])."""
+        return axes if isinstance(axes, Swept) else cls(axes)
+
     def product(self, names: Iterable[str],
                 fixed: Mapping[str, Any]) -> list[np.ndarray]:
         """The values of `names` broadcast over the grid the run solves: one dimension per
