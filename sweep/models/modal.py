@@ -45,6 +45,22 @@ PARTICIPATION = 4.0 / np.pi
 int phi dx / int phi^2 dx over the span (docs/model.md sec. 5)."""
 
 
+def power(x: Any, n: int) -> Any:
+    """x**n for a whole n >= 1 by repeated squaring: each element rounded the same way whatever
+    the array's length or shape. NumPy's ``**`` on arrays may take a vectorised pow whose
+    results differ by an ulp from the one-element path, so a grid point would differ from the
+    same point run alone."""
+    result = None
+    square = x
+    while True:
+        if n & 1:
+            result = square if result is None else result * square
+        n >>= 1
+        if not n:
+            return result
+        square = square * square
+
+
 def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
     """Coefficients of the re-derived modal equation (docs/model.md sec. 2), m = 1.
 
@@ -56,17 +72,17 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
     k = np.pi / p["length"]
     ei = p["youngs_modulus"] * p["inertia"]
     rho_a = p["density"] * p["area"]
-    w1_sq = ei / rho_a * k ** 4
+    w1_sq = ei / rho_a * power(k, 4)
     w1 = np.sqrt(w1_sq)
     load = p["load_amplitude"]
     return {
         "mass": 1.0,
         "k": w1_sq,
-        "g": p["membrane"] * p["youngs_modulus"] / p["density"] * k ** 4
-        - 1.25 * ei / rho_a * k ** 6,
-        "h": -21.0 / 16.0 * ei / rho_a * k ** 8,
+        "g": p["membrane"] * p["youngs_modulus"] / p["density"] * power(k, 4)
+        - 1.25 * ei / rho_a * power(k, 6),
+        "h": -21.0 / 16.0 * ei / rho_a * power(k, 8),
         "k_load": -load * k ** 2 / rho_a,
-        "g_load": load * k ** 4 / (2.0 * rho_a),
+        "g_load": load * power(k, 4) / (2.0 * rho_a),
         "omega_1": w1,
         "buckling_load": ei * k ** 2,
         "omega_ref": w1,
@@ -83,15 +99,15 @@ def paper(p: Mapping[str, Any]) -> dict[str, Any]:
     l = p["length"]
     scale = p["load_amplitude"] / PAPER_LOAD
     k_static = 1.73 * np.pi ** 2 * l
-    k_cos = PAPER_COS_LINEAR[p["paper_parametric"]] * l ** 5
+    k_cos = PAPER_COS_LINEAR[p["paper_parametric"]] * power(l, 5)
     mass = 0.5 * l
     return {
         "mass": mass,
         "k": k_static,
-        "g": 6.6e5 * np.pi ** 2 * l ** 3 - 2.1 * np.pi ** 4 / l,
-        "h": 76.0 * np.pi ** 6 / l ** 3,
+        "g": 6.6e5 * np.pi ** 2 * power(l, 3) - 2.1 * np.pi ** 4 / l,
+        "h": 76.0 * np.pi ** 6 / power(l, 3),
         "k_load": -k_cos * scale,
-        "g_load": PAPER_COS_CUBIC[p["paper_parametric"]] * np.pi ** 2 * l ** 3 * scale,
+        "g_load": PAPER_COS_CUBIC[p["paper_parametric"]] * np.pi ** 2 * power(l, 3) * scale,
         "omega_1": np.sqrt(k_static / mass),
         "buckling_load": PAPER_LOAD * k_static / k_cos,
         "omega_ref": PAPER_OMEGA0,
@@ -287,7 +303,7 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
     """
     k = np.pi / p["length"]
     rho_a = p["density"] * p["area"]
-    w1_sq = p["youngs_modulus"] * p["inertia"] / rho_a * k ** 4
+    w1_sq = p["youngs_modulus"] * p["inertia"] / rho_a * power(k, 4)
     w1 = np.sqrt(w1_sq)
     load = p["load_amplitude"] * k ** 2 / rho_a
     harmonic = p["load_type"] == "harmonic"
@@ -296,7 +312,7 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
         "damping": 2.0 * p["damping_ratio"] * w1,
         "load_mean": 0.0 if harmonic else load,
         "load_cos": load if harmonic else 0.0,
-        "membrane": 4.0 * p["membrane"] * p["youngs_modulus"] / p["density"] * k ** 4,
+        "membrane": 4.0 * p["membrane"] * p["youngs_modulus"] / p["density"] * power(k, 4),
         "k_sq": k ** 2,
         "omega": one_mode["omega"],
         "bound": one_mode["bound"],
