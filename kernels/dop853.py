@@ -7,11 +7,14 @@ rejects the same steps as ``solve_ivp(method="DOP853")`` up to round-off. Twelve
 sides per attempt (the last, f(t + h, y_new), is the next step's first), against RK45's six,
 but steps about three times as long at the same error on this oscillator: fewer attempts.
 
-Dense output: not DOP853's seventh-order interpolant (three more right-hand sides a step) but
-the quintic Hermite interpolant of q through q, q' and q'' at both ends of the step
-(`hermite_coefficients`); q' is its derivative (a quartic). Its error is of order h^6
-(about 2e-5 (omega h)^6 of the amplitude at the step's middle), far below the tolerance at the
-steps DOP853 takes. The state is y = (q, q') in (m, m/s).
+Dense output: DOP853's own seventh-order interpolant (`extra_stages`, `dense_coefficients`),
+as SciPy's `Dop853DenseOutput`: three more right-hand sides, paid only on a step whose dense
+output something needs (an extremum of q, the tail's start, a threshold crossing, a time-series
+sample), so its amplitudes are those of SciPy's DOP853 to round-off at every tolerance. The
+modal drivers, whose midspan deflection is a projection of N modes, use the quintic Hermite
+interpolant of q through q, q' and q'' at both ends of the step (`hermite_coefficients`; error
+of order h^6, about 2e-5 (omega h)^6 of the amplitude at the step's middle), which needs no
+further stage. The state is y = (q, q') in (m, m/s).
 
 Coefficients: SciPy's `dop853_coefficients` (BSD-3-Clause), from Hairer's DOP853 Fortran code.
 """
@@ -22,6 +25,7 @@ import numba as nb
 import numpy as np
 
 from .dopri5 import explicit_rk_step
+from .oscillator import acceleration
 
 N_STAGES = 12
 ERROR_ESTIMATOR_ORDER = 7
@@ -105,6 +109,87 @@ A[12, 11] = 4.47106157277725905176885569043e-2
 B = A[N_STAGES].copy()
 A = A[:N_STAGES].copy()
 
+# The dense output's three extra stages (rows N_STAGES + 1 .. N_STAGES_EXTENDED - 1 of the
+# extended K; row N_STAGES is f(t + h, y_new)) and its interpolator matrix D.
+N_STAGES_EXTENDED = 16
+RHS_DENSE = N_STAGES_EXTENDED - N_STAGES - 1     # right-hand sides the dense output adds
+C_EXTRA = np.array([0.1, 0.2, 7.0 / 9.0])
+A_EXTRA = np.zeros((RHS_DENSE, N_STAGES_EXTENDED))
+A_EXTRA[0, 0] = 5.61675022830479523392909219681e-2
+A_EXTRA[0, 6] = 2.53500210216624811088794765333e-1
+A_EXTRA[0, 7] = -2.46239037470802489917441475441e-1
+A_EXTRA[0, 8] = -1.24191423263816360469010140626e-1
+A_EXTRA[0, 9] = 1.5329179827876569731206322685e-1
+A_EXTRA[0, 10] = 8.20105229563468988491666602057e-3
+A_EXTRA[0, 11] = 7.56789766054569976138603589584e-3
+A_EXTRA[0, 12] = -8.298e-3
+A_EXTRA[1, 0] = 3.18346481635021405060768473261e-2
+A_EXTRA[1, 5] = 2.83009096723667755288322961402e-2
+A_EXTRA[1, 6] = 5.35419883074385676223797384372e-2
+A_EXTRA[1, 7] = -5.49237485713909884646569340306e-2
+A_EXTRA[1, 10] = -1.08347328697249322858509316994e-4
+A_EXTRA[1, 11] = 3.82571090835658412954920192323e-4
+A_EXTRA[1, 12] = -3.40465008687404560802977114492e-4
+A_EXTRA[1, 13] = 1.41312443674632500278074618366e-1
+A_EXTRA[2, 0] = -4.28896301583791923408573538692e-1
+A_EXTRA[2, 5] = -4.69762141536116384314449447206
+A_EXTRA[2, 6] = 7.68342119606259904184240953878
+A_EXTRA[2, 7] = 4.06898981839711007970213554331
+A_EXTRA[2, 8] = 3.56727187455281109270669543021e-1
+A_EXTRA[2, 12] = -1.39902416515901462129418009734e-3
+A_EXTRA[2, 13] = 2.9475147891527723389556272149
+A_EXTRA[2, 14] = -9.15095847217987001081870187138
+
+D = np.zeros((4, N_STAGES_EXTENDED))
+D[0, 0] = -0.84289382761090128651353491142e+1
+D[0, 5] = 0.56671495351937776962531783590
+D[0, 6] = -0.30689499459498916912797304727e+1
+D[0, 7] = 0.23846676565120698287728149680e+1
+D[0, 8] = 0.21170345824450282767155149946e+1
+D[0, 9] = -0.87139158377797299206789907490
+D[0, 10] = 0.22404374302607882758541771650e+1
+D[0, 11] = 0.63157877876946881815570249290
+D[0, 12] = -0.88990336451333310820698117400e-1
+D[0, 13] = 0.18148505520854727256656404962e+2
+D[0, 14] = -0.91946323924783554000451984436e+1
+D[0, 15] = -0.44360363875948939664310572000e+1
+D[1, 0] = 0.10427508642579134603413151009e+2
+D[1, 5] = 0.24228349177525818288430175319e+3
+D[1, 6] = 0.16520045171727028198505394887e+3
+D[1, 7] = -0.37454675472269020279518312152e+3
+D[1, 8] = -0.22113666853125306036270938578e+2
+D[1, 9] = 0.77334326684722638389603898808e+1
+D[1, 10] = -0.30674084731089398182061213626e+2
+D[1, 11] = -0.93321305264302278729567221706e+1
+D[1, 12] = 0.15697238121770843886131091075e+2
+D[1, 13] = -0.31139403219565177677282850411e+2
+D[1, 14] = -0.93529243588444783865713862664e+1
+D[1, 15] = 0.35816841486394083752465898540e+2
+D[2, 0] = 0.19985053242002433820987653617e+2
+D[2, 5] = -0.38703730874935176555105901742e+3
+D[2, 6] = -0.18917813819516756882830838328e+3
+D[2, 7] = 0.52780815920542364900561016686e+3
+D[2, 8] = -0.11573902539959630126141871134e+2
+D[2, 9] = 0.68812326946963000169666922661e+1
+D[2, 10] = -0.10006050966910838403183860980e+1
+D[2, 11] = 0.77771377980534432092869265740
+D[2, 12] = -0.27782057523535084065932004339e+1
+D[2, 13] = -0.60196695231264120758267380846e+2
+D[2, 14] = 0.84320405506677161018159903784e+2
+D[2, 15] = 0.11992291136182789328035130030e+2
+D[3, 0] = -0.25693933462703749003312586129e+2
+D[3, 5] = -0.15418974869023643374053993627e+3
+D[3, 6] = -0.23152937917604549567536039109e+3
+D[3, 7] = 0.35763911791061412378285349910e+3
+D[3, 8] = 0.93405324183624310003907691704e+2
+D[3, 9] = -0.37458323136451633156875139351e+2
+D[3, 10] = 0.10409964950896230045147246184e+3
+D[3, 11] = 0.29840293426660503123344363579e+2
+D[3, 12] = -0.43533456590011143754432175058e+2
+D[3, 13] = 0.96324553959188282948394950600e+2
+D[3, 14] = -0.39177261675615439165231486172e+2
+D[3, 15] = -0.14972683625798562581422125276e+3
+
 # Error estimators (length N_STAGES + 1; f(t + h, y_new) has weight 0 in both).
 E3 = np.zeros(N_STAGES + 1)
 E3[:-1] = B
@@ -181,7 +266,7 @@ def hermite_terms(q0, v0, a0, q1, v1, a1, h):
 def hermite_coefficients(q0, v0, a0, q1, v1, a1, h, Qc):
     """The quintic Hermite interpolant (`hermite_terms`) in the layout of
     dopri5.dense_coefficients: q(x) = q0 + h x (Qc[0, 0] + x (Qc[0, 1] + ...)), and its
-    derivative q'(x) = v0 + h x (Qc[1, 0] + ...), a quartic (Qc[1, 4] = 0)."""
+    derivative q'(x) = v0 + h x (Qc[1, 0] + ...), a quartic (Qc[1, 4:] = 0, Qc[0, 5:] = 0)."""
     c3, c4, c5 = hermite_terms(q0, v0, a0, q1, v1, a1, h)
     Qc[0, 0] = v0
     Qc[0, 1] = 0.5 * h * a0
@@ -193,3 +278,61 @@ def hermite_coefficients(q0, v0, a0, q1, v1, a1, h, Qc):
     Qc[1, 2] = 4.0 * c4 / (h * h)
     Qc[1, 3] = 5.0 * c5 / (h * h)
     Qc[1, 4] = 0.0
+    Qc[0, 5] = 0.0
+    Qc[0, 6] = 0.0
+    Qc[1, 5] = 0.0
+    Qc[1, 6] = 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def extra_stages(t, q0, v0, h, p, o, s, K, fast, parametric, base):
+    """The dense output's three extra stages of the accepted step of size h (s) from t (s),
+    (q0, v0) (m, m/s): K (N_STAGES_EXTENDED, 2) holds the step's stages in rows 0..N_STAGES
+    (row N_STAGES: f(t + h, y_new)); rows N_STAGES + 1.. are filled, as SciPy's
+    `DOP853._dense_output_impl`. p[o + column * s]: the point's prepared row; fast: the
+    right-hand side's cosine switch (oscillator.acceleration)."""
+    for r in range(RHS_DENSE):
+        row = N_STAGES + 1 + r
+        dq = 0.0
+        dv = 0.0
+        for j in range(row):
+            dq += K[j, 0] * A_EXTRA[r, j]
+            dv += K[j, 1] * A_EXTRA[r, j]
+        q = q0 + dq * h
+        v = v0 + dv * h
+        K[row, 0] = v
+        K[row, 1] = acceleration(t + C_EXTRA[r] * h, q, v, p, o, s, fast, parametric, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def dense_coefficients(K, h, q0, v0, q1, v1, Qc):
+    """DOP853's seventh-order interpolant of the step of size h (s) from (q0, v0) to (q1, v1)
+    in the layout of dopri5.dense_coefficients: y_i(x) = y_i(0) + h x (Qc[i, 0] + x (Qc[i, 1]
+    + ... + x Qc[i, 6])), x = (t - t_old)/h; K: the extended stages, `extra_stages` done.
+
+    SciPy's Dop853DenseOutput writes it as y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 +
+    x (F4 + (1 - x) (F5 + x F6)))))) with F0 = dy, F1 = h f_old - dy, F2 = 2 dy - h (f_new +
+    f_old) and F3..F6 = h D K; expanding the nested products gives the powers of x below."""
+    for i in range(2):
+        dy = (q1 - q0) if i == 0 else (v1 - v0)
+        f0 = dy
+        f1 = h * K[0, i] - dy
+        f2 = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
+        f3 = 0.0
+        f4 = 0.0
+        f5 = 0.0
+        f6 = 0.0
+        for j in range(N_STAGES_EXTENDED):
+            f3 += D[0, j] * K[j, i]
+            f4 += D[1, j] * K[j, i]
+            f5 += D[2, j] * K[j, i]
+            f6 += D[3, j] * K[j, i]
+        # the h of h D K and the 1/h of the layout cancel
+        inv_h = 1.0 / h
+        Qc[i, 0] = (f0 + f1) * inv_h
+        Qc[i, 1] = (f2 - f1) * inv_h + f3
+        Qc[i, 2] = -f2 * inv_h - 2.0 * f3 + f4 + f5
+        Qc[i, 3] = f3 - 2.0 * f4 - 3.0 * f5 + f6
+        Qc[i, 4] = f4 + 3.0 * f5 - 3.0 * f6
+        Qc[i, 5] = 3.0 * f6 - f5
+        Qc[i, 6] = -f6

@@ -201,24 +201,30 @@ def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, o, s, ord
     return min(100.0 * h0, h1, interval, max_step)
 
 
+DENSE_TERMS = 7     # columns of an interpolant's coefficient array: up to degree 7 in x
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def dense_coefficients(K, Q):
-    """Q[:, :4] = K^T P: the quartic interpolant of the last step; Q has shape (2, 5), the
-    layout of a quintic (dop853.hermite_coefficients), and Q[:, 4] = 0."""
+    """Q[:, :4] = K^T P: the quartic interpolant of the last step; Q has shape (2, DENSE_TERMS),
+    the layout of DOP853's seventh-order interpolant (dop853.dense_coefficients), and
+    Q[:, 4:] = 0."""
     for i in range(2):
         for k in range(4):
             s = 0.0
             for j in range(N_STAGES + 1):
                 s += K[j, i] * P[j, k]
             Q[i, k] = s
-        Q[i, 4] = 0.0
+        for k in range(4, DENSE_TERMS):
+            Q[i, k] = 0.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def dense_value(y_old_i, h, c, x):
     """One component of the interpolant at x = (t - t_old)/h in [0, 1]: y_old_i its value at
-    the step's start, c its row of dense_coefficients or dop853.hermite_coefficients (Q[i])."""
-    return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * c[4])))))
+    the step's start, c its row of dense_coefficients or dop853's (Q[i])."""
+    return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * (
+        c[4] + x * (c[5] + x * c[6])))))))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -13,9 +13,10 @@ These loops run across the lanes with straight-line arithmetic, so LLVM vectoris
 - `_pi_factors`: the PI controller's step-size factors (only when that controller is chosen);
 - `_finish`: accept/reject and the step-size update of every lane, and the metrics of an
   ordinary accepted step;
-- `_locate_extrema` (`_locate_extrema8` for DOP853's Hermite interpolant): for the steps that
-  hold an extremum of q, where it lies on the dense output (safeguarded Newton), run only when
-  some lane has one.
+- `_locate_extrema`: for the RK45 steps that hold an extremum of q, where it lies on the dense
+  output (safeguarded Newton), run only when some lane has one. A DOP853 step that holds one is
+  located by trajectory.record_step on DOP853's own seventh-order interpolant, whose three extra
+  right-hand sides it computes for that lane alone.
 
 Whatever else is not ordinary (a lane's first or last step, a step near SciPy's minimum, the
 extremum's bookkeeping, the tail's start, a time-series sample, a threshold crossing, a
@@ -42,7 +43,7 @@ from . import dop853
 from . import metrics as mt
 from . import stages
 from . import trajectory as tj
-from .dopri5 import (A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
+from .dopri5 import (DENSE_TERMS, A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
                      RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
 from .layout import MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
@@ -74,7 +75,8 @@ W_XE = W_QN + 4                   # the accepted step's extremum of q: x = (t - 
 W_QE = W_QN + 5                   # q there (m)
 W_FACTOR = W_QN + 6               # the PI controller's step-size factor for the attempt
 W_AB = W_QN + 7                   # base excitation a_b(t + h) at the attempt's end (m/s^2)
-W_ROWS = W_QN + 8
+W_K8 = W_QN + 8                   # DOP853's stage s = 1 .. 11, component c at row W_K8 + 2 (s - 1) + c
+W_ROWS = W_K8 + 2 * (dop853.N_STAGES - 1)
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -211,9 +213,9 @@ def _attempt(W, rtol, n_run, parametric, base):
 def _attempt8(W, rtol, n_run, parametric, base):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
-    (W_K + 12, W_K + 13) and SciPy's DOP853 error norm from dop853.E5, E3 (W_ERR). The other
-    stages stay in registers: the DOP853 dense output needs only the step's ends
-    (dop853.hermite_coefficients).
+    (W_K + 12, W_K + 13), stages 1 .. 11 in W_K8 (the dense output of a step that needs one,
+    dop853.dense_coefficients, is built from them by trajectory.record_step) and SciPy's DOP853
+    error norm from dop853.E5, E3 (W_ERR).
     """
     L = LANES
     for j in range(n_run):
@@ -237,6 +239,28 @@ def _attempt8(W, rtol, n_run, parametric, base):
         sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
         W[(W_K + 12) * L + j] = vn
         W[(W_K + 13) * L + j] = kv[dop853.N_STAGES]
+        W[(W_K8 + 0) * L + j] = kq[1]
+        W[(W_K8 + 1) * L + j] = kv[1]
+        W[(W_K8 + 2) * L + j] = kq[2]
+        W[(W_K8 + 3) * L + j] = kv[2]
+        W[(W_K8 + 4) * L + j] = kq[3]
+        W[(W_K8 + 5) * L + j] = kv[3]
+        W[(W_K8 + 6) * L + j] = kq[4]
+        W[(W_K8 + 7) * L + j] = kv[4]
+        W[(W_K8 + 8) * L + j] = kq[5]
+        W[(W_K8 + 9) * L + j] = kv[5]
+        W[(W_K8 + 10) * L + j] = kq[6]
+        W[(W_K8 + 11) * L + j] = kv[6]
+        W[(W_K8 + 12) * L + j] = kq[7]
+        W[(W_K8 + 13) * L + j] = kv[7]
+        W[(W_K8 + 14) * L + j] = kq[8]
+        W[(W_K8 + 15) * L + j] = kv[8]
+        W[(W_K8 + 16) * L + j] = kq[9]
+        W[(W_K8 + 17) * L + j] = kv[9]
+        W[(W_K8 + 18) * L + j] = kq[10]
+        W[(W_K8 + 19) * L + j] = kv[10]
+        W[(W_K8 + 20) * L + j] = kq[11]
+        W[(W_K8 + 21) * L + j] = kv[11]
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
@@ -437,30 +461,6 @@ def _locate_extrema(W, n_run):
         W[W_QE * L + j] = q0 + h * (x * (cq0 + x * (cq1 + x * (cq2 + x * cq3))))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _locate_extrema8(W, n_run):
-    """`_locate_extrema` after a DOP853 attempt: on the quintic Hermite interpolant of q
-    (dop853.hermite_terms, the dense output trajectory.record_step uses for DOP853)."""
-    L = LANES
-    for j in range(n_run):
-        want = W[W_FLAG * L + j] == HAS_EXTREMUM
-        h = W[W_H * L + j]
-        q0 = W[tj.Q * L + j]
-        v0 = W[tj.V * L + j]
-        a0 = W[tj.FV * L + j]
-        q1 = W[W_QN * L + j]
-        v1 = W[W_VN * L + j]
-        a1 = W[(W_K + 13) * L + j]
-        c3, c4, c5 = dop853.hermite_terms(q0, v0, a0, q1, v1, a1, h)
-        inv_h = 1.0 / h               # one division: they hold up the vector units
-        inv_hh = inv_h * inv_h
-        x, converged = _newton_extremum(v0, v1, h, a0, 3.0 * c3 * inv_hh, 4.0 * c4 * inv_hh,
-                                        5.0 * c5 * inv_hh)
-        W[W_XE * L + j] = x if want & converged else -1.0
-        W[W_QE * L + j] = q0 + h * (x * (v0 + x * (0.5 * h * a0 + x * inv_h * (c3 + x * (
-            c4 + x * c5)))))
-
-
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, settings, point, lane, W, states, reals, counts, series, parametric,
                base):
@@ -515,8 +515,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     capacity = np.full(L, bufs[0].shape[0], np.int64)   # rows of bufs[j], read without the list:
                                                         # a list access costs two atomic updates
     point = np.full(L, -1, np.int64)
-    K = np.empty((N_STAGES + 1 if eighth is None else 2, 2))   # DOP853: f at both ends only
-    Qc = np.empty((2, 5))
+    K = np.empty((N_STAGES + 1 if eighth is None else dop853.N_STAGES_EXTENDED, 2))
+    Qc = np.empty((2, DENSE_TERMS))
     next_point = lo
     n_run = min(L, hi - lo)   # lanes the vector loops cover: the active ones, rounded up to SIMD
                               # width (min() keeps it a run-time int: one compiled _prepare)
@@ -563,11 +563,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             _observe_acceleration(W, settings, n_run)
         if n_flagged == 0:
             continue
-        if n_extrema > 0:
-            if eighth is None:
-                _locate_extrema(W, n_run)
-            else:
-                _locate_extrema8(W, n_run)
+        if n_extrema > 0 and eighth is None:
+            _locate_extrema(W, n_run)
         for j in range(n_run):
             flag = W[W_FLAG * L + j]
             if flag == ORDINARY:
@@ -580,9 +577,12 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                     K[s, 0] = W[(W_K + 2 * s) * L + j]
                     K[s, 1] = W[(W_K + 2 * s + 1) * L + j]
             else:
-                K[1, 0] = W[(W_K + 2 * N_STAGES) * L + j]
-                K[1, 1] = W[(W_K + 2 * N_STAGES + 1) * L + j]
-            xe = W[W_XE * L + j] if flag == HAS_EXTREMUM else -1.0
+                for s in range(1, dop853.N_STAGES):
+                    K[s, 0] = W[(W_K8 + 2 * (s - 1)) * L + j]
+                    K[s, 1] = W[(W_K8 + 2 * s - 1) * L + j]
+                K[dop853.N_STAGES, 0] = W[(W_K + 2 * N_STAGES) * L + j]
+                K[dop853.N_STAGES, 1] = W[(W_K + 2 * N_STAGES + 1) * L + j]
+            xe = W[W_XE * L + j] if (flag == HAS_EXTREMUM) & (eighth is None) else -1.0
             if W[tj.N_EXT * L + j] >= capacity[j]:
                 bufs[j] = tj.with_room(bufs[j], W[j::L])
                 capacity[j] = bufs[j].shape[0]

@@ -23,8 +23,8 @@ import numpy as np
 
 from . import metrics as mt
 from . import dop853
-from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL, PI_MIN_ERR_PREV,
-                     RHS_PER_ATTEMPT,
+from .dopri5 import (DENSE_TERMS, ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
+                     PI_MIN_ERR_PREV, RHS_PER_ATTEMPT,
                      dense_coefficients, dense_root, dense_value, initial_step, pi_log2_err,
                      pi_step_factor, step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
@@ -265,8 +265,8 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
     """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
     y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
     SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
-    the extrema buffer (regrown when full). Qc is scratch for the interpolant, shape (2, 5).
-    p: the point's prepared row (oscillator.prepare).
+    the extrema buffer (regrown when full). Qc is scratch for the interpolant, shape
+    (2, DENSE_TERMS). p: the point's prepared row (oscillator.prepare).
     """
     if control(settings, acc, err):
         if acc[N_EXT] >= buf.shape[0]:
@@ -276,16 +276,30 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
     return buf
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def fsal_row(K):
+    """The row of K that holds f(t + h, y_new): the last, or row dop853.N_STAGES of DOP853's
+    extended K (whose rows after it are the dense output's extra stages)."""
+    return dop853.N_STAGES if K.shape[0] == dop853.N_STAGES_EXTENDED else K.shape[0] - 1
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def interpolant(settings, acc, K, q_new, v_new, h, Qc):
-    """Qc: the dense output of the accepted step from acc's state to (q_new, v_new), K its
-    stage derivatives (only the last, f(t + h, y_new), for DOP853). RK45: its own quartic;
-    DOP853: the quintic Hermite interpolant (dop853.hermite_coefficients)."""
-    if settings[METHOD] != 0.0:
+def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
+    """Qc (2, DENSE_TERMS): the dense output of the accepted step from acc's state to
+    (q_new, v_new), K its stage derivatives. RK45: its own quartic. DOP853 with the extended K
+    (dop853.N_STAGES_EXTENDED rows: the one-mode drivers): its own seventh-order interpolant,
+    whose three extra right-hand sides are computed here (and counted); with a K of two rows,
+    f at the step's ends (the modal drivers' midspan projection): the quintic Hermite
+    interpolant (dop853.hermite_coefficients). p[o + column * s]: the point's prepared row."""
+    if settings[METHOD] == 0.0:
+        dense_coefficients(K, Qc)
+    elif K.shape[0] == dop853.N_STAGES_EXTENDED:
+        dop853.extra_stages(acc[T], acc[Q], acc[V], h, p, o, s, K, None, parametric, base)
+        acc[RHS_EVALS] += dop853.RHS_DENSE
+        dop853.dense_coefficients(K, h, acc[Q], acc[V], q_new, v_new, Qc)
+    else:
         dop853.hermite_coefficients(acc[Q], acc[V], acc[FV], q_new, v_new,
                                     K[K.shape[0] - 1, 1], h, Qc)
-    else:
-        dense_coefficients(K, Qc)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -395,7 +409,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = t_new
         if math.isfinite(q_new) and abs(q_new) > bound and abs(q_old) <= bound:
-            interpolant(settings, acc, K, q_new, v_new, h, Qc)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
             side = 1.0 if q_new > 0.0 else -1.0
             acc[T_STOP] = t + dense_root(q_old, h, Qc[0], side * bound, 0.0, 1.0) * h
         return
@@ -412,7 +426,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             xe = xe_known
             qe = qe_known
         else:
-            interpolant(settings, acc, K, q_new, v_new, h, Qc)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
             have_qc = True
             xe = dense_root(v_old, h, Qc[1], 0.0, 0.0, 1.0)
             qe = dense_value(q_old, h, Qc[0], xe)
@@ -434,7 +448,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
 
     if t < t_tail <= t_new:
         if not have_qc:
-            interpolant(settings, acc, K, q_new, v_new, h, Qc)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
             have_qc = True
         qt = dense_value(q_old, h, Qc[0], (t_tail - t) / h)
         acc[PEAK] = max(acc[PEAK], abs(qt))
@@ -442,21 +456,21 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qt)
         acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qt)
 
-    thr, above = observe_step_end(acc, 0, 1, p, o, s, t, h, t_new, q_new, K[K.shape[0] - 1, 1],
+    thr, above = observe_step_end(acc, 0, 1, p, o, s, t, h, t_new, q_new, K[fsal_row(K), 1],
                                   t_tail, track, centre, thr_fixed, thr_rel, True, None, base)
 
     if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
         if xa >= 0.0:
             if not have_qc:
-                interpolant(settings, acc, K, q_new, v_new, h, Qc)
+                interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
                 have_qc = True
             x = dense_root(q_old, h, Qc[0], centre + side * thr, xa, xb)
             acc[LAST_ABOVE] = t + x * h
 
     if k < n_samples and k * dt_sample <= t_new:
         if not have_qc:
-            interpolant(settings, acc, K, q_new, v_new, h, Qc)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
             have_qc = True
         while k < n_samples and k * dt_sample <= t_new:
             series[k] = dense_value(q_old, h, Qc[0], (k * dt_sample - t) / h)
@@ -466,8 +480,9 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     acc[T] = t_new
     acc[Q] = q_new
     acc[V] = v_new
-    acc[FQ] = K[K.shape[0] - 1, 0]
-    acc[FV] = K[K.shape[0] - 1, 1]
+    last = fsal_row(K)
+    acc[FQ] = K[last, 0]
+    acc[FV] = K[last, 1]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -262,8 +262,7 @@ _VECTOR_LOOPS = [("_prepare", lambda W, s: (W, s, lanes.LANES)),
                  ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, True, True, None)),
                  ("_finish", lambda W, s: (W, s, 0, lanes.LANES, None, None, True, True)),
                  ("_observe_acceleration", lambda W, s: (W, s, lanes.LANES)),
-                 ("_locate_extrema", lambda W, s: (W, lanes.LANES)),
-                 ("_locate_extrema8", lambda W, s: (W, lanes.LANES))]
+                 ("_locate_extrema", lambda W, s: (W, lanes.LANES))]
 
 
 @pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
