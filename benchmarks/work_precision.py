@@ -225,6 +225,9 @@ def parse_args() -> argparse.Namespace:
     p.add_argument("--dop853", action="store_true",
                    help="also run cable-sweep with DOP853 (solver.method = dop853)")
     p.add_argument("--no-numbalsoda", action="store_true", help="skip the numbalsoda peers")
+    p.add_argument("--no-diffrax", action="store_true", help="skip the diffrax (JAX) peers")
+    p.add_argument("--errors", default="1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11",
+                   help="amplitude errors of the fastest-method table (comma-separated)")
     p.add_argument("--no-scipy", action="store_true",
                    help="skip the SciPy peers (quick checks only)")
     p.add_argument("--plot", metavar="PATH", help="save the work-precision plot as PNG")
@@ -427,6 +430,16 @@ def run_numbalsoda(ns: Numbalsoda, name: str, table: np.ndarray, rtol: float, at
         out2, ok2, _, wall2 = ns.solve(name, table, t_eval, rtol, atol, threads=2, timed=True)
         if not (np.array_equal(out, out2, equal_nan=True) and np.array_equal(ok, ok2)):
             notes.append("2-thread outputs differ from 1-thread outputs")
+    return sampled_measurement(f"numbalsoda {name}", rtol, atol, table, t_eval, out, ok, evals,
+                               np.full(len(table), math.nan), wall, wall2, notes, cfg)
+
+
+def sampled_measurement(method: str, rtol: float, atol: float, table: np.ndarray,
+                        t_eval: np.ndarray, out: np.ndarray, ok: np.ndarray, evals: np.ndarray,
+                        steps: np.ndarray, wall: float, wall2: float, notes: list[str],
+                        cfg: Settings) -> Measurement:
+    """A peer's Measurement from its samples out (n, nt, 2) of q, q' at t_eval: the metrics of
+    `reference_metrics` on a quintic Hermite interpolant through (q, q', q'') (not timed)."""
     n = len(table)
     amp, q_end, settling = (np.full(n, math.nan) for _ in range(3))
     state = np.full(n, "solver_failed", dtype=object)
@@ -440,8 +453,127 @@ def run_numbalsoda(ns: Numbalsoda, name: str, table: np.ndarray, rtol: float, at
         q_end[i] = q[-1]
     if not ok.all():
         notes.append(f"{int((~ok).sum())} points failed")
-    return Measurement(f"numbalsoda {name}", rtol, atol, wall, np.full(n, math.nan), evals,
-                       amp, q_end, state, settling, wall2, notes)
+    return Measurement(method, rtol, atol, wall, steps, evals, amp, q_end, state, settling,
+                       wall2, notes)
+
+
+# --- diffrax ---------------------------------------------------------------------------------
+
+class Diffrax:
+    """diffrax (JAX) Tsit5, Dopri5 and Dopri8 over all points: `jax.jit(jax.vmap(solve))` on one
+    CPU device for 1 thread, `jax.pmap` of that over two devices (the points split in halves)
+    for 2 threads. JAX is told, before it is imported, to make two host devices of one thread
+    each (XLA_FLAGS). The right-hand side is the oscillator's (kernels.oscillator.acceleration
+    with the cos(W t) load terms) written in jax.numpy on the point's prepared row. PIDController
+    with SciPy's rtol/atol (an RMS norm, as SciPy's), SaveAt(ts=...) on the --ns-samples times,
+    as numbalsoda; the metrics from those samples. Steps: diffrax's num_accepted_steps; RHS
+    evaluations: its num_steps (accepted and rejected) x the stages a step costs (FSAL counted
+    once: Tsit5 and Dopri5 6, Dopri8 13)."""
+
+    SOLVERS = ("Tsit5", "Dopri5", "Dopri8")
+    RHS_PER_STEP = {"Tsit5": 6, "Dopri5": 6, "Dopri8": 13}
+
+    def __init__(self) -> None:
+        import os
+        if "jax" not in sys.modules:
+            os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "")
+                                       + " --xla_force_host_platform_device_count=2"
+                                       " --xla_cpu_multi_thread_eigen=false"
+                                       " intra_op_parallelism_threads=1")
+        import jax
+        jax.config.update("jax_enable_x64", True)
+        import diffrax
+        import jax.numpy as jnp
+        self.jax, self.jnp, self.diffrax = jax, jnp, diffrax
+        self.fns: dict = {}
+
+    def _compiled(self, name: str, n_eval: int):
+        key = (name, n_eval)
+        if key in self.fns:
+            return self.fns[key]
+        jax, jnp, dfx = self.jax, self.jnp, self.diffrax
+
+        def rhs(t, y, P):
+            q, v = y[0], y[1]
+            cw = jnp.cos(P[osc.OMEGA] * t + P[osc.LOAD_PHASE])
+            q2 = q * q
+            a = ((P[osc.K0] + P[osc.K1] * cw) * q + (P[osc.G0] + P[osc.G1] * cw) * q * q2
+                 + P[osc.H] * q * q2 * q2 + P[osc.DAMPING] * v)
+            return jnp.stack([v, a])
+
+        solver = getattr(dfx, name)()
+
+        def one(P, y0, ts, rtol, atol):
+            sol = dfx.diffeqsolve(dfx.ODETerm(rhs), solver, 0.0, T_END, None, y0, args=P,
+                                  saveat=dfx.SaveAt(ts=ts),
+                                  stepsize_controller=dfx.PIDController(rtol=rtol, atol=atol),
+                                  max_steps=None, throw=False)
+            return (sol.ys, sol.result == dfx.RESULTS.successful,
+                    sol.stats["num_accepted_steps"], sol.stats["num_steps"])
+
+        batched = jax.vmap(one, in_axes=(0, 0, None, None, None))
+        fns = (jax.jit(batched), jax.pmap(batched, in_axes=(0, 0, None, None, None)))
+        self.fns[key] = fns
+        return fns
+
+    def warm_up(self, table: np.ndarray, t_eval: np.ndarray) -> float:
+        """Compile every solver on 1 and 2 devices; returns the wall time of that."""
+        start = time.perf_counter()
+        for name in self.SOLVERS:
+            for threads in (1, 2):
+                self.solve(name, table, t_eval, 1e-3, 1e-7, threads)
+        return time.perf_counter() - start
+
+    def solve(self, name: str, table: np.ndarray, t_eval: np.ndarray, rtol: float, atol: float,
+              threads: int, timed: bool = False):
+        """(samples (n, nt, 2), success (n,), accepted steps (n,), steps (n,), best wall
+        time or NaN)."""
+        jnp = self.jnp
+        n = len(table)
+        if np.any(table[:, osc.BASE_ACCEL] != 0.0):
+            raise ValueError("Diffrax: the rhs has no base excitation but a row has one")
+        P = np.zeros((n, osc.N_PARAMS))
+        for i, row in enumerate(table):
+            osc.prepare.py_func(row, P[i], 0, 1)
+        y0 = np.ascontiguousarray(table[:, [osc.Q0, osc.V0]])
+        single, parallel = self._compiled(name, t_eval.size)
+        ts = jnp.asarray(t_eval)
+        if threads == 1:
+            args = (jnp.asarray(P), jnp.asarray(y0))
+            fn = single
+        else:
+            half = (n + 1) // 2
+            pad = 2 * half - n
+            P2 = np.concatenate([P, P[:pad]]).reshape(2, half, -1)
+            y2 = np.concatenate([y0, y0[:pad]]).reshape(2, half, 2)
+            args = (jnp.asarray(P2), jnp.asarray(y2))
+            fn = parallel
+
+        def once():
+            result = fn(*args, ts, rtol, atol)
+            self.jax.block_until_ready(result)
+            return result
+
+        wall = best_time(once) if timed else math.nan
+        ys, ok, accepted, steps = (np.asarray(x) for x in once())
+        if threads != 1:
+            ys, ok, accepted, steps = (x.reshape((-1,) + x.shape[2:])[:n]
+                                       for x in (ys, ok, accepted, steps))
+        return ys, ok, accepted.astype(float), steps.astype(float), wall
+
+
+def run_diffrax(dx: Diffrax, name: str, table: np.ndarray, rtol: float, atol: float,
+                cfg: Settings) -> Measurement:
+    """diffrax `name` on all points, timed on 1 and 2 devices; metrics from the samples."""
+    t_eval = np.linspace(0.0, T_END, cfg.ns_samples)
+    out, ok, accepted, steps, wall = dx.solve(name, table, t_eval, rtol, atol, 1, timed=True)
+    notes = []
+    out2, ok2, _, _, wall2 = dx.solve(name, table, t_eval, rtol, atol, 2, timed=True)
+    if not np.allclose(out, out2, rtol=1e-12, atol=0.0, equal_nan=True):
+        notes.append("2-device outputs differ from 1-device outputs beyond 1e-12")
+    evals = steps * Diffrax.RHS_PER_STEP[name]
+    return sampled_measurement(f"diffrax {name}", rtol, atol, table, t_eval, out, ok, evals,
+                               accepted, wall, wall2, notes, cfg)
 
 
 # --- errors and reporting --------------------------------------------------------------------
@@ -603,10 +735,56 @@ def equal_error_report(runs: list[Measurement], ref: Reference, judged: np.ndarr
     return lines, {"target_error": target, "target_rtol": at.rtol, "methods": walls}
 
 
+def fastest_report(runs: list[Measurement], ref: Reference, judged: np.ndarray,
+                   targets: list[float]) -> tuple[list[str], list[dict]]:
+    """Lines of the fastest-method table: at each target amplitude error, every method's wall
+    time there (log-log interpolation, `wall_at_error`) on 1 and on 2 threads, the fastest
+    cable-sweep method against the fastest peer, and its JSON record."""
+    curves = {method: curve(runs, method) for method in methods_of(runs)}
+    errors = {method: [max_amp_err(m, ref, judged) for m in ms] for method, ms in curves.items()}
+    record = []
+    rows = []
+    for target in targets:
+        entry = {"target_error": target}
+        cells = [f"{target:.0e}"]
+        for two in (False, True):
+            walls = {}
+            for method, ms in curves.items():
+                wall, how = wall_at_error(ms, errors[method], target, two_threads=two)
+                if math.isfinite(wall):
+                    walls[method] = wall
+            ours = {m: w for m, w in walls.items() if m.startswith(CABLE)}
+            peers = {m: w for m, w in walls.items() if not m.startswith(CABLE)}
+            best = min(ours, key=ours.get) if ours else None
+            peer = min(peers, key=peers.get) if peers else None
+            key = "2_threads" if two else "1_thread"
+            entry[key] = {"fastest_cable_sweep": best, "wall_s": ours.get(best),
+                          "fastest_peer": peer, "peer_wall_s": peers.get(peer),
+                          "all": walls}
+            cells += [f"{best} {ours[best]:.4g}" if best else "not reached",
+                      f"{peer} {peers[peer]:.4g}" if peer else "not reached",
+                      (f"**{peers[peer] / ours[best]:.1f}x**" if best and peer else
+                       ("cable-sweep only" if best else "peer only" if peer else ""))]
+        record.append(entry)
+        rows.append(cells)
+    lines = ["## Fastest method at each amplitude error\n",
+             markdown_table(["amp err", "fastest cable-sweep, 1 thread (s)",
+                             "fastest peer, 1 thread (s)", "peer / cable-sweep, 1 thread",
+                             "fastest cable-sweep, 2 threads (s)", "fastest peer, 2 threads (s)",
+                             "peer / cable-sweep, 2 threads"], rows),
+             "\nWall time for all points at that max amplitude error (non-decayed points), "
+             "interpolated in log-log between the bracketing rtols of each method; a method "
+             "that never reaches the error is left out; SciPy has no 2-thread row. Ratio > 1: "
+             "the fastest cable-sweep method is that many times faster than the fastest peer."]
+    return lines, record
+
+
 STYLE = {CABLE: ("o", "C0"), CABLE_PI: ("P", "C5"), CABLE_DOP853: ("X", "C6"),
          "SciPy RK45": ("s", "C1"),
          "SciPy DOP853": ("^", "C2"),
-         "numbalsoda dop853": ("D", "C3"), "numbalsoda lsoda": ("v", "C4")}
+         "numbalsoda dop853": ("D", "C3"), "numbalsoda lsoda": ("v", "C4"),
+         "diffrax Tsit5": ("<", "C7"), "diffrax Dopri5": (">", "C8"),
+         "diffrax Dopri8": ("*", "C9")}
 
 
 def plot(runs: list[Measurement], ref: Reference, judged: np.ndarray, path: str,
@@ -673,6 +851,17 @@ def main() -> None:
                           "(pip install numbalsoda).")
             print(ns_message, file=sys.stderr)
 
+    dx = None
+    dx_compile_s = math.nan
+    dx_message = ""
+    if not args.no_diffrax:
+        try:
+            dx = Diffrax()
+        except ImportError as exc:
+            dx_message = (f"diffrax not installed ({exc}): its rows are skipped "
+                          "(pip install diffrax).")
+            print(dx_message, file=sys.stderr)
+
     start = time.perf_counter()
     ref = reference_solution(table, args.ref_rtol, args.ref_atol, cfg)
     ref_s = time.perf_counter() - start
@@ -686,6 +875,8 @@ def main() -> None:
             warm_up(table, variant(scene, {key: value}))
     if ns is not None:
         ns_compile_s = ns.warm_up(table, np.linspace(0.0, T_END, args.ns_samples))
+    if dx is not None:
+        dx_compile_s = dx.warm_up(table, np.linspace(0.0, T_END, args.ns_samples))
 
     runs: list[Measurement] = []
     for rtol in rtols:
@@ -701,6 +892,9 @@ def main() -> None:
         if ns is not None:
             for name in Numbalsoda.SOLVERS:
                 runs.append(run_numbalsoda(ns, name, table, rtol, atol, cfg))
+        if dx is not None:
+            for name in Diffrax.SOLVERS:
+                runs.append(run_diffrax(dx, name, table, rtol, atol, cfg))
         print(f"rtol {rtol:g} done", file=sys.stderr, flush=True)
     order = methods_of(runs)
     runs.sort(key=lambda m: (order.index(m.method), -m.rtol))
@@ -721,9 +915,11 @@ def main() -> None:
           f"{np.max(final_state_errors(check.q_end, ref)):.1e}. cable-sweep first call "
           f"(compile or cache load): {compile_s:.2f} s"
           + (f"; numbalsoda loops compile: {ns_compile_s:.2f} s" if ns is not None else "")
+          + (f"; diffrax compile: {dx_compile_s:.2f} s" if dx is not None else "")
           + ".\n")
-    if ns_message:
-        print(ns_message + "\n")
+    for message in (ns_message, dx_message):
+        if message:
+            print(message + "\n")
     rows = []
     for m in runs:
         amp_err = amplitude_errors(m.amplitude, ref)
@@ -765,6 +961,8 @@ def main() -> None:
 
     lines, equal = equal_error_report(runs, ref, ~decayed, args.target_rtol)
     print("\n".join(lines))
+    lines, fastest = fastest_report(runs, ref, ~decayed, floats(args.errors))
+    print("\n" + "\n".join(lines))
 
     if args.plot:
         plot(runs, ref, ~decayed, args.plot, equal.get("target_error"))
@@ -783,7 +981,8 @@ def main() -> None:
             "numbalsoda": ns_message or f"{args.ns_samples} samples",
             "threshold": args.threshold, "recommended_rtol": chosen,
             "recommended_atol": None if chosen is None else atol_for(chosen, args),
-            "equal_error": equal,
+            "equal_error": equal, "fastest": fastest,
+            "diffrax_compile_s": dx_compile_s,
             "runs": [{"method": m.method, "rtol": m.rtol, "atol": m.atol, "wall_s": m.wall_s,
                       "wall_2_threads_s": m.wall2_s,
                       "mean_steps": float(np.mean(m.steps)),

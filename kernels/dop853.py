@@ -7,14 +7,18 @@ rejects the same steps as ``solve_ivp(method="DOP853")`` up to round-off. Twelve
 sides per attempt (the last, f(t + h, y_new), is the next step's first), against RK45's six,
 but steps about three times as long at the same error on this oscillator: fewer attempts.
 
-Dense output: DOP853's own seventh-order interpolant (`extra_stages`, `dense_coefficients`),
-as SciPy's `Dop853DenseOutput`: three more right-hand sides, paid only on a step whose dense
-output something needs (an extremum of q, the tail's start, a threshold crossing, a time-series
-sample), so its amplitudes are those of SciPy's DOP853 to round-off at every tolerance. The
-modal drivers, whose midspan deflection is a projection of N modes, use the quintic Hermite
-interpolant of q through q, q' and q'' at both ends of the step (`hermite_coefficients`; error
-of order h^6, about 2e-5 (omega h)^6 of the amplitude at the step's middle), which needs no
-further stage. The state is y = (q, q') in (m, m/s).
+Dense output, two of them. DOP853's own seventh-order interpolant (`dense_output`, as SciPy's
+`Dop853DenseOutput`) costs three more right-hand sides, paid only on a step whose dense output
+something needs (an extremum of q, the tail's start, a threshold crossing, a time-series
+sample); with it the amplitudes are those of SciPy's DOP853 to round-off. The quintic Hermite
+interpolant of q through q, q' and q'' at both ends of the step (`hermite_coefficients`) needs
+no further stage; its error is of order h^6 (about 2e-5 (omega h)^6 of the amplitude at the
+step's middle), and since DOP853's steps shrink only as rtol^(1/8), it outgrows the
+integration's own error as rtol tightens: on the work-precision points it adds 3 % to the
+amplitude error at rtol 1e-5, doubles it at 1e-6 and makes it 23x at 1e-8. So the one-mode
+drivers take the seventh-order interpolant where rtol < SEVENTH_ORDER_BELOW_RTOL and the
+Hermite one above; the modal drivers, whose midspan deflection is a projection of N modes,
+always the Hermite one. The state is y = (q, q') in (m, m/s).
 
 Coefficients: SciPy's `dop853_coefficients` (BSD-3-Clause), from Hairer's DOP853 Fortran code.
 """
@@ -113,6 +117,8 @@ A = A[:N_STAGES].copy()
 # extended K; row N_STAGES is f(t + h, y_new)) and its interpolator matrix D.
 N_STAGES_EXTENDED = 16
 RHS_DENSE = N_STAGES_EXTENDED - N_STAGES - 1     # right-hand sides the dense output adds
+SEVENTH_ORDER_BELOW_RTOL = 3e-6                  # rtol below which the one-mode drivers read
+                                                 # the dense output off `dense_output`
 C_EXTRA = np.array([0.1, 0.2, 7.0 / 9.0])
 A_EXTRA = np.zeros((RHS_DENSE, N_STAGES_EXTENDED))
 A_EXTRA[0, 0] = 5.61675022830479523392909219681e-2
@@ -284,55 +290,96 @@ def hermite_coefficients(q0, v0, a0, q1, v1, a1, h, Qc):
     Qc[1, 6] = 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def extra_stages(t, q0, v0, h, p, o, s, K, fast, parametric, base):
-    """The dense output's three extra stages of the accepted step of size h (s) from t (s),
-    (q0, v0) (m, m/s): K (N_STAGES_EXTENDED, 2) holds the step's stages in rows 0..N_STAGES
-    (row N_STAGES: f(t + h, y_new)); rows N_STAGES + 1.. are filled, as SciPy's
-    `DOP853._dense_output_impl`. p[o + column * s]: the point's prepared row; fast: the
-    right-hand side's cosine switch (oscillator.acceleration)."""
-    for r in range(RHS_DENSE):
-        row = N_STAGES + 1 + r
-        dq = 0.0
-        dv = 0.0
-        for j in range(row):
-            dq += K[j, 0] * A_EXTRA[r, j]
-            dv += K[j, 1] * A_EXTRA[r, j]
-        q = q0 + dq * h
-        v = v0 + dv * h
-        K[row, 0] = v
-        K[row, 1] = acceleration(t + C_EXTRA[r] * h, q, v, p, o, s, fast, parametric, base)
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def dense_output(t, q0, v0, q1, v1, h, p, o, s, K, Qc, fast, parametric, base):
+    """DOP853's seventh-order interpolant of the accepted step of size h (s) from (t, q0, v0)
+    to (q1, v1) (s, m, m/s), as SciPy's `DOP853._dense_output_impl` and `Dop853DenseOutput`,
+    into Qc (2, DENSE_TERMS) in the layout of dopri5.dense_coefficients: y_i(x) = y_i(0) +
+    h x (Qc[i, 0] + x (Qc[i, 1] + ... + x Qc[i, 6])), x = (t' - t)/h.
+
+    K (N_STAGES_EXTENDED, 2) holds the step's stages in rows 0..N_STAGES (row N_STAGES:
+    f(t + h, y_new)); its rows N_STAGES + 1.. get the three extra stages (A_EXTRA, C_EXTRA:
+    three right-hand sides). p[o + column * s]: the point's prepared row; fast: the right-hand
+    side's cosine switch (oscillator.acceleration).
+
+    SciPy writes the interpolant as y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 + x (F4 +
+    (1 - x) (F5 + x F6)))))), F0 = dy, F1 = h f_old - dy, F2 = 2 dy - h (f_new + f_old),
+    F3..F6 = h D K; expanding the nested products gives the powers of x below. Every sum over
+    the step's own stages is taken in one pass (fourteen independent chains of fused
+    multiply-adds, not seven in a row), the extra stages' terms after: a dense output costs
+    about one attempt of the lanes per lane, not three."""
+    a0q = 0.0
+    a0v = 0.0
+    a1q = 0.0
+    a1v = 0.0
+    a2q = 0.0
+    a2v = 0.0
+    d0q = 0.0
+    d0v = 0.0
+    d1q = 0.0
+    d1v = 0.0
+    d2q = 0.0
+    d2v = 0.0
+    d3q = 0.0
+    d3v = 0.0
+    for j in range(N_STAGES + 1):
+        kq = K[j, 0]
+        kv = K[j, 1]
+        a0q += A_EXTRA[0, j] * kq
+        a0v += A_EXTRA[0, j] * kv
+        a1q += A_EXTRA[1, j] * kq
+        a1v += A_EXTRA[1, j] * kv
+        a2q += A_EXTRA[2, j] * kq
+        a2v += A_EXTRA[2, j] * kv
+        d0q += D[0, j] * kq
+        d0v += D[0, j] * kv
+        d1q += D[1, j] * kq
+        d1v += D[1, j] * kv
+        d2q += D[2, j] * kq
+        d2v += D[2, j] * kv
+        d3q += D[3, j] * kq
+        d3v += D[3, j] * kv
+    r0 = N_STAGES + 1
+    v = v0 + a0v * h
+    K[r0, 0] = v
+    K[r0, 1] = acceleration(t + C_EXTRA[0] * h, q0 + a0q * h, v, p, o, s, fast, parametric, base)
+    a1q += A_EXTRA[1, r0] * K[r0, 0]
+    a1v += A_EXTRA[1, r0] * K[r0, 1]
+    a2q += A_EXTRA[2, r0] * K[r0, 0]
+    a2v += A_EXTRA[2, r0] * K[r0, 1]
+    v = v0 + a1v * h
+    K[r0 + 1, 0] = v
+    K[r0 + 1, 1] = acceleration(t + C_EXTRA[1] * h, q0 + a1q * h, v, p, o, s, fast,
+                                parametric, base)
+    a2q += A_EXTRA[2, r0 + 1] * K[r0 + 1, 0]
+    a2v += A_EXTRA[2, r0 + 1] * K[r0 + 1, 1]
+    v = v0 + a2v * h
+    K[r0 + 2, 0] = v
+    K[r0 + 2, 1] = acceleration(t + C_EXTRA[2] * h, q0 + a2q * h, v, p, o, s, fast,
+                                parametric, base)
+    for j in range(r0, N_STAGES_EXTENDED):
+        d0q += D[0, j] * K[j, 0]
+        d0v += D[0, j] * K[j, 1]
+        d1q += D[1, j] * K[j, 0]
+        d1v += D[1, j] * K[j, 1]
+        d2q += D[2, j] * K[j, 0]
+        d2v += D[2, j] * K[j, 1]
+        d3q += D[3, j] * K[j, 0]
+        d3v += D[3, j] * K[j, 1]
+    inv_h = 1.0 / h          # the h of h D K and the 1/h of the layout cancel
+    _dense_row(Qc, 0, q1 - q0, K[0, 0], K[N_STAGES, 0], h, inv_h, d0q, d1q, d2q, d3q)
+    _dense_row(Qc, 1, v1 - v0, K[0, 1], K[N_STAGES, 1], h, inv_h, d0v, d1v, d2v, d3v)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def dense_coefficients(K, h, q0, v0, q1, v1, Qc):
-    """DOP853's seventh-order interpolant of the step of size h (s) from (q0, v0) to (q1, v1)
-    in the layout of dopri5.dense_coefficients: y_i(x) = y_i(0) + h x (Qc[i, 0] + x (Qc[i, 1]
-    + ... + x Qc[i, 6])), x = (t - t_old)/h; K: the extended stages, `extra_stages` done.
-
-    SciPy's Dop853DenseOutput writes it as y_old + x (F0 + (1 - x) (F1 + x (F2 + (1 - x) (F3 +
-    x (F4 + (1 - x) (F5 + x F6)))))) with F0 = dy, F1 = h f_old - dy, F2 = 2 dy - h (f_new +
-    f_old) and F3..F6 = h D K; expanding the nested products gives the powers of x below."""
-    for i in range(2):
-        dy = (q1 - q0) if i == 0 else (v1 - v0)
-        f0 = dy
-        f1 = h * K[0, i] - dy
-        f2 = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
-        f3 = 0.0
-        f4 = 0.0
-        f5 = 0.0
-        f6 = 0.0
-        for j in range(N_STAGES_EXTENDED):
-            f3 += D[0, j] * K[j, i]
-            f4 += D[1, j] * K[j, i]
-            f5 += D[2, j] * K[j, i]
-            f6 += D[3, j] * K[j, i]
-        # the h of h D K and the 1/h of the layout cancel
-        inv_h = 1.0 / h
-        Qc[i, 0] = (f0 + f1) * inv_h
-        Qc[i, 1] = (f2 - f1) * inv_h + f3
-        Qc[i, 2] = -f2 * inv_h - 2.0 * f3 + f4 + f5
-        Qc[i, 3] = f3 - 2.0 * f4 - 3.0 * f5 + f6
-        Qc[i, 4] = f4 + 3.0 * f5 - 3.0 * f6
-        Qc[i, 5] = 3.0 * f6 - f5
-        Qc[i, 6] = -f6
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _dense_row(Qc, i, dy, f_old, f_new, h, inv_h, f3, f4, f5, f6):
+    """Row i of `dense_output`'s coefficients from component i's dy, f_old, f_new and D K."""
+    f1 = h * f_old - dy
+    f2 = 2.0 * dy - h * (f_new + f_old)
+    Qc[i, 0] = (dy + f1) * inv_h
+    Qc[i, 1] = (f2 - f1) * inv_h + f3
+    Qc[i, 2] = -f2 * inv_h - 2.0 * f3 + f4 + f5
+    Qc[i, 3] = f3 - 2.0 * f4 - 3.0 * f5 + f6
+    Qc[i, 4] = f4 + 3.0 * f5 - 3.0 * f6
+    Qc[i, 5] = 3.0 * f6 - f5
+    Qc[i, 6] = -f6

@@ -265,3 +265,36 @@ def dense_root(y_old_i, h, c, target, xa, xb):
                 fb *= 0.5
             side = 1
     return 0.5 * (xa + xb)
+
+
+EXTREMUM_NEWTON_STEPS = 4     # Newton steps `dense_extremum` takes before it falls back to
+EXTREMUM_RESIDUAL = 1e-14     # dense_root; |q'(x)| / (|q'_old| + |q'_new|) that ends them
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def dense_extremum(v_old, v_new, h, c):
+    """x in [0, 1] where the interpolated q' (row c = Q[1] of an interpolant; v_old, v_new: q'
+    at the step's ends, of opposite signs or v_new = 0) vanishes: Newton's method from the
+    linear guess, kept inside the sign bracket, until the residual is at round-off
+    (EXTREMUM_RESIDUAL); where EXTREMUM_NEWTON_STEPS do not get there, `dense_root` on the
+    bracket left. A few evaluations of the interpolant where the bracketed root finder alone
+    takes ten or more."""
+    positive = v_old > 0.0
+    xa = 0.0
+    xb = 1.0
+    x = v_old / (v_old - v_new) if v_old != v_new else 0.5
+    x = x if 0.0 <= x <= 1.0 else 0.5
+    small = EXTREMUM_RESIDUAL * (abs(v_old) + abs(v_new))
+    for _ in range(EXTREMUM_NEWTON_STEPS):
+        g = dense_value(v_old, h, c, x)
+        if abs(g) <= small:
+            return x
+        dg = h * (c[0] + x * (2.0 * c[1] + x * (3.0 * c[2] + x * (4.0 * c[3] + x * (
+            5.0 * c[4] + x * (6.0 * c[5] + x * 7.0 * c[6]))))))
+        if (g > 0.0) == positive:
+            xa = x
+        else:
+            xb = x
+        x_new = x - g / dg if dg != 0.0 else 0.5 * (xa + xb)
+        x = x_new if xa < x_new < xb else 0.5 * (xa + xb)
+    return dense_root(v_old, h, c, 0.0, xa, xb)

@@ -15,8 +15,9 @@ These loops run across the lanes with straight-line arithmetic, so LLVM vectoris
   ordinary accepted step;
 - `_locate_extrema`: for the RK45 steps that hold an extremum of q, where it lies on the dense
   output (safeguarded Newton), run only when some lane has one. A DOP853 step that holds one is
-  located by trajectory.record_step on DOP853's own seventh-order interpolant, whose three extra
-  right-hand sides it computes for that lane alone.
+  located by trajectory.record_step on DOP853's dense output (trajectory.interpolant: its own
+  seventh-order interpolant below rtol 3e-6, whose three extra right-hand sides it computes for
+  that lane alone; the quintic Hermite one above).
 
 Whatever else is not ordinary (a lane's first or last step, a step near SciPy's minimum, the
 extremum's bookkeeping, the tail's start, a time-series sample, a threshold crossing, a
@@ -213,8 +214,8 @@ def _attempt(W, rtol, n_run, parametric, base):
 def _attempt8(W, rtol, n_run, parametric, base):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
-    (W_K + 12, W_K + 13), stages 1 .. 11 in W_K8 (the dense output of a step that needs one,
-    dop853.dense_coefficients, is built from them by trajectory.record_step) and SciPy's DOP853
+    (W_K + 12, W_K + 13), stages 1 .. 11 in W_K8 (the seventh-order dense output of a step that
+    needs one, dop853.dense_output, is built from them by trajectory.record_step) and SciPy's DOP853
     error norm from dop853.E5, E3 (W_ERR).
     """
     L = LANES

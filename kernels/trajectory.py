@@ -24,9 +24,9 @@ import numpy as np
 from . import metrics as mt
 from . import dop853
 from .dopri5 import (DENSE_TERMS, ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
-                     PI_MIN_ERR_PREV, RHS_PER_ATTEMPT,
-                     dense_coefficients, dense_root, dense_value, initial_step, pi_log2_err,
-                     pi_step_factor, step_factor)
+                     PI_MIN_ERR_PREV, RHS_PER_ATTEMPT, dense_coefficients, dense_extremum,
+                     dense_root, dense_value, initial_step, pi_log2_err, pi_step_factor,
+                     step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      MIN_STEP, RTOL, SAMPLE_DT, STEADY_PERIODS, STEADY_TOL, STOP_STEADY, TAIL,
                      T_END)
@@ -287,19 +287,21 @@ def fsal_row(K):
 def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
     """Qc (2, DENSE_TERMS): the dense output of the accepted step from acc's state to
     (q_new, v_new), K its stage derivatives. RK45: its own quartic. DOP853 with the extended K
-    (dop853.N_STAGES_EXTENDED rows: the one-mode drivers): its own seventh-order interpolant,
-    whose three extra right-hand sides are computed here (and counted); with a K of two rows,
-    f at the step's ends (the modal drivers' midspan projection): the quintic Hermite
-    interpolant (dop853.hermite_coefficients). p[o + column * s]: the point's prepared row."""
+    (dop853.N_STAGES_EXTENDED rows: the one-mode drivers) and rtol below
+    dop853.SEVENTH_ORDER_BELOW_RTOL: its own seventh-order interpolant, whose three extra
+    right-hand sides are computed here (and counted); otherwise (a looser rtol, or the modal
+    drivers' midspan projection) the quintic Hermite interpolant (dop853.hermite_coefficients).
+    p[o + column * s]: the point's prepared row."""
     if settings[METHOD] == 0.0:
         dense_coefficients(K, Qc)
-    elif K.shape[0] == dop853.N_STAGES_EXTENDED:
-        dop853.extra_stages(acc[T], acc[Q], acc[V], h, p, o, s, K, None, parametric, base)
+    elif (K.shape[0] == dop853.N_STAGES_EXTENDED
+          and settings[RTOL] < dop853.SEVENTH_ORDER_BELOW_RTOL):
+        dop853.dense_output(acc[T], acc[Q], acc[V], q_new, v_new, h, p, o, s, K, Qc, True,
+                            parametric, base)
         acc[RHS_EVALS] += dop853.RHS_DENSE
-        dop853.dense_coefficients(K, h, acc[Q], acc[V], q_new, v_new, Qc)
     else:
         dop853.hermite_coefficients(acc[Q], acc[V], acc[FV], q_new, v_new,
-                                    K[K.shape[0] - 1, 1], h, Qc)
+                                    K[fsal_row(K), 1], h, Qc)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -428,7 +430,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         else:
             interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
             have_qc = True
-            xe = dense_root(v_old, h, Qc[1], 0.0, 0.0, 1.0)
+            xe = dense_extremum(v_old, v_new, h, Qc[1])
             qe = dense_value(q_old, h, Qc[0], xe)
         te = t + xe * h
         kind = mt.MAXIMUM if v_old > 0.0 else mt.MINIMUM
