@@ -1,4 +1,4 @@
-"""Work-precision of cable-sweep against SciPy RK45/DOP853 and numbalsoda dop853/lsoda.
+"""Work-precision of cable-sweep against SciPy RK45/DOP853, numbalsoda dop853/lsoda and diffrax.
 
 Wall time against the error of what a user reads (amplitude, settling time and state, final
 state), on the same points, on the same machine, in the same run; it also picks the default
@@ -59,6 +59,12 @@ tolerance govern until |q| falls ~10x below q0.
     The plain max of the samples would underestimate the amplitude by up to (w dt)^2/8 (2.5e-5
     measured at 20001 samples), far above the errors compared here. numbalsoda reports no step
     counts: "mean steps" is empty.
+  - diffrax (optional extra: `pip install jax diffrax`; skipped with a message if it is not
+    importable; --no-diffrax) Tsit5, Dopri5 and Dopri8: `jax.jit(jax.vmap(...))` of
+    `diffeqsolve` over all points on one single-threaded CPU device (1 thread) and `jax.pmap`
+    of it over two (2 threads), PIDController with the same rtol/atol, its dense output
+    evaluated on the --ns-samples times afterwards (not timed); metrics as numbalsoda's. See
+    the `Diffrax` class.
 Reported per method and rtol: wall time for the set (1 thread; 2 threads for cable-sweep and
 numbalsoda), mean accepted steps, mean right-hand-side evaluations, max relative amplitude
 error |A - A_ref| / A_ref, the settling-time error max |Ts - Ts_ref| / t_end over the points
@@ -81,7 +87,9 @@ Equal-error ratios: the error target is the max amplitude error cable-sweep reac
 --target-rtol (1e-8, the default rtol; the nearest rtol run otherwise). Each method's wall time
 at that error is interpolated linearly in log(wall) against log(error) between the two rtols
 that bracket it (the first crossing from the loose end); cable-sweep's speed ratio against each
-peer at 1 thread (and at 2 threads against numbalsoda) is printed.
+peer at 1 thread (and at 2 threads against numbalsoda) is printed. Then, for each amplitude
+error of --errors (1e-3 .. 1e-11), the fastest cable-sweep method and the fastest peer there,
+on 1 and on 2 threads, and their ratio (`fastest_report`).
 
 Command (full size; run on an otherwise idle machine with >= 2 cores; a few minutes, mostly
 SciPy RK45 and the metrics extraction of the SciPy runs)
@@ -129,8 +137,9 @@ NS_COUNTER = osc.N_PARAMS           # slot of the RHS-call counter in a numbalso
                                     # after the prepared parameter row
 NS_TERMS = (True, None)             # the oscillator's (parametric, base) in the numbalsoda rhs: the
                                     # cos(W t) load terms, no base excitation (this scene has none)
-NS_ROW = 24                         # data row length: 192 bytes, so that one point's counter
-                                    # never shares a cache line with another point's row
+NS_ROW = (NS_COUNTER + 8) // 8 * 8  # data row length: whole 64-byte lines, so that one point's
+                                    # counter never shares a cache line with another point's row
+DX_MAX_STEPS = 100_000              # diffrax's step bound (its dense output is stored per step)
 TIE = 1.01                          # equal-error: an error within 1 % of the target reaches it
 
 SCENE = """
@@ -465,8 +474,10 @@ class Diffrax:
     for 2 threads. JAX is told, before it is imported, to make two host devices of one thread
     each (XLA_FLAGS). The right-hand side is the oscillator's (kernels.oscillator.acceleration
     with the cos(W t) load terms) written in jax.numpy on the point's prepared row. PIDController
-    with SciPy's rtol/atol (an RMS norm, as SciPy's), SaveAt(ts=...) on the --ns-samples times,
-    as numbalsoda; the metrics from those samples. Steps: diffrax's num_accepted_steps; RHS
+    with SciPy's rtol/atol (an RMS norm, as SciPy's), SaveAt(dense=True): the timed call is the
+    solve with its dense output, as cable-sweep's reads its metrics off its own; the samples on
+    the --ns-samples times are evaluated from it afterwards (not timed; SaveAt(ts=...) on 20 001
+    times made the solve itself several times slower), the metrics from those samples. Steps: diffrax's num_accepted_steps; RHS
     evaluations: its num_steps (accepted and rejected) x the stages a step costs (FSAL counted
     once: Tsit5 and Dopri5 6, Dopri8 13)."""
 
@@ -503,16 +514,21 @@ class Diffrax:
 
         solver = getattr(dfx, name)()
 
-        def one(P, y0, ts, rtol, atol):
+        def one(P, y0, rtol, atol):
             sol = dfx.diffeqsolve(dfx.ODETerm(rhs), solver, 0.0, T_END, None, y0, args=P,
-                                  saveat=dfx.SaveAt(ts=ts),
+                                  saveat=dfx.SaveAt(dense=True),
                                   stepsize_controller=dfx.PIDController(rtol=rtol, atol=atol),
-                                  max_steps=None, throw=False)
-            return (sol.ys, sol.result == dfx.RESULTS.successful,
+                                  max_steps=DX_MAX_STEPS, throw=False)
+            return sol
+
+        def samples(sol, ts):
+            return (jax.vmap(sol.evaluate)(ts), sol.result == dfx.RESULTS.successful,
                     sol.stats["num_accepted_steps"], sol.stats["num_steps"])
 
-        batched = jax.vmap(one, in_axes=(0, 0, None, None, None))
-        fns = (jax.jit(batched), jax.pmap(batched, in_axes=(0, 0, None, None, None)))
+        batched = jax.vmap(one, in_axes=(0, 0, None, None))
+        sampled = jax.vmap(samples, in_axes=(0, None))
+        fns = (jax.jit(batched), jax.pmap(batched, in_axes=(0, 0, None, None)),
+               jax.jit(sampled), jax.pmap(sampled, in_axes=(0, None)))
         self.fns[key] = fns
         return fns
 
@@ -536,26 +552,26 @@ class Diffrax:
         for i, row in enumerate(table):
             osc.prepare.py_func(row, P[i], 0, 1)
         y0 = np.ascontiguousarray(table[:, [osc.Q0, osc.V0]])
-        single, parallel = self._compiled(name, t_eval.size)
+        single, parallel, sample_single, sample_parallel = self._compiled(name, t_eval.size)
         ts = jnp.asarray(t_eval)
         if threads == 1:
             args = (jnp.asarray(P), jnp.asarray(y0))
-            fn = single
+            fn, sample = single, sample_single
         else:
             half = (n + 1) // 2
             pad = 2 * half - n
             P2 = np.concatenate([P, P[:pad]]).reshape(2, half, -1)
             y2 = np.concatenate([y0, y0[:pad]]).reshape(2, half, 2)
             args = (jnp.asarray(P2), jnp.asarray(y2))
-            fn = parallel
+            fn, sample = parallel, sample_parallel
 
         def once():
-            result = fn(*args, ts, rtol, atol)
+            result = fn(*args, rtol, atol)
             self.jax.block_until_ready(result)
             return result
 
         wall = best_time(once) if timed else math.nan
-        ys, ok, accepted, steps = (np.asarray(x) for x in once())
+        ys, ok, accepted, steps = (np.asarray(x) for x in sample(once(), ts))
         if threads != 1:
             ys, ok, accepted, steps = (x.reshape((-1,) + x.shape[2:])[:n]
                                        for x in (ys, ok, accepted, steps))
@@ -831,6 +847,20 @@ def fmt(x: float, spec: str) -> str:
     return "" if not math.isfinite(x) else format(x, spec)
 
 
+def optional_peer(cls, packages: str, skip: bool):
+    """(an instance of the peer class cls, "") or (None, why not) where it is skipped or its
+    packages (`packages`, as pip names them) are not installed."""
+    if skip:
+        return None, ""
+    try:
+        return cls(), ""
+    except ImportError as exc:
+        message = (f"{packages} not installed ({exc}): its rows are skipped "
+                   f"(pip install {packages}).")
+        print(message, file=sys.stderr)
+        return None, message
+
+
 def main() -> None:
     args = parse_args()
     self_check(verbose=False)            # reference_metrics on closed forms (< 1 s)
@@ -840,27 +870,9 @@ def main() -> None:
     cfg = Settings(tail=scene.get("metrics.tail"), tol=scene.get("metrics.tolerance"),
                    ns_samples=args.ns_samples)
 
-    ns = None
-    ns_compile_s = math.nan
-    ns_message = ""
-    if not args.no_numbalsoda:
-        try:
-            ns = Numbalsoda()
-        except ImportError as exc:
-            ns_message = (f"numbalsoda not installed ({exc}): its rows are skipped "
-                          "(pip install numbalsoda).")
-            print(ns_message, file=sys.stderr)
-
-    dx = None
-    dx_compile_s = math.nan
-    dx_message = ""
-    if not args.no_diffrax:
-        try:
-            dx = Diffrax()
-        except ImportError as exc:
-            dx_message = (f"diffrax not installed ({exc}): its rows are skipped "
-                          "(pip install diffrax).")
-            print(dx_message, file=sys.stderr)
+    ns, ns_message = optional_peer(Numbalsoda, "numbalsoda", args.no_numbalsoda)
+    dx, dx_message = optional_peer(Diffrax, "jax diffrax", args.no_diffrax)
+    ns_compile_s = dx_compile_s = math.nan
 
     start = time.perf_counter()
     ref = reference_solution(table, args.ref_rtol, args.ref_atol, cfg)
