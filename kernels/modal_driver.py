@@ -194,6 +194,19 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal, Km, Qm):
+    """After trajectory.record_step on the step [t, t_new]: where the early stop
+    (solver.stop_when_steady) moved the tail window to start inside it (acc[T_TAIL] is no
+    longer t_tail), each mode's tail amplitude restarts there, as the midspan's does: the
+    mode's value at the new start, its extremum after it and the step's end."""
+    if acc[tj.T_TAIL] == t_tail:
+        return
+    for i in range(n_modes):
+        modal[i] = 0.0
+    _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, Qm)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
     """Set up a trajectory at t = 0 from raw row `row` for both multi-mode drivers: the initial
     state y and f = f(0, y) (length 2N each, written here), SciPy's initial step, the midspan
@@ -240,8 +253,6 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     n = n_modes
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
-    t_end = settings[T_END]
-    t_tail = t_end * (1.0 - settings[TAIL])
     eighth = settings[METHOD] != 0.0
     n_stages = dop853.N_STAGES if eighth else dopri5.N_STAGES
     A = dop853.A if eighth else dopri5.A
@@ -284,6 +295,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
                 acc[tj.T_STOP] = t_new
         if acc[tj.STATUS] != mt.RUNNING:
             break
+        t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, Qm)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
@@ -293,6 +305,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         tj.record_step(p1, 0, 1, settings, acc, K_mid, _project(y_new, weights, 0, n),
                        _project(y_new, weights, n, n), h, Qc, buf, series, track, centre,
                        thr_fixed, thr_rel, -1.0, 0.0, True, base)
+        restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, Qm)
         for i in range(dim):
             y[i] = y_new[i]
         K[0, :] = K[n_stages, :]

@@ -53,7 +53,7 @@ from . import modes as md
 from . import trajectory as tj
 from .lanes import _step_factor
 from .layout import (CONTROLLER, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
-                     N_REALS, RTOL, SAMPLE_DT, TAIL, TOL, T_END, WANT_SETTLING)
+                     N_REALS, RTOL, SAMPLE_DT, TOL, T_END, WANT_SETTLING)
 from .oscillator import BOUND, N_PARAMS
 from .transverse import classify_metrics
 
@@ -270,12 +270,12 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     metrics (trajectory.observe_step_end, as in record_step) and moves to its end (MOVE 1);
     any other is left to the scalar path (FLAG 2). Returns how many lanes it flagged."""
     L = LANES
-    t_tail = settings[T_END] * (1.0 - settings[TAIL])
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
     n_flagged = 0
     for l in range(n_run):
+        t_tail = W[tj.T_TAIL * L + l]          # the lane's own tail window start
         active = H[l] > 0.0
         accepted = ERR[l] < 1.0
         t = W[tj.T * L + l]
@@ -310,13 +310,14 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, t_tail, n_run):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run):
     """Each mode's tail amplitude at the end of an ordinary accepted step (MOVE 1, FLAG 0):
-    MOD[i, l] = max(MOD[i, l], |q_i(t_new)|) once t_new >= t_tail."""
+    MOD[i, l] = max(MOD[i, l], |q_i(t_new)|) once t_new >= the lane's tail start."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
-            take = (MOVE[l] != 0.0) & (FLAG[l] == 0.0) & (W[tj.T_NEW * L + l] >= t_tail)
+            take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
+                    & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
             MOD[i, l] = max(MOD[i, l], abs(YN[i, l])) if take else MOD[i, l]
 
 
@@ -392,8 +393,7 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, buf, series, i,
-                  track, thr_rel, t_tail, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc,
-                  base):
+                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
     """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
     modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
     by modal_driver._observe_modes, the midspan Observer trajectory.record_step) on copies of
@@ -418,9 +418,8 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
         ynl[c] = YN[c, j]
     for c in range(n):
         ml[c] = MOD[c, j]
+    t_tail = acc[tj.T_TAIL]
     drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
-    for c in range(n):
-        MOD[c, j] = ml[c]
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
         Kmid[r, 1] = KM[r, 1, j]
@@ -428,6 +427,9 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     v_new = drv._project(ynl, weights, n, n)
     tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
                    0.0, 0.0, thr_rel, -1.0, 0.0, True, base)
+    drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
+    for c in range(n):
+        MOD[c, j] = ml[c]
     return True                  # (a midspan divergence moves on, as in the scalar driver)
 
 
@@ -443,7 +445,6 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     n = n_modes
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
-    t_tail = settings[T_END] * (1.0 - settings[TAIL])
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     n_samples = series.shape[1]
@@ -535,7 +536,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
         _mode_events(Y, YN, H, ERR, BOUNDS, EV, n, n_run)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, t_tail, n_run)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run)
         if n_flagged > 0:
             for j in range(n_run):
                 if FLAG[j] != 2.0:
@@ -544,7 +545,6 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     bufs[j] = tj.with_room(bufs[j], W[j::L])
                     capacity[j] = bufs[j].shape[0]
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
-                                 weights, bufs[j], series, point[j], track, thr_rel, t_tail,
-                                 eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
+                                 weights, bufs[j], series, point[j], track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)
