@@ -393,6 +393,29 @@ def terminate_raises() -> Iterator[None]:
 
 
 @contextlib.contextmanager
+def signals_held() -> Iterator[list[int]]:
+    """Within the block, Ctrl-C (SIGINT), SIGTERM and SIGHUP are recorded (their numbers appended
+    to the list yielded) instead of raising: for the final write of a finished run, which an
+    exception inside netCDF4 or xarray would leave half done (xarray's file lock, taken when
+    the exception struck, is then awaited for ever in its close). Only in the main thread, and
+    only over Python's own handlers (as `_interrupt_sets`)."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+    ours = {signal.SIGINT: (signal.default_int_handler,)}
+    ours.update({s: (signal.SIG_DFL, _raise_terminated) for s in TERMINATING})
+    taken = [s for s, defaults in ours.items() if signal.getsignal(s) in defaults]
+    previous = {s: signal.signal(s, lambda signum, frame: received.append(signum))
+                for s in taken}
+    try:
+        yield received
+    finally:
+        for s, before in previous.items():
+            signal.signal(s, before)
+
+
+@contextlib.contextmanager
 def _interrupt_sets(stop: threading.Event) -> Iterator[list[int]]:
     """Within the block, Ctrl-C (SIGINT), SIGTERM and SIGHUP set `stop` instead of ending the
     run at once, so it ends after the blocks in hand and keeps them; the signal's number is

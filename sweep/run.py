@@ -78,13 +78,31 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         options = run_options(scene, threads=threads, progress=progress, **persist)
         ds = models.model_for(scene.get("model.kind")).run(scene, options)
         if output is not None:
-            write_netcdf(ds, output, overwrite)
-            ChunkStore(output, "").remove()
+            _write_whole(ds, output, overwrite)
     finally:
         if output is not None:
             # a run that failed before finishing a chunk leaves no store to block the next one
             ChunkStore(output, "").release(discard_empty=True)
     return ds
+
+
+def _write_whole(ds: Any, output: str | os.PathLike, overwrite: bool) -> None:
+    """Write the finished run to `output` and drop its chunk store, with Ctrl-C, SIGTERM and
+    SIGHUP held until both are done (the result is whole by then; a signal is reported as a
+    warning, not lost work)."""
+    import signal
+    import warnings
+
+    from .errors import CableSweepWarning
+    from .execute import signals_held
+    from .store import ChunkStore
+    with signals_held() as held:
+        write_netcdf(ds, output, overwrite)
+        ChunkStore(output, "").remove()
+    if held:
+        warnings.warn(f"{signal.Signals(held[0]).name} received while writing "
+                      f"'{os.fspath(output)}': the write was finished first, the result is "
+                      "complete", CableSweepWarning, stacklevel=3)
 
 
 def _check_scheduler(scene: Scene, scheduler: str) -> None:
