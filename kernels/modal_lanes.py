@@ -53,7 +53,7 @@ from . import modes as md
 from . import trajectory as tj
 from .lanes import _step_factor
 from .layout import (CONTROLLER, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
-                     N_REALS, RTOL, SAMPLE_DT, TOL, T_END, WANT_SETTLING)
+                     N_REALS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING)
 from .oscillator import BOUND, N_PARAMS
 from .transverse import classify_metrics
 
@@ -200,11 +200,11 @@ def _prepare(W, H, FLAG, settings, n_run):
     SciPy's clamp and failure cannot apply (H: the step, FLAG 0). Other lanes get FLAG 1 (the
     scalar next_attempt's turn) and are left as they are."""
     L = LANES
-    t_end = settings[T_END]
     max_step = settings[MAX_STEP]
     max_steps = settings[MAX_STEPS]
     min_user = settings[MIN_STEP]
     for l in range(n_run):
+        t_end = W[tj.T_FINAL * L + l]         # the lane's own end (solver.stop_when_steady)
         t = W[tj.T * L + l]
         h_abs = W[tj.H_ABS * L + l]
         fresh = W[tj.REJECTED_NOW * L + l] == 0.0

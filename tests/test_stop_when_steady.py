@@ -94,6 +94,8 @@ def test_several_modes_stop_and_their_modal_amplitudes_are_the_full_runs(driver)
     scale = modal_final.max(axis=-1, keepdims=True)          # the point's largest mode
     assert (np.abs(modal_early - modal_final) / scale).max() < 1e-3
     assert np.all(early.state.values[stopped] == 2)
+    # a stopped point ends there: fewer right-hand sides than the full run
+    assert np.all(early.n_rhs.values[stopped] < final.n_rhs.values[stopped])
 
 
 def test_a_beating_response_never_stops():
