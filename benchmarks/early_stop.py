@@ -13,7 +13,8 @@ the early amplitude from the full run's tail maximum and from its final level (a
 modes, of each mode's tail amplitude from its final level, relative to the point's largest
 mode); points that did not stop must equal the full run bit for bit.
 
-Command (2-core machine, otherwise idle):
+Command (2-core machine, otherwise idle; scene labels as arguments run only those, e.g.
+"harness-base-sine" for the five-mode map alone):
     python benchmarks/early_stop.py
 """
 
@@ -55,9 +56,14 @@ def modal_worst(early, final, steady) -> str:
 def main() -> None:
     print("| scene | points | full (s) | early (s) | speed-up | RHS ratio | stopped | "
           "worst / median vs full tail max | worst / median vs full final level | "
-          "modal amplitudes: worst vs final level | not stopped equal |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "stopped points: worst vs final level | "
+          "stopped points: modal amplitudes, worst vs final level | not stopped equal |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    wanted = sys.argv[1:]          # scene labels to run (default: all)
     for name, extra, repeats in SCENES:
+        label = name + (" (" + ", ".join(f"{k}={v}" for k, v in extra.items()) + ")" if extra else "")
+        if wanted and label not in wanted:
+            continue
         full_scene = sweep.load_scene(name, overrides=extra)
         sweep.run(full_scene, threads=2, progress=False)              # compile / load
         t_full, full = best(full_scene, repeats)
@@ -73,11 +79,12 @@ def main() -> None:
         r_full = np.abs(a_e - a_f)[steady] / a_f[steady]
         r_final = np.abs(a_e - a_n)[steady] / a_n[steady]
         same = bool(np.array_equal(a_e[~stopped], a_f[~stopped]))
-        label = name + (" (" + ", ".join(f"{k}={v}" for k, v in extra.items()) + ")" if extra else "")
+        r_stopped = (np.abs(a_e - a_n) / a_n)[steady & stopped]
         print(f"| {label} | {a_f.size} | {t_full:.3f} | {t_early:.3f} | {t_full / t_early:.2f}x | "
               f"{float(full.n_rhs.sum() / early.n_rhs.sum()):.2f} | {int(stopped.sum())} | "
               f"{r_full.max():.1e} / {np.median(r_full):.1e} | {r_final.max():.1e} / "
-              f"{np.median(r_final):.1e} | {modal_worst(early, final, steady)} | {same} |")
+              f"{np.median(r_final):.1e} | {r_stopped.max():.1e} | "
+              f"{modal_worst(early, final, steady & stopped)} | {same} |")
 
 
 if __name__ == "__main__":
