@@ -393,42 +393,41 @@ def terminate_raises() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def signals_held() -> Iterator[list[int]]:
-    """Within the block, Ctrl-C (SIGINT), SIGTERM and SIGHUP are recorded (their numbers appended
-    to the list yielded) instead of raising: for the final write of a finished run, which an
-    exception inside netCDF4 or xarray would leave half done (xarray's file lock, taken when
-    the exception struck, is then awaited for ever in its close). Only in the main thread, and
-    only over Python's own handlers (as `_interrupt_sets`)."""
-    received: list[int] = []
+def _stopping_signals(handler: Callable[[int, Any], None]) -> Iterator[None]:
+    """Within the block, `handler` answers Ctrl-C (SIGINT), SIGTERM and SIGHUP. Only in the main
+    thread, and only over Python's own SIGINT handler and the default (or terminate_raises's)
+    SIGTERM and SIGHUP handlers (not over one a caller installed, nor where one is ignored)."""
     if threading.current_thread() is not threading.main_thread():
-        yield received
+        yield
         return
     ours = {signal.SIGINT: (signal.default_int_handler,)}
     ours.update({s: (signal.SIG_DFL, _raise_terminated) for s in TERMINATING})
     taken = [s for s, defaults in ours.items() if signal.getsignal(s) in defaults]
-    previous = {s: signal.signal(s, lambda signum, frame: received.append(signum))
-                for s in taken}
+    previous = {s: signal.signal(s, handler) for s in taken}
     try:
-        yield received
+        yield
     finally:
         for s, before in previous.items():
             signal.signal(s, before)
 
 
 @contextlib.contextmanager
-def _interrupt_sets(stop: threading.Event) -> Iterator[list[int]]:
-    """Within the block, Ctrl-C (SIGINT), SIGTERM and SIGHUP set `stop` instead of ending the
-    run at once, so it ends after the blocks in hand and keeps them; the signal's number is
-    appended to the list yielded. A second one raises KeyboardInterrupt. Only in the main
-    thread, and only over Python's own SIGINT handler and the default (or terminate_raises's)
-    SIGTERM and SIGHUP handlers (not over one a caller installed, nor where one is ignored)."""
+def signals_held() -> Iterator[list[int]]:
+    """Within the block, Ctrl-C, SIGTERM and SIGHUP are recorded (their numbers appended to the
+    list yielded) instead of raising (`_stopping_signals`): for the final write of a finished
+    run, which an exception inside netCDF4 or xarray would leave half done (xarray's file lock,
+    taken when the exception struck, is then awaited for ever in its close)."""
     received: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
+    with _stopping_signals(lambda signum, frame: received.append(signum)):
         yield received
-        return
-    ours = {signal.SIGINT: (signal.default_int_handler,)}
-    ours.update({s: (signal.SIG_DFL, _raise_terminated) for s in TERMINATING})
-    taken = [s for s, defaults in ours.items() if signal.getsignal(s) in defaults]
+
+
+@contextlib.contextmanager
+def _interrupt_sets(stop: threading.Event) -> Iterator[list[int]]:
+    """Within the block, Ctrl-C, SIGTERM and SIGHUP set `stop` instead of ending the run at
+    once (`_stopping_signals`), so it ends after the blocks in hand and keeps them; the
+    signal's number is appended to the list yielded. A second one raises KeyboardInterrupt."""
+    received: list[int] = []
 
     def handler(signum: int, frame: Any) -> None:
         if stop.is_set():
@@ -436,12 +435,8 @@ def _interrupt_sets(stop: threading.Event) -> Iterator[list[int]]:
         received.append(signum)
         stop.set()
 
-    previous = {s: signal.signal(s, handler) for s in taken}
-    try:
+    with _stopping_signals(handler):
         yield received
-    finally:
-        for s, before in previous.items():
-            signal.signal(s, before)
 
 
 def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.ndarray], n: int,
