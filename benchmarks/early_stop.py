@@ -61,7 +61,8 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     wanted = sys.argv[1:]          # scene labels to run (default: all)
     for name, extra, repeats in SCENES:
-        label = name + (" (" + ", ".join(f"{k}={v}" for k, v in extra.items()) + ")" if extra else "")
+        label = name + (" (" + ", ".join(f"{k}={v}" for k, v in extra.items()) + ")"
+                        if extra else "")
         if wanted and label not in wanted:
             continue
         full_scene = sweep.load_scene(name, overrides=extra)

@@ -477,8 +477,8 @@ class Diffrax:
     with SciPy's rtol/atol (an RMS norm, as SciPy's), SaveAt(dense=True): the timed call is the
     solve with its dense output, as cable-sweep's reads its metrics off its own; the samples on
     the --ns-samples times are evaluated from it afterwards (not timed; SaveAt(ts=...) on 20 001
-    times made the solve itself several times slower), the metrics from those samples. Steps: diffrax's num_accepted_steps; RHS
-    evaluations: its num_steps (accepted and rejected) x the stages a step costs (FSAL counted
+    times made the solve itself several times slower), the metrics from those samples.
+    Steps: diffrax's num_accepted_steps; RHS evaluations: its num_steps (accepted and rejected) x the stages a step costs (FSAL counted
     once: Tsit5 and Dopri5 6, Dopri8 13)."""
 
     SOLVERS = ("Tsit5", "Dopri5", "Dopri8")

@@ -207,7 +207,7 @@ DENSE_TERMS = 7     # columns of an interpolant's coefficient array: up to degre
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def dense_coefficients(K, Q):
     """Q[:, :4] = K^T P: the quartic interpolant of the last step; Q has shape (2, DENSE_TERMS),
-    the layout of DOP853's seventh-order interpolant (dop853.dense_coefficients), and
+    the layout of DOP853's seventh-order interpolant (dop853.dense_output), and
     Q[:, 4:] = 0."""
     for i in range(2):
         for k in range(4):

@@ -44,8 +44,8 @@ from . import dop853
 from . import metrics as mt
 from . import stages
 from . import trajectory as tj
-from .dopri5 import (DENSE_TERMS, A, B, C, E, MAX_FACTOR, MIN_FACTOR, MIN_RTOL, N_STAGES, P,
-                     RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
+from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, A, B, C, E, MAX_FACTOR, MIN_FACTOR,
+                     MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
 from .layout import MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
@@ -76,7 +76,7 @@ W_XE = W_QN + 4                   # the accepted step's extremum of q: x = (t - 
 W_QE = W_QN + 5                   # q there (m)
 W_FACTOR = W_QN + 6               # the PI controller's step-size factor for the attempt
 W_AB = W_QN + 7                   # base excitation a_b(t + h) at the attempt's end (m/s^2)
-W_K8 = W_QN + 8                   # DOP853's stage s = 1 .. 11, component c at row W_K8 + 2 (s - 1) + c
+W_K8 = W_QN + 8                   # DOP853's stage s = 1..11, component c: W_K8 + 2 (s - 1) + c
 W_ROWS = W_K8 + 2 * (dop853.N_STAGES - 1)
 
 # W_FLAG values.
@@ -214,9 +214,9 @@ def _attempt(W, rtol, n_run, parametric, base):
 def _attempt8(W, rtol, n_run, parametric, base):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
-    (W_K + 12, W_K + 13), stages 1 .. 11 in W_K8 (the seventh-order dense output of a step that
-    needs one, dop853.dense_output, is built from them by trajectory.record_step) and SciPy's DOP853
-    error norm from dop853.E5, E3 (W_ERR).
+    (W_K + 12, W_K + 13), stages 1 .. 11 in W_K8 (the seventh-order dense output of a step
+    that needs one, dop853.dense_output, is built from them by trajectory.record_step) and
+    SciPy's DOP853 error norm from dop853.E5, E3 (W_ERR).
     """
     L = LANES
     for j in range(n_run):
@@ -393,7 +393,8 @@ def _dense_row(k0, k1, k2, k3, k4, k5, k6, p):
 NEWTON_ITERATIONS = 2       # safeguarded Newton steps for an extremum's position; where they
                             # leave it short of round-off, record_step's root finder takes over
                             # (a third step cost more than those rare fallbacks: 3 % slower)
-NEWTON_RESIDUAL = 1e-14     # |q'(x)| / (|q'_old| + |q'_new|) at which the root is at round-off
+NEWTON_RESIDUAL = EXTREMUM_RESIDUAL   # |q'(x)| / (|q'_old| + |q'_new|) at which the root is
+                                      # at round-off (the scalar dopri5.dense_extremum's too)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -545,6 +545,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     bufs[j] = tj.with_room(bufs[j], W[j::L])
                     capacity[j] = bufs[j].shape[0]
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
-                                 weights, bufs[j], series, point[j], track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
+                                 weights, bufs[j], series, point[j], track, thr_rel, eighth,
+                                 n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)
