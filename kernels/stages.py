@@ -384,6 +384,19 @@ def _inline_outside_chains(expr, caller_ir, callee_ir) -> bool:
     return not getattr(caller_ir.func_id.func, "stage_chain", False)
 
 
+@functools.lru_cache(maxsize=None)
+def _written_rhs(rhs: Callable, switches: tuple) -> Callable:
+    """`rhs` written out for `switches` ((name, None or True) pairs, sorted) as the Numba
+    function a chain calls: one per right-hand side and combination of switches, shared by
+    every method's chain (writing it out is most of a chain's import time)."""
+    rhs_source, rhs_namespace = written_out(rhs, dict(switches))
+    exec(compile(rhs_source, f"<right-hand side {rhs.py_func.__name__} {dict(switches)}>",
+                 "exec"), rhs_namespace)
+    flat = rhs_namespace[rhs.py_func.__name__]
+    flat.__doc__ = rhs_source
+    return nb.njit(nogil=True, error_model="numpy", inline=_inline_outside_chains)(flat)
+
+
 def make_chain(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[float],
                rhs: Callable, sums: Sequence[Sequence[float]] = (), skip_zeros: bool = False,
                name: str = "chain", switches: dict | None = None) -> Callable:
@@ -392,13 +405,7 @@ def make_chain(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[flo
     itself written out with its callees (`written_out`, specialised to `switches`: e.g.
     {"parametric": None, "base": True}; the chain's own parametric and base are then unread)
     and inlined into the chain's caller."""
-    rhs_source, rhs_namespace = written_out(rhs, switches)
-    exec(compile(rhs_source, f"<right-hand side {rhs.py_func.__name__} of {name}>", "exec"),
-         rhs_namespace)
-    flat = rhs_namespace[rhs.py_func.__name__]
-    flat.__doc__ = rhs_source
-    namespace = {"rhs": nb.njit(nogil=True, error_model="numpy",
-                                inline=_inline_outside_chains)(flat)}
+    namespace = {"rhs": _written_rhs(rhs, tuple(sorted((switches or {}).items())))}
     source = chain_source(A, B, C, sums, skip_zeros, name)
     exec(compile(source, f"<stage chain {name}>", "exec"), namespace)
     function = namespace[name]
