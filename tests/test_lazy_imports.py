@@ -77,3 +77,33 @@ def test_xarray_still_sees_dask_arrays_once_dask_is_imported(tmp_path):
             f"b.to_netcdf({str(tmp_path / 'again.nc')!r})\n"
             "assert float(abs(b.amplitude - ds.amplitude).max()) == 0.0\n")
     assert "dask" in _loaded_after(code)["loaded"]
+
+
+def test_a_cli_run_imports_no_scipy_linalg_and_numba_keeps_its_linear_algebra(tmp_path):
+    """The command line loads Numba's registries without the SciPy import its BLAS probe
+    makes (sweep/numba_start.py); afterwards SciPy, np.dot and np.convolve in compiled code
+    work and give the right answers."""
+    out = tmp_path / "f5.nc"
+    code = ("import sys\nfrom sweep.cli import main\n"
+            f"main(['run', 'paper-fig5', '-o', {str(out)!r}, '--set', 'solver.t_end=0.2', "
+            "'-q'])\n"
+            "linalg_after_run = 'scipy.linalg' in sys.modules\n"
+            "import numpy as np, numba, scipy.linalg\n"
+            "@numba.njit\n"
+            "def f(a, b):\n"
+            "    return np.dot(a, b), np.convolve(a, b)\n"
+            "a, b = np.arange(3.0), np.array([2.0, -1.0, 0.5])\n"
+            "d, c = f(a, b)\n"
+            "assert d == np.dot(a, b) and np.allclose(c, np.convolve(a, b))\n"
+            "assert np.allclose(scipy.linalg.solve(np.eye(2) * 2.0, np.ones(2)), 0.5)\n"
+            "print('linalg after run:', linalg_after_run)\n")
+    result = _loaded_after(code)
+    assert "linalg after run: False" in result["stdout"]
+    assert out.exists()
+
+
+def test_the_numba_start_leaves_a_process_with_numba_started_alone():
+    code = ("import numba\n@numba.njit\ndef g(x):\n    return x + 1\ng(1)\n"
+            "from sweep.numba_start import start_without_scipy\n"
+            "print('started:', start_without_scipy())\n")
+    assert "started: False" in _loaded_after(code)["stdout"]
