@@ -27,6 +27,8 @@ from typing import Callable
 
 import numpy as np
 
+from .specialise import call
+
 MIN_BLOCK = 128        # points per block, at least (smaller blocks leave lanes idle as they drain)
 MAX_BLOCK = 1024       # at most
 SHARE = 2              # a block is at most 1/SHARE of a thread's share of the points left
@@ -103,25 +105,25 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
 
         def kernel(lo: int, hi: int) -> None:
             for i in range(lo, hi):
-                tk.solve_swept_block(params, swept_settings(settings, durations, i), i, i + 1,
-                                     states, reals, counts, series, envelope, parametric, base)
+                call(tk.solve_swept_block, params, swept_settings(settings, durations, i), i,
+                     i + 1, states, reals, counts, series, envelope, parametric, base)
     elif driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
-            tk.solve_block(params, settings, lo, hi, states, reals, counts, series, parametric,
-                           base)
+            call(tk.solve_block, params, settings, lo, hi, states, reals, counts, series,
+                 parametric, base)
     else:
         pi = True if settings[tk.CONTROLLER] != 0.0 else None
         eighth = True if settings[tk.METHOD] != 0.0 else None
 
         def kernel(lo: int, hi: int) -> None:
-            lanes.solve_block(params, settings, lo, hi, states, reals, counts, series, pi,
-                              eighth, parametric, base)
+            call(lanes.solve_block, params, settings, lo, hi, states, reals, counts, series,
+                 pi, eighth, parametric, base)
 
     def solve_block(lo: int, hi: int) -> None:
         kernel(lo, hi)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
-            tk.settle_second_pass(params[lo:hi], settings, states[lo:hi], reals[lo:hi],
-                                  counts[lo:hi], parametric, base)
+            call(tk.settle_second_pass, params[lo:hi], settings, states[lo:hi], reals[lo:hi],
+                 counts[lo:hi], parametric, base)
         if on_block is not None:
             on_block(lo, hi)
 
@@ -157,16 +159,15 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
     def solve_block(lo: int, hi: int) -> None:
         if swept:
             for i in range(lo, hi):
-                modal_driver.solve_swept_block(params, n_modes,
-                                               swept_settings(settings, durations, i), i, i + 1,
-                                               states, reals, counts, series, modal, final,
-                                               envelope, base)
+                call(modal_driver.solve_swept_block, params, n_modes,
+                     swept_settings(settings, durations, i), i, i + 1, states, reals, counts,
+                     series, modal, final, envelope, base)
         else:
-            kernel.solve_block(params, n_modes, settings, lo, hi, states, reals, counts,
-                               series, modal, final, base)
+            call(kernel.solve_block, params, n_modes, settings, lo, hi, states, reals,
+                 counts, series, modal, final, base)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
-            modal_driver.settle_second_pass(params[lo:hi], n_modes, settings, states[lo:hi],
-                                            reals[lo:hi], counts[lo:hi], base)
+            call(modal_driver.settle_second_pass, params[lo:hi], n_modes, settings,
+                 states[lo:hi], reals[lo:hi], counts[lo:hi], base)
         if on_block is not None:
             on_block(lo, hi)
 

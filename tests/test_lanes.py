@@ -14,6 +14,7 @@ from sweep.kernels.oscillator import Q0
 
 from conftest import param_row, settings
 from sweep.threads import solve_transverse
+from sweep.specialise import call
 
 
 def _solve(driver, rows, s, n_samples=0):
@@ -280,7 +281,7 @@ def test_lanes_loops_are_vectorised(name, args):
     options = {k: v for k, v in kernel.targetoptions.items() if k not in ("cache", "nopython")}
     fresh = numba.njit(**options)(kernel.py_func)
     W = np.zeros(lanes.W_ROWS * lanes.LANES)
-    fresh(*args(W, settings()))
+    call(fresh, *args(W, settings()))         # the switches typed as the run types them
     mnemonics = [line.split()[0] for text in fresh.inspect_asm().values()
                  for line in text.splitlines() if line.startswith("\t") and line.split()]
     packed = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+pd", m))
@@ -300,7 +301,8 @@ s = settings(rtol=1e-6, t_end=5.0, sample_dt=0.05)
 n = rows.shape[0]
 out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)), np.empty((n, tk.N_COUNTS), np.int64),
        np.empty((n, 101)))
-lanes.solve_block(rows, s, 0, n, *out, None, None, True, None)
+from sweep.specialise import call
+call(lanes.solve_block, rows, s, 0, n, *out, None, None, True, None)
 np.savez({result!r}, *out)
 """
 

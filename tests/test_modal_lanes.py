@@ -21,6 +21,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
 from sweep.models import transverse as tm
+from sweep.specialise import call
 
 
 def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
@@ -37,7 +38,8 @@ def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int)
     out = (np.full(n, 99, np.int8), np.full((n, tk.N_REALS), -1.0),
            np.full((n, tk.N_COUNTS), -1, np.int64), np.full((n, n_samples), -1.0),
            np.full((n, n_modes), -1.0), np.full((n, 2 * n_modes), -1.0))
-    driver.solve_block(rows, n_modes, s, 0, n, *out, True if s[tk.BASE] != 0.0 else None)
+    call(driver.solve_block, rows, n_modes, s, 0, n, *out,
+         True if s[tk.BASE] != 0.0 else None)
     return out
 
 
@@ -186,7 +188,7 @@ def test_a_block_inside_a_table_and_idle_lanes():
     rows, n, s, n_samples = case_rows("n3-base-dop853")
     whole = solve(modal_lanes, rows, n, s, n_samples)
     part = tuple(np.full_like(x, 7) for x in whole)
-    modal_lanes.solve_block(rows, n, s, 5, 12, *part, True)
+    call(modal_lanes.solve_block, rows, n, s, 5, 12, *part, True)
     for x, y in zip(whole, part):
         np.testing.assert_array_equal(y[5:12], x[5:12])
         assert np.all(y[:5] == 7) and np.all(y[12:] == 7)

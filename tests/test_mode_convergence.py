@@ -22,6 +22,7 @@ from sweep.kernels import layout as tk
 from sweep.kernels import modes as md
 from sweep.kernels import oscillator as osc
 from sweep.models import modal
+from sweep.specialise import call
 
 from conftest import settings, solve
 
@@ -48,8 +49,8 @@ def _solve_modes(rows, n_modes, s):
     reals = np.empty((n, tk.N_REALS))
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     modal_amp = np.empty((n, n_modes))
-    modal_driver.solve_block(rows, n_modes, s, 0, n, states, reals, counts, np.empty((n, 0)),
-                             modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None)
+    call(modal_driver.solve_block, rows, n_modes, s, 0, n, states, reals, counts,
+         np.empty((n, 0)), modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None)
     return states, reals, counts, modal_amp
 
 
