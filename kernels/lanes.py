@@ -481,7 +481,7 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series, 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, parametric,
-                 base):
+                 base, eighth):
     """trajectory.record_step for lane j (point i) after an accepted attempt. The lane's views of
     W and of the point's time-series row are taken here, where Numba keeps no reference counts
     (`_nrt=False`; nothing here allocates): taken in solve_block, each view cost two atomic
@@ -489,7 +489,7 @@ def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, para
     L = LANES
     tj.record_step(W, W_P * L + j, L, settings, W[j::L], K, W[W_QN * L + j],
                    W[W_VN * L + j], W[W_H * L + j], Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base)
+                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base, eighth)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -589,4 +589,4 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                 bufs[j] = tj.with_room(bufs[j], W[j::L])
                 capacity[j] = bufs[j].shape[0]
             _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe,
-                         parametric, base)
+                         parametric, base, eighth)

@@ -302,9 +302,14 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
             K_mid[j, 1] = _project(K[j], weights, n, n)
         if acc[tj.N_EXT] >= buf.shape[0]:
             buf = tj.with_room(buf, acc)
-        tj.record_step(p1, 0, 1, settings, acc, K_mid, _project(y_new, weights, 0, n),
-                       _project(y_new, weights, n, n), h, Qc, buf, series, track, centre,
-                       thr_fixed, thr_rel, -1.0, 0.0, True, base)
+        q_mid = _project(y_new, weights, 0, n)
+        v_mid = _project(y_new, weights, n, n)
+        if eighth:             # the method's switch, a constant in each call
+            tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series,
+                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, True)
+        else:
+            tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series,
+                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, None)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, Qm)
         for i in range(dim):
             y[i] = y_new[i]

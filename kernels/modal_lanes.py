@@ -425,8 +425,12 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
         Kmid[r, 1] = KM[r, 1, j]
     q_new = drv._project(ynl, weights, 0, n)
     v_new = drv._project(ynl, weights, n, n)
-    tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, -1.0, 0.0, True, base)
+    if eighth:                 # the method's switch, a constant in each call
+        tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
+                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, True)
+    else:
+        tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
+                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, None)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
     for c in range(n):
         MOD[c, j] = ml[c]

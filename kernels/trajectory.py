@@ -261,7 +261,7 @@ def control(settings, acc, err):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
-                   track, centre, thr_fixed, thr_rel, parametric, base):
+                   track, centre, thr_fixed, thr_rel, parametric, base, eighth):
     """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
     y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
     SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
@@ -272,7 +272,7 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
         if acc[N_EXT] >= buf.shape[0]:
             buf = with_room(buf, acc)
         record_step(p, 0, 1, settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
-                    centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base)
+                    centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth)
     return buf
 
 
@@ -284,15 +284,17 @@ def fsal_row(K):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
+def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base, eighth):
     """Qc (2, DENSE_TERMS): the dense output of the accepted step from acc's state to
-    (q_new, v_new), K its stage derivatives. RK45: its own quartic. DOP853 with the extended K
+    (q_new, v_new), K its stage derivatives. `eighth`, the method's switch (None: RK45, True:
+    DOP853, as settings[METHOD]; a switch, so a scene compiles one method's interpolants).
+    RK45: its own quartic. DOP853 with the extended K
     (dop853.N_STAGES_EXTENDED rows: the one-mode drivers) and rtol below
     dop853.SEVENTH_ORDER_BELOW_RTOL: its own seventh-order interpolant, whose three extra
     right-hand sides are computed here (and counted); otherwise (a looser rtol, or the modal
     drivers' midspan projection) the quintic Hermite interpolant (dop853.hermite_coefficients).
     p[o + column * s]: the point's prepared row."""
-    if settings[METHOD] == 0.0:
+    if eighth is None:
         dense_coefficients(K, Qc)
     elif (K.shape[0] == dop853.N_STAGES_EXTENDED
           and settings[RTOL] < dop853.SEVENTH_ORDER_BELOW_RTOL):
@@ -388,11 +390,13 @@ def _observe_base(acc, a, sa, p, o, s, t, h, t_new, fv_new, t_tail, take, fast, 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
-                thr_fixed, thr_rel, xe_known, qe_known, parametric, base):
+                thr_fixed, thr_rel, xe_known, qe_known, parametric, base, eighth):
     """Reduce the metrics of an accepted step [acc[T], acc[T_NEW]] on its dense output and
     advance the trajectory to its end. p[o + column * s]: the point's prepared row (its
     divergence bound on |q|, m, and base excitation); `buf` must have room for one more
     extremum (`with_room`).
+
+    eighth: the method's switch (None: RK45, True: DOP853), for `interpolant`.
 
     If the driver has already located the step's extremum of q, xe_known in [0, 1] is its
     x = (t - t_old)/h and qe_known q there; xe_known < 0 means: locate it here. The interpolant
@@ -411,7 +415,8 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         acc[STATUS] = mt.DIVERGED
         acc[T_STOP] = t_new
         if math.isfinite(q_new) and abs(q_new) > bound and abs(q_old) <= bound:
-            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
+                        eighth)
             side = 1.0 if q_new > 0.0 else -1.0
             acc[T_STOP] = t + dense_root(q_old, h, Qc[0], side * bound, 0.0, 1.0) * h
         return
@@ -428,7 +433,8 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             xe = xe_known
             qe = qe_known
         else:
-            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
+                        eighth)
             have_qc = True
             xe = dense_extremum(v_old, v_new, h, Qc[1])
             qe = dense_value(q_old, h, Qc[0], xe)
@@ -450,7 +456,8 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
 
     if t < t_tail <= t_new:
         if not have_qc:
-            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
+                        eighth)
             have_qc = True
         qt = dense_value(q_old, h, Qc[0], (t_tail - t) / h)
         acc[PEAK] = max(acc[PEAK], abs(qt))
@@ -465,14 +472,16 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
         if xa >= 0.0:
             if not have_qc:
-                interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
+                interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
+                        eighth)
                 have_qc = True
             x = dense_root(q_old, h, Qc[0], centre + side * thr, xa, xb)
             acc[LAST_ABOVE] = t + x * h
 
     if k < n_samples and k * dt_sample <= t_new:
         if not have_qc:
-            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base)
+            interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
+                        eighth)
             have_qc = True
         while k < n_samples and k * dt_sample <= t_new:
             series[k] = dense_value(q_old, h, Qc[0], (k * dt_sample - t) / h)

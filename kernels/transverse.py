@@ -63,11 +63,15 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
         if eighth:
             dop853.rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
+            buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
+                                    series, track, centre, thr_fixed, thr_rel, parametric, base,
+                                    True)
         else:
             rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
-        buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
-                                series, track, centre, thr_fixed, thr_rel, parametric, base)
+            buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
+                                    series, track, centre, thr_fixed, thr_rel, parametric, base,
+                                    None)
     tj.end_series(acc, series)
     return acc, buf
 
