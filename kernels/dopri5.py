@@ -202,27 +202,31 @@ def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, o, s, ord
 
 
 DENSE_TERMS = 7     # columns of an interpolant's coefficient array: up to degree 7 in x
+QUARTIC_TERMS = 4   # columns of RK45's own: its quartic (its drivers allocate no more)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def dense_coefficients(K, Q):
-    """Q[:, :4] = K^T P: the quartic interpolant of the last step; Q has shape (2, DENSE_TERMS),
-    the layout of DOP853's seventh-order interpolant (dop853.dense_output), and
-    Q[:, 4:] = 0."""
+    """Q[:, :4] = K^T P: the quartic interpolant of the last step. Q has shape (2,
+    QUARTIC_TERMS), or (2, DENSE_TERMS), the layout of DOP853's seventh-order interpolant
+    (dop853.dense_output), with Q[:, 4:] = 0."""
     for i in range(2):
         for k in range(4):
             s = 0.0
             for j in range(N_STAGES + 1):
                 s += K[j, i] * P[j, k]
             Q[i, k] = s
-        for k in range(4, DENSE_TERMS):
+        for k in range(4, Q.shape[1]):
             Q[i, k] = 0.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def dense_value(y_old_i, h, c, x):
     """One component of the interpolant at x = (t - t_old)/h in [0, 1]: y_old_i its value at
-    the step's start, c its row of dense_coefficients or dop853's (Q[i])."""
+    the step's start, c its row of dense_coefficients or dop853's (Q[i]): a quartic when c
+    has QUARTIC_TERMS entries (the same value as the degree-7 sum with zeros above x^4)."""
+    if c.shape[0] == QUARTIC_TERMS:
+        return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * c[3]))))
     return y_old_i + h * (x * (c[0] + x * (c[1] + x * (c[2] + x * (c[3] + x * (
         c[4] + x * (c[5] + x * c[6])))))))
 
@@ -289,8 +293,11 @@ def dense_extremum(v_old, v_new, h, c):
         g = dense_value(v_old, h, c, x)
         if abs(g) <= small:
             return x
-        dg = h * (c[0] + x * (2.0 * c[1] + x * (3.0 * c[2] + x * (4.0 * c[3] + x * (
-            5.0 * c[4] + x * (6.0 * c[5] + x * 7.0 * c[6]))))))
+        if c.shape[0] == QUARTIC_TERMS:
+            dg = h * (c[0] + x * (2.0 * c[1] + x * (3.0 * c[2] + x * (4.0 * c[3]))))
+        else:
+            dg = h * (c[0] + x * (2.0 * c[1] + x * (3.0 * c[2] + x * (4.0 * c[3] + x * (
+                5.0 * c[4] + x * (6.0 * c[5] + x * 7.0 * c[6]))))))
         if (g > 0.0) == positive:
             xa = x
         else:

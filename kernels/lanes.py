@@ -44,8 +44,9 @@ from . import dop853
 from . import metrics as mt
 from . import stages
 from . import trajectory as tj
-from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, A, B, C, E, MAX_FACTOR, MIN_FACTOR,
-                     MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err, pi_step_factor)
+from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, MAX_FACTOR,
+                     MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
+                     pi_step_factor)
 from .layout import MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
@@ -518,7 +519,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                                                         # a list access costs two atomic updates
     point = np.full(L, -1, np.int64)
     K = np.empty((N_STAGES + 1 if eighth is None else dop853.N_STAGES_EXTENDED, 2))
-    Qc = np.empty((2, DENSE_TERMS))
+    Qc = np.empty((2, QUARTIC_TERMS if eighth is None else DENSE_TERMS))   # RK45: its quartic
     next_point = lo
     n_run = min(L, hi - lo)   # lanes the vector loops cover: the active ones, rounded up to SIMD
                               # width (min() keeps it a run-time int: one compiled _prepare)

@@ -267,8 +267,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     K = np.empty((n_stages + 1, dim))
     K_mid = np.empty((n_stages + 1, 2))
     Km = np.empty((n_stages + 1, 2))
-    Qc = np.empty((2, dopri5.DENSE_TERMS))
-    Qm = np.empty((2, dopri5.DENSE_TERMS))
+    terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
+    Qc = np.empty((2, terms))
+    Qm = np.empty((2, terms))
     y = np.empty(dim)
     y_new = np.empty(dim)
     stage = np.empty(dim)

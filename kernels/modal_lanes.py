@@ -489,9 +489,10 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     ml = np.empty(n)
     Kl = np.empty((n_stages + 1, dim))
     Km = np.empty((n_stages + 1, 2))
-    Qm = np.empty((2, dopri5.DENSE_TERMS))
+    terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
+    Qm = np.empty((2, terms))
     Kmid = np.empty((2 if eighth else n_stages + 1, 2))
-    Qc = np.empty((2, dopri5.DENSE_TERMS))
+    Qc = np.empty((2, terms))
     bufs = [tj.new_buffer() for _ in range(L)]
     capacity = np.full(L, bufs[0].shape[0], np.int64)
     point = np.full(L, -1, np.int64)

@@ -24,7 +24,7 @@ import numpy as np
 from . import metrics as mt
 from . import trajectory as tj
 from . import dop853
-from .dopri5 import DENSE_TERMS, MIN_RTOL, error_norm, rk_step
+from .dopri5 import DENSE_TERMS, MIN_RTOL, QUARTIC_TERMS, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
 from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FIRST_BAND,
                      N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
@@ -48,7 +48,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
     buf = tj.new_buffer()
     eighth = settings[METHOD] != 0.0
     K = np.empty((dop853.N_STAGES_EXTENDED if eighth else 7, 2))   # DOP853: room for the
-    Qc = np.empty((2, DENSE_TERMS))                                   # dense output's stages
+    Qc = np.empty((2, DENSE_TERMS if eighth else QUARTIC_TERMS))     # dense output's stages
     y = np.empty(2)
     y_new = np.empty(2)
     tj.start(p, 0, 1, settings, acc, series, parametric, base)
