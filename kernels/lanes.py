@@ -482,7 +482,7 @@ def _load_lane(params, settings, point, lane, W, states, reals, counts, series, 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, parametric,
-                 base, eighth):
+                 base, eighth, steady):
     """trajectory.record_step for lane j (point i) after an accepted attempt. The lane's views of
     W and of the point's time-series row are taken here, where Numba keeps no reference counts
     (`_nrt=False`; nothing here allocates): taken in solve_block, each view cost two atomic
@@ -490,12 +490,13 @@ def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, para
     L = LANES
     tj.record_step(W, W_P * L + j, L, settings, W[j::L], K, W[W_QN * L + j],
                    W[W_VN * L + j], W[W_H * L + j], Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base, eighth)
+                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base, eighth,
+                   steady)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth,
-                parametric, base):
+                parametric, base, steady):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
 
@@ -504,7 +505,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     True for DOP853 (SciPy's controller only). None is a type of its own to Numba, which
     prunes the branches on `pi is None` at compile time: each combination is its own
     specialisation, compiled without the others' code. `base` likewise: None, or True when
-    settings[BASE] is 1 (oscillator's base-excitation switch).
+    settings[BASE] is 1 (oscillator's base-excitation switch); `steady` True when
+    settings[STOP_STEADY] is 1 (the early stop, trajectory.record_step).
     """
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
@@ -590,4 +592,4 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                 bufs[j] = tj.with_room(bufs[j], W[j::L])
                 capacity[j] = bufs[j].shape[0]
             _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe,
-                         parametric, base, eighth)
+                         parametric, base, eighth, steady)

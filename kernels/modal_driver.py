@@ -244,7 +244,8 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base):
+def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base,
+              steady):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the midspan deflection's metrics
     (kernels.trajectory's accumulator) and each mode's tail amplitude (modal, length N, m) on
@@ -307,10 +308,12 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         v_mid = _project(y_new, weights, n, n)
         if eighth:             # the method's switch, a constant in each call
             tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series,
-                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, True)
+                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, True,
+                           steady)
         else:
             tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series,
-                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, None)
+                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, None,
+                           steady)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, Qm)
         for i in range(dim):
             y[i] = y_new[i]
@@ -358,7 +361,8 @@ def at_rest(row, n_modes, t, y, band, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, n_modes, settings, reals, counts, series, modal, final, envelope, base):
+def solve_point(row, n_modes, settings, reals, counts, series, modal, final, envelope, base,
+                steady):
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
     mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
     parameters give INVALID_INPUT, NaN metrics."""
@@ -377,7 +381,7 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
             envelope[j] = math.nan
         return mt.INVALID_INPUT
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                            settings[TOL], series, modal, base)
+                            settings[TOL], series, modal, base, steady)
     resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
@@ -391,7 +395,7 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, n_modes, settings, states, reals, counts, base):
+def settle_second_pass(params, n_modes, settings, states, reals, counts, base, steady):
     """Finish the points left SECOND_PASS (at rest away from zero), as
     kernels.transverse.settle_second_pass does for one mode: integrate again to find the
     final midspan value, then track |q_mid - final| against the band."""
@@ -401,10 +405,10 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base):
         if states[i] != mt.SECOND_PASS:
             continue
         first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
-                                np.empty(0), modal, base)
+                                np.empty(0), modal, base, steady)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
-                                 np.empty(0), modal, base)
+                                 np.empty(0), modal, base, steady)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -414,7 +418,7 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
-                final, base):
+                final, base, steady):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
     kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
     max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
@@ -423,14 +427,14 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     none = np.empty(0)
     for i in range(lo, hi):
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], none, base)
+                                modal[i], final[i], none, base, steady)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
-                      final, envelope, base):
+                      final, envelope, base, steady):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope of the midspan deflection: envelope (n, n_bands) (m; n_bands may be 0)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], envelope[i], base)
+                                modal[i], final[i], envelope[i], base, steady)

@@ -393,7 +393,8 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, buf, series, i,
-                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
+                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base,
+                  steady):
     """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
     modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
     by modal_driver._observe_modes, the midspan Observer trajectory.record_step) on copies of
@@ -427,10 +428,10 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     v_new = drv._project(ynl, weights, n, n)
     if eighth:                 # the method's switch, a constant in each call
         tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
-                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, True)
+                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, True, steady)
     else:
         tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
-                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, None)
+                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, None, steady)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
     for c in range(n):
         MOD[c, j] = ml[c]
@@ -439,12 +440,12 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, final,
-                base):
+                base, steady):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
-    state). base: None, or True when
-    settings[BASE] is 1. Releases the GIL (sweep.threads runs blocks on threads)."""
+    state). base: None, or True when settings[BASE] is 1; steady: None, or True when
+    settings[STOP_STEADY] is 1 (the early stop). Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
     n = n_modes
     dim = 2 * n
@@ -551,6 +552,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     capacity[j] = bufs[j].shape[0]
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
                                  weights, bufs[j], series, point[j], track, thr_rel, eighth,
-                                 n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base):
+                                 n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base,
+                                 steady):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)

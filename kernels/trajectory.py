@@ -23,12 +23,12 @@ import numpy as np
 
 from . import metrics as mt
 from . import dop853
-from .dopri5 import (DENSE_TERMS, ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
+from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
                      PI_MIN_ERR_PREV, RHS_PER_ATTEMPT, dense_coefficients, dense_extremum,
                      dense_root, dense_value, initial_step, pi_log2_err, pi_step_factor,
                      step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
-                     MIN_STEP, RTOL, SAMPLE_DT, STEADY_PERIODS, STEADY_TOL, STOP_STEADY, TAIL,
+                     MIN_STEP, RTOL, SAMPLE_DT, STEADY_PERIODS, STEADY_TOL, TAIL,
                      T_END)
 from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
 from .stages import InlineWhereTrue
@@ -261,7 +261,7 @@ def control(settings, acc, err):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
-                   track, centre, thr_fixed, thr_rel, parametric, base, eighth):
+                   track, centre, thr_fixed, thr_rel, parametric, base, eighth, steady):
     """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
     y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
     SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
@@ -272,7 +272,7 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
         if acc[N_EXT] >= buf.shape[0]:
             buf = with_room(buf, acc)
         record_step(p, 0, 1, settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
-                    centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth)
+                    centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth, steady)
     return buf
 
 
@@ -390,13 +390,15 @@ def _observe_base(acc, a, sa, p, o, s, t, h, t_new, fv_new, t_tail, take, fast, 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
-                thr_fixed, thr_rel, xe_known, qe_known, parametric, base, eighth):
+                thr_fixed, thr_rel, xe_known, qe_known, parametric, base, eighth, steady):
     """Reduce the metrics of an accepted step [acc[T], acc[T_NEW]] on its dense output and
     advance the trajectory to its end. p[o + column * s]: the point's prepared row (its
     divergence bound on |q|, m, and base excitation); `buf` must have room for one more
     extremum (`with_room`).
 
-    eighth: the method's switch (None: RK45, True: DOP853), for `interpolant`.
+    eighth: the method's switch (None: RK45, True: DOP853), for `interpolant`; steady: the
+    early stop's (None, or True with settings[STOP_STEADY]: solver.stop_when_steady), a
+    switch so that a scene without it does not compile it.
 
     If the driver has already located the step's extremum of q, xe_known in [0, 1] is its
     x = (t - t_old)/h and qe_known q there; xe_known < 0 means: locate it here. The interpolant
@@ -450,7 +452,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qe))
             acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qe)
             acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qe)
-        if (settings[STOP_STEADY] != 0.0 and kind == mt.MAXIMUM
+        if (steady is not None and kind == mt.MAXIMUM
                 and acc[T_FINAL] == settings[T_END]):
             t_tail = _stop_when_steady(settings, acc, buf, te, qe, t_tail)
 

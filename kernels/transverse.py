@@ -35,10 +35,11 @@ from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepar
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric, base):
+def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric, base,
+              steady):
     """Integrate one point (p: its prepared row, oscillator.prepare) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing metrics on the fly. base: oscillator's
-    base-excitation switch (None or True).
+    base-excitation switch (None or True); steady: the early stop's (trajectory.record_step).
 
     When `track`, the accumulator's LAST_ABOVE is the last time |q - centre| exceeded
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
@@ -65,13 +66,13 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
             err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
             buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
                                     series, track, centre, thr_fixed, thr_rel, parametric, base,
-                                    True)
+                                    True, steady)
         else:
             rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
             buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
                                     series, track, centre, thr_fixed, thr_rel, parametric, base,
-                                    None)
+                                    None, steady)
     tj.end_series(acc, series)
     return acc, buf
 
@@ -198,7 +199,7 @@ def at_rest(p, o, s, acc, band, parametric, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, settings, states, reals, counts, parametric, base):
+def settle_second_pass(params, settings, states, reals, counts, parametric, base, steady):
     """Finish the points a driver left as SECOND_PASS (at rest away from zero): integrate
     again to find the final value, then a second time tracking |q - q_final| against the band
     tol * amplitude; the settling time is the last time q was outside it. The state becomes
@@ -211,10 +212,10 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
         p = np.empty(N_PARAMS)
         prepare(params[i], p, 0, 1)
         first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0), parametric,
-                             base)
+                             base, steady)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), parametric,
-                              base)
+                              base, steady)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -223,7 +224,7 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, settings, reals, counts, series, envelope, parametric, base):
+def solve_point(row, settings, reals, counts, series, envelope, parametric, base, steady):
     """Integrate the point of parameter row `row` and classify it. Never raises for bad
     parameters: they give INVALID_INPUT. With settings[SWEPT] (a swept base frequency) the
     sweep's outputs too (`swept_outputs`: peak frequency, envelope; the state COMPLETED)."""
@@ -235,7 +236,7 @@ def solve_point(row, settings, reals, counts, series, envelope, parametric, base
     p = np.empty(N_PARAMS)
     prepare(row, p, 0, 1)
     acc, buf = integrate(p, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                         settings[TOL], series, parametric, base)
+                         settings[TOL], series, parametric, base, steady)
     state = classify(p, 0, 1, settings, acc, buf, reals, counts, parametric, base)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(p, EXCITATION, 1, settings, acc, buf, state, reals, envelope)
@@ -261,7 +262,8 @@ def swept_outputs(p, o, s, settings, acc, buf, state, reals, envelope):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, settings, lo, hi, states, reals, counts, series, parametric, base):
+def solve_block(params, settings, lo, hi, states, reals, counts, series, parametric, base,
+                steady):
     """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
@@ -269,19 +271,20 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, paramet
     be 0). Each point's result depends only on its own row. Releases the GIL: the sweep layer
     runs blocks on several threads (sweep.threads). Points left SECOND_PASS are finished by
     settle_second_pass. base: oscillator's base-excitation switch, None or True (True when
-    settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one).
+    settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one); steady
+    likewise, True when settings[STOP_STEADY] is 1 (solver.stop_when_steady).
     """
     none = np.empty(0)
     for i in range(lo, hi):
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], none,
-                                parametric, base)
+                                parametric, base, steady)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, settings, lo, hi, states, reals, counts, series, envelope,
-                      parametric, base):
+                      parametric, base, steady):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope: envelope (n, n_bands) (m; n_bands may be 0, `swept_outputs`)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i],
-                                envelope[i], parametric, base)
+                                envelope[i], parametric, base, steady)

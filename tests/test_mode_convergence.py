@@ -23,6 +23,7 @@ from sweep.kernels import modes as md
 from sweep.kernels import oscillator as osc
 from sweep.models import modal
 from sweep.specialise import call
+from sweep.threads import early_stop
 
 from conftest import settings, solve
 
@@ -50,7 +51,8 @@ def _solve_modes(rows, n_modes, s):
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     modal_amp = np.empty((n, n_modes))
     call(modal_driver.solve_block, rows, n_modes, s, 0, n, states, reals, counts,
-         np.empty((n, 0)), modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None)
+         np.empty((n, 0)), modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None,
+         early_stop(s))
     return states, reals, counts, modal_amp
 
 
