@@ -445,7 +445,8 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
     state). base: None, or True when settings[BASE] is 1; steady: None, or True when
-    settings[STOP_STEADY] is 1 (the early stop). Releases the GIL (sweep.threads runs blocks on threads)."""
+    settings[STOP_STEADY] is 1 (the early stop). Releases the GIL (sweep.threads runs blocks
+    on threads)."""
     L = LANES
     n = n_modes
     dim = 2 * n

@@ -285,10 +285,10 @@ def fsal_row(K):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base, eighth):
-    """Qc (2, DENSE_TERMS): the dense output of the accepted step from acc's state to
-    (q_new, v_new), K its stage derivatives. `eighth`, the method's switch (None: RK45, True:
-    DOP853, as settings[METHOD]; a switch, so a scene compiles one method's interpolants).
-    RK45: its own quartic. DOP853 with the extended K
+    """Qc (2, QUARTIC_TERMS) for RK45, (2, DENSE_TERMS) for DOP853: the dense output of the
+    accepted step from acc's state to (q_new, v_new), K its stage derivatives. `eighth`, the
+    method's switch (None: RK45, True: DOP853, as settings[METHOD]; a switch, so a scene
+    compiles one method's interpolants). RK45: its own quartic. DOP853 with the extended K
     (dop853.N_STAGES_EXTENDED rows: the one-mode drivers) and rtol below
     dop853.SEVENTH_ORDER_BELOW_RTOL: its own seventh-order interpolant, whose three extra
     right-hand sides are computed here (and counted); otherwise (a looser rtol, or the modal
@@ -474,8 +474,8 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
         if xa >= 0.0:
             if not have_qc:
-                interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
-                        eighth)
+                interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric,
+                            base, eighth)
                 have_qc = True
             x = dense_root(q_old, h, Qc[0], centre + side * thr, xa, xb)
             acc[LAST_ABOVE] = t + x * h
