@@ -23,13 +23,16 @@ _BLAS_PROBE = "scipy.linalg.cython_blas"
 
 def start_without_scipy() -> bool:
     """Load Numba's registries now, without importing SciPy, unless they (or SciPy's BLAS
-    module) are already loaded. Returns True when it did."""
+    module) are already loaded. Returns True when it did; False, and nothing changed, where
+    it cannot (a Numba whose internals differ: it then loads them at its first compile)."""
     if "numba.np.arraymath" in sys.modules or _BLAS_PROBE in sys.modules:
         return False
-    from numba.core.registry import cpu_target
     sys.modules[_BLAS_PROBE] = None            # `import` of it raises ImportError
     try:
+        from numba.core.registry import cpu_target
         cpu_target.target_context.refresh()
+    except Exception:           # another Numba's internals: it loads them itself, as ever
+        return False
     finally:
         if sys.modules.get(_BLAS_PROBE, 0) is None:
             del sys.modules[_BLAS_PROBE]

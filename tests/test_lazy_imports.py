@@ -107,3 +107,14 @@ def test_the_numba_start_leaves_a_process_with_numba_started_alone():
             "from sweep.numba_start import start_without_scipy\n"
             "print('started:', start_without_scipy())\n")
     assert "started: False" in _loaded_after(code)["stdout"]
+
+
+def test_the_numba_start_gives_way_to_a_numba_it_does_not_know():
+    code = ("import sys\nfrom numba.core import registry\n"
+            "class Broken:\n    target_context = property(lambda self: 1 / 0)\n"
+            "registry.cpu_target = Broken()\n"
+            "from sweep.numba_start import start_without_scipy\n"
+            "print('started:', start_without_scipy())\n"
+            "print('probe left:', 'scipy.linalg.cython_blas' in sys.modules)\n")
+    out = _loaded_after(code)["stdout"]
+    assert "started: False" in out and "probe left: False" in out
