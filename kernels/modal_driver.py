@@ -245,16 +245,16 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base,
-              steady):
+              eighth, steady):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the midspan deflection's metrics
     (kernels.trajectory's accumulator) and each mode's tail amplitude (modal, length N, m) on
-    the fly; `track`, centre, thr_fixed, thr_rel: as transverse.integrate. Returns
-    (accumulator, extrema buffer, final state y)."""
+    the fly; `track`, centre, thr_fixed, thr_rel and the switches base, eighth (the method,
+    as settings[METHOD]) and steady: as transverse.integrate. Returns (accumulator, extrema
+    buffer, final state y)."""
     n = n_modes
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
-    eighth = settings[METHOD] != 0.0
     n_stages = dop853.N_STAGES if eighth else dopri5.N_STAGES
     A = dop853.A if eighth else dopri5.A
     B = dop853.B if eighth else dopri5.B
@@ -306,14 +306,8 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
             buf = tj.with_room(buf, acc)
         q_mid = _project(y_new, weights, 0, n)
         v_mid = _project(y_new, weights, n, n)
-        if eighth:             # the method's switch, a constant in each call
-            tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series,
-                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, True,
-                           steady)
-        else:
-            tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series,
-                           track, centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, None,
-                           steady)
+        tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series, track,
+                       centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, Qm)
         for i in range(dim):
             y[i] = y_new[i]
@@ -362,7 +356,7 @@ def at_rest(row, n_modes, t, y, band, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_point(row, n_modes, settings, reals, counts, series, modal, final, envelope, base,
-                steady):
+                eighth, steady):
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
     mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
     parameters give INVALID_INPUT, NaN metrics."""
@@ -381,7 +375,7 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
             envelope[j] = math.nan
         return mt.INVALID_INPUT
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                            settings[TOL], series, modal, base, steady)
+                            settings[TOL], series, modal, base, eighth, steady)
     resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
@@ -395,7 +389,8 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, n_modes, settings, states, reals, counts, base, steady):
+def settle_second_pass(params, n_modes, settings, states, reals, counts, base, eighth,
+                       steady):
     """Finish the points left SECOND_PASS (at rest away from zero), as
     kernels.transverse.settle_second_pass does for one mode: integrate again to find the
     final midspan value, then track |q_mid - final| against the band."""
@@ -405,10 +400,10 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base, s
         if states[i] != mt.SECOND_PASS:
             continue
         first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
-                                np.empty(0), modal, base, steady)
+                                np.empty(0), modal, base, eighth, steady)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
-                                 np.empty(0), modal, base, steady)
+                                 np.empty(0), modal, base, eighth, steady)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -418,7 +413,7 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base, s
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
-                final, base, steady):
+                final, base, eighth, steady):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
     kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
     max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
@@ -427,14 +422,14 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     none = np.empty(0)
     for i in range(lo, hi):
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], none, base, steady)
+                                modal[i], final[i], none, base, eighth, steady)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
-                      final, envelope, base, steady):
+                      final, envelope, base, eighth, steady):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope of the midspan deflection: envelope (n, n_bands) (m; n_bands may be 0)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], envelope[i], base, steady)
+                                modal[i], final[i], envelope[i], base, eighth, steady)

@@ -426,12 +426,8 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
         Kmid[r, 1] = KM[r, 1, j]
     q_new = drv._project(ynl, weights, 0, n)
     v_new = drv._project(ynl, weights, n, n)
-    if eighth:                 # the method's switch, a constant in each call
-        tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
-                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, True, steady)
-    else:
-        tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
-                       track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, None, steady)
+    tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
+                   0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
     for c in range(n):
         MOD[c, j] = ml[c]
@@ -440,12 +436,13 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, final,
-                base, steady):
+                base, eighth, steady):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
-    state). base: None, or True when settings[BASE] is 1; steady: None, or True when
-    settings[STOP_STEADY] is 1 (the early stop). Releases the GIL (sweep.threads runs blocks
+    state). base: None, or True when settings[BASE] is 1; eighth: None, or True when
+    settings[METHOD] is 1 (DOP853); steady: None, or True when settings[STOP_STEADY] is 1 (the
+    early stop). Releases the GIL (sweep.threads runs blocks
     on threads)."""
     L = LANES
     n = n_modes
@@ -454,7 +451,6 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     n_samples = series.shape[1]
-    eighth = settings[METHOD] != 0.0
     n_stages = dop853.N_STAGES if eighth else dopri5.N_STAGES
     last = 1 if eighth else n_stages          # f(t + h, y_new)'s row of KM
     A = dop853.A if eighth else dopri5.A

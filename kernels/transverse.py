@@ -28,7 +28,7 @@ from .dopri5 import DENSE_TERMS, MIN_RTOL, QUARTIC_TERMS, error_norm, rk_step
 from .layout import *  # noqa: F401,F403  (settings and output layouts, re-exported)
 from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FIRST_BAND,
                      N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
-                     METHOD, REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, STOP_TIME, T_END,
+                     REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, STOP_TIME, T_END,
                      TOL, WANT_SETTLING)
 from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepare,
                          stiffness)
@@ -36,10 +36,11 @@ from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepar
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric, base,
-              steady):
+              eighth, steady):
     """Integrate one point (p: its prepared row, oscillator.prepare) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing metrics on the fly. base: oscillator's
-    base-excitation switch (None or True); steady: the early stop's (trajectory.record_step).
+    base-excitation switch (None or True); eighth: the method's (None: RK45, True: DOP853, as
+    settings[METHOD]); steady: the early stop's (trajectory.record_step).
 
     When `track`, the accumulator's LAST_ABOVE is the last time |q - centre| exceeded
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
@@ -47,7 +48,6 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
     rtol = max(settings[RTOL], MIN_RTOL)
     acc = np.empty(tj.N_SLOTS)
     buf = tj.new_buffer()
-    eighth = settings[METHOD] != 0.0
     K = np.empty((dop853.N_STAGES_EXTENDED if eighth else 7, 2))   # DOP853: room for the
     Qc = np.empty((2, DENSE_TERMS if eighth else QUARTIC_TERMS))     # dense output's stages
     y = np.empty(2)
@@ -61,18 +61,15 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
         y[1] = acc[tj.V]
         K[0, 0] = acc[tj.FQ]
         K[0, 1] = acc[tj.FV]
-        if eighth:
-            dop853.rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
-            err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
-            buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
-                                    series, track, centre, thr_fixed, thr_rel, parametric, base,
-                                    True, steady)
-        else:
+        if eighth is None:
             rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
-            buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
-                                    series, track, centre, thr_fixed, thr_rel, parametric, base,
-                                    None, steady)
+        else:
+            dop853.rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
+            err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
+        buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
+                                series, track, centre, thr_fixed, thr_rel, parametric, base,
+                                eighth, steady)
     tj.end_series(acc, series)
     return acc, buf
 
@@ -199,7 +196,8 @@ def at_rest(p, o, s, acc, band, parametric, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, settings, states, reals, counts, parametric, base, steady):
+def settle_second_pass(params, settings, states, reals, counts, parametric, base, eighth,
+                       steady):
     """Finish the points a driver left as SECOND_PASS (at rest away from zero): integrate
     again to find the final value, then a second time tracking |q - q_final| against the band
     tol * amplitude; the settling time is the last time q was outside it. The state becomes
@@ -212,10 +210,10 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
         p = np.empty(N_PARAMS)
         prepare(params[i], p, 0, 1)
         first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0), parametric,
-                             base, steady)
+                             base, eighth, steady)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), parametric,
-                              base, steady)
+                              base, eighth, steady)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -224,7 +222,8 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, settings, reals, counts, series, envelope, parametric, base, steady):
+def solve_point(row, settings, reals, counts, series, envelope, parametric, base, eighth,
+                steady):
     """Integrate the point of parameter row `row` and classify it. Never raises for bad
     parameters: they give INVALID_INPUT. With settings[SWEPT] (a swept base frequency) the
     sweep's outputs too (`swept_outputs`: peak frequency, envelope; the state COMPLETED)."""
@@ -236,7 +235,7 @@ def solve_point(row, settings, reals, counts, series, envelope, parametric, base
     p = np.empty(N_PARAMS)
     prepare(row, p, 0, 1)
     acc, buf = integrate(p, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                         settings[TOL], series, parametric, base, steady)
+                         settings[TOL], series, parametric, base, eighth, steady)
     state = classify(p, 0, 1, settings, acc, buf, reals, counts, parametric, base)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(p, EXCITATION, 1, settings, acc, buf, state, reals, envelope)
@@ -263,7 +262,7 @@ def swept_outputs(p, o, s, settings, acc, buf, state, reals, envelope):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, parametric, base,
-                steady):
+                eighth, steady):
     """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
@@ -271,20 +270,21 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, paramet
     be 0). Each point's result depends only on its own row. Releases the GIL: the sweep layer
     runs blocks on several threads (sweep.threads). Points left SECOND_PASS are finished by
     settle_second_pass. base: oscillator's base-excitation switch, None or True (True when
-    settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one); steady
-    likewise, True when settings[STOP_STEADY] is 1 (solver.stop_when_steady).
+    settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one); eighth
+    likewise, True when settings[METHOD] is 1 (DOP853); steady, True when settings[STOP_STEADY]
+    is 1 (solver.stop_when_steady).
     """
     none = np.empty(0)
     for i in range(lo, hi):
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], none,
-                                parametric, base, steady)
+                                parametric, base, eighth, steady)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, settings, lo, hi, states, reals, counts, series, envelope,
-                      parametric, base, steady):
+                      parametric, base, eighth, steady):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope: envelope (n, n_bands) (m; n_bands may be 0, `swept_outputs`)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i],
-                                envelope[i], parametric, base, steady)
+                                envelope[i], parametric, base, eighth, steady)

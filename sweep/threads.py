@@ -98,7 +98,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
     parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
-    steady = early_stop(settings)
+    eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept:
         if driver != "scalar":
@@ -107,14 +107,14 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         def kernel(lo: int, hi: int) -> None:
             for i in range(lo, hi):
                 call(tk.solve_swept_block, params, swept_settings(settings, durations, i), i,
-                     i + 1, states, reals, counts, series, envelope, parametric, base, steady)
+                     i + 1, states, reals, counts, series, envelope, parametric, base, eighth,
+                     steady)
     elif driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
             call(tk.solve_block, params, settings, lo, hi, states, reals, counts, series,
-                 parametric, base, steady)
+                 parametric, base, eighth, steady)
     else:
         pi = True if settings[tk.CONTROLLER] != 0.0 else None
-        eighth = True if settings[tk.METHOD] != 0.0 else None
 
         def kernel(lo: int, hi: int) -> None:
             call(lanes.solve_block, params, settings, lo, hi, states, reals, counts, series,
@@ -124,7 +124,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         kernel(lo, hi)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             call(tk.settle_second_pass, params[lo:hi], settings, states[lo:hi], reals[lo:hi],
-                 counts[lo:hi], parametric, base, steady)
+                 counts[lo:hi], parametric, base, eighth, steady)
         if on_block is not None:
             on_block(lo, hi)
 
@@ -153,7 +153,7 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
     else:
         kernel = modal_driver
     base = True if settings[tk.BASE] != 0.0 else None
-    steady = early_stop(settings)
+    eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept and driver != "scalar":
         raise ValueError("a swept base frequency takes driver 'scalar'")
@@ -163,17 +163,24 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
             for i in range(lo, hi):
                 call(modal_driver.solve_swept_block, params, n_modes,
                      swept_settings(settings, durations, i), i, i + 1, states, reals, counts,
-                     series, modal, final, envelope, base, steady)
+                     series, modal, final, envelope, base, eighth, steady)
         else:
             call(kernel.solve_block, params, n_modes, settings, lo, hi, states, reals,
-                 counts, series, modal, final, base, steady)
+                 counts, series, modal, final, base, eighth, steady)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             call(modal_driver.settle_second_pass, params[lo:hi], n_modes, settings,
-                 states[lo:hi], reals[lo:hi], counts[lo:hi], base, steady)
+                 states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)
         if on_block is not None:
             on_block(lo, hi)
 
     run_blocks(solve_block, params.shape[0], threads, stop, one_at_a_time=swept)
+
+
+def method_switch(settings: np.ndarray) -> bool | None:
+    """The kernels' method switch (`eighth`): True for DOP853 (settings[METHOD] is 1), None
+    for RK45 (each compiles only its own method's code)."""
+    from sweep.kernels import layout as tk
+    return True if settings[tk.METHOD] != 0.0 else None
 
 
 def early_stop(settings: np.ndarray) -> bool | None:

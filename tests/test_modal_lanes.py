@@ -22,7 +22,7 @@ from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
 from sweep.models import transverse as tm
 from sweep.specialise import call
-from sweep.threads import early_stop
+from sweep.threads import early_stop, method_switch
 
 
 def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
@@ -40,7 +40,7 @@ def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int)
            np.full((n, tk.N_COUNTS), -1, np.int64), np.full((n, n_samples), -1.0),
            np.full((n, n_modes), -1.0), np.full((n, 2 * n_modes), -1.0))
     call(driver.solve_block, rows, n_modes, s, 0, n, *out,
-         True if s[tk.BASE] != 0.0 else None, early_stop(s))
+         True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s))
     return out
 
 
@@ -189,7 +189,8 @@ def test_a_block_inside_a_table_and_idle_lanes():
     rows, n, s, n_samples = case_rows("n3-base-dop853")
     whole = solve(modal_lanes, rows, n, s, n_samples)
     part = tuple(np.full_like(x, 7) for x in whole)
-    call(modal_lanes.solve_block, rows, n, s, 5, 12, *part, True, early_stop(s))
+    call(modal_lanes.solve_block, rows, n, s, 5, 12, *part, True, method_switch(s),
+         early_stop(s))
     for x, y in zip(whole, part):
         np.testing.assert_array_equal(y[5:12], x[5:12])
         assert np.all(y[:5] == 7) and np.all(y[12:] == 7)

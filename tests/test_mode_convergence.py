@@ -23,7 +23,7 @@ from sweep.kernels import modes as md
 from sweep.kernels import oscillator as osc
 from sweep.models import modal
 from sweep.specialise import call
-from sweep.threads import early_stop
+from sweep.threads import early_stop, method_switch
 
 from conftest import settings, solve
 
@@ -52,7 +52,7 @@ def _solve_modes(rows, n_modes, s):
     modal_amp = np.empty((n, n_modes))
     call(modal_driver.solve_block, rows, n_modes, s, 0, n, states, reals, counts,
          np.empty((n, 0)), modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None,
-         early_stop(s))
+         method_switch(s), early_stop(s))
     return states, reals, counts, modal_amp
 
 
