@@ -266,7 +266,8 @@ def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
     y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
     SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
     the extrema buffer (regrown when full). Qc is scratch for the interpolant, shape
-    (2, DENSE_TERMS). p: the point's prepared row (oscillator.prepare).
+    (2, QUARTIC_TERMS) for RK45, (2, DENSE_TERMS) for DOP853 (`interpolant`). p: the point's
+    prepared row (oscillator.prepare); eighth, steady: `record_step`'s switches.
     """
     if control(settings, acc, err):
         if acc[N_EXT] >= buf.shape[0]:
