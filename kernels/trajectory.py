@@ -299,7 +299,9 @@ def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base
         dense_coefficients(K, Qc)
     elif (K.shape[0] == dop853.N_STAGES_EXTENDED
           and settings[RTOL] < dop853.SEVENTH_ORDER_BELOW_RTOL):
-        dop853.dense_output(acc[T], acc[Q], acc[V], q_new, v_new, h, p, o, s, K, Qc, True,
+        # fast None: the extra stages evaluate the row's own excitation (a sweep, a level
+        # table, the sweep's end), not the fixed sine the lanes' vector loop assumes.
+        dop853.dense_output(acc[T], acc[Q], acc[V], q_new, v_new, h, p, o, s, K, Qc, None,
                             parametric, base)
         acc[RHS_EVALS] += dop853.RHS_DENSE
     else:

@@ -133,7 +133,7 @@ def _summary(ds, seconds: float) -> str:
               for v, m in zip(np.atleast_1d(flags["flag_values"]), flags["flag_meanings"].split())]
     states = ", ".join(f"{c} {m}" for c, m in counts if c)
     n = int(ds.attrs["n_points"])
-    ways = " x 2 directions (up, down)" if "direction" in ds[name].dims else ""
+    ways = (f" ({n // 2} x 2 directions: up, down)" if "direction" in ds[name].dims else "")
     return (f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'}{ways} in {seconds:.2f} s "
             f"({states})")
 

@@ -5,13 +5,15 @@
 The odd modes are the ones a symmetric load drives (base excitation; an even mode takes part
 only through a parametric instability of its own), so the check adds two modes, the next odd
 one among them (docs/model.md sec. 7). For every metric of the result (amplitude, peak
-amplitude, settling time, response period, absolute acceleration, and each modal amplitude
-the coarse run has) it reports the largest relative change |x(N + 2) - x(N)| / |x(N + 2)| over
+amplitude, settling time, response period, absolute acceleration, transmissibility, a
+sweep's peak frequency and envelope, a stability chart's growth rate and multiplier, and each
+modal amplitude the coarse run has) it reports the largest relative change |x(N + 2) - x(N)| / |x(N + 2)| over
 the grid points where both runs succeeded, where on the grid that is, and at how many points
 the change exceeds the tolerance; points whose state changed are counted apart. The tail
 window's metrics (TAIL_METRICS) are not compared at points that decayed in either run. A modal
 amplitude's change is taken relative to the point's largest modal amplitude (a mode at rest,
-round-off in both runs, does not count). N is enough for a tolerance when every change is within it.
+round-off in both runs, does not count). N is enough for a tolerance when something was
+compared and every change is within it; with nothing compared there is no verdict.
 """
 
 from __future__ import annotations
@@ -27,9 +29,12 @@ from .errors import UserError
 from .schema import BY_DOTTED
 
 METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
-           "absolute_acceleration", "modal_amplitude")
-"""The result variables compared, where both runs have them."""
-SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled")
+           "absolute_acceleration", "transmissibility", "peak_frequency", "envelope",
+           "growth_rate", "floquet_multiplier", "modal_amplitude")
+"""The result variables compared, where both runs have them: the time-domain metrics of
+every kind of run (fixed frequency, stepped, swept: its peak, peak frequency and envelope)
+and a stability chart's Floquet results."""
+SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled", "completed")
 """States whose metrics mean something (the failure states have NaN metrics)."""
 TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude")
 """Metrics of the tail window, not compared where either run decayed: a decayed point's tail
@@ -63,9 +68,15 @@ class Report:
     state_changes: int       # grid points whose state differs between the two runs
     points: int
 
+    def compared(self) -> bool:
+        """Whether any metric was compared at any point (a verdict needs something)."""
+        return any(c.compared > 0 for c in self.changes)
+
     def enough(self) -> bool:
-        """Whether every metric changed by at most the tolerance (relative) and no state did."""
-        return self.state_changes == 0 and all(c.over == 0 for c in self.changes)
+        """Whether something was compared, every metric changed by at most the tolerance
+        (relative) and no state did."""
+        return (self.compared() and self.state_changes == 0
+                and all(c.over == 0 for c in self.changes))
 
     def text(self) -> str:
         """The report as a short table for a terminal."""
@@ -81,7 +92,11 @@ class Report:
         if self.state_changes:
             lines.append(f"  state changed at {self.state_changes} of {self.points} points")
         modes = f"{self.n_modes} mode{'s' if self.n_modes != 1 else ''}"
-        if self.enough():
+        if not self.compared():
+            lines.append(f"{modes}: no verdict: no metric could be compared at any point "
+                         "(every point failed in one of the runs, or the result holds none of "
+                         f"{', '.join(METRICS)})")
+        elif self.enough():
             lines.append(f"{modes}: enough for {tolerance:g} relative (every metric within it "
                          "at every point, no state change)")
         else:
@@ -105,13 +120,20 @@ def _short(value: Any) -> str:
 def compare(coarse: xr.Dataset, fine: xr.Dataset, tolerance: float = 0.01) -> Report:
     """The Report of two results of one scene, with N (coarse) and N + 2 (fine) modes."""
     n_modes = coarse.sizes.get("mode", 1)
-    meanings = coarse["state"].attrs["flag_meanings"].split()
-    flags = np.atleast_1d(coarse["state"].attrs["flag_values"])
-    ok = [int(f) for f, m in zip(flags, meanings) if m in SUCCESS_STATES]
-    both = coarse["state"].isin(ok) & fine["state"].isin(ok)
-    decayed = [int(f) for f, m in zip(flags, meanings) if m == "decayed"]
-    live = both & ~coarse["state"].isin(decayed) & ~fine["state"].isin(decayed)
-    state_changes = int((coarse["state"] != fine["state"]).sum())
+    if "state" in coarse and "state" in fine:
+        meanings = coarse["state"].attrs["flag_meanings"].split()
+        flags = np.atleast_1d(coarse["state"].attrs["flag_values"])
+        ok = [int(f) for f, m in zip(flags, meanings) if m in SUCCESS_STATES]
+        both = coarse["state"].isin(ok) & fine["state"].isin(ok)
+        decayed = [int(f) for f, m in zip(flags, meanings) if m == "decayed"]
+        live = both & ~coarse["state"].isin(decayed) & ~fine["state"].isin(decayed)
+        state_changes = int((coarse["state"] != fine["state"]).sum())
+        points = int(np.prod(coarse["state"].shape))
+    else:                  # no time-domain run (a stability chart): every point compared
+        grid = [d for d in coarse.dims if d in coarse.coords and d != "mode"]
+        both = live = xr.DataArray(np.ones([coarse.sizes[d] for d in grid], bool), dims=grid,
+                                   coords={d: coarse[d] for d in grid})
+        state_changes, points = 0, int(both.size)
     changes = []
     for name in METRICS:
         if name not in coarse or name not in fine:
@@ -127,8 +149,7 @@ def compare(coarse: xr.Dataset, fine: xr.Dataset, tolerance: float = 0.01) -> Re
                                        tolerance, scale))
         else:
             changes.append(_change(name, a, b, mask, tolerance))
-    return Report(n_modes, tolerance, changes, state_changes,
-                  int(np.prod(coarse["state"].shape)))
+    return Report(n_modes, tolerance, changes, state_changes, points)
 
 
 def _change(metric: str, coarse: xr.DataArray, fine: xr.DataArray, mask: xr.DataArray,

@@ -442,8 +442,8 @@ def _interrupt_sets(stop: threading.Event) -> Iterator[list[int]]:
 def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.ndarray], n: int,
             args: tuple, place: Callable[[int, int, dict], None], *, chunk_size: int,
             backend: str = "threads", threads: int = 0, scheduler: str | None = None,
-            workers: int = 0, progress: bool = False, store: ChunkStore | None = None,
-            done: dict | None = None) -> int:
+            workers: int = 0, progress: bool = False, announce: bool | None = None,
+            store: ChunkStore | None = None, done: dict | None = None) -> int:
     """Solve points 0..n-1 (solve order) chunk by chunk; returns the number of points computed.
 
     rows_for(lo, hi) builds the kernel's parameter rows of a chunk just before it runs, so the
@@ -455,6 +455,7 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     On Ctrl-C the run stops after the work in hand, saves it and raises RunInterrupted.
     When the dask cluster fails (a worker that keeps dying, a lost scheduler, a malformed
     result) the run stops with the finished chunks kept and raises one UserError line.
+    progress: the bar (a terminal); announce: the compile lines (default: as progress).
     """
     done = done or {}
     where = f"chunk store '{store.directory}'" if store is not None else "chunk store"
@@ -468,7 +469,8 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     failure = None
     try:
         with _interrupt_sets(stop) as received, \
-                announce_compilation(progress, bar) as clock:
+                announce_compilation(progress if announce is None else announce,
+                                     bar) as clock:
             if backend == "dask":
                 try:
                     _execute_dask(chunk_fn, rows_for, args, _split(gaps, chunk_size), keeper,

@@ -132,6 +132,12 @@ def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = Fals
                 for name, var in ds.data_vars.items() if var.ndim >= 1 and var.dtype.kind == "f"}
     # CF: coordinates have no missing values, so no _FillValue (xarray adds NaN to floats).
     encoding.update({name: {"_FillValue": None} for name in ds.coords})
+    # CF wants numeric coordinate variables: a label coordinate (a sweep's direction, "up" and
+    # "down") is written as a char array, which xarray reads back as the same strings, so
+    # .sel(direction="up") works as before and CF checkers read it as a string-valued label.
+    for name, var in ds.coords.items():
+        if var.dtype.kind in "OUS":
+            encoding[name] = {"dtype": "S1"}
     try:
         fd, name = tempfile.mkstemp(dir=parent, prefix=f".{out.name}.{os.getpid()}.",
                                     suffix=".tmp")
@@ -147,6 +153,7 @@ def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = Fals
             raise UserError(f"output '{out}': the temporary file '{tmp}' was replaced while "
                             "it was written (someone else writes in this directory; choose "
                             "another -o path)")
+        os.fchmod(fd, 0o666 & ~_umask())      # as any tool's new file, not mkstemp's 0600
         os.fsync(fd)
         os.replace(tmp, out)
         fsync_directory(parent)
@@ -159,6 +166,13 @@ def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = Fals
     finally:
         os.close(fd)
     return out
+
+
+def _umask() -> int:
+    """The process's umask (read by setting it, then setting it back)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def _unlink_ours(tmp: Path, made: os.stat_result) -> None:

@@ -61,6 +61,9 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     from .runner import run_options
     if output is not None:
         check_output_path(output, overwrite)
+    # The bar only on a terminal; the lines that say a cold start is compiling (minutes on a
+    # first run) wherever the caller has not asked for quiet: a CI log, nohup, a notebook.
+    announce = progress is not False
     if progress is None:
         progress = sys.stderr.isatty()
     if threads is None:
@@ -75,7 +78,8 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         remove_stale_temporaries(output)            # of a write that was killed
     from .store import ChunkStore
     try:
-        options = run_options(scene, threads=threads, progress=progress, **persist)
+        options = run_options(scene, threads=threads, progress=progress, announce=announce,
+                              **persist)
         ds = models.model_for(scene.get("model.kind")).run(scene, options)
         if output is not None:
             _write_whole(ds, output, overwrite)

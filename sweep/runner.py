@@ -32,7 +32,8 @@ class RunOptions:
 
     backend "threads" | "dask"; workers: dask LocalCluster processes (0: one per core);
     chunk_size: points per kernel call or task (None: chosen from the grid); threads: worker
-    threads (0: all cores); progress: a bar on stderr; scheduler: an existing dask scheduler's
+    threads (0: all cores); progress: a bar on stderr; announce: a line on stderr when Numba
+    starts compiling and one when it is done, terminal or not; scheduler: an existing dask scheduler's
     address (the caller's, never a scene's); output: the netCDF path whose chunk store keeps
     finished chunks (None: no store); resume, overwrite: as sweep.run's; fingerprint: what
     decides the results (`run_fingerprint`), which a chunk store must match.
@@ -42,6 +43,7 @@ class RunOptions:
     chunk_size: int | None = None
     threads: int = 0
     progress: bool = False
+    announce: bool = False
     scheduler: str | None = None
     output: str | os.PathLike | None = None
     resume: bool = False
@@ -50,13 +52,14 @@ class RunOptions:
 
 
 def run_options(scene: Scene, *, threads: int = 0, progress: bool = False,
-                output: str | os.PathLike | None = None, resume: bool = False,
+                announce: bool = False, output: str | os.PathLike | None = None, resume: bool = False,
                 overwrite: bool = False, scheduler: str | None = None) -> RunOptions:
     """The RunOptions of running `scene` with sweep.run's arguments (a scheduler forces the
     dask backend)."""
     return RunOptions(backend="dask" if scheduler else scene.get("run.backend"),
                       workers=scene.get("run.workers"), chunk_size=scene.get("run.chunk_size"),
-                      threads=threads, progress=progress, scheduler=scheduler, output=output,
+                      threads=threads, progress=progress, announce=announce,
+                      scheduler=scheduler, output=output,
                       resume=resume, overwrite=overwrite, fingerprint=run_fingerprint(scene))
 
 
@@ -187,7 +190,8 @@ def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
                        placer(outputs, order),
                        chunk_size=chunk, backend=options.backend, threads=options.threads,
                        scheduler=options.scheduler, workers=options.workers,
-                       progress=options.progress, store=store, done=done)
+                       progress=options.progress, announce=options.announce, store=store,
+                       done=done)
     if options.resume:
         sys.stderr.write(f"resumed: {n - computed:,} of {n:,} points were already done, "
                          f"{computed:,} computed\n")

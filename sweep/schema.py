@@ -39,6 +39,7 @@ class Key:
     minimum, maximum: inclusive bounds unless ``exclusive_min`` / ``exclusive_max``.
     choices: allowed strings for kind "str".
     axis: the axis (and coordinate) name when the key is sweepable, else None.
+    help: what `sweep keys` says of it, where that is more than the long name.
     """
 
     section: str
@@ -53,6 +54,7 @@ class Key:
     exclusive_max: bool = False
     choices: tuple[str, ...] = field(default_factory=tuple)
     axis: str | None = None
+    help: str = ""
 
     @property
     def dotted(self) -> str:
@@ -90,8 +92,10 @@ KEYS: tuple[Key, ...] = (
     # [load]
     Key("load", "type", "str", "harmonic", choices=("harmonic", "constant"),
         long_name="end load: harmonic P0 cos(W t) or constant P0 from t = 0"),
-    Key("load", "amplitude", "float", 4.0, units="N",
-        long_name="end load amplitude P0 (positive = compression)", axis="load_amplitude"),
+    Key("load", "amplitude", "float", 0.0, units="N",
+        long_name="end load amplitude P0 (positive = compression)", axis="load_amplitude",
+        help="end load amplitude P0 (positive = compression); default 0: no end load unless "
+        "the scene gives one (the paper scenes give 4 N)"),
     Key("load", "frequency_ratio", "float", None, units="1", minimum=0.0,
         long_name="load frequency over the span's first natural frequency, W/w1",
         axis="frequency_ratio"),

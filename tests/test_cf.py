@@ -51,6 +51,13 @@ def cf_problems(path: Path) -> list[str]:
     problems = [f"{priority} {check['name']}: {msg}"
                 for priority in FAILING for check in report[priority] for msg in check["msgs"]]
     assert problems or report["high_count"] == report["medium_count"] == 0, report
+    # A check that crashed (e.g. on a string coordinate variable) is reported on stderr and
+    # in the exit status, not in the lists: the checker must have run every check.
+    crashed = [line for line in (done.stderr + done.stdout).splitlines()
+               if "exceptions occurred" in line or line.startswith(test + ".check_")]
+    assert not crashed, crashed
+    if not problems:
+        assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
     return problems
 
 

@@ -197,6 +197,30 @@ def test_jumps_bracket_the_harmonic_balance_folds_and_the_branches_differ(both_w
     assert 0.3 < c["k3"] * a_fold ** 2 / c["w1"] ** 2 < 0.7
 
 
+LINEAR_FREQS = F1 * np.linspace(0.8, 1.2, 9)      # coarse steps of 0.05 f1 over resonance
+LINEAR_LEVEL_G = 1e-4                             # K3 a^2 / w1^2 ~ 1e-5: no hysteresis
+
+
+def test_a_steep_slope_both_ways_is_no_jump():
+    """A linear span stepped coarsely over its resonance: the tail amplitude changes by more
+    than the jump factor 1.5 between neighbouring dwells (SciPy's stepped run, written here,
+    says so), but up and down follow the one branch there is (within the 5 % the last
+    dwell's ring-down leaves, e^(-zeta w1 T/2) of the change), so no dwell of either direction
+    is flagged a jump. The engine's amplitudes are the reference's to 1e-3."""
+    up_order = np.argsort(LINEAR_FREQS)
+    reference_up = stepped_reference(LINEAR_FREQS, LINEAR_LEVEL_G * G, up_order)
+    reference_down = stepped_reference(LINEAR_FREQS, LINEAR_LEVEL_G * G, up_order[::-1])
+    np.testing.assert_allclose(reference_up, reference_down, rtol=0.05)
+    assert _jump_indices(reference_up, up_order) and \
+        _jump_indices(reference_down, up_order[::-1])           # steep: a ratio above 1.5
+    ds = _stepped(LINEAR_FREQS, LINEAR_LEVEL_G, "both")
+    for direction, reference in (("up", reference_up), ("down", reference_down)):
+        np.testing.assert_allclose(ds["amplitude"].sel(direction=direction).values,
+                                   reference, rtol=1e-3)
+    assert not np.any(ds["jump"].values), ds["jump"].values
+    assert "different branches" in ds["jump"].attrs["long_name"]
+
+
 def test_several_modes_carry_every_mode(tmp_path):
     """modes = 3: each dwell starts from every mode's final state. Against tests/galerkin.py's
     independent projection, two dwells stepped up (the second's start carried), to 1e-4."""

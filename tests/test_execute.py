@@ -24,6 +24,8 @@ SCENE = """
 name = "execute-test"
 [cable]
 damping_ratio = 0.02
+[load]
+amplitude = 4.0
 [initial]
 displacement = 1e-3
 [axes]
@@ -82,6 +84,8 @@ LONG_SCENE = """
 name = "kill-and-resume"
 [cable]
 damping_ratio = 0.02
+[load]
+amplitude = 4.0
 [initial]
 displacement = 1e-3
 [axes]

@@ -92,6 +92,8 @@ def test_sweep_drivers_agree_and_lanes_is_the_default():
     text = """
 [cable]
 damping_ratio = 0.01
+[load]
+amplitude = 4.0
 [initial]
 displacement = 1e-3
 [axes]

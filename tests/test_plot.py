@@ -26,6 +26,7 @@ coefficients = "consistent"
 [cable]
 damping_ratio = 0.02
 [load]
+amplitude = 4.0
 frequency_ratio = 2.0
 [initial]
 displacement = 1e-4
@@ -44,6 +45,8 @@ coefficients = "consistent"
 [cable]
 damping_ratio = 0.02
 inertia = 5.73e-12              # m^4, the paper's number (the overlay test computes with it)
+[load]
+amplitude = 4.0                 # N, the paper's end load
 [initial]
 displacement = 1e-4
 [axes]

@@ -250,9 +250,10 @@ def test_sweep_plot_draws_every_figure_of_a_sweep_run_both_ways(both_ways, tmp_p
     out = tmp_path / "figs"
     assert main(["plot", str(path), "-o", str(out)]) == 0
     names = {p.name for p in out.iterdir()}
-    expected = {"peak_amplitude", "peak_frequency", "amplitude", "absolute_acceleration_g",
+    expected = {"peak_amplitude", "peak_frequency", "absolute_acceleration_g",
                 "envelope", "envelope_map-up", "envelope_map-down"}
     assert {f"both-{key}.png" for key in expected} <= names, names
+    assert "both-amplitude.png" not in names      # a sweep stores no tail amplitude
     assert "envelope_map" not in {n[len("both-"):-len(".png")] for n in names}
     assert all((out / n).stat().st_size > 1000 for n in names)
     assert "Traceback" not in capsys.readouterr().err
@@ -288,7 +289,8 @@ def test_the_envelope_of_a_sweep_run_both_ways_has_an_up_and_a_down_line_per_poi
 def test_the_peak_lines_of_a_sweep_run_both_ways_overlay_up_and_down(both_ways):
     ds, _ = both_ways
     figures = splot.plot(ds)
-    for var in ("peak_amplitude", "peak_frequency", "amplitude"):
+    assert "amplitude" not in figures          # a sweep stores no tail amplitude
+    for var in ("peak_amplitude", "peak_frequency"):
         ax = figures[var].axes[0]
         by_way = {line.get_gid(): line for line in ax.get_lines()
                   if str(line.get_gid()).startswith("direction-")}

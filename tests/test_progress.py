@@ -21,6 +21,8 @@ PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 SMALL = """
 name = "progress-test"
+[load]
+amplitude = 4.0
 [axes]
 length = {start = 0.3, stop = 1.0, num = 6}
 frequency_ratio = {start = 0.5, stop = 3.0, num = 5}

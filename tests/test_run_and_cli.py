@@ -22,6 +22,8 @@ name = "small"
 coefficients = "consistent"
 [cable]
 damping_ratio = 0.02
+[load]
+amplitude = 4.0
 [initial]
 displacement = 1e-3
 [axes]
@@ -177,3 +179,17 @@ def test_summary_counts_states_by_their_flag_values():
                    progress=False)
     assert _summary(ds, 1.0).endswith("(1 completed)")
 
+
+
+@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
+def test_output_file_follows_the_umask(tmp_path, umask, mode):
+    """The netCDF file gets the mode any tool's new file gets (0666 less the umask), not the
+    temporary file's 0600."""
+    from sweep.io import write_netcdf
+    ds = xr.Dataset({"x": ("n", np.arange(3.0))}, coords={"n": np.arange(3)})
+    old = os.umask(umask)
+    try:
+        out = write_netcdf(ds, tmp_path / "out.nc")
+    finally:
+        os.umask(old)
+    assert os.stat(out).st_mode & 0o777 == mode

@@ -25,6 +25,8 @@ SCENE = """
 name = "store-test"
 [cable]
 damping_ratio = 0.02
+[load]
+amplitude = 4.0
 [initial]
 displacement = 1e-3
 [axes]

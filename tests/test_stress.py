@@ -172,6 +172,8 @@ def test_short_stiff_spans_next_to_long_soft_ones():
     ds = run("""
 [cable]
 damping_ratio = 0.02
+[load]
+amplitude = 4.0
 [initial]
 displacement = 1e-4
 [axes]
@@ -234,7 +236,9 @@ def _axis(values):
 
 scene_values = st.fixed_dictionaries({
     "length": st.lists(st.floats(0.2, 2.0), min_size=1, max_size=3, unique=True),
-    "load_amplitude": st.lists(st.floats(0.0, 20.0), min_size=1, max_size=2, unique=True),
+    # one amplitude at least above 0: a load frequency axis without a load is refused
+    "load_amplitude": st.lists(st.floats(0.0, 20.0), min_size=1, max_size=2, unique=True)
+    .filter(lambda amplitudes: any(a > 0.0 for a in amplitudes)),
     "frequency_ratio": st.lists(st.floats(0.3, 3.0), min_size=1, max_size=2, unique=True),
     "damping_ratio": st.floats(0.0, 0.1),
     "q0": st.floats(-5e-3, 5e-3),
@@ -294,7 +298,7 @@ def test_undamped_unforced_points_conserve_energy(k0, g0, h, q0, v0, rtol):
 
 
 def test_a_grid_too_large_for_memory_is_refused_before_any_work():
-    text = ("[axes]\nlength = {start = 0.1, stop = 1.0, num = 200000}\n"
+    text = ("[load]\namplitude = 4.0\n[axes]\nlength = {start = 0.1, stop = 1.0, num = 200000}\n"
             "frequency_ratio = {start = 0.5, stop = 3.0, num = 200000}\n")
     with pytest.raises(sweep.UserError, match="GiB"):
         sweep.run(scene(text), progress=False)

@@ -22,7 +22,9 @@ conditions). Results are stored in the axis's own order whatever the direction.
 
 Jumps: where a dwell's tail amplitude differs from the previous dwell's (in the sweep's order)
 by more than `continuation.jump_ratio`, the response changed branch: the `jump` flag says up
-(the amplitude rose) or down (it fell) at that dwell.
+(the amplitude rose) or down (it fell) at that dwell. Swept both ways, a flag stands only where
+the up and down sweeps were on different branches at the dwell before it (hysteresis); a steep
+slope that both directions follow alike is no jump.
 """
 
 from __future__ import annotations
@@ -182,12 +184,36 @@ def jumps(amplitude: np.ndarray, states: np.ndarray, axis: int, order: np.ndarra
     return np.moveaxis(back, -1, axis)
 
 
-def jump_attrs(axis_name: str, ratio: float) -> dict[str, object]:
-    """CF flag attributes of the `jump` variable."""
+def branches_differ(flags: list[np.ndarray], amplitudes: list[np.ndarray], axis: int,
+                    orders: tuple[np.ndarray, ...], ratio: float) -> list[np.ndarray]:
+    """The flags of a sweep run both ways (up, down: `jumps`' flags, the tail amplitudes in
+    grid shape), kept only at jumps: where the dwell before the flagged one (in that sweep's
+    order) has up and down amplitudes more than `ratio` apart, i.e. the sweep leaves a branch
+    the other direction is not on. A steep slope that both directions climb alike (no
+    hysteresis) is flagged by `jumps` in both and here in neither."""
+    up, down = (np.moveaxis(a, axis, -1) for a in amplitudes)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        differ = (np.maximum(up, down) > ratio * np.minimum(up, down)) \
+            & np.isfinite(up) & np.isfinite(down)
+    kept = []
+    for f, order in zip(flags, orders):
+        f = np.moveaxis(f, axis, -1).copy()
+        before = np.zeros(f.shape, bool)          # whether the dwell before, in this order,
+        before[..., order[1:]] = differ[..., order[:-1]]     # is where the branches differ
+        f[~before] = NO_JUMP
+        kept.append(np.moveaxis(f, -1, axis))
+    return kept
+
+
+def jump_attrs(axis_name: str, ratio: float, both: bool) -> dict[str, object]:
+    """CF flag attributes of the `jump` variable (both: the sweep ran both ways, and a flag
+    stands only where the up and down branches differ, `branches_differ`)."""
+    where = ("where the up and down sweeps are on different branches" if both else
+             "(run both ways to tell a jump from a steep slope)")
     return {"units": "1", "flag_values": np.array([NO_JUMP, JUMP_UP, JUMP_DOWN], np.int8),
             "flag_meanings": JUMP_MEANINGS,
             "long_name": f"jump of the tail amplitude from the previous step along {axis_name} "
-                         f"in the sweep's direction (by more than a factor {ratio:g})"}
+                         f"in the sweep's direction (by more than a factor {ratio:g}) {where}"}
 
 
 def direction_coordinate(directions: list[str], long_name: str = "direction of the stepped "

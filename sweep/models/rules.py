@@ -273,11 +273,12 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
             _fail(f"scene keys '{dotted}' and 'base.sweep'", "give one frequency, not both (a "
                   "fixed frequency, or a sweep)", f"remove {dotted} or the sweep")
     values = {d: given.get(d) for d in SWEEP_KEYS}
-    start, stop, _ = sweep_grid(values, axes)
+    start, stop, rate = sweep_grid(values, axes)
     if np.any(start == stop):
         _fail(where, "start and stop are equal at some point: nothing to sweep",
               "give different start and stop frequencies (stop below start sweeps down), or "
               "use base.frequency for a fixed frequency")
+    _check_sweep_extent(given, start, stop, rate)
     if table is not None:
         low, high = table[0][0], table[-1][0]
         f_lo, f_hi = float(np.min(np.minimum(start, stop))), float(np.max(np.maximum(start, stop)))
@@ -298,6 +299,50 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
         _fail("scene key 'outputs.settling_time'", "a sweep has no settling time (its "
               "excitation never stops changing)", "remove it: a swept scene stores "
               "peak_amplitude, peak_frequency and, with outputs.envelope = true, the envelope")
+
+
+MIN_SWEEP_CYCLES = 10.0
+"""Fewest excitation cycles a sweep may pass through: fewer is a transient, not a sweep."""
+MAX_SWEEP_DURATION = 1e7
+"""Longest sweep (s, about 4 months): beyond it a sweep is a fixed frequency to any step."""
+
+
+def _check_sweep_extent(given: dict[str, Any], start: Any, stop: Any, rate: Any) -> None:
+    """Refuse what cannot be a sweep: one that passes fewer than MIN_SWEEP_CYCLES cycles of
+    its excitation (|stop - start| / lam, lam = rate ln2 / 60: a rate of 1e300 oct/min, or a
+    one-ulp sweep) or lasts longer than MAX_SWEEP_DURATION (a rate of 5e-324 oct/min), and a
+    solver.t_end that would cut a sweep short (each point's run ends with its own sweep when
+    t_end is not given)."""
+    where = "scene key 'base.sweep'"
+    with np.errstate(all="ignore"):
+        start, stop, rate = np.broadcast_arrays(*(np.asarray(x, np.float64)
+                                                  for x in (start, stop, rate)))
+        duration = 60.0 * np.abs(np.log2(stop / start)) / rate
+        cycles = np.abs(stop - start) / (rate * math.log(2.0) / 60.0)
+    few = ~(cycles >= MIN_SWEEP_CYCLES)
+    if np.any(few):
+        i = np.unravel_index(int(np.argmax(few)), few.shape)
+        _fail(where, f"the sweep from {float(start[i])!r} to {float(stop[i])!r} Hz at "
+              f"{float(rate[i])!r} oct/min "
+              f"passes {float(cycles[i]):.3g} cycles of its excitation, fewer than "
+              f"{MIN_SWEEP_CYCLES:g}: that is no sweep", "give a slower rate or a wider "
+              "frequency range (a launch sine sweep is 2-4 octaves per minute)")
+    long = ~(duration <= MAX_SWEEP_DURATION)
+    if np.any(long):
+        i = np.unravel_index(int(np.argmax(long)), long.shape)
+        _fail(where, f"the sweep from {float(start[i])!r} to {float(stop[i])!r} Hz at "
+              f"{float(rate[i])!r} oct/min "
+              f"lasts {float(duration[i]):.3g} s, longer than {MAX_SWEEP_DURATION:g} s",
+              "give a faster rate (a launch sine sweep is 2-4 octaves per minute), or use "
+              "base.frequency for a fixed frequency")
+    t_end = given.get("solver.t_end")
+    longest = float(np.max(duration))
+    if t_end is not None and t_end < longest * (1.0 - 1e-12):
+        _fail("scene key 'solver.t_end'", f"{t_end!r} s ends before the sweep does "
+              f"({longest:.6g} s at its longest): the sweep would be cut short",
+              "remove solver.t_end (each point then ends with its own sweep), or give one "
+              f"of at least {longest:.6g} s (after the sweep the clamps stop and the span "
+              "rings down)")
 
 
 def check_pairs(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
@@ -333,9 +378,10 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
             if axis in axes:
                 _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
                       f"remove the {axis} axis, or use load.type = 'harmonic'")
+    _check_load_frequency_axis(given, axes)
     _check_modes(given, axes)
     _check_continuation(given, axes)
-    _check_stability(given)
+    _check_stability(given, axes)
     _check_steady_stop(given, axes)
     if given.get("model.coefficients") == "paper":
         for axis in axes:
@@ -344,6 +390,24 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
         _check_paper_cable(given)
+
+
+def _check_load_frequency_axis(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Refuse an axis of the end load's frequency (frequency_ratio, frequency) in a scene
+    without an end load (load.amplitude 0, its default, at every point): it would sweep
+    nothing. A scene written for the old 4 N default is told to give its load."""
+    amplitude = axes["load_amplitude"] if "load_amplitude" in axes \
+        else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
+    if np.any(np.asarray(amplitude, dtype=float) != 0.0):
+        return
+    for axis in ("frequency_ratio", "frequency"):
+        if axis in axes:
+            where = (f"[points] '{axis}'" if axis in getattr(axes, "zipped", ())
+                     else f"axis '{axis}'")
+            _fail(where, "sweeps the end load's frequency, but the scene has no end load "
+                  "(load.amplitude is 0, its default)", "give load.amplitude in N (e.g. "
+                  "amplitude = 4.0 under [load], as the paper's case), or remove the axis; a "
+                  "base excitation's frequency is base_frequency or base_frequency_ratio")
 
 
 def _refuse_without(given: dict[str, Any], dependents: tuple[str, ...], problem: str,
@@ -374,10 +438,18 @@ def _check_steady_stop(given: dict[str, Any], axes: dict[str, np.ndarray]) -> No
               "base.frequency")
 
 
-def _check_stability(given: dict[str, Any]) -> None:
-    """outputs.stability needs a period: a harmonic end load (docs/model.md sec. 8)."""
+def _check_stability(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """outputs.stability needs a period: a harmonic end load (docs/model.md sec. 8), of an
+    amplitude other than 0 at some point (without one the chart is a vacuous 'stable')."""
     if not given.get("outputs.stability"):
         return
+    amplitude = axes.get("load_amplitude") if "load_amplitude" in axes \
+        else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
+    if not np.any(np.asarray(amplitude, dtype=float) != 0.0):
+        _fail("scene key 'outputs.stability'", "needs a harmonic end load: the scene's "
+              "load.amplitude is 0, so there is no parametric excitation and every point "
+              "would be a vacuous 'stable'", "give load.amplitude (N) or a load_amplitude "
+              "axis, or remove outputs.stability")
     if given.get("load.type") == "constant":
         _fail("scene key 'outputs.stability'", "needs a harmonic end load (Floquet multipliers "
               "over its period); a constant load has none: its straight span is unstable above "
@@ -631,7 +703,8 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
         params["inertia"] = default_inertia(params["area"])
     params.update(coefficients=values["model.coefficients"], load_type=values["load.type"],
                   paper_parametric=values["model.paper_parametric"],
-                  divergence_bound=values["metrics.divergence_bound"])
+                  divergence_bound=values["metrics.divergence_bound"],
+                  base_levels_g=values.get(BASE_TABLE_KEY))
     if params["load_type"] == "constant":
         params["frequency"] = None
     with np.errstate(all="ignore"):
@@ -639,10 +712,16 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
             derived = wave_parameters(params, values["solver.t_end"], values["solver.transits"])
         else:
             derived = oscillator(params)
+        table = params["base_levels_g"]
+        levels = ([] if table is None or kind == "longitudinal" else
+                  [("base_levels", np.array([g for _, g in table]) * schema.STANDARD_GRAVITY)])
     bad = [(name, np.atleast_1d(np.asarray(derived[name], dtype=np.float64)))
-           for name in _CHECKED_COEFFICIENTS[kind]]
+           for name in _CHECKED_COEFFICIENTS[kind]] + levels
     bad = [(name, v) for name, v in bad if not np.all(np.isfinite(v))]
     if not bad:
+        if kind == "transverse":
+            _check_fixed_frequency_in_table(values, axes, params, derived)
+            _check_stability_frequency(values, axes, derived)
         return
     name, coefficient = bad[0]
     corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0
@@ -656,12 +735,75 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
                  else f"[points] '{axis}' entry {value!r}" if axis in getattr(axes, "zipped", ())
                  else f"axis '{axis}' at {value!r}")
         inputs.append((not (value == 0 or _PLAUSIBLE[0] <= abs(value) <= _PLAUSIBLE[1]), where))
+    if table is not None and not all(math.isfinite(g * schema.STANDARD_GRAVITY)
+                                     for _, g in table):
+        inputs.append((True, f"scene key '{BASE_TABLE_KEY}'"))
     named = [w for odd, w in inputs if odd] or [w for _, w in inputs]
+    base_level = any(f"'{d}'" in w or f"'{schema.BY_DOTTED[d].axis}'" in w for w in named
+                     for d in BASE_LEVEL_KEYS + (BASE_TABLE_KEY,))
     _fail(", ".join(named),
           f"give the derived coefficient {name} = {float(coefficient[corner])!r}, not a "
           f"finite float64 (so are: {', '.join(n for n, _ in bad)})",
+          "give the base level in g of a physical size, e.g. base.acceleration_g = 1.0 or "
+          "levels_g = [[5.0, 0.5], [100.0, 0.6]] (Hz, g)" if base_level else
           "give the cable data in SI units with physical magnitudes, e.g. cable.density = "
           "8900 kg/m^3, cable.area = 6e-6 m^2, cable.youngs_modulus = 1.1e11 Pa")
+
+
+def _check_fixed_frequency_in_table(values: dict[str, Any], axes: dict[str, np.ndarray],
+                                    params: dict[str, Any], derived: dict[str, Any]) -> None:
+    """Refuse a fixed base frequency outside the level table (base.levels_g): the table has
+    no level there. The frequency (base.frequency in Hz, or base.frequency_ratio times each
+    span's f1) is checked at every corner of the grid, where its extremes lie (a product of
+    powers of the parameters, as `_check_coefficients` says)."""
+    table = params["base_levels_g"]
+    if table is None or params.get("base_sweep_start") is not None:
+        return
+    if params.get("base_frequency") is None and params.get("base_frequency_ratio") is None:
+        return
+    frequency = np.atleast_1d(np.asarray(derived["base_omega"], np.float64)) / (2.0 * np.pi)
+    low, high = table[0][0], table[-1][0]
+    outside = (frequency < low * (1 - 1e-12)) | (frequency > high * (1 + 1e-12))
+    if not np.any(outside):
+        return
+    f = float(frequency[int(np.argmax(outside))])
+    dotted = "base.frequency" if params.get("base_frequency") is not None \
+        else "base.frequency_ratio"
+    axis = schema.BY_DOTTED[dotted].axis
+    where = (f"[points] '{axis}'" if axis in getattr(axes, "zipped", ())
+             else f"axis '{axis}'" if axis in axes else f"scene key '{dotted}'")
+    _fail(f"{where} and scene key '{BASE_TABLE_KEY}'", f"the base frequency reaches "
+          f"{f:.6g} Hz, outside the table's {low:g} to {high:g} Hz (no level there)",
+          "extend the table to every base frequency of the scene, or give a constant level "
+          "with base.acceleration_g")
+
+
+MAX_STABILITY_RATIO = 1e4
+"""Highest W/w1 of a stability chart. The parametric resonances of a span lie at
+W = (w_i + w_j) / n, below 2 w_N (50 w1 with five pinned modes); far above them one load
+period is so short that a multiplier's distance from 1 (about 2 pi zeta w1 / W) falls below
+the integration error (at W/w1 = 1e9 a damped span came out 'unstable')."""
+
+
+def _check_stability_frequency(values: dict[str, Any], axes: dict[str, np.ndarray],
+                               derived: dict[str, Any]) -> None:
+    """Refuse outputs.stability at a load frequency above MAX_STABILITY_RATIO w1 (at any
+    corner of the grid, where W/w1's extremes lie)."""
+    if not values.get("outputs.stability") or values["load.type"] != "harmonic":
+        return
+    with np.errstate(all="ignore"):
+        ratio = np.atleast_1d(np.asarray(derived["omega"], np.float64)
+                              / (2.0 * np.pi * np.asarray(derived["natural_frequency"])))
+    if not np.any(ratio > MAX_STABILITY_RATIO):
+        return
+    axis = "frequency" if "frequency" in axes else "frequency_ratio"
+    where = (f"axis '{axis}'" if axis in axes else "scene key 'load.frequency'"
+             if values.get("load.frequency") is not None else "scene key 'load.frequency_ratio'")
+    _fail(f"{where} with outputs.stability", f"the load frequency reaches "
+          f"W/w1 = {float(np.max(ratio)):.3g}, above {MAX_STABILITY_RATIO:g}: far above every "
+          "parametric resonance, where one load period is too short for its Floquet "
+          "multiplier to be told from 1", f"keep W/w1 <= {MAX_STABILITY_RATIO:g} (the "
+          "resonances lie at W = 2 w1 / n and between the modes' sums)")
 
 
 def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
@@ -681,8 +823,14 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
     if "solver.t_end" not in mentioned and not swept:
         values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps
     if swept:            # no settling; the scalar driver; the peaks over the whole sweep
+        # and no variable that means nothing for a sweep: no response period (the frequency
+        # never stops changing), no tail amplitude where the tail is the whole sweep (it
+        # would be peak_amplitude again)
+        whole = "metrics.tail" not in mentioned
         for dotted, value in (("outputs.settling_time", False), ("solver.driver", "scalar"),
-                              ("metrics.tail", 1.0), ("solver.max_steps", SWEEP_MAX_STEPS)):
+                              ("metrics.tail", 1.0), ("solver.max_steps", SWEEP_MAX_STEPS),
+                              ("outputs.response_period", False)) + (
+                                  (("outputs.amplitude", False),) if whole else ()):
             if dotted not in mentioned:
                 values[dotted] = value
     paper = values["model.coefficients"] == "paper"

@@ -321,6 +321,16 @@ def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
     return out
 
 
+def _derived_table(coeffs: dict[str, Any], has_base: bool) -> dict[str, tuple[str, str]]:
+    """The closed forms a time-domain result stores: _DERIVED, without load_frequency where
+    the scene has no end load at any point (it would be a frequency of nothing), and with
+    base excitation's."""
+    table = dict(_DERIVED)
+    if not np.any(np.asarray(coeffs["load_ratio"]) != 0.0):
+        table.pop("load_frequency")
+    return table | (_BASE_DERIVED if has_base else {})
+
+
 def stability_dataset(inputs: Inputs, coeffs: dict[str, Any], stable: dict[str, xr.DataArray],
                       elapsed: float) -> xr.Dataset:
     """The Dataset of a stability-only scene: the Floquet outputs and the closed forms."""
@@ -524,13 +534,17 @@ def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], sy
             grid_out[k][lines.reshape(-1)] = v[d * n_lines:(d + 1) * n_lines].reshape(
                 (n_lines * dwells,) + v.shape[2:])
         outs.append(grid_out)
+    amplitudes = [out["reals"][:, tk.AMPLITUDE].reshape(shape) for out in outs]
+    flags = [ct.jumps(a, out["states"].reshape(shape), axis, order, inputs.jump_ratio)
+             for a, out, order in zip(amplitudes, outs, orders)]
+    both = len(directions) == 2
+    if both:
+        flags = ct.branches_differ(flags, amplitudes, axis, orders, inputs.jump_ratio)
     results = []
-    for order, out in zip(orders, outs):
+    for out, flag in zip(outs, flags):
         ds = assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
-        flags = ct.jumps(out["reals"][:, tk.AMPLITUDE].reshape(shape),
-                         out["states"].reshape(shape), axis, order, inputs.jump_ratio)
-        ds["jump"] = xr.DataArray(flags, dims=dims,
-                                  attrs=ct.jump_attrs(inputs.continuation, inputs.jump_ratio))
+        ds["jump"] = xr.DataArray(flag, dims=dims, attrs=ct.jump_attrs(
+            inputs.continuation, inputs.jump_ratio, both))
         results.append(ds)
     if len(results) == 1:
         ds = results[0]
@@ -560,7 +574,9 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...], direction
     for name in per_point:
         ds[name] = ds[name].transpose(ct.DIRECTION_DIM, *first[name].dims)
         ds[name].attrs = first[name].attrs
-    ds.attrs = first.attrs
+    ds.attrs = dict(first.attrs)
+    # every point solved, in both directions (each direction's Dataset counted its own)
+    ds.attrs["n_points"] = counter(int(first.attrs["n_points"]) * len(results))[()]
     return ds
 
 
@@ -682,8 +698,7 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
             data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
                                       attrs={"units": "1",
                                              "long_name": long_name.format(method=short)})
-    data.update(derived_variables(coeffs, coords,
-                                  _DERIVED | (_BASE_DERIVED if inputs.has_base else {})))
+    data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
     if result.modal is not None:
         data.update(modal_outputs(result.modal, dims, shape, coeffs, coords))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:

@@ -61,9 +61,9 @@ def _build(text: str, source: str, default_name: str,
     rules.check_base(given, swept, "base" in doc, file_has_base)
     kind = models.rules_for(rules.model_kind(given))
     _check_continued(given, points)
-    kind.check(given, swept)
+    rules.check_pairs(given, swept)     # two spellings of one quantity first: the rules
+    kind.check(given, swept)            # below read one of them
     _check_run(given)
-    rules.check_pairs(given, swept)
     values = _resolve(given, swept, kind)
     kind.check_resolved(values, swept, given)
     return Scene(name=name, description=description, values=values, axes=axes,
