@@ -50,7 +50,8 @@ SCENE = "launch-sine-qualification"
 def chirp_rhs(row: np.ndarray):
     """f(t, y) of the one-mode System with the row's swept, tabled base excitation, written
     out in Python (the kernel's columns read once): q'' = -(c q' + k0 q + g0 q^3 + h q^5)/m
-    - G a_b(t), a_b = A(u) sin(phi(t)), u = ln w_b + lam t, phi = w_b (exp(lam t) - 1)/lam."""
+    - G a_b(t), a_b = A(u) R(t) sin(phi(t)), u = ln w_b + lam t, phi = w_b (exp(lam t) - 1)/lam,
+    R the level's rise (1 - cos(pi t / T_r)) / 2 over the first T_r s."""
     m, c, k0, g0, h = (float(row[i]) for i in (osc.MASS, osc.DAMPING, osc.K0, osc.G0, osc.H))
     gamma = float(row[osc.PARTICIPATION])
     b = osc.EXCITATION
@@ -60,6 +61,7 @@ def chirp_rhs(row: np.ndarray):
     edges = [float(row[b + ex.EDGE + k]) for k in range(n)]
     logs = [float(row[b + ex.LOG_LEVEL + k]) for k in range(n)]
     slopes = [float(row[b + ex.SLOPE + k]) for k in range(n)]
+    rise = float(row[b + ex.RAMP])
 
     def rhs(t: float, y: np.ndarray) -> list[float]:
         q, v = y
@@ -70,6 +72,8 @@ def chirp_rhs(row: np.ndarray):
             while k + 1 < n and u >= edges[k + 1]:
                 k += 1
             level = math.exp(logs[k] + slopes[k] * (u - edges[k]))
+            if t < rise:                  # the level's rise over the sweep's first cycles
+                level *= 0.5 - 0.5 * math.cos(math.pi * t / rise)
             a_b = level * math.sin(w_b * math.expm1(lam * t) / lam)
         return [v, -(c * v + k0 * q + g0 * q ** 3 + h * q ** 5) / m - gamma * a_b]
 

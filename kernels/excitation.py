@@ -12,7 +12,9 @@ The level A(t) is the constant ACCEL, or (SEGMENTS > 0) a table of segments in t
 the excitation frequency, u(t) = ln w(t) = LOG_OMEGA + lam t: on segment k, which starts at
 u = EDGE[k], ln A = LOG_LEVEL[k] + SLOPE[k] (u - EDGE[k]) (A in m/s^2). That is a table of
 (frequency, level) breakpoints interpolated log-log, read along the sweep whichever way it
-runs. After END (s; the sweep's end) the clamps stop: a_b = 0.
+runs. After END (s; the sweep's end) the clamps stop: a_b = 0. A sweep's level rises from 0
+over its first RAMP seconds, as a shaker's does, by the factor (1 - cos(pi t / RAMP)) / 2
+(RAMP = 0: full level from t = 0).
 
 The columns form one block, read as p[o + column * s] from its first column (the accessor of
 kernels.oscillator: o the block's first slot, s the stride), so each System places the block
@@ -35,13 +37,14 @@ MAX_SEGMENTS = 8    # room for this many segments (a level table of up to 9 brea
 EDGE = 7                            # segment k starts at u = p[EDGE + k] (ln of rad/s)
 LOG_LEVEL = EDGE + MAX_SEGMENTS     # ln A there (A in m/s^2)
 SLOPE = LOG_LEVEL + MAX_SEGMENTS    # d ln A / d ln w on the segment (1)
-SIZE = SLOPE + MAX_SEGMENTS
+RAMP = SLOPE + MAX_SEGMENTS         # with SEGMENTS > 0: the level's rise time from 0 (s)
+SIZE = RAMP + 1
 
 NAMES = (("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments",
           "sweep_end", "log_base_omega")
          + tuple(f"level_edge_{k}" for k in range(MAX_SEGMENTS))
          + tuple(f"level_log_{k}" for k in range(MAX_SEGMENTS))
-         + tuple(f"level_slope_{k}" for k in range(MAX_SEGMENTS)))
+         + tuple(f"level_slope_{k}" for k in range(MAX_SEGMENTS)) + ("level_ramp",))
 """The block's column names, in order (sweep.models.modal.base_excitation gives them)."""
 
 
@@ -66,8 +69,11 @@ def level(t, p, o, s):
     k = 0
     while k + 1 < n and u >= p[o + (EDGE + k + 1) * s]:
         k += 1
-    return math.exp(p[o + (LOG_LEVEL + k) * s]
-                    + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
+    a = math.exp(p[o + (LOG_LEVEL + k) * s] + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
+    ramp = p[o + RAMP * s]
+    if t < ramp:
+        a *= 0.5 - 0.5 * math.cos(math.pi * t / ramp)
+    return a
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -134,8 +134,13 @@ def _summary(ds, seconds: float) -> str:
     states = ", ".join(f"{c} {m}" for c, m in counts if c)
     n = int(ds.attrs["n_points"])
     ways = (f" ({n // 2} x 2 directions: up, down)" if "direction" in ds[name].dims else "")
-    return (f"{ds.attrs['title']}: {n} point{'' if n == 1 else 's'}{ways} in {seconds:.2f} s "
-            f"({states})")
+    from .errors import escape
+    return (f"{escape(str(ds.attrs['title']))}: {n} point{'' if n == 1 else 's'}{ways} in "
+            f"{seconds:.2f} s ({states})")
+
+
+MAX_DPI = 2400.0
+"""Highest --dpi: a 7 x 5 inch figure at 2400 dpi is 200 megapixels, more than any print."""
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -199,8 +204,9 @@ def _plot(args: argparse.Namespace) -> int:
     from pathlib import Path
     from .plot import load_result, parse_select, plot, save
 
-    if not args.dpi > 0:
-        raise UserError(f"--dpi {args.dpi:g}: must be a positive resolution, e.g. --dpi 100")
+    if not 1 <= args.dpi <= MAX_DPI:
+        raise UserError(f"--dpi {args.dpi:g}: must be a resolution from 1 to {MAX_DPI:g} dots "
+                        "per inch (give e.g. --dpi 100 for a screen, 300 for print)")
     formats = [f for f in args.format.split(",") if f.strip()]
     if not formats:
         raise UserError("--format: give at least one format, e.g. --format png,svg")

@@ -344,6 +344,13 @@ def table(result: xr.Dataset) -> str:
     return "\n".join(lines)
 
 
+MIN_REFINE_TOLERANCE = 1e-9
+"""Finest --tolerance relative to the longest length: a bracket is halved about 30 times
+from a 1 m grid step to it, far above the round-off where bisection stops halving."""
+MAX_BISECTIONS = 64
+"""Most halvings of one bracket (a bound whatever the tolerance)."""
+
+
 def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                 max_amplitude: float | None = None, quantity: str | None = None,
                 tolerance: float = 1e-3) -> xr.Dataset:
@@ -384,7 +391,9 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     if not isinstance(text, str) or not text.strip():
         raise UserError("design --refine: the result has no 'scene' attribute to run again "
                         "(give a result written by 'sweep run ... -o FILE.nc')")
-    stored = load_scene_text(text, source="the result's scene")
+    # the reader's machine decides how the runs execute, never the file's scene
+    here = {"run.backend": "threads", "run.workers": 0, "run.threads": 0}
+    stored = load_scene_text(text, source="the result's scene", overrides=here)
     scene_axes = set(stored.axes) | ({POINT_DIM} if stored.points else set())
     stepped = ds.attrs.get("continuation_axis")
     stepped = stepped if isinstance(stepped, str) and stepped in ds.dims else None
@@ -398,14 +407,29 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         raise UserError(f"design --refine: axis {', '.join(missing)} is not an axis of the "
                         "result's stored scene, so it cannot be run again (refine the result "
                         "'sweep run' wrote)")
+    extra = sorted(a for a in scene_axes if a not in ds.dims)
+    if extra:
+        raise UserError(f"design --refine: the result's stored scene has axis "
+                        f"{', '.join(extra)} that its data do not: the file was not written "
+                        "by 'sweep run' as it stands (refine the result 'sweep run' wrote)")
+    units = ds[LENGTH].attrs.get("units")
+    if units != "m":
+        raise UserError(f"design --refine: the result's length is in {units!r}, not metres: "
+                        "the stored scene would be run at the wrong spans (refine the result "
+                        "'sweep run' wrote)")
     lengths = np.asarray(ds[LENGTH].values, float)
+    finest = MIN_REFINE_TOLERANCE * float(np.max(np.abs(lengths)))
+    if not tol >= finest:
+        raise UserError(f"--tolerance {tol:g}: below what a bisection on these lengths can "
+                        f"reach ({MIN_REFINE_TOLERANCE:g} of the longest, {finest:.3g} m; "
+                        "give --tolerance 0.001 or any length down to that)")
     nonfrequency = [k for k in CRITERIA if k != "min_frequency"]
     runs = 0
 
     def fails(point: dict[str, Any], length: float) -> list[str]:
         """The non-frequency criteria the engine's one-length run at `length` fails."""
         nonlocal runs
-        overrides: dict[str, Any] = {f"axes.{LENGTH}": [float(length)]}
+        overrides: dict[str, Any] = {f"axes.{LENGTH}": [float(length)], **here}
         for a, v in point.items():
             if a == POINT_DIM:               # the parameter set's values, as scalars
                 overrides.update({BY_AXIS[k].dotted: float(values[int(v)])
@@ -460,7 +484,9 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                 spans[flat_i], limited[flat_i] = l_f, "min_frequency"
                 continue
             hi, by = l_f, at_f[0]
-        while hi - lo > tol:
+        for _ in range(MAX_BISECTIONS):
+            if not hi - lo > tol:
+                break
             mid = 0.5 * (lo + hi)
             at_mid = fails(point, mid)
             if at_mid:

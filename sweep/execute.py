@@ -152,7 +152,8 @@ def stepped_chunk(lines: np.ndarray, kernel: Callable[..., dict], kernel_args: t
     `kernel` (transverse_chunk or modes_chunk, with kernel_args), the state and phases carried
     as `carry` says, dwell: the dwell time (s); the lines share `threads`. Returns the kernel's
     outputs with a dwell axis after the first: (lines, dwells, ...). A line is the unit of a
-    chunk (a dask task, a stored chunk): its dwells depend on each other."""
+    chunk (a dask task, a stored chunk): its dwells depend on each other. With `stop` set (an
+    interrupt) no new dwell starts, and an unfinished chunk reports nothing."""
     from .models import continuation as ct
     from .threads import thread_count
     m = lines.shape[0]
@@ -163,12 +164,12 @@ def stepped_chunk(lines: np.ndarray, kernel: Callable[..., dict], kernel_args: t
     line_points = np.arange(m * dwells).reshape(m, dwells)
     groups = [(line_points[direction == d], np.asarray(order), flat)
               for d, order in enumerate(orders) if np.any(direction == d)]
-    ct.solve_lines(rows, groups, carry, dwell, lambda batch: kernel(batch, *kernel_args,
-                                                                    threads=1),
-                   workers=thread_count(threads))
+    whole = ct.solve_lines(rows, groups, carry, dwell,
+                           lambda batch: kernel(batch, *kernel_args, threads=1),
+                           workers=thread_count(threads), stop=stop)
     out = {k: v.reshape((m, dwells) + v.shape[1:]) for k, v in flat.items()}
-    if on_block is not None:
-        on_block(0, m, out)
+    if on_block is not None and whole:
+        on_block(0, m, out)          # interrupted part-way, no line is whole: nothing to keep
     return out
 
 

@@ -55,6 +55,7 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params["load_type"] = scene.get("load.type")
     params["divergence_bound"] = scene.get("metrics.divergence_bound")
     params["base_levels_g"] = scene.get("base.levels_g")
+    params["base_sweep_ramp_cycles"] = scene.get("base.sweep.ramp_cycles")
     if params["load_type"] == "constant":      # no frequency axis: refused by load_scene
         params["frequency"] = None
     return params

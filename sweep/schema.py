@@ -121,6 +121,9 @@ KEYS: tuple[Key, ...] = (
         axis="base_sweep_stop"),
     Key("base", "sweep.rate", "float", None, units="min-1", minimum=0.0, exclusive_min=True,
         long_name="logarithmic sine sweep: rate in octaves per minute", axis="base_sweep_rate"),
+    Key("base", "sweep.ramp_cycles", "float", None, units="1", minimum=0.0,
+        long_name="logarithmic sine sweep: cycles of the start frequency over which the level "
+                  "rises from 0 (default 10; 0: full level from t = 0)"),
     Key("base", "sweep.direction", "str", None, choices=("up", "down", "both"),
         long_name="logarithmic sine sweep: from the lower of start and stop to the upper (up), "
                   "back (down) or both (a direction dimension); default: from start to stop"),

@@ -68,3 +68,14 @@ def paper_row():
                      g0=6.6e5 * np.pi ** 2 * l ** 3 - 2.1 * np.pi ** 4 / l,
                      g1=0.54 * np.pi ** 2 * l ** 3, h=76 * np.pi ** 6 / l ** 3,
                      omega=1.86 * np.pi, v0=0.0321, bound=l)
+
+
+COMPILE_LINES = ("compiling the Numba kernels", "compiled in ")
+"""The lines a cold start prints on stderr, terminal or not (sweep.execute)."""
+
+
+def stderr_lines(text: str) -> list[str]:
+    """The non-empty lines of a run's stderr but the cold start's compile lines: a test that
+    counts the lines a run says about an interrupt or an error holds on a cold cache too."""
+    return [line for line in text.strip().splitlines()
+            if line.strip() and not line.startswith(COMPILE_LINES)]

@@ -288,6 +288,9 @@ CLI_CASES = [
     ("no-subcommand", [], ["command", "usage"], None),
     ("unknown-option", ["run", "paper-fig5", "-o", "out.nc", "--bogus"], ["--bogus"], None),
     ("scenes-extra-argument", ["scenes", "extra"], ["extra"], None),
+    # the resolution is checked before the result is read
+    ("plot-dpi-huge", ["plot", "paper-fig5.nc", "--dpi", "1e6"], ["--dpi 1e+06", "2400"],
+     None),
 ]
 
 
@@ -509,3 +512,11 @@ def test_output_under_a_file_says_it_is_a_file(tmp_path):
     from sweep.io import check_output_path
     with pytest.raises(sweep.UserError, match="is a file, not a directory"):
         check_output_path(tmp_path / "afile" / "x.nc")
+
+
+def test_a_scene_name_with_terminal_codes_is_escaped_in_the_summary(workdir, capsys):
+    """The summary line quotes the scene's name as the error lines do: escaped, never raw."""
+    assert main(["run", "paper-fig5", "-o", "out.nc", "--set", "name=fig\x1b[2J5",
+                 "--set", "solver.t_end=0.05"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "fig\\x1b[2J5: 4 points" in out, out

@@ -20,6 +20,8 @@ import sweep.execute as ex
 from sweep.cli import main as sweep_main
 from sweep.errors import UserError
 
+from conftest import stderr_lines
+
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 TINY = """
@@ -38,7 +40,7 @@ def _env() -> dict:
 
 
 def _one_error_line(stderr: str) -> str:
-    lines = [line for line in stderr.splitlines() if line.strip()]
+    lines = stderr_lines(stderr)
     assert len(lines) == 1 and lines[0].startswith("sweep: error: "), stderr
     return lines[0]
 

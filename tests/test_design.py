@@ -329,6 +329,42 @@ def test_refine_bad_tolerance_is_one_line(results):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("tolerance", [1e-300, 1e-17, 1e-11])
+def test_refine_refuses_a_tolerance_no_bisection_reaches(results, tolerance):
+    """Below 1e-9 of the longest span the bracket would be halved to round-off for ever: one
+    line, before any run."""
+    ds = _coarse_linear(results)
+    with pytest.raises(sweep.UserError, match="--tolerance") as info:
+        refine_span(ds, max_amplitude=1e-7, tolerance=tolerance)
+    assert "\n" not in str(info.value) and "reach" in str(info.value)
+
+
+def test_refine_runs_only_what_the_result_holds(results):
+    """A stored scene with an axis the data lack (a crafted 2e6-point one), a length not in
+    metres, or a dask cluster of its own is not run as the file says: the first two are
+    refused in one line, the third runs on this machine's threads."""
+    ds = _coarse_linear(results)
+    assert "\n[axes]\n" in ds.attrs["scene"] and 'backend = "threads"' in ds.attrs["scene"]
+    extra = ds.copy()
+    extra.attrs["scene"] = ds.attrs["scene"].replace(
+        "\n[axes]\n", "\n[axes]\ndamping_ratio = {start = 0.01, stop = 0.05, num = 2000000}\n",
+        1)
+    with pytest.raises(sweep.UserError, match="damping_ratio") as info:
+        refine_span(extra, max_amplitude=1e-7, tolerance=1e-3)
+    assert "\n" not in str(info.value)
+    mm = ds.copy()
+    mm["length"] = mm["length"] * 1e3
+    mm["length"].attrs = dict(ds["length"].attrs, units="mm")
+    with pytest.raises(sweep.UserError, match="metres"):
+        refine_span(mm, max_amplitude=1e-7, tolerance=1e-3)
+    dask = ds.copy()
+    dask.attrs["scene"] = ds.attrs["scene"].replace(
+        'backend = "threads"\nworkers = 0', 'backend = "dask"\nworkers = 6', 1)
+    assert 'workers = 6' in dask.attrs["scene"]
+    out = refine_span(dask, max_amplitude=1e-7, tolerance=1e-2)
+    assert int(out.attrs["refine_runs"]) >= 1           # ran, in-process (no cluster started)
+
+
 def test_cli_design_refine_prints_and_writes(results, tmp_path, capsys):
     from test_cf import cf_problems
     src = tmp_path / "coarse-linear.nc"

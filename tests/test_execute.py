@@ -18,6 +18,8 @@ import xarray as xr
 import sweep
 from sweep.cli import main as sweep_main
 
+from conftest import stderr_lines
+
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 SCENE = """
@@ -169,7 +171,7 @@ def test_ctrl_c_keeps_finished_blocks_says_how_to_resume_and_exits_130(tmp_path,
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
-    lines = err.strip().splitlines()
+    lines = stderr_lines(err)
     assert len(lines) == 1 and "Traceback" not in err, err
     kept = _stored_points(store)
     assert 0 < kept < LONG_POINTS

@@ -223,6 +223,35 @@ def test_huge_declared_dimensions_are_refused_before_reading(tmp_path, capsys):
     _refused([path], tmp_path / "figs", capsys, "GiB of data")
 
 
+def test_a_small_file_declaring_gigabytes_of_zeros_is_refused_before_inflating(tmp_path,
+                                                                              capsys):
+    """A file of a few MiB whose compressed variable inflates to 1 GiB of zeros (within the
+    machine's memory, so the memory check alone lets it through): refused from its declared
+    size against the file's, for plot and design alike, without reading the variable."""
+    import netCDF4
+    path = tmp_path / "bomb.nc"
+    n = 2**14
+    with netCDF4.Dataset(path, "w") as nc:
+        nc.cable_sweep_version = "0.1.0"
+        nc.createDimension("length", n)
+        nc.createDimension("elapsed_time", 2**13)
+        length = nc.createVariable("length", "f8", ("length",))
+        length[:] = np.linspace(0.1, 1.0, n)
+        length.units = "m"
+        state = nc.createVariable("state", "i1", ("length",))
+        state.flag_values = np.arange(2, dtype=np.int8)
+        state.flag_meanings = "decayed steady"
+        zeros = nc.createVariable("displacement", "f8", ("length", "elapsed_time"), zlib=True,
+                                  complevel=9, chunksizes=(256, 2**13))
+        for i in range(0, n, 256):
+            zeros[i:i + 256, :] = 0.0
+    assert path.stat().st_size < 8 * 2**20                   # 1 GiB declared
+    _refused([path], tmp_path / "figs", capsys, "times it")
+    assert cli.main(["design", str(path), "--min-frequency", "10"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "times it" in err, err
+
+
 # ------------------------------------------------------------- as real processes
 
 def _assert_refused(done: subprocess.CompletedProcess, fragment: str, figs: Path) -> None:

@@ -18,6 +18,8 @@ import xarray as xr
 import sweep
 from sweep.store import ChunkStore
 
+from conftest import stderr_lines
+
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 # 63 points, 8 chunks of up to 8: a fraction of a second once the kernels are cached.
@@ -361,7 +363,7 @@ def test_sigterm_and_sighup_stop_like_ctrl_c(tmp_path, signum):
     proc.send_signal(signum)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 128 + signum, err
-    lines = err.strip().splitlines()
+    lines = stderr_lines(err)
     assert len(lines) == 1 and "Traceback" not in err, err
     assert signal.Signals(signum).name in lines[0]
     assert lines[0].endswith("finish the run with: sweep run s.toml -o out.nc --resume"), err

@@ -30,6 +30,7 @@ slope that both directions follow alike is no jump.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from typing import Callable
 
@@ -110,10 +111,13 @@ def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int,
 
 def solve_lines(rows: np.ndarray, groups: list[tuple[np.ndarray, np.ndarray, dict]],
                 carry: Carry, dwell: float, solve: Callable[[np.ndarray], dict],
-                advance: Callable[[int], None] | None = None, workers: int = 1) -> None:
+                advance: Callable[[int], None] | None = None, workers: int = 1,
+                stop: threading.Event | None = None) -> bool:
     """`solve_continued`'s work: each group (lines, order, outputs) is a set of lines (point
     indices into `rows`, one line a row, its dwells along it) swept in `order`, filling
-    `outputs` at those points. The groups' lines are cut into tasks that the threads share."""
+    `outputs` at those points. The groups' lines are cut into tasks that the threads share.
+    With `stop` set (an interrupt) no new dwell starts: the lines are left unfinished.
+    Returns whether every line ran all its dwells."""
     n_lines = sum(g[0].shape[0] for g in groups)
     # shares of at least one lanes group each: fewer lines than that a call leaves lanes idle,
     # and two such calls side by side took longer than one thread doing both (measured)
@@ -121,30 +125,31 @@ def solve_lines(rows: np.ndarray, groups: list[tuple[np.ndarray, np.ndarray, dic
     tasks = [(order, lines[i::per_group], out) for lines, order, out in groups
              for i in range(per_group) if lines[i::per_group].shape[0]]
 
-    def run(task) -> None:
+    def run(task) -> bool:
         order, share, out = task
-        _sweep_lines(rows, share, order, carry, dwell, solve, out, advance)
+        return _sweep_lines(rows, share, order, carry, dwell, solve, out, advance, stop)
 
     if workers <= 1 or len(tasks) == 1:
-        for task in tasks:
-            run(task)
-        return
+        return all([run(task) for task in tasks])
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(min(workers, len(tasks)), thread_name_prefix="cable-sweep") as pool:
-        for future in [pool.submit(run, task) for task in tasks]:
-            future.result()
+        return all([future.result() for future in [pool.submit(run, task) for task in tasks]])
 
 
 def _sweep_lines(rows: np.ndarray, lines: np.ndarray, order: np.ndarray, carry: Carry,
                  dwell: float, solve: Callable[[np.ndarray], dict],
-                 outputs: dict[str, np.ndarray], advance: Callable[[int], None] | None) -> None:
-    """The dwells of `lines` (point indices, one line a row, dwells along it) in `order`."""
+                 outputs: dict[str, np.ndarray], advance: Callable[[int], None] | None,
+                 stop: threading.Event | None = None) -> bool:
+    """The dwells of `lines` (point indices, one line a row, dwells along it) in `order`; with
+    `stop` set, no further dwell. Returns whether the lines ran all their dwells."""
     columns = list(carry.state)
     start = rows[lines[:, order[0]]][:, columns]       # the scene's initial conditions
     state = start.copy()
     phase_b = np.zeros(lines.shape[0])
     phase_w = np.zeros(lines.shape[0])
     for k in order:
+        if stop is not None and stop.is_set():
+            return False
         points = lines[:, k]
         batch = rows[points].copy()
         batch[:, columns] = state
@@ -159,6 +164,7 @@ def _sweep_lines(rows: np.ndarray, lines: np.ndarray, order: np.ndarray, carry: 
         phase_w = np.where(failed, 0.0, _wrap(phase_w + batch[:, carry.load_omega] * dwell))
         if advance is not None:
             advance(points.size)
+    return True
 
 
 def jumps(amplitude: np.ndarray, states: np.ndarray, axis: int, order: np.ndarray,

@@ -23,7 +23,7 @@ from .swept import Swept
 EXCITATION_NAMES: tuple[str, ...] = (
     ("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments", "sweep_end",
      "log_base_omega") + tuple(f"level_{what}_{k}" for what in ("edge", "log", "slope")
-                               for k in range(8)))
+                               for k in range(8)) + ("level_ramp",))
 """kernels.excitation.NAMES, written here so that the models need not import Numba (a test
 checks that the two agree)."""
 
@@ -48,6 +48,17 @@ def sweep_frequency(t: Any, start: Any, stop: Any, rate: Any) -> Any:
     return start * np.exp(sweep_rate(start, stop, rate) * t)
 
 
+DEFAULT_RAMP_CYCLES = 10.0
+"""base.sweep.ramp_cycles of a scene that gives none: the level rises over 10 cycles of the
+sweep's start frequency (0.1 s at 100 Hz, 2 s at 5 Hz), as a shaker ramps its level up."""
+
+
+def ramp_time(start: Any, cycles: Any) -> Any:
+    """The level's rise time (s) at the start of a sweep from `start` (Hz): `cycles` cycles of
+    the start frequency (docs/model.md sec. 6)."""
+    return cycles / start
+
+
 def sweep_phase(t: Any, start: Any, stop: Any, rate: Any) -> Any:
     """phi(t) (rad) of the sweep at time t (s): 2 pi f_s (exp(lam t) - 1) / lam."""
     lam = sweep_rate(start, stop, rate)
@@ -66,10 +77,11 @@ def table_level(levels_g: Sequence[Sequence[float]], frequency: Any) -> Any:
 
 
 def block(accel: Any, omega: Any, rate: Any = 0.0, end: Any = math.inf,
-          levels_g: Sequence[Sequence[float]] | None = None) -> dict[str, Any]:
+          levels_g: Sequence[Sequence[float]] | None = None, ramp: Any = 0.0) -> dict[str, Any]:
     """kernels.excitation's columns by name (its NAMES): constant level accel (m/s^2) or, with
     a sweep and a table, the table's segments; omega the (start) angular frequency (rad/s);
-    rate lam (1/s, 0: fixed frequency); end: the sweep's end (s, after which a_b = 0).
+    rate lam (1/s, 0: fixed frequency); end: the sweep's end (s, after which a_b = 0); ramp:
+    a sweep's level rise time (s, `ramp_time`; 0: full level from t = 0).
 
     A table with a fixed frequency is read here (accel = its level there); along a sweep the
     kernel reads it (segments in ln w: edges ln(2 pi f_k), ln A_k, log-log slopes)."""
@@ -78,8 +90,10 @@ def block(accel: Any, omega: Any, rate: Any = 0.0, end: Any = math.inf,
                            "log_base_omega": 0.0}
     for k in range(MAX_BREAKPOINTS - 1):
         out[f"level_edge_{k}"] = out[f"level_log_{k}"] = out[f"level_slope_{k}"] = 0.0
+    out["level_ramp"] = 0.0
     if not np.any(np.asarray(rate) != 0.0):
         return out
+    out["level_ramp"] = ramp
     if levels_g is None:                  # one segment of slope 0: the level ends with the sweep
         with np.errstate(divide="ignore"):
             out.update(level_segments=1.0, sweep_end=end, log_base_omega=np.log(omega),

@@ -239,8 +239,11 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
         lam = excitation.sweep_rate(start, stop, rate)
         end = excitation.sweep_duration(start, stop, rate)
         accel = 0.0 if levels is not None else _level(p)
+        cycles = p.get("base_sweep_ramp_cycles")
+        ramp = excitation.ramp_time(start, excitation.DEFAULT_RAMP_CYCLES if cycles is None
+                                    else cycles)
         return {"participation": PARTICIPATION,
-                **excitation.block(accel, omega, lam, end, levels)}
+                **excitation.block(accel, omega, lam, end, levels, ramp)}
     if p.get("base_frequency") is not None:
         omega = 2.0 * np.pi * p["base_frequency"]
     else:
@@ -267,7 +270,8 @@ def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> d
     (NaN where that is unbounded: undamped at resonance), and resonance_amplification (1):
     Q = 1/(2 zeta), its peak over the quasi-static Gamma A / w1^2 (NaN undamped).
     """
-    with np.errstate(divide="ignore", invalid="ignore"):
+    omega = np.float64(omega) if isinstance(omega, float) else omega   # inf, not OverflowError
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         denominator = np.sqrt((omega_1 ** 2 - omega ** 2) ** 2
                               + (2.0 * damping_ratio * omega_1 * omega) ** 2)
         linear = PARTICIPATION * accel / denominator

@@ -252,9 +252,17 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
                 _fail(f"scene keys '{dotted}' and '{BASE_TABLE_KEY}'", "give one level, not "
                       "both (a constant level, or a table of breakpoints)",
                       f"remove one of them: {_PAIR_UNITS['base.acceleration']}")
+    if not swept and given.get("base.sweep.ramp_cycles") is not None:
+        _fail("scene key 'base.sweep.ramp_cycles'", "needs a sweep (start, stop and rate): a "
+              "fixed frequency starts at full level", "write sweep = { start = 5.0, stop = "
+              "100.0, rate = 2.0, ramp_cycles = 10.0 }, or remove the key")
     if not swept and given.get(SWEEP_DIRECTION) is not None:
         _fail(f"scene key '{SWEEP_DIRECTION}'", "needs a sweep (start, stop and rate)",
               "write sweep = { start = 5.0, stop = 100.0, rate = 2.0, direction = 'both' }")
+    if not given.get("outputs.envelope"):
+        _refuse_without(given, ("outputs.bands_per_octave",), "sets the envelope's bands, but "
+                        "the scene asks for no envelope", "add outputs.envelope = true (a sweep's "
+                        "response envelope), or remove the key")
     if not swept:
         for dotted in ("outputs.envelope",):
             if given.get(dotted):
@@ -335,6 +343,16 @@ def _check_sweep_extent(given: dict[str, Any], start: Any, stop: Any, rate: Any)
               f"lasts {float(duration[i]):.3g} s, longer than {MAX_SWEEP_DURATION:g} s",
               "give a faster rate (a launch sine sweep is 2-4 octaves per minute), or use "
               "base.frequency for a fixed frequency")
+    cycles_up = given.get("base.sweep.ramp_cycles")
+    if cycles_up is not None:
+        rise = cycles_up / start
+        slow = ~(rise <= 0.5 * duration)
+        if np.any(slow):
+            i = np.unravel_index(int(np.argmax(slow)), slow.shape)
+            _fail("scene key 'base.sweep.ramp_cycles'", f"{cycles_up!r} cycles of "
+                  f"{float(start[i])!r} Hz take {float(rise[i]):.3g} s, more than half the "
+                  f"sweep ({float(duration[i]):.3g} s): the level would hardly reach the "
+                  "table's", "give fewer cycles (default 10), or 0 for full level from t = 0")
     t_end = given.get("solver.t_end")
     longest = float(np.max(duration))
     if t_end is not None and t_end < longest * (1.0 - 1e-12):
@@ -525,6 +543,13 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     if given.get("outputs.stability"):
         _fail("scene key 'outputs.stability'", "only for model.kind = 'transverse' (Floquet "
               "multipliers of the span's transverse modes)", "remove it")
+    if given.get("continuation.axis") is not None:
+        _fail("scene key 'continuation.axis'", "only for model.kind = 'transverse' (a stepped "
+              "sweep carries a span's transverse state); a longitudinal scene would ignore it",
+              "remove [continuation]")
+    _refuse_without(given, ("model.modes", "solver.stop_when_steady"),
+                    "only for model.kind = 'transverse' (Galerkin modes, the steady early "
+                    "stop); a longitudinal scene would ignore it", "remove the key")
     load_type = given.get("load.type", LONGITUDINAL_LOAD)
     if load_type != LONGITUDINAL_LOAD:
         _fail("scene key 'load.type'",
@@ -721,6 +746,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     if not bad:
         if kind == "transverse":
             _check_fixed_frequency_in_table(values, axes, params, derived)
+            _check_base_frequency_ratio(values, axes, params, derived)
             _check_stability_frequency(values, axes, derived)
         return
     name, coefficient = bad[0]
@@ -776,6 +802,38 @@ def _check_fixed_frequency_in_table(values: dict[str, Any], axes: dict[str, np.n
           f"{f:.6g} Hz, outside the table's {low:g} to {high:g} Hz (no level there)",
           "extend the table to every base frequency of the scene, or give a constant level "
           "with base.acceleration_g")
+
+
+MAX_BASE_RATIO = 1e6
+"""Highest base frequency over f1: beyond it the span follows its clamps rigidly (the
+response is (4/pi) A / w^2, below round-off of the quasi-static one) and an explicit step
+would have to resolve the excitation for ever."""
+
+
+def _check_base_frequency_ratio(values: dict[str, Any], axes: dict[str, np.ndarray],
+                                params: dict[str, Any], derived: dict[str, Any]) -> None:
+    """Refuse a base frequency (fixed, or a sweep's highest) above MAX_BASE_RATIO x f1 at
+    any corner of the grid."""
+    if derived.get("participation") is None or not np.any(np.asarray(derived["participation"])):
+        return
+    with np.errstate(all="ignore"):
+        f1 = np.asarray(derived["natural_frequency"], np.float64)
+        if params.get("base_sweep_start") is not None:
+            top = np.maximum(np.asarray(params["base_sweep_start"], np.float64),
+                             np.asarray(params["base_sweep_stop"], np.float64))
+        else:
+            top = np.asarray(derived["base_omega"], np.float64) / (2.0 * np.pi)
+        ratio = np.atleast_1d(top / f1)
+    if not np.any(ratio > MAX_BASE_RATIO):
+        return
+    keys = [d for d in ("base.frequency", "base.frequency_ratio", "base.sweep.start",
+                        "base.sweep.stop") if values.get(d) is not None
+            or schema.BY_DOTTED[d].axis in axes]
+    _fail(", ".join(f"scene key '{d}'" for d in keys) or "scene section '[base]'",
+          f"the base frequency reaches {float(np.max(ratio)):.3g} times the span's f1, above "
+          f"{MAX_BASE_RATIO:g}: the span follows its clamps rigidly there, and no step could "
+          "resolve the excitation", "give base frequencies in Hz of a launch environment "
+          "(5-2000 Hz)")
 
 
 MAX_STABILITY_RATIO = 1e4

@@ -67,7 +67,8 @@ def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Fig
     else:
         dim = span.dims[0]
         x = _coord(ds, dim)
-        ax.plot(x, values * factor, color="0.6", lw=1.2, zorder=1, **kwargs)
+        if dim != POINT_DIM:   # parameter sets are unrelated: no line from one to the next
+            ax.plot(x, values * factor, color="0.6", lw=1.2, zorder=1, **kwargs)
         handles = []
         bys = np.asarray(by.values).astype(str)
         finite = values[np.isfinite(values)]

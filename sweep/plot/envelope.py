@@ -112,7 +112,9 @@ def plot_envelope(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     edges = _band_edges(ds)
     points = [ds.isel({dim: i}) for i in range(ds.sizes[dim])] if dim else [ds]
     good = _good_states(ds["state"])
-    colours = [f"C{i % 10}" for i in range(len(points))]
+    scale = _colour_scale(ds, dim, len(points))
+    colours = ([scale[0](scale[1](float(v))) for v in ds[dim].values] if scale else
+               [f"C{i % 10}" for i in range(len(points))])
     ways = ([str(d) for d in ds[DIRECTION_DIM].values] if DIRECTION_DIM in ds["state"].dims
             else [None])
     handles: list = []
@@ -139,7 +141,7 @@ def plot_envelope(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
             if first is None:
                 first = line
                 drawn.append((part, colour))
-        if first is not None:
+        if first is not None and scale is None:
             handles.append(first if ways == [None] else
                            Line2D([], [], color=colour, lw=2.0, label=text))
     if ways != [None] and drawn:
@@ -177,8 +179,37 @@ def plot_envelope(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     _log_ticks(ax, "x")
     if drawn:
         _log_ticks(ax, "y")
+    if scale is not None:
+        _colour_bar(ax, ds, dim, scale)
     _legend(ax, handles)
     return fig
+
+
+MAX_NAMED_POINTS = 8
+"""More points than this get a colour scale by their value and a colour bar, not a legend
+entry each (ten colours would repeat, and the legend would outgrow the plot)."""
+
+
+def _colour_scale(ds: xr.Dataset, dim: str | None, count: int) -> tuple | None:
+    """(colormap, Normalize) over the swept axis's values when there are more than
+    MAX_NAMED_POINTS points of a numeric axis; None otherwise."""
+    if dim is None or count <= MAX_NAMED_POINTS or ds[dim].dtype.kind not in "iuf":
+        return None
+    from matplotlib import colormaps
+    from matplotlib.colors import Normalize
+    values = np.asarray(ds[dim].values, dtype=float)
+    return colormaps["viridis"], Normalize(float(np.nanmin(values)), float(np.nanmax(values)))
+
+
+def _colour_bar(ax: Axes, ds: xr.Dataset, dim: str, scale: tuple) -> None:
+    """The colour bar of `_colour_scale`, under the plot, labelled with the axis and units."""
+    from matplotlib.cm import ScalarMappable
+    units = ds[dim].attrs.get("units")
+    label = ds[dim].attrs.get("long_name", dim) if dim == "point" else dim
+    bar = ax.figure.colorbar(ScalarMappable(norm=scale[1], cmap=scale[0]), ax=ax,
+                             location="top", fraction=0.05, pad=0.02, aspect=40)
+    bar.set_label(f"{label} [{units}]" if units and units != "1" else label, fontsize="small")
+    bar.ax.tick_params(labelsize="small")
 
 
 def _bands_per_octave(freq: np.ndarray) -> int | None:

@@ -27,6 +27,8 @@ def label(da: xr.DataArray, units: str | None = None) -> str:
     if len(name) > _MAX_LABEL:
         name = str(da.name or name).replace("_", " ")
     units = da.attrs.get("units") if units is None else units
+    if units and name.endswith(f" in {units}"):        # not "... in g [g]"
+        name = name[:-len(f" in {units}")]
     return f"{name} [{units}]" if units and units != "1" else name
 
 

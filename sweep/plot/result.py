@@ -121,7 +121,7 @@ def load_result(path: str | os.PathLike) -> xr.Dataset:
         raise _unreadable(where, exc) from exc
     with opened:
         _check_attrs(opened, where)
-        _check_bytes(opened, where)
+        _check_bytes(opened, where, info.st_size)
         try:
             ds = opened.load()
         except Exception as exc:  # noqa: BLE001 - a truncated or corrupted file
@@ -211,12 +211,26 @@ def _check_attrs(ds: xr.Dataset, where: str) -> None:
                                     f"{_REWRITE}")
 
 
-def _check_bytes(ds: xr.Dataset, where: str) -> None:
-    """Refuse data declared larger than the memory available (before reading any of it)."""
+MAX_INFLATION = 200
+"""Most a result's declared data may exceed its file's size (beyond INFLATION_FLOOR bytes):
+what `sweep run` writes compresses far less; a small file that declares gigabytes of one
+repeated value would take minutes to inflate."""
+INFLATION_FLOOR = 256 * 2**20
+
+
+def _check_bytes(ds: xr.Dataset, where: str, file_bytes: int | None = None) -> None:
+    """Refuse data declared larger than the memory available, or (given the file's size
+    `file_bytes`) more than MAX_INFLATION times the file, before reading any of it."""
     from ..run import available_memory
     sizes = {name: int(var.size) * var.dtype.itemsize for name, var in ds.variables.items()}
     have = available_memory()
     total = sum(sizes.values())
+    if file_bytes is not None and total > max(INFLATION_FLOOR, MAX_INFLATION * file_bytes):
+        big = max(sizes, key=sizes.get)
+        raise UserError(f"{where}: declares {total / 2**30:,.1f} GiB of data (variable "
+                        f"'{_short(big)}') in a file of {file_bytes / 2**20:,.1f} MiB, more "
+                        f"than {MAX_INFLATION} times it: no result of 'sweep run' compresses "
+                        f"so; {_REWRITE}")
     if have is not None and total > 0.8 * have[0]:
         big = max(sizes, key=sizes.get)
         dims = ", ".join(f"{d} = {n:,}" for d, n in ds[big].sizes.items())

@@ -117,8 +117,12 @@ def _coord(ds: xr.Dataset, dim: str) -> np.ndarray:
 
 def _plain_ticks(ax: Axes) -> None:
     """Tick labels that are the numbers themselves: no offset ("1e-12+2") and no scientific
-    multiplier on any linear axis (log axes keep their own formatter)."""
-    for axis in (ax.xaxis, ax.yaxis):
+    multiplier on any linear axis, and on a log axis (a colour bar's too) 10, 20, 50, 100 as
+    engineers read them, not 10^1, 10^2 (`_log_ticks`)."""
+    for which, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+        if axis.get_scale() == "log":
+            _log_ticks(ax, which)
+            continue
         formatter = axis.get_major_formatter()
         if isinstance(formatter, ScalarFormatter):
             formatter.set_useOffset(False)
@@ -195,8 +199,15 @@ def _wide_range(values: np.ndarray) -> bool:
     v = v[np.isfinite(v)]
     return bool(v.size and np.all(v > 0) and v.max() > 100 * v.min())
 
+LONG_LEGEND_LABEL = 44
+"""Characters of a legend label beyond which the legend takes one column: two columns of
+such labels are wider than the figure and would be cut off at its edges."""
+
+
 def _legend(ax: Axes, handles: list, title: str | None = None) -> None:
     if handles:
+        longest = max(len(str(h.get_label())) for h in handles)
+        columns = 1 if longest > LONG_LEGEND_LABEL else min(2, len(handles))
         ax.legend(handles=handles, title=title, loc="upper center", bbox_to_anchor=(0.5, -0.14),
-                  ncols=min(2, len(handles)), fontsize="small", title_fontsize="small",
+                  ncols=columns, fontsize="small", title_fontsize="small",
                   frameon=False, handlelength=3.0)

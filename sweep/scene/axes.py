@@ -20,6 +20,9 @@ RANGE_KEYS: tuple[str, ...] = ("start", "stop", "num", "spacing")
 LOG_DIGITS = 15
 """Significant digits of the values of a log-spaced range (its endpoints are kept exactly)."""
 MAX_AXIS_POINTS = 10_000_000
+MAX_GRID_POINTS = 10_000_000_000
+"""Most points of the product of the axes, refused from the axes' sizes before any value is
+built (the memory check later refuses what this machine cannot hold)."""
 _COMMON_AXES = ("length", "load_amplitude", "frequency_ratio", "frequency", "damping_ratio")
 _SWEEPABLE_TEXT = ", ".join(dict.fromkeys([*(a for a in _COMMON_AXES if a in schema.BY_AXIS),
                                           *schema.BY_AXIS]))
@@ -38,6 +41,7 @@ def _flatten_axes(table: dict[str, Any]) -> dict[str, Any]:
 
 def _check_axes(table: dict[str, Any]) -> dict[str, np.ndarray]:
     """Validate ``[axes]``: axis name -> read-only float64 array, in table order."""
+    _check_grid_size(table)
     axes: dict[str, np.ndarray] = {}
     for entry, raw in table.items():
         axis = _axis_name(entry)
@@ -45,6 +49,24 @@ def _check_axes(table: dict[str, Any]) -> dict[str, np.ndarray]:
             _fail(f"axis '{entry}'", f"axis '{axis}' is given twice", "keep one of the entries")
         axes[axis] = _axis_values(axis, raw)
     return axes
+
+
+def _check_grid_size(table: dict[str, Any]) -> None:
+    """Refuse a grid of more than MAX_GRID_POINTS from its axes' sizes (list lengths and range
+    nums), before building any axis: a 10^7 x 10^7 grid is refused at once."""
+    sizes = []
+    for entry, raw in table.items():
+        if isinstance(raw, list):
+            sizes.append((entry, len(raw)))
+        elif isinstance(raw, dict) and isinstance(raw.get("num"), int) \
+                and not isinstance(raw.get("num"), bool) and raw["num"] >= 1:
+            sizes.append((entry, raw["num"]))
+    total = math.prod(n for _, n in sizes)
+    if total > MAX_GRID_POINTS:
+        shape = " x ".join(f"{n:,}" for _, n in sizes)
+        _fail(f"axes {', '.join(repr(e) for e, _ in sizes)}", f"a grid of {shape} = "
+              f"{total:.3g} points, more than {MAX_GRID_POINTS:.0e} (no machine holds its "
+              "results)", "give fewer values (smaller nums), or split the sweep into several runs")
 
 
 def _axis_or_none(entry: str) -> str | None:

@@ -104,6 +104,11 @@ def _check_run(given: dict[str, Any]) -> None:
         _fail("scene key 'run.workers'", "only for run.backend = 'dask' (the LocalCluster's "
               "worker processes); the threads backend would ignore it",
               "use run.threads for the threads backend, or set run.backend = 'dask'")
+    cores = os.cpu_count() or 1          # run.threads is capped at the cores (threads.py)
+    if given.get("run.workers", 0) > cores:
+        _fail("scene key 'run.workers'", f"{given['run.workers']} worker processes on a "
+              f"machine of {cores} core{'s' if cores != 1 else ''}: more would only compete "
+              "for them", f"give at most {cores}, or 0 for one per core")
 
 
 def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray],
