@@ -321,7 +321,8 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                 "none: its steps are solved in order); nothing kept, no output written")
     words = list(sys.argv[1:] if argv is None else argv)
     command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
-    kept = (f"{exc.kept:,} of {exc.total:,} points are kept" if hasattr(exc, "kept")
+    kept = (f"{exc.kept:,} of {exc.total:,} {getattr(exc, 'unit', 'points')} are kept"
+            if hasattr(exc, "kept")
             else "finished chunks are kept")
     how = ("interrupted" if getattr(exc, "signum", 2) == 2
            else f"{signal.Signals(exc.signum).name} received")

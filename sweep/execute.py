@@ -40,13 +40,14 @@ class RunInterrupted(KeyboardInterrupt):
     chunk store `store` (None when the run had no output file, so nothing was kept)."""
 
     def __init__(self, kept: int, total: int, store: Path | None,
-                 signum: int = signal.SIGINT) -> None:
+                 signum: int = signal.SIGINT, unit: str = "points") -> None:
         self.kept, self.total, self.store, self.signum = kept, total, store, signum
+        self.unit = unit
         if store is None:
             text = ("interrupted: results were not kept (a run with an output file keeps "
                     "every finished chunk, and resume=True finishes it)")
         else:
-            text = (f"interrupted: {kept:,} of {total:,} points are kept in '{store}' "
+            text = (f"interrupted: {kept:,} of {total:,} {unit} are kept in '{store}' "
                     "(run again with resume=True to compute only the rest)")
         super().__init__(text)
 
@@ -191,14 +192,14 @@ class Progress:
     when not `enabled`. Safe to advance from several threads. The time Numba spends compiling
     is taken off the bar's clock (`exclude`), so the rate and the time left are the kernel's."""
 
-    def __init__(self, total: int, done: int, enabled: bool) -> None:
+    def __init__(self, total: int, done: int, enabled: bool, unit: str = "points") -> None:
         self.lock = threading.Lock()
         self.bar = None
         if enabled:
             from tqdm import tqdm
             # smoothing=0: the rate is the average since the start (compiling excluded), the
             # honest one for points solved in a random order
-            self.bar = tqdm(total=total, initial=done, unit=" points",
+            self.bar = tqdm(total=total, initial=done, unit=f" {unit}",
                             dynamic_ncols=True, smoothing=0.0, mininterval=0.5,
                             file=sys.stderr, leave=True)
 
@@ -444,7 +445,8 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
             args: tuple, place: Callable[[int, int, dict], None], *, chunk_size: int,
             backend: str = "threads", threads: int = 0, scheduler: str | None = None,
             workers: int = 0, progress: bool = False, announce: bool | None = None,
-            store: ChunkStore | None = None, done: dict | None = None) -> int:
+            store: ChunkStore | None = None, done: dict | None = None,
+            unit: str = "points") -> int:
     """Solve points 0..n-1 (solve order) chunk by chunk; returns the number of points computed.
 
     rows_for(lo, hi) builds the kernel's parameter rows of a chunk just before it runs, so the
@@ -456,7 +458,9 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     On Ctrl-C the run stops after the work in hand, saves it and raises RunInterrupted.
     When the dask cluster fails (a worker that keeps dying, a lost scheduler, a malformed
     result) the run stops with the finished chunks kept and raises one UserError line.
-    progress: the bar (a terminal); announce: the compile lines (default: as progress).
+    progress: the bar (a terminal); announce: the compile lines (default: as progress);
+    unit: what a row is, for the bar and the interrupt line ("points"; a stepped sweep's
+    "lines").
     """
     done = done or {}
     where = f"chunk store '{store.directory}'" if store is not None else "chunk store"
@@ -464,7 +468,7 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     todo = sum(hi - lo for lo, hi in gaps)
     for (lo, hi), arrays in done.items():
         place(lo, hi, arrays)
-    bar = Progress(n, n - todo, progress)
+    bar = Progress(n, n - todo, progress, unit)
     keeper = _Keeper(store, bar)
     stop = threading.Event()
     failure = None
@@ -489,7 +493,7 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     if stop.is_set():
         raise RunInterrupted(n - todo + keeper.saved, n,
                              store.directory if store is not None else None,
-                             received[0] if received else signal.SIGINT)
+                             received[0] if received else signal.SIGINT, unit)
     return todo
 
 

@@ -168,12 +168,13 @@ def run_fingerprint(scene: Scene) -> str:
 
 def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
                   rows_at: Callable[[np.ndarray], np.ndarray], args: tuple,
-                  outputs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+                  outputs: dict[str, np.ndarray], unit: str = "points") -> dict[str, np.ndarray]:
     """Solve every grid point in chunks as `options` say (backend, threads, chunk store),
     filling `outputs` (grid order, first axis = points): chunk_fn(rows, *args) is the model's
     kernel call, rows_at(flat indices) the model's parameter rows of those points. With an
     output path every finished chunk is persisted next to it and, when resuming, only the
-    missing chunks are computed."""
+    missing chunks are computed. unit: what a row is ("points"; a stepped sweep's "lines"),
+    for the bar and the lines it prints."""
     from .execute import default_chunk_size, execute
     from .store import ChunkStore
     n = next(iter(outputs.values())).shape[0]
@@ -191,8 +192,8 @@ def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
                        chunk_size=chunk, backend=options.backend, threads=options.threads,
                        scheduler=options.scheduler, workers=options.workers,
                        progress=options.progress, announce=options.announce, store=store,
-                       done=done)
+                       done=done, unit=unit)
     if options.resume:
-        sys.stderr.write(f"resumed: {n - computed:,} of {n:,} points were already done, "
+        sys.stderr.write(f"resumed: {n - computed:,} of {n:,} {unit} were already done, "
                          f"{computed:,} computed\n")
     return outputs

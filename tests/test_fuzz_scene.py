@@ -25,7 +25,16 @@ HOSTILE_VALUES = [
     "{start = 1, stop = 2, num = " + "9" * 30 + "}", '"\\ud800"', "0x7fffffffffffffff",
 ]
 EXTRA_LINES = ["[axes]", "[cable]", "x = 1", '"\\u001b[31m" = 1', "[[cable]]", "a.b.c = 1",
-               "[solver]\nrtol = 1e-300", "[axes]\ndensity = [5e-324]", "= 1", "[" * 50]
+               "[solver]\nrtol = 1e-300", "[axes]\ndensity = [5e-324]", "= 1", "[" * 50,
+               # the keys and rules of this session: ramps, level tables, workers, huge grids
+               "[base]\nsweep = { start = 5.0, stop = 100.0, rate = 2.0, ramp_cycles = 1e308 }",
+               "[base]\nsweep = { start = 5.0, stop = 100.0, rate = 5e-324, ramp_cycles = -1 }",
+               "[base]\nlevels_g = [[5.0, 1e308], [100.0, 1.0]]\nfrequency = 1e300",
+               "[base]\nacceleration_g = 1.0\nfrequency_ratio = 1e300",
+               "[run]\nbackend = \"dask\"\nworkers = 100000",
+               "[axes]\nlength = {start = 0.1, stop = 1.0, num = 10000000}\n"
+               "frequency_ratio = {start = 0.5, stop = 3.0, num = 10000000}",
+               "[outputs]\nbands_per_octave = 0\nstability = true"]
 
 
 def _check(text: str) -> None:

@@ -67,7 +67,7 @@ def test_a_dask_cluster_gives_the_in_process_result(case, tmp_path):
 
 
 def test_an_interrupted_run_keeps_its_chunks_and_resumes_to_the_same_result(case, tmp_path,
-                                                                           monkeypatch):
+                                                                           monkeypatch, capsys):
     scene, whole = case
     scene = sweep.load_scene_text(scene.text, overrides={"run.chunk_size": 1, "run.threads": 1})
     stepped = scene.get("continuation.axis") is not None
@@ -90,7 +90,11 @@ def test_an_interrupted_run_keeps_its_chunks_and_resumes_to_the_same_result(case
     assert store.is_dir() and any(store.iterdir())       # the finished chunks are kept
     monkeypatch.setattr(ex, name, real)
     calls.clear()
+    capsys.readouterr()
     ds = sweep.run(scene, output=out, resume=True)
     _same(ds, whole)
+    # a stepped sweep's unit of work is a line, and it says so
+    unit = "lines" if stepped else "points"
+    assert f"2 of 6 {unit} were already done" in capsys.readouterr().err   # 3 spans x 2 ways
     with xr.open_dataset(out) as written:
         _same(written, whole)

@@ -526,7 +526,7 @@ def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], sy
     template = system.outputs(0)
     out = solve_chunked(options, stepped_chunk, line_rows, args,
                         {k: np.empty((total, dwells) + v.shape[1:], v.dtype)
-                         for k, v in template.items()})
+                         for k, v in template.items()}, unit="lines")
     outs = []
     for d in range(len(directions)):
         grid_out = {k: np.empty((n_points,) + v.shape[1:], v.dtype) for k, v in template.items()}
