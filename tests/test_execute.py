@@ -232,6 +232,25 @@ def test_progress_says_when_the_kernels_compile_and_only_then(capsys):
     assert "compil" not in capsys.readouterr().err
 
 
+def test_a_cold_start_is_announced_off_a_terminal_too(capsys):
+    """No bar (stderr is not a terminal: CI, nohup, a notebook's !sweep run), but the two
+    compile lines all the same: a first run that compiles for minutes is never silent."""
+    from sweep.execute import execute
+
+    values = np.zeros(4)
+
+    def place(lo, hi, arrays):
+        values[lo:hi] = arrays["value"]
+
+    execute(_chunk_compiling_a_fresh_function, lambda lo, hi: np.arange(lo, hi), 4, (),
+            place, chunk_size=2, progress=False, announce=True)
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    assert lines[0].startswith("compiling the Numba kernels") and \
+        lines[-1].startswith("compiled in "), err
+    assert "\r" not in err and "%|" not in err                  # no bar
+
+
 # --- blocks, checkpoints by time, resumable ranges -----------------------------------------
 
 def _rows(n: int, seed: int = 3) -> np.ndarray:

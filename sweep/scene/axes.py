@@ -65,8 +65,9 @@ def _check_grid_size(table: dict[str, Any]) -> None:
     if total > MAX_GRID_POINTS:
         shape = " x ".join(f"{n:,}" for _, n in sizes)
         _fail(f"axes {', '.join(repr(e) for e, _ in sizes)}", f"a grid of {shape} = "
-              f"{total:.3g} points, more than {MAX_GRID_POINTS:.0e} (no machine holds its "
-              "results)", "give fewer values (smaller nums), or split the sweep into several runs")
+              f"{total:.3g} points, more than {MAX_GRID_POINTS:.0e}: its results alone need "
+              f"over {total * 8 / 2**30:,.0f} GiB (8 bytes a point at the least)",
+              "give fewer values (smaller nums), or split the sweep into several runs")
 
 
 def _axis_or_none(entry: str) -> str | None:
