@@ -7,9 +7,9 @@ only through a parametric instability of its own), so the check adds two modes, 
 one among them (docs/model.md sec. 7). For every metric of the result (amplitude, peak
 amplitude, settling time, response period, absolute acceleration, transmissibility, a
 sweep's peak frequency and envelope, a stability chart's growth rate and multiplier, and each
-modal amplitude the coarse run has) it reports the largest relative change |x(N + 2) - x(N)| / |x(N + 2)| over
-the grid points where both runs succeeded, where on the grid that is, and at how many points
-the change exceeds the tolerance; points whose state changed are counted apart. The tail
+modal amplitude the coarse run has) it reports the largest relative change
+|x(N + 2) - x(N)| / |x(N + 2)| over the grid points where both runs succeeded, where on the
+grid that is, and at how many points the change exceeds the tolerance; points whose state changed are counted apart. The tail
 window's metrics (TAIL_METRICS) are not compared at points that decayed in either run. A modal
 amplitude's change is taken relative to the point's largest modal amplitude (a mode at rest,
 round-off in both runs, does not count). N is enough for a tolerance when something was

@@ -74,7 +74,7 @@ from typing import Any
 
 import numpy as np
 
-from .excitation import SWEEP_DIRECTION, SWEEP_KEYS, end_time, sweep_grid
+from .excitation import SWEEP_DIRECTION, SWEEP_KEYS, end_time, sweep_duration, sweep_grid
 from .swept import Swept
 
 from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span counts
@@ -325,24 +325,25 @@ def _check_sweep_extent(given: dict[str, Any], start: Any, stop: Any, rate: Any)
     with np.errstate(all="ignore"):
         start, stop, rate = np.broadcast_arrays(*(np.asarray(x, np.float64)
                                                   for x in (start, stop, rate)))
-        duration = 60.0 * np.abs(np.log2(stop / start)) / rate
+        duration = sweep_duration(start, stop, rate)
         cycles = np.abs(stop - start) / (rate * math.log(2.0) / 60.0)
+
+    def which(bad: np.ndarray) -> tuple[tuple[int, ...], str]:
+        i = np.unravel_index(int(np.argmax(bad)), bad.shape)
+        return i, (f"the sweep from {float(start[i])!r} to {float(stop[i])!r} Hz at "
+                   f"{float(rate[i])!r} oct/min")
     few = ~(cycles >= MIN_SWEEP_CYCLES)
     if np.any(few):
-        i = np.unravel_index(int(np.argmax(few)), few.shape)
-        _fail(where, f"the sweep from {float(start[i])!r} to {float(stop[i])!r} Hz at "
-              f"{float(rate[i])!r} oct/min "
-              f"passes {float(cycles[i]):.3g} cycles of its excitation, fewer than "
-              f"{MIN_SWEEP_CYCLES:g}: that is no sweep", "give a slower rate or a wider "
+        i, sweep = which(few)
+        _fail(where, f"{sweep} passes {float(cycles[i]):.3g} cycles of its excitation, fewer "
+              f"than {MIN_SWEEP_CYCLES:g}: that is no sweep", "give a slower rate or a wider "
               "frequency range (a launch sine sweep is 2-4 octaves per minute)")
     long = ~(duration <= MAX_SWEEP_DURATION)
     if np.any(long):
-        i = np.unravel_index(int(np.argmax(long)), long.shape)
-        _fail(where, f"the sweep from {float(start[i])!r} to {float(stop[i])!r} Hz at "
-              f"{float(rate[i])!r} oct/min "
-              f"lasts {float(duration[i]):.3g} s, longer than {MAX_SWEEP_DURATION:g} s",
-              "give a faster rate (a launch sine sweep is 2-4 octaves per minute), or use "
-              "base.frequency for a fixed frequency")
+        i, sweep = which(long)
+        _fail(where, f"{sweep} lasts {float(duration[i]):.3g} s, longer than "
+              f"{MAX_SWEEP_DURATION:g} s", "give a faster rate (a launch sine sweep is 2-4 "
+              "octaves per minute), or use base.frequency for a fixed frequency")
     cycles_up = given.get("base.sweep.ramp_cycles")
     if cycles_up is not None:
         rise = cycles_up / start
@@ -414,18 +415,30 @@ def _check_load_frequency_axis(given: dict[str, Any], axes: dict[str, np.ndarray
     """Refuse an axis of the end load's frequency (frequency_ratio, frequency) in a scene
     without an end load (load.amplitude 0, its default, at every point): it would sweep
     nothing. A scene written for the old 4 N default is told to give its load."""
-    amplitude = axes["load_amplitude"] if "load_amplitude" in axes \
-        else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
-    if np.any(np.asarray(amplitude, dtype=float) != 0.0):
+    if _has_end_load(given, axes):
         return
-    for axis in ("frequency_ratio", "frequency"):
-        if axis in axes:
-            where = (f"[points] '{axis}'" if axis in getattr(axes, "zipped", ())
-                     else f"axis '{axis}'")
-            _fail(where, "sweeps the end load's frequency, but the scene has no end load "
+    for dotted in ("load.frequency_ratio", "load.frequency"):
+        if schema.BY_DOTTED[dotted].axis in axes:
+            _fail(_where(dotted, axes), "sweeps the end load's frequency, but the scene has no end load "
                   "(load.amplitude is 0, its default)", "give load.amplitude in N (e.g. "
                   "amplitude = 4.0 under [load], as the paper's case), or remove the axis; a "
                   "base excitation's frequency is base_frequency or base_frequency_ratio")
+
+
+def _where(dotted: str, axes: dict[str, np.ndarray]) -> str:
+    """How a message names key `dotted`: its [points] entry, its axis, or the scene key."""
+    axis = schema.BY_DOTTED[dotted].axis
+    if axis in getattr(axes, "zipped", ()):
+        return f"[points] '{axis}'"
+    return f"axis '{axis}'" if axis in axes else f"scene key '{dotted}'"
+
+
+def _has_end_load(given: dict[str, Any], axes: dict[str, np.ndarray]) -> bool:
+    """Whether the scene loads the span axially anywhere: load.amplitude (N, default 0), as a
+    key or its axis, other than 0 at some point."""
+    amplitude = axes["load_amplitude"] if "load_amplitude" in axes \
+        else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
+    return bool(np.any(np.asarray(amplitude, dtype=float) != 0.0))
 
 
 def _refuse_without(given: dict[str, Any], dependents: tuple[str, ...], problem: str,
@@ -461,9 +474,7 @@ def _check_stability(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None
     amplitude other than 0 at some point (without one the chart is a vacuous 'stable')."""
     if not given.get("outputs.stability"):
         return
-    amplitude = axes.get("load_amplitude") if "load_amplitude" in axes \
-        else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
-    if not np.any(np.asarray(amplitude, dtype=float) != 0.0):
+    if not _has_end_load(given, axes):
         _fail("scene key 'outputs.stability'", "needs a harmonic end load: the scene's "
               "load.amplitude is 0, so there is no parametric excitation and every point "
               "would be a vacuous 'stable'", "give load.amplitude (N) or a load_amplitude "
@@ -795,10 +806,7 @@ def _check_fixed_frequency_in_table(values: dict[str, Any], axes: dict[str, np.n
     f = float(frequency[int(np.argmax(outside))])
     dotted = "base.frequency" if params.get("base_frequency") is not None \
         else "base.frequency_ratio"
-    axis = schema.BY_DOTTED[dotted].axis
-    where = (f"[points] '{axis}'" if axis in getattr(axes, "zipped", ())
-             else f"axis '{axis}'" if axis in axes else f"scene key '{dotted}'")
-    _fail(f"{where} and scene key '{BASE_TABLE_KEY}'", f"the base frequency reaches "
+    _fail(f"{_where(dotted, axes)} and scene key '{BASE_TABLE_KEY}'", f"the base frequency reaches "
           f"{f:.6g} Hz, outside the table's {low:g} to {high:g} Hz (no level there)",
           "extend the table to every base frequency of the scene, or give a constant level "
           "with base.acceleration_g")
@@ -854,10 +862,9 @@ def _check_stability_frequency(values: dict[str, Any], axes: dict[str, np.ndarra
                               / (2.0 * np.pi * np.asarray(derived["natural_frequency"])))
     if not np.any(ratio > MAX_STABILITY_RATIO):
         return
-    axis = "frequency" if "frequency" in axes else "frequency_ratio"
-    where = (f"axis '{axis}'" if axis in axes else "scene key 'load.frequency'"
-             if values.get("load.frequency") is not None else "scene key 'load.frequency_ratio'")
-    _fail(f"{where} with outputs.stability", f"the load frequency reaches "
+    dotted = ("load.frequency" if values.get("load.frequency") is not None
+              or "frequency" in axes else "load.frequency_ratio")
+    _fail(f"{_where(dotted, axes)} with outputs.stability", f"the load frequency reaches "
           f"W/w1 = {float(np.max(ratio)):.3g}, above {MAX_STABILITY_RATIO:g}: far above every "
           "parametric resonance, where one load period is too short for its Floquet "
           "multiplier to be told from 1", f"keep W/w1 <= {MAX_STABILITY_RATIO:g} (the "
