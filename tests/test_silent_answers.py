@@ -263,3 +263,16 @@ def test_workers_with_the_dask_backend_and_resolved_scenes_still_load():
     assert scene.get("run.workers") == 2
     for name in sweep.builtin_scenes():          # resolved scenes write every key out
         sweep.load_scene_text(sweep.load_scene(name).to_toml())
+
+
+def test_a_longitudinal_scene_without_an_end_load_warns():
+    """The end load is the longitudinal case's only cause (no end load by default since the
+    4 N default went): a scene without one would give a span at rest everywhere, so it warns;
+    with a load, or a load axis with a load somewhere, it does not."""
+    text = 'name = "wave"\n[model]\nkind = "longitudinal"\n[solver]\nintervals = 50\n'
+    with pytest.warns(CableSweepWarning, match="longitudinal scene is the wave"):
+        sweep.load_scene_text(text)
+    for loaded in ("[load]\namplitude = 4.0\n", "[axes]\nload_amplitude = [0.0, 2.0]\n"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", CableSweepWarning)
+            sweep.load_scene_text(text + loaded)

@@ -928,6 +928,11 @@ def _check_longitudinal_resolved(values: dict[str, Any], axes: dict[str, np.ndar
     _check_time_levels(values, axes)
     _check_snapshot_times(values, axes)
     _check_sample_count(values, "outputs.histories")
+    if not _has_end_load(given, axes):
+        warnings.warn("load.amplitude = 0 at every point (the default: no end load), and a "
+                      "longitudinal scene is the wave an end load sends, so every point stays "
+                      "at rest; give load.amplitude in N, e.g. amplitude = 4.0 under [load] as "
+                      "the paper's case", CableSweepWarning, stacklevel=5)
 
 
 @dataclass(frozen=True)
