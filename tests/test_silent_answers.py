@@ -224,7 +224,7 @@ def test_a_scene_of_the_zero_solution_warns():
 @pytest.mark.parametrize("text", ["[initial]\ndisplacement = 1e-4\n",
                                   "[axes]\ninitial_velocity = [0.0, 1e-3]\n",
                                   '[model]\ncoefficients = "paper"\n',   # v0 = 0.0321 m/s
-                                  LONG])
+                                  LONG + "[load]\namplitude = 4.0\n"])    # the wave's cause
 def test_a_scene_with_a_start_does_not_warn(text):
     with warnings.catch_warnings():
         warnings.simplefilter("error", CableSweepWarning)
