@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..errors import UserError
-from .labels import _point_text, _title
+from .labels import _point_text, _title, label
 from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import _legend, _log_ticks, _new_axes, state_styles
 
@@ -204,11 +204,9 @@ def _colour_scale(ds: xr.Dataset, dim: str | None, count: int) -> tuple | None:
 def _colour_bar(ax: Axes, ds: xr.Dataset, dim: str, scale: tuple) -> None:
     """The colour bar of `_colour_scale`, under the plot, labelled with the axis and units."""
     from matplotlib.cm import ScalarMappable
-    units = ds[dim].attrs.get("units")
-    label = ds[dim].attrs.get("long_name", dim) if dim == "point" else dim
     bar = ax.figure.colorbar(ScalarMappable(norm=scale[1], cmap=scale[0]), ax=ax,
                              location="top", fraction=0.05, pad=0.02, aspect=40)
-    bar.set_label(f"{label} [{units}]" if units and units != "1" else label, fontsize="small")
+    bar.set_label(label(ds[dim]), fontsize="small")
     bar.ax.tick_params(labelsize="small")
 
 
