@@ -46,7 +46,9 @@ PEAK_FREQUENCY = 8  # swept scenes: the excitation frequency (Hz) when |q| had i
                     # extremum; NaN otherwise
 STOP_TIME = 9       # with STOP_STEADY: when a point found steady ended (s, before t_end); NaN
                     # for a point that ran to t_end
-N_REALS = 10
+SPAN_MAX = 10       # multi-mode: max |w(x, t)| over the span and the tail window (m), the
+                    # largest deflection anywhere (>= AMPLITUDE); NaN for one mode
+N_REALS = 11
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -29,8 +29,9 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
-from .layout import (FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS, RHS_EVALS, RTOL,
-                     SETTLING, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
+from .layout import (AMPLITUDE, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS, PERIOD,
+                     RHS_EVALS, RTOL, SETTLING, SPAN_MAX, SWEPT, TAIL, TOL, T_END,
+                     WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
 
@@ -172,48 +173,186 @@ def _mode_interpolant(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, Qm):
-    """Each mode's running tail amplitude modal[i] = max |q_i| over the tail (m): the step's
-    end, the tail's start inside the step, and an extremum of q_i inside the step."""
-    for i in range(n_modes):
-        v0 = y[n_modes + i]
-        v1 = y_new[n_modes + i]
-        if t_new >= t_tail:
-            modal[i] = max(modal[i], abs(y_new[i]))
-        turns = (v0 > 0.0 and v1 <= 0.0) or (v0 < 0.0 and v1 >= 0.0)
-        starts = t < t_tail <= t_new
-        if turns or starts:
-            _mode_interpolant(y, y_new, K, h, i, n_modes, eighth, Km, Qm)
-        if turns:                     # the extremum: where the interpolant's q_i' is 0
-            x = dopri5.dense_root(y[n_modes + i], h, Qm[1], 0.0, 0.0, 1.0)
-            if t + x * h >= t_tail:
-                modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, Qm[0], x)))
-        if starts:
-            qt = dopri5.dense_value(y[i], h, Qm[0], (t_tail - t) / h)
-            modal[i] = max(modal[i], abs(qt))
+def modal_size(n_modes):
+    """Length of the modes' accumulator `modal` of both multi-mode drivers: each mode's tail
+    amplitude max |q_n| over the tail window (slots 0..N-1, m), each mode's peak max |q_n| at
+    the accepted steps' ends over the whole run (N..2N-1, m), the largest deflection over
+    the span in the tail window (slot 2N, m; `_observe_span`) and the mode shapes at its
+    place x*, sin(n pi x* / l) (2N + 1..3N; the midspan's until the tail window starts)."""
+    return 3 * n_modes + 1
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal, Km, Qm):
+def _project_rate(y, y_new, QA, modal, n_modes, Qp):
+    """The rate of the deflection at x* (modal's mode shapes there, `modal_size`) at the
+    step's ends, (r0, r1) (m/s), and its interpolant into Qp[1]."""
+    n = n_modes
+    r0 = 0.0
+    r1 = 0.0
+    for j in range(Qp.shape[1]):
+        Qp[1, j] = 0.0
+    for c in range(n):
+        phi = modal[2 * n + 1 + c]
+        r0 += phi * y[n + c]
+        r1 += phi * y_new[n + c]
+        for j in range(Qp.shape[1]):
+            Qp[1, j] += phi * QA[c, 1, j]
+    return r0, r1
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _turns(r0, r1):
+    """Whether a rate going from r0 to r1 over a step changes sign (an extremum)."""
+    return (r0 > 0.0 and r1 <= 0.0) or (r0 < 0.0 and r1 >= 0.0)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, stations, Qp):
+    """The largest deflection over the span near the fraction x of the accepted step (every
+    mode's interpolant in QA), into modal[2N] (m), and its place x* into modal's mode
+    shapes: the span's maximum at x, at its place (modes.span_argmax), then at the instant
+    inside the step where the deflection there turns (the root of its interpolated rate),
+    twice. qx (N), Qp (2, terms): scratch."""
+    n = n_modes
+    for c in range(n):
+        qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
+    top, where = md.span_argmax(qx, n, stations)
+    best = where
+    for _ in range(2):
+        for c in range(n):
+            modal[2 * n + 1 + c] = math.sin((c + 1.0) * math.pi * where)
+        r0, r1 = _project_rate(y, y_new, QA, modal, n, Qp)
+        if not _turns(r0, r1):
+            break
+        x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
+        for c in range(n):
+            qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
+        value, where = md.span_argmax(qx, n, stations)
+        if value > top:
+            top = value
+            best = where
+    if top > modal[2 * n]:
+        modal[2 * n] = top
+    else:
+        best = -1.0
+    if best >= 0.0:
+        for c in range(n):
+            modal[2 * n + 1 + c] = math.sin((c + 1.0) * math.pi * best)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
+                   stations, Qp):
+    """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each
+    mode's peak at the step's end; in the tail window each mode's tail amplitude max |q_i|
+    (the step's end, the tail's start inside the step, and an extremum of q_i inside the
+    step, on its own interpolant) and the span's largest deflection at those instants (the
+    tail's start and every mode's extremum: where the span's maximum in time lies, to second
+    order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every mode's
+    interpolant, scratch; qx (N), Qp (2, terms): scratch; stations: modes.span_stations(N).
+    And where the deflection at the place x* of the largest so far turns inside the step (a
+    crest there that no mode's extremum marks), the span there too."""
+    n = n_modes
+    for i in range(n):
+        modal[n + i] = max(modal[n + i], abs(y_new[i]))
+        if t_new >= t_tail:
+            modal[i] = max(modal[i], abs(y_new[i]))
+    if t_new < t_tail:
+        return
+    r0 = 0.0
+    r1 = 0.0
+    for c in range(n):
+        r0 += modal[2 * n + 1 + c] * y[n + c]
+        r1 += modal[2 * n + 1 + c] * y_new[n + c]
+    crest = _turns(r0, r1)                           # at x*, as it stands at the step's start
+    located = False
+    if crest:                                        # first: x* may move below
+        for c in range(n):
+            _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
+        located = True
+        for j in range(Qp.shape[1]):
+            Qp[1, j] = 0.0
+        for c in range(n):
+            for j in range(Qp.shape[1]):
+                Qp[1, j] += modal[2 * n + 1 + c] * QA[c, 1, j]
+        x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
+        if t + x * h >= t_tail:
+            _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
+    if t < t_tail:                                   # the tail starts inside the step
+        if not located:
+            for c in range(n):
+                _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
+        located = True
+        x = (t_tail - t) / h
+        for c in range(n):
+            modal[c] = max(modal[c], abs(dopri5.dense_value(y[c], h, QA[c, 0], x)))
+        _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
+    for i in range(n):
+        v0 = y[n + i]
+        v1 = y_new[n + i]
+        if not ((v0 > 0.0 and v1 <= 0.0) or (v0 < 0.0 and v1 >= 0.0)):
+            continue
+        if not located:
+            for c in range(n):
+                _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
+            located = True
+        x = dopri5.dense_root(y[n + i], h, QA[i, 1], 0.0, 0.0, 1.0)   # q_i' = 0
+        if t + x * h >= t_tail:
+            modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
+            _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
+                  stations, Qp):
     """After trajectory.record_step on the step [t, t_new]: where the early stop
     (solver.stop_when_steady) moved the tail window to start inside it (acc[T_TAIL] is no
-    longer t_tail), each mode's tail amplitude restarts there, as the midspan's does: the
-    mode's value at the new start, its extremum after it and the step's end."""
+    longer t_tail), each mode's tail amplitude and the span's restart there, as the midspan's
+    does: the values at the new start, the extrema after it and the step's end."""
     if acc[tj.T_TAIL] == t_tail:
         return
     for i in range(n_modes):
         modal[i] = 0.0
-    _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, Qm)
+    modal[2 * n_modes] = 0.0
+    _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, QA,
+                   qx, stations, Qp)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
+def span_state(state, modal, y, n_modes, settings, reals):
+    """The state judged from the whole response, and reals[SPAN_MAX]: a point whose midspan
+    deflection decayed (DECAYED) while some mode's tail amplitude exceeds settings[TOL] x the
+    largest mode's peak has not decayed: a mode with a node at midspan (an even one) kept
+    moving; it is left OFF_MIDSPAN for `judge_off_midspan`. reals[SPAN_MAX] = the largest
+    deflection over the span in the tail window (m): modal[2N] (`_observe_modes`), the span
+    at the final state y (a growing response peaks there) and at least the midspan
+    amplitude; NaN where the point failed."""
+    n = n_modes
+    if state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS:
+        return state
+    final = md.span_maximum(y, n, md.span_stations(n))
+    reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
+    if state != mt.DECAYED:
+        return state
+    peak = 0.0
+    for i in range(n):
+        peak = max(peak, modal[n + i])
+    for i in range(n):
+        if modal[i] > settings[TOL] * peak:
+            return mt.OFF_MIDSPAN
+    return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weights, stations,
+          base):
     """Set up a trajectory at t = 0 from raw row `row` for both multi-mode drivers: the initial
-    state y and f = f(0, y) (length 2N each, written here), SciPy's initial step, the midspan
-    deflection's accumulator acc (trajectory.begin; p1: `observer_row`), each mode's tail
-    amplitude modal (length N) and the divergence test of every mode at t = 0. pp, S, T: the
-    prepared row, the right-hand side's scratch and the tables (modes.prepare, scratch,
-    tables)."""
+    state y and f = f(0, y) (length 2N each, written here), SciPy's initial step, the watched
+    deflection's accumulator acc (trajectory.begin; p1: `observer_row`; weights: the
+    deflection's mode weights, modes.midspan_weights for the midspan), the modes'
+    accumulator modal (`modal_size`) and the divergence test of every mode at t = 0. pp, S, T:
+    the prepared row, the right-hand side's scratch and the tables (modes.prepare, scratch,
+    tables); stations: modes.span_stations(N)."""
     n = n_modes
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
     t_end = settings[T_END]
@@ -231,13 +370,18 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
         h_abs = initial_step(y, f, t_end, settings[MAX_STEP], rtol, atol_q, atol_v, order,
                              S, n, T, base)
         evals += 1.0
-    weights = md.midspan_weights(n)
     fv = _project(f, weights, n, n)
     a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
     tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
              fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
     for i in range(n):
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
+        modal[n + i] = abs(y[i])
+    modal[2 * n] = md.span_maximum(y, n, stations) if t_tail <= 0.0 else 0.0
+    midspan = md.midspan_weights(n)
+    for i in range(n):
+        modal[2 * n + 1 + i] = midspan[i]
+    for i in range(n):
         if not abs(y[i]) <= row[md.BOUND]:
             acc[tj.STATUS] = mt.DIVERGED
             acc[tj.T_STOP] = 0.0
@@ -245,12 +389,13 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base,
-              eighth, steady):
+              eighth, steady, weights):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
-    SciPy's RK45 or DOP853 (settings[METHOD]), reducing the midspan deflection's metrics
-    (kernels.trajectory's accumulator) and each mode's tail amplitude (modal, length N, m) on
-    the fly; `track`, centre, thr_fixed, thr_rel and the switches base, eighth (the method,
-    as settings[METHOD]) and steady: as transverse.integrate. Returns (accumulator, extrema
+    SciPy's RK45 or DOP853 (settings[METHOD]), reducing the watched deflection's metrics
+    (kernels.trajectory's accumulator; weights: its mode weights, modes.midspan_weights for
+    the midspan) and the modes' accumulator (modal, `modal_size`, m) on the fly; `track`,
+    centre, thr_fixed, thr_rel and the switches base, eighth (the method, as
+    settings[METHOD]) and steady: as transverse.integrate. Returns (accumulator, extrema
     buffer, final state y)."""
     n = n_modes
     dim = 2 * n
@@ -264,20 +409,21 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     md.prepare(row, n, pp)
     S = md.scratch(pp, n, T)
     p1 = observer_row(row, n)
-    weights = md.midspan_weights(n)
+    stations = md.span_stations(n)
     K = np.empty((n_stages + 1, dim))
     K_mid = np.empty((n_stages + 1, 2))
     Km = np.empty((n_stages + 1, 2))
     terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
     Qc = np.empty((2, terms))
-    Qm = np.empty((2, terms))
+    QA = np.empty((n, 2, terms))
+    qx = np.empty(n)
     y = np.empty(dim)
     y_new = np.empty(dim)
     stage = np.empty(dim)
     acc = np.empty(tj.N_SLOTS)
     buf = tj.new_buffer()
 
-    start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, base)
+    start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, weights, stations, base)
     atol_q = acc[tj.ATOL_Q]
     atol_v = acc[tj.ATOL_V]
 
@@ -298,7 +444,8 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         if acc[tj.STATUS] != mt.RUNNING:
             break
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
-        _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, Qm)
+        _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
+                       stations, Qc)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
             K_mid[j, 1] = _project(K[j], weights, n, n)
@@ -308,7 +455,8 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         v_mid = _project(y_new, weights, n, n)
         tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series, track,
                        centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
-        restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, Qm)
+        restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
+                      stations, Qc)
         for i in range(dim):
             y[i] = y_new[i]
         K[0, :] = K[n_stages, :]
@@ -374,15 +522,19 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
         for j in range(envelope.shape[0]):
             envelope[j] = math.nan
         return mt.INVALID_INPUT
+    ext = np.empty(modal_size(n_modes))
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                            settings[TOL], series, modal, base, eighth, steady)
+                            settings[TOL], series, ext, base, eighth, steady,
+                            md.midspan_weights(n_modes))
     resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(row, md.EXCITATION, 1, settings, acc, buf, state, reals, envelope)
+    else:
+        state = span_state(state, ext, y, n_modes, settings, reals)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for j in range(n_modes):
-        modal[j] = math.nan if failed else modal[j]
+        modal[j] = math.nan if failed else ext[j]
     for j in range(2 * n_modes):
         final[j] = math.nan if failed else y[j]
     return state
@@ -395,18 +547,56 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base, e
     kernels.transverse.settle_second_pass does for one mode: integrate again to find the
     final midspan value, then track |q_mid - final| against the band."""
     done = 0
-    modal = np.empty(n_modes)
+    modal = np.empty(modal_size(n_modes))
+    weights = md.midspan_weights(n_modes)
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
         first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
-                                np.empty(0), modal, base, eighth, steady)
+                                np.empty(0), modal, base, eighth, steady, weights)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
-                                 np.empty(0), modal, base, eighth, steady)
+                                 np.empty(0), modal, base, eighth, steady, weights)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
+        done += 1
+    return done
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, base, eighth,
+                      steady):
+    """Finish the points a driver left OFF_MIDSPAN (`span_state`: the midspan deflection
+    decayed while a mode with a node at midspan kept moving): integrate again watching the
+    mode with the largest tail amplitude (modal, (n, N), m) instead of the midspan, and take
+    its state, response period and settling time; the midspan's amplitude, peak and
+    acceleration stay. A mode found at rest away from zero is STEADY (no settling time).
+    Returns how many points it judged."""
+    n = n_modes
+    done = 0
+    ext = np.empty(modal_size(n))
+    own_reals = np.empty(N_REALS)
+    own_counts = np.empty(N_COUNTS, np.int64)
+    for i in range(params.shape[0]):
+        if states[i] != mt.OFF_MIDSPAN:
+            continue
+        k = 0
+        for c in range(n):
+            if modal[i, c] > modal[i, k]:
+                k = c
+        weights = np.zeros(n)
+        weights[k] = 1.0
+        acc, buf, y = integrate(params[i], n, settings, settings[WANT_SETTLING] != 0.0, 0.0,
+                                0.0, settings[TOL], np.empty(0), ext, base, eighth, steady,
+                                weights)
+        resting = at_rest(params[i], n, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
+        state = classify_metrics(settings, acc, buf, own_reals, own_counts, base, resting)
+        reals[i, PERIOD] = own_reals[PERIOD]
+        reals[i, SETTLING] = own_reals[SETTLING]
+        reals[i, FAILURE_TIME] = own_reals[FAILURE_TIME]
+        counts[i, RHS_EVALS] += own_counts[RHS_EVALS]
+        states[i] = mt.STEADY if state == mt.SECOND_PASS else state
         done += 1
     return done
 

@@ -248,9 +248,12 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(Y, YN, H, ERR, BOUNDS, EV, n, n_run):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, an extremum of q_n or a
-    divergence (|q_n| > bound, or q_n' not finite): the scalar path's turn; else 0."""
+    divergence (|q_n| > bound, or q_n' not finite), or, ending in the tail window, a crest of
+    the deflection at the place x* of the span's largest (its mode shapes in MOD, as
+    modal_driver._observe_modes tests it): the scalar path's turn; else 0."""
+    L = LANES
     for l in range(n_run):
         EV[l] = 0.0
     for i in range(n):
@@ -260,6 +263,15 @@ def _mode_events(Y, YN, H, ERR, BOUNDS, EV, n, n_run):
             turns = ((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0))
             bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
             EV[l] = 1.0 if turns | bad else EV[l]
+    for l in range(n_run):
+        r0 = 0.0
+        r1 = 0.0
+        for i in range(n):
+            r0 += MOD[2 * n + 1 + i, l] * Y[n + i, l]
+            r1 += MOD[2 * n + 1 + i, l] * YN[n + i, l]
+        crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
+        tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
+        EV[l] = 1.0 if crest & tail else EV[l]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -311,14 +323,18 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run):
-    """Each mode's tail amplitude at the end of an ordinary accepted step (MOVE 1, FLAG 0):
-    MOD[i, l] = max(MOD[i, l], |q_i(t_new)|) once t_new >= the lane's tail start."""
+    """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
+    accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
+    MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
+    same once t_new >= the lane's tail start."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
-            take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
-                    & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
-            MOD[i, l] = max(MOD[i, l], abs(YN[i, l])) if take else MOD[i, l]
+            ordinary = (MOVE[l] != 0.0) & (FLAG[l] == 0.0)
+            take = ordinary & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l])
+            q = abs(YN[i, l])
+            MOD[i, l] = max(MOD[i, l], q) if take else MOD[i, l]
+            MOD[n + i, l] = max(MOD[n + i, l], q) if ordinary else MOD[n + i, l]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -334,7 +350,7 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
-               series, modal, final, T, pp, yl, fl, base):
+               series, modal, final, T, pp, yl, fl, stations, base):
     """Give lane j the trajectory of row `point`, set up by the scalar driver's own
     modal_driver.start (f(0), SciPy's initial step, the midspan accumulator, each mode's tail
     amplitude and divergence at t = 0). An invalid row is answered at once
@@ -362,19 +378,20 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
     p1 = drv.observer_row(row, n)
     for c in range(N_PARAMS):
         P1[c * L + j] = p1[c]
-    mod = np.empty(n)
-    drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod, base)
+    mod = np.empty(MOD.shape[0])
+    drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod,
+              md.midspan_weights(n), stations, base)
     for c in range(dim):
         Y[c, j] = yl[c]
         K[0, c, j] = fl[c]
-    for c in range(n):
+    for c in range(MOD.shape[0]):
         MOD[c, j] = mod[c]
     return True
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, series, modal,
-              final, buf, yl, base):
+              final, buf, yl, ml, base):
     """Classify lane j's finished trajectory (row `point`) as modal_driver.solve_point does."""
     acc = W[j::LANES]
     tj.end_series(acc, series[point])
@@ -383,6 +400,9 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
     resting = drv.at_rest(params[point], n, acc[tj.T], yl, settings[TOL] * acc[tj.TAIL_AMP],
                           base)
     state = classify_metrics(settings, acc, buf, reals[point], counts[point], base, resting)
+    for c in range(MOD.shape[0]):
+        ml[c] = MOD[c, j]
+    state = drv.span_state(state, ml, yl, n, settings, reals[point])
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for c in range(n):
         modal[point, c] = math.nan if failed else MOD[c, j]
@@ -393,8 +413,8 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, buf, series, i,
-                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base,
-                  steady):
+                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, stations,
+                  Kmid, Qc, base, steady):
     """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
     modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
     by modal_driver._observe_modes, the midspan Observer trajectory.record_step) on copies of
@@ -417,10 +437,11 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     for c in range(2 * n):
         yl[c] = Y[c, j]
         ynl[c] = YN[c, j]
-    for c in range(n):
+    for c in range(MOD.shape[0]):
         ml[c] = MOD[c, j]
     t_tail = acc[tj.T_TAIL]
-    drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
+    drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, stations,
+                       Qc)
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
         Kmid[r, 1] = KM[r, 1, j]
@@ -428,8 +449,9 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     v_new = drv._project(ynl, weights, n, n)
     tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
                    0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
-    drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, Qm)
-    for c in range(n):
+    drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx,
+                      stations, Qc)
+    for c in range(MOD.shape[0]):
         MOD[c, j] = ml[c]
     return True                  # (a midspan divergence moves on, as in the scalar driver)
 
@@ -468,7 +490,8 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     K = np.zeros((n_stages + 1, dim, L))
     KM = np.zeros((n_stages + 1, 2, L))
     QV = np.zeros((2, L))
-    MOD = np.zeros((n, L))
+    MOD = np.zeros((drv.modal_size(n), L))
+    stations = md.span_stations(n)
     PP = np.zeros((md.prepared_size(n), L))
     P1 = np.zeros(N_PARAMS * L)
     FLD = np.zeros((4, nodes, L))
@@ -484,11 +507,12 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     yl = np.empty(dim)
     ynl = np.empty(dim)
     fl = np.empty(dim)
-    ml = np.empty(n)
+    ml = np.empty(drv.modal_size(n))
+    qx = np.empty(n)
     Kl = np.empty((n_stages + 1, dim))
     Km = np.empty((n_stages + 1, 2))
     terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
-    Qm = np.empty((2, terms))
+    QA = np.empty((n, 2, terms))
     Kmid = np.empty((2 if eighth else n_stages + 1, 2))
     Qc = np.empty((2, terms))
     bufs = [tj.new_buffer() for _ in range(L)]
@@ -514,13 +538,13 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     if step > 0.0:
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
-                              counts, series, modal, final, bufs[j], yl, base)
+                              counts, series, modal, final, bufs[j], yl, ml, base)
                     point[j] = -1
                 if next_point >= hi:
                     break
                 if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, MOD,
                               states, reals, counts, series, modal, final, T, pp, yl, fl,
-                              base):
+                              stations, base):
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()
                     capacity[j] = bufs[j].shape[0]
@@ -536,7 +560,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                  n_run, base)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _mode_events(Y, YN, H, ERR, BOUNDS, EV, n, n_run)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run)
@@ -549,7 +573,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     capacity[j] = bufs[j].shape[0]
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
                                  weights, bufs[j], series, point[j], track, thr_rel, eighth,
-                                 n_stages, Kl, yl, ynl, ml, Km, Qm, Kmid, Qc, base,
-                                 steady):
+                                 n_stages, Kl, yl, ynl, ml, Km, QA, qx, stations, Kmid,
+                                 Qc, base, steady):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)

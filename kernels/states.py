@@ -17,6 +17,8 @@ COMPLETED = 8         # the run reached t_end, and it has no settling to judge (
 RUNNING = -1
 SECOND_PASS = -2      # internal: STEADY at rest away from zero, its settling time still to be found
                       # by transverse.settle_second_pass; never left in a result
+OFF_MIDSPAN = -3      # internal: the midspan deflection decayed while a mode with a node there
+                      # kept moving; judged again on that mode by modal_driver.judge_off_midspan
 
 # STATE_MEANINGS[flag] is the CF flag_meaning of `flag`.
 STATE_MEANINGS = ("invalid_input", "decayed", "steady", "modulated", "unsettled", "diverged",

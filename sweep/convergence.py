@@ -30,13 +30,14 @@ from .schema import BY_DOTTED
 
 METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
            "absolute_acceleration", "transmissibility", "peak_frequency", "envelope",
-           "growth_rate", "floquet_multiplier", "modal_amplitude")
+           "growth_rate", "floquet_multiplier", "modal_amplitude", "max_deflection")
 """The result variables compared, where both runs have them: the time-domain metrics of
 every kind of run (fixed frequency, stepped, swept: its peak, peak frequency and envelope)
 and a stability chart's Floquet results."""
 SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled", "completed")
 """States whose metrics mean something (the failure states have NaN metrics)."""
-TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude")
+TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude",
+                "max_deflection")
 """Metrics of the tail window, not compared where either run decayed: a decayed point's tail
 is below metrics.tolerance x its peak by definition, and what is left of it there (its rate
 of decay, round-off near the absolute tolerance) is no answer to compare."""
@@ -204,8 +205,8 @@ def mode_convergence(source: str, overrides: Mapping[str, Any] | None = None,
     if not 1 <= n <= most - 2:
         raise UserError(f"--modes {n}: the check runs {n} and {n + 2} modes, and model.modes "
                         f"is 1 to {most} (give --modes 1 to {most - 2})")
-    results = []
-    for count in (n, n + 2):
-        resolved = load_scene(source, overrides={**overrides, **overrides_for(scene, count)})
-        results.append(run(resolved, threads=threads, progress=progress))
+    # both scenes read (and a refusal of either said) before anything runs
+    scenes = [load_scene(source, overrides={**overrides, **overrides_for(scene, count)})
+              for count in (n, n + 2)]
+    results = [run(resolved, threads=threads, progress=progress) for resolved in scenes]
     return compare(results[0], results[1], tolerance), results[0], results[1]

@@ -167,6 +167,9 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
         else:
             call(kernel.solve_block, params, n_modes, settings, lo, hi, states, reals,
                  counts, series, modal, final, base, eighth, steady)
+        if np.any(states[lo:hi] == mt.OFF_MIDSPAN):
+            call(modal_driver.judge_off_midspan, params[lo:hi], n_modes, settings,
+                 states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth, steady)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             call(modal_driver.settle_second_pass, params[lo:hi], n_modes, settings,
                  states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)

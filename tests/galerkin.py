@@ -188,3 +188,35 @@ def tail_maxima(sol: OdeSolution, n_modes: int, t_end: float, tail: float = 0.5,
     midspan = _tail_max(lambda s: shape @ sol(s)[:n_modes],
                         lambda s: shape @ sol(s)[n_modes:], t)
     return modal, midspan
+
+
+def span_tail_maximum(sol: OdeSolution, n_modes: int, t_end: float, tail: float = 0.5,
+                      fastest_hz: float = 1.0, samples_per_period: int = 64,
+                      stations: int = 801) -> float:
+    """max |w(x, t)| = |sum_n q_n(t) sin(n pi x / l)| (m) over the span and the tail window
+    [t_end (1 - tail), t_end] (s) of a dense output, by brute force: on a grid of
+    samples_per_period instants per period of the fastest motion (fastest_hz, Hz) plus the
+    step ends, times `stations` equally spaced stations, then refined from the best few grid
+    points by Nelder-Mead in (t, x), kept inside the window and the span."""
+    from scipy.optimize import minimize
+    t0 = t_end * (1.0 - tail)
+    grid = np.linspace(t0, t_end, int(samples_per_period * fastest_hz * (t_end - t0)) + 2)
+    ends = np.asarray(sol.ts)
+    t = np.unique(np.concatenate((grid, ends[(ends > t0) & (ends < t_end)])))
+    x = np.linspace(0.0, 1.0, stations)
+    n = np.arange(1, n_modes + 1)
+    shapes = np.sin(np.outer(n, x) * math.pi)                 # (N, stations)
+    w = np.abs(sol(t)[:n_modes].T @ shapes)                   # (times, stations)
+
+    def deflection(z: np.ndarray) -> float:
+        s = min(max(z[0], t0), t_end)
+        xi = min(max(z[1], 0.0), 1.0)
+        return -abs(float(sol(s)[:n_modes] @ np.sin(n * math.pi * xi)))
+
+    best = float(w.max())
+    for flat in np.argsort(w, axis=None)[-5:]:
+        i, j = np.unravel_index(flat, w.shape)
+        found = minimize(deflection, np.array([t[i], x[j]]), method="Nelder-Mead",
+                         options={"xatol": 1e-13, "fatol": 1e-18, "maxiter": 4000})
+        best = max(best, -float(found.fun))
+    return best

@@ -165,7 +165,7 @@ def test_sweep_modes_refuses_what_it_cannot_compare(tmp_path, capsys):
     assert main(["modes", str(path), "--tolerance", "2"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--tolerance" in err
-    assert main(["modes", "paper-fig5"]) == 2
+    assert main(["modes", "paper-fig5"]) == 2          # refused before anything runs
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "model.modes" in err and "paper" in err
     assert main(["modes", str(path), "--modes", "11"]) == 2

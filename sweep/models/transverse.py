@@ -563,7 +563,7 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...], direction
     direction coordinate's (default: a stepped sweep's)."""
     from . import continuation as ct
     first = results[0]
-    solved = {"state", "jump", "modal_amplitude", "peak_frequency", "envelope", *_REALS,
+    solved = {"state", "jump", "modal_amplitude", "max_deflection", "peak_frequency", "envelope", *_REALS,
               *_COUNTS, *BASE_OUTPUTS}
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
@@ -701,6 +701,12 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
     if result.modal is not None:
         data.update(modal_outputs(result.modal, dims, shape, coeffs, coords))
+        if not inputs.swept and "outputs.amplitude" in inputs.wanted:
+            data["max_deflection"] = xr.DataArray(
+                result.reals[:, tk.SPAN_MAX].reshape(shape), dims=dims,
+                attrs={"units": "m", "long_name": "largest deflection anywhere on the span: "
+                       "max |w(x, t)| over 0 <= x <= l and the tail window (amplitude is the "
+                       "midspan's)"})
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                derived(coeffs["base_accel"], coords))
