@@ -79,3 +79,11 @@ def stderr_lines(text: str) -> list[str]:
     counts the lines a run says about an interrupt or an error holds on a cold cache too."""
     return [line for line in text.strip().splitlines()
             if line.strip() and not line.startswith(COMPILE_LINES)]
+
+
+def fast_first(cases, fast) -> list:
+    """pytest parameters of `cases` (a dict's keys or a list), every one but `fast` marked
+    slow: the fast tier (`pytest -m "not slow"`) keeps one case of a check, CI runs them all."""
+    return [pytest.param(*(c if isinstance(c, tuple) else (c,)),
+                         marks=() if c == fast else pytest.mark.slow)
+            for c in cases]

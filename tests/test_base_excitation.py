@@ -41,7 +41,7 @@ import sweep
 from sweep.kernels import oscillator as osc
 from sweep.kernels import transverse as tk
 
-from conftest import param_row, settings, solve
+from conftest import fast_first, param_row, settings, solve
 
 # Table 1 cable (docs/model.md sec. 1) with the bending moment of the solid round section.
 E = 1.1e11                     # Young's modulus, Pa
@@ -182,7 +182,7 @@ LINEAR_SOLVERS = {("rk45", "lanes"): (1e-8, 1e-5), ("rk45", "scalar"): (1e-8, 1e
                   ("dop853", "lanes"): (1e-10, 1e-3), ("dop853", "scalar"): (1e-10, 1e-3)}
 
 
-@pytest.mark.parametrize("method, driver", list(LINEAR_SOLVERS))
+@pytest.mark.parametrize("method, driver", fast_first(LINEAR_SOLVERS, ("rk45", "lanes")))
 def test_linear_resonance_curve_matches_the_closed_forms(method, driver):
     """amplitude = (4/pi) A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2) and absolute acceleration
     |A - w^2 q_hat| (transmissibility: that over A) across resonance, 2 % and 5 % damping.
@@ -227,7 +227,7 @@ NL_CASES = {
 }
 
 
-@pytest.mark.parametrize("name", list(NL_CASES))
+@pytest.mark.parametrize("name", fast_first(NL_CASES, "below resonance, rk45"))
 def test_nonlinear_response_matches_scipy(name):
     """The Table 1 span (alpha = 3/8), stretched well into the nonlinear range (K3 a^2 / w1^2
     0.2-0.8; above resonance a run from rest lands on the upper branch, 2.5 times the linear

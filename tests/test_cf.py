@@ -67,6 +67,7 @@ def scene_output(name: str, tmp_path: Path, **more) -> tuple[xr.Dataset, Path]:
     return sweep.run(scene, output=out, progress=False), out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(sweep.builtin_scenes()))
 def test_builtin_scene_output_passes_the_cf_checker_and_round_trips(name, tmp_path):
     ds, out = scene_output(name, tmp_path)
@@ -102,6 +103,7 @@ def test_the_checker_sees_what_was_wrong_before(tmp_path):
     assert "_FillValue" in problems and "since" in problems
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method, other", [("dop853", "RK45"), ("rk45", "DOP853")])
 def test_provenance_names_the_integrator_that_ran(method, other, tmp_path):
     ds, out = scene_output("harness-parametric", tmp_path, **{"solver.method": method})

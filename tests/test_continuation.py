@@ -159,6 +159,7 @@ def both_ways():
     return _stepped(STEP_FREQS, STEP_LEVEL_G, "both")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("direction", ["up", "down"])
 def test_every_dwell_matches_an_independent_stepped_run(both_ways, direction):
     order = np.argsort(STEP_FREQS) if direction == "up" else np.argsort(STEP_FREQS)[::-1]
@@ -201,6 +202,7 @@ LINEAR_FREQS = F1 * np.linspace(0.8, 1.2, 9)      # coarse steps of 0.05 f1 over
 LINEAR_LEVEL_G = 1e-4                             # K3 a^2 / w1^2 ~ 1e-5: no hysteresis
 
 
+@pytest.mark.slow
 def test_a_steep_slope_both_ways_is_no_jump():
     """A linear span stepped coarsely over its resonance: the tail amplitude changes by more
     than the jump factor 1.5 between neighbouring dwells (SciPy's stepped run, written here,
@@ -221,6 +223,7 @@ def test_a_steep_slope_both_ways_is_no_jump():
     assert "different branches" in ds["jump"].attrs["long_name"]
 
 
+@pytest.mark.slow
 def test_several_modes_carry_every_mode(tmp_path):
     """modes = 3: each dwell starts from every mode's final state. Against tests/galerkin.py's
     independent projection, two dwells stepped up (the second's start carried), to 1e-4."""

@@ -175,6 +175,7 @@ def test_a_malformed_result_is_refused_in_one_line(arrays, words):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.slow
 def test_a_malformed_result_stops_the_run_and_nothing_of_it_is_placed(monkeypatch):
     pytest.importorskip("dask.distributed")
 
@@ -223,6 +224,7 @@ if __name__ == "__main__":
 """
 
 
+@pytest.mark.slow
 def test_a_local_cluster_whose_workers_keep_dying_ends_in_one_line(tmp_path):
     pytest.importorskip("dask.distributed")
     script = tmp_path / "dying.py"

@@ -51,6 +51,7 @@ def assert_same_result(a: xr.Dataset, b: xr.Dataset, ignore: set = frozenset()) 
         {k: v for k, v in b.attrs.items() if k not in skip}
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_equals_threads_for_any_chunking():
     pytest.importorskip("dask.distributed")
     threads = sweep.run(sweep.load_scene_text(SCENE), progress=False)
@@ -62,6 +63,7 @@ def test_dask_local_cluster_equals_threads_for_any_chunking():
         assert_same_result(sweep.run(scene, progress=False), threads, ignore={"scene"})
 
 
+@pytest.mark.slow
 def test_longitudinal_on_dask_equals_threads():
     pytest.importorskip("dask.distributed")
     text = ("[model]\nkind = 'longitudinal'\n[solver]\nintervals = 50\n[axes]\n"
@@ -138,6 +140,7 @@ def _start_and_wait_for_a_chunk(tmp_path, args):
     return proc, store
 
 
+@pytest.mark.slow
 def test_a_killed_run_keeps_finished_blocks_and_resumes_to_the_same_file(tmp_path, long_whole,
                                                                         capsys):
     """Killed (SIGKILL) part-way through one default chunk, a run has its finished blocks in
@@ -162,6 +165,7 @@ def test_a_killed_run_keeps_finished_blocks_and_resumes_to_the_same_file(tmp_pat
         assert_same_result(a, b)
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_finished_blocks_says_how_to_resume_and_exits_130(tmp_path, long_whole,
                                                                         capsys):
     """SIGINT part-way: exit status 130, one line on stderr (no traceback, no progress bar:

@@ -195,6 +195,7 @@ def test_pi_controller_is_accurate_and_rejects_less():
     assert out["pi"][1] < out["scipy"][1]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["rk45", "dop853"])
 def test_second_pass_points_in_a_threaded_lanes_batch(method):
     """Points at rest away from zero (overdamped creep, a damped post-buckled swing) get their
@@ -268,6 +269,7 @@ _VECTOR_LOOPS = [("_prepare", lambda W, s: (W, s, lanes.LANES)),
                  ("_locate_extrema", lambda W, s: (W, lanes.LANES))]
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(platform.machine().lower() not in ("x86_64", "amd64"),
                     reason="reads x86 assembly")
 @pytest.mark.parametrize("name, args", _VECTOR_LOOPS,
@@ -309,6 +311,7 @@ np.savez({result!r}, *out)
 """
 
 
+@pytest.mark.slow
 def test_lanes_stay_in_bounds_as_lanes_reload_and_buffers_grow(tmp_path):
     """Every array access of the lanes driver stays in bounds. Numba does not check indices,
     and the flagged lanes' bookkeeping (`_record_lane`) runs without reference counting, so a

@@ -51,6 +51,7 @@ def test_sweep_run_stays_the_function_after_importing_the_submodule():
     assert sweep.run.__module__ == "sweep.run"
 
 
+@pytest.mark.slow
 def test_a_threads_run_and_a_plot_import_no_dask(tmp_path):
     out = tmp_path / "f5.nc"
     code = ("import sweep\n"
@@ -63,6 +64,7 @@ def test_a_threads_run_and_a_plot_import_no_dask(tmp_path):
     assert {"numpy", "xarray", "numba"} <= set(loaded)
 
 
+@pytest.mark.slow
 def test_xarray_still_sees_dask_arrays_once_dask_is_imported(tmp_path):
     out = tmp_path / "f5.nc"
     code = ("import sweep\n"
@@ -79,6 +81,7 @@ def test_xarray_still_sees_dask_arrays_once_dask_is_imported(tmp_path):
     assert "dask" in _loaded_after(code)["loaded"]
 
 
+@pytest.mark.slow
 def test_a_cli_run_imports_no_scipy_linalg_and_numba_keeps_its_linear_algebra(tmp_path):
     """The command line loads Numba's registries without the SciPy import its BLAS probe
     makes (sweep/numba_start.py); afterwards SciPy, np.dot and np.convolve in compiled code

@@ -223,6 +223,7 @@ def _period2_reference() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return times, peaks, is_max
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("driver", ["scalar", "lanes"])
 def test_period_two_orbit_is_steady_with_its_true_period(driver):
     """Maxima alternating between two levels: steady, period two maxima long, settling time the

@@ -16,6 +16,8 @@ from matplotlib.figure import Figure
 import sweep
 from sweep import plot as splot
 
+from conftest import fast_first
+
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -211,6 +213,7 @@ def test_select_picks_values_and_names_what_is_wrong(results):
         splot.plot(ds, select={"length": 0.5})
 
 
+@pytest.mark.slow
 def test_cli_plot_writes_png_and_svg(results, tmp_path):
     _, path = results["map"]
     done = cli("plot", str(path), "-o", str(tmp_path / "figs"), "--format", "png,svg",
@@ -226,6 +229,7 @@ def test_cli_plot_writes_png_and_svg(results, tmp_path):
         "<?xml")
 
 
+@pytest.mark.slow
 def test_cli_plot_defaults_to_the_current_directory_without_a_display(results, tmp_path):
     _, path = results["longitudinal-one"]
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND",
@@ -245,12 +249,15 @@ def test_importing_the_plot_module_picks_no_backend():
     assert done.stdout.strip() == "False"
 
 
-@pytest.mark.parametrize("make, message", [
+NOT_RESULTS = [
     (lambda p: p.write_text("this is not netCDF\n"), "not a readable netCDF file"),
     (lambda p: xr.Dataset({"a": ("x", [1.0, 2.0])}).to_netcdf(p), "not a cable-sweep result"),
     (lambda p: None, "no such file"),
     (lambda p: p.mkdir(), "is a directory"),
-])
+]
+
+
+@pytest.mark.parametrize("make, message", fast_first(NOT_RESULTS, NOT_RESULTS[0]))
 def test_cli_plot_refuses_a_file_that_is_not_a_result(tmp_path, make, message):
     target = tmp_path / "thing.nc"
     make(target)
@@ -263,13 +270,16 @@ def test_cli_plot_refuses_a_file_that_is_not_a_result(tmp_path, make, message):
     assert not (tmp_path / "figs").exists()
 
 
-@pytest.mark.parametrize("args, message", [
+BAD_PLOT_OPTIONS = [
     (["--select", "depth=1"], "'depth' is not a swept axis"),
     (["--select", "length=0.55"], "not a value of axis 'length'"),
     (["--select", "length"], "expected DIM=VALUE"),
     (["--select", "length=long"], "is not a number"),
     (["--format", "png,bogus"], "format 'bogus'"),
-])
+]
+
+
+@pytest.mark.parametrize("args, message", fast_first(BAD_PLOT_OPTIONS, BAD_PLOT_OPTIONS[0]))
 def test_cli_plot_bad_options_are_one_line(results, tmp_path, args, message):
     _, path = results["map"]
     done = cli("plot", str(path), "-o", str(tmp_path), *args)
@@ -287,6 +297,7 @@ def test_cli_plot_bad_options_are_one_line(results, tmp_path, args, message):
     ("stepped_sine.py", "stepped_sine", ("amplitude", "absolute_acceleration_g")),
     ("qualification_sweep.py", "qualification_sweep", ("envelope", "peak_amplitude")),
 ])
+@pytest.mark.slow
 def test_examples_run_on_a_reduced_grid(tmp_path, script, stem, keys):
     env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
     done = subprocess.run([sys.executable, str(EXAMPLES / script), "--small", "--out",

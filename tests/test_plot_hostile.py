@@ -223,6 +223,7 @@ def test_huge_declared_dimensions_are_refused_before_reading(tmp_path, capsys):
     _refused([path], tmp_path / "figs", capsys, "GiB of data")
 
 
+@pytest.mark.slow
 def test_a_small_file_declaring_gigabytes_of_zeros_is_refused_before_inflating(tmp_path,
                                                                               capsys):
     """A file of a few MiB whose compressed variable inflates to 1 GiB of zeros (within the

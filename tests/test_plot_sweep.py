@@ -245,6 +245,7 @@ def _with_directions(ds: xr.Dataset, down_factor: float = 0.5) -> xr.Dataset:
     return out
 
 
+@pytest.mark.slow
 def test_sweep_plot_draws_every_figure_of_a_sweep_run_both_ways(both_ways, tmp_path, capsys):
     _, path = both_ways
     out = tmp_path / "figs"

@@ -311,6 +311,7 @@ def test_design_gives_each_cable_its_own_span():
     assert str(refined.limited_by.values[1]) == "max_amplitude"
 
 
+@pytest.mark.slow
 def test_plots_label_each_parameter_set_with_its_values(tmp_path):
     import matplotlib
     matplotlib.use("Agg")

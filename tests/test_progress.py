@@ -13,6 +13,7 @@ import termios
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import sweep
 from sweep.execute import Progress, announce_compilation, execute
@@ -92,6 +93,7 @@ def test_compiling_is_kept_off_the_bars_clock(capsys):
     assert err.count("compiling the Numba kernels") == 1 and "compiled in" in err
 
 
+@pytest.mark.slow
 def test_a_terminal_gets_one_line_that_fits_a_narrow_window(tmp_path):
     """`sweep run` on a 40-column terminal: a tqdm bar from the start, every redraw within 40
     columns on one line (no wrapping), and the summary after it."""

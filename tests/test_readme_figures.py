@@ -13,6 +13,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 import readme_figures as rf  # noqa: E402
 
+pytestmark = pytest.mark.slow      # runs the built-in scenes whole
+
 
 @pytest.fixture(scope="module")
 def runs():

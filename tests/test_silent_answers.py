@@ -231,6 +231,7 @@ def test_a_scene_with_a_start_does_not_warn(text):
         load_scene_text(text)
 
 
+@pytest.mark.slow
 def test_cli_says_in_one_line_what_an_empty_scene_ran(tmp_path):
     empty = tmp_path / "empty.toml"
     empty.write_text("")

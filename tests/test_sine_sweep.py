@@ -50,6 +50,8 @@ from scipy.optimize import minimize_scalar
 import sweep
 from sweep.errors import SceneError, UserError
 
+from conftest import fast_first
+
 # The default cable (docs/model.md sec. 1): inertia area^2 / (4 pi), the solid round section.
 E = 1.1e11                     # Young's modulus, Pa
 RHO = 8900.0                   # density, kg/m^3
@@ -248,7 +250,7 @@ def runs():
 
 
 @pytest.mark.parametrize("method", METHODS)
-@pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.parametrize("name", fast_first(CASES, "0.1 g up"))
 def test_sweep_peak_matches_scipy(name, method, references, runs):
     """peak_amplitude to 1e-4 relative, peak_frequency to 0.05 Hz (half a period's frequency
     change is ~0.02 Hz, so a neighbouring extremum would already be close); amplitude is the
@@ -281,6 +283,7 @@ def test_sweep_peak_matches_scipy(name, method, references, runs):
         assert ref.peak > 5.0 * quasi_static
 
 
+@pytest.mark.slow
 def test_a_sweep_from_rest_at_full_level_keeps_its_start_up_transient(references):
     """base.sweep.ramp_cycles = 0: the clamps start at full level at the sweep's first
     frequency, the old start. The quasi-static span swept down from 60 Hz then peaks at its
@@ -296,7 +299,7 @@ def test_a_sweep_from_rest_at_full_level_keeps_its_start_up_transient(references
     assert 1.2 * ramped < ref.peak < 1.5 * ramped
 
 
-@pytest.mark.parametrize("g", [0.5, 0.1])
+@pytest.mark.parametrize("g", fast_first([0.5, 0.1], 0.1))
 def test_up_sweep_peaks_above_down_sweep(g, references, runs):
     """A hardening span swept up rides the upper branch past f1 (and the sweep rate delays the
     peak in the sweep's direction); swept down it jumps up at the lower fold: the up sweep's
@@ -352,8 +355,8 @@ def test_slow_sweep_approaches_steady_resonance():
 # -------------------------------------------------------------------- 3. the envelope
 
 @pytest.mark.parametrize("method", METHODS)
-@pytest.mark.parametrize("name", ["0.5 g up", "0.5 g down", "0.1 g up", "0.1 g down",
-                                  "quasi-static up", "quasi-static down"])
+@pytest.mark.parametrize("name", fast_first(["0.5 g up", "0.5 g down", "0.1 g up", "0.1 g down",
+                                             "quasi-static up", "quasi-static down"], "0.1 g up"))
 def test_envelope_matches_scipy_extrema_binned(name, method, references, runs):
     """The envelope against the SciPy extrema binned into the same bands: equal to 1e-4 in
     every band (20-35 Hz below resonance, the resonant bands, those above; the quasi-static
@@ -393,6 +396,7 @@ LEVELS_G = [[10.0, 0.2], [40.0, 0.2], [50.0, 0.4], [100.0, 0.4]]
 TABLE_BANDS = 12               # 1/12-octave bands (6 % wide): the envelope follows the level
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", METHODS)
 def test_level_table_sweep_matches_scipy(method):
     """levels_g interpolated log-log (+6.2 dB/octave between 40 and 50 Hz): a 20 -> 80 Hz sweep
@@ -426,6 +430,7 @@ def test_level_table_sweep_matches_scipy(method):
 
 # ------------------------------------------------------------------ three modes, two tolerances
 
+@pytest.mark.slow
 def test_three_modes_sweep_converges_in_tolerance(references):
     """model.modes = 3 on the 0.5 g up sweep: the midspan deflection q1 - q3 at rtol 1e-8 and
     1e-10 agree (peak to 1e-6, its frequency to 1e-3 Hz), the antisymmetric q2 stays zero from

@@ -92,6 +92,7 @@ def _complete_store(tmp_path: Path) -> Path:
     return store
 
 
+@pytest.mark.slow
 def test_damaged_and_foreign_chunks_are_recomputed_in_one_line(tmp_path, whole):
     """Empty, truncated, one flipped byte, a chunk copied over another range, another run's
     chunk and a symbolic link: each is recomputed (one line, no traceback), the link's target
@@ -132,6 +133,7 @@ def test_damaged_and_foreign_chunks_are_recomputed_in_one_line(tmp_path, whole):
     _same(tmp_path / "out.nc", whole)
 
 
+@pytest.mark.slow
 def test_a_second_run_on_a_store_in_use_is_refused_and_a_stale_lock_taken_over(tmp_path,
                                                                              whole):
     """While this process holds the store, a second `sweep run` says one line naming it and
@@ -190,6 +192,7 @@ def test_a_user_error_after_the_store_was_made_does_not_block_the_same_command(t
     sweep.run(scene, output=out, resume=True, overwrite=True, progress=False)
 
 
+@pytest.mark.slow
 def test_planted_links_are_never_written_through(tmp_path, whole):
     """A link at the old predictable temporary name, a symlinked chunk store and a link at
     OUT.nc itself: every target is left untouched (the link at OUT.nc is replaced by the file);
@@ -288,6 +291,7 @@ def _no_temporaries(disk: Path) -> None:
     assert left == [], left
 
 
+@pytest.mark.slow
 def test_a_full_disk_before_during_chunks_and_during_the_write_is_one_line_and_resumable(
         small_disk, tmp_path):
     disk = small_disk
@@ -347,6 +351,7 @@ SHORT_BLOCKS = ("import sys, sweep.execute as e, sweep.threads as t; "
                 "from sweep.cli import main; sys.exit(main(sys.argv[1:]))")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
 def test_sigterm_and_sighup_stop_like_ctrl_c(tmp_path, signum):
     """Part-way through a chunk: exit status 128 + signum, one line naming the --resume
@@ -384,6 +389,7 @@ def test_a_signal_during_the_final_write_waits_for_it():
     assert {s: signal.getsignal(s) for s in before} == before
 
 
+@pytest.mark.slow
 def test_sigterm_while_writing_finishes_the_file(tmp_path):
     """The run's last phase: SIGTERM sent once the chunk store is complete lands in the write;
     the file is written whole, the store dropped, the process exits at once (not hung)."""

@@ -58,6 +58,7 @@ def case(request):
     return scene, sweep.run(scene)
 
 
+@pytest.mark.slow
 def test_a_dask_cluster_gives_the_in_process_result(case, tmp_path):
     pytest.importorskip("dask.distributed")
     scene, whole = case
