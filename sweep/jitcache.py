@@ -33,6 +33,21 @@ def sources_digest(kernels_dir: Path) -> str:
     return h.hexdigest()
 
 
+def package_sources_digest(package: str = "sweep.kernels") -> str:
+    """`sources_digest` of `package`'s directory, found without importing it (so without
+    Numba); "" where it cannot be found or read."""
+    try:
+        spec = importlib.util.find_spec(package)
+    except (ImportError, ValueError):
+        return ""
+    if spec is None or not spec.submodule_search_locations:
+        return ""
+    try:
+        return sources_digest(Path(list(spec.submodule_search_locations)[0]))
+    except OSError:
+        return ""
+
+
 def drop_stale_cache(package: str) -> bool:
     """Delete the cached kernels of `package` (e.g. "sweep.kernels", found without importing
     it) in its __pycache__ when any of its sources changed since they were written. Returns

@@ -155,14 +155,18 @@ def placer(outputs: dict[str, np.ndarray], order: np.ndarray) -> Callable[[int, 
 
 def run_fingerprint(scene: Scene) -> str:
     """What decides a run's results: every scene value but the run.* keys, the axes and the
-    [points] (in order: their order is the point dimension's)."""
+    [points] (in order: their order is the point dimension's), the package version and the
+    kernels' sources (a chunk stored by other kernels, whose outputs may differ in values or
+    layout, is never resumed from)."""
     from .execute import fingerprint
+    from .jitcache import package_sources_digest
     values = {k: v for k, v in scene.values.items() if not k.startswith("run.")}
     axes = {k: [float(x) for x in v] for k, v in scene.axes.items()}
+    code = (package_version(), package_sources_digest())
     if not scene.points:
-        return fingerprint(sorted(values.items()), sorted(axes.items()), package_version())
+        return fingerprint(sorted(values.items()), sorted(axes.items()), *code)
     points = {k: [float(x) for x in v] for k, v in scene.points.items()}
-    return fingerprint(sorted(values.items()), sorted(axes.items()), package_version(),
+    return fingerprint(sorted(values.items()), sorted(axes.items()), *code,
                        list(points.items()))
 
 

@@ -161,8 +161,9 @@ class ChunkStore:
             stored = stored if isinstance(stored, dict) else None
         if stored is not None and stored.get("fingerprint") != self.fingerprint:
             self.release()
-            raise UserError(f"chunk store '{self.directory}': made by a different scene "
-                            "(remove it, or use --overwrite to start again)")
+            raise UserError(f"chunk store '{self.directory}': made by a different scene or "
+                            "another version of cable-sweep (remove it, or use --overwrite to "
+                            "start again)")
         try:
             chunk_size = int(stored["chunk_size"]) if stored is not None else chunk_size
         except (KeyError, TypeError, ValueError):

@@ -407,3 +407,25 @@ def test_sigterm_while_writing_finishes_the_file(tmp_path):
     assert "SIGTERM received while writing 'out.nc'" in done.stderr
     assert (tmp_path / "out.nc").exists() and not (tmp_path / "out.nc.chunks").exists()
     _no_temporaries(tmp_path)
+
+
+def test_a_store_made_by_other_kernels_is_never_resumed(tmp_path, monkeypatch):
+    """The run's fingerprint holds the kernels' sources: a store left by other kernels (whose
+    outputs may differ in value or layout, e.g. a `reals` column added) is refused on
+    --resume in one line, never read into this run's arrays."""
+    from sweep import jitcache, runner
+    from sweep.errors import UserError
+    scene = sweep.load_scene("paper-fig5")
+    assert jitcache.package_sources_digest() != ""
+    mine = runner.run_fingerprint(scene)
+    monkeypatch.setattr(jitcache, "package_sources_digest",
+                        lambda package="sweep.kernels": "0" * 64)
+    theirs = runner.run_fingerprint(scene)
+    assert theirs != mine
+    old = ChunkStore(tmp_path / "o.nc", theirs)
+    old.open(resume=False, overwrite=False, chunk_size=2)
+    old.save(0, 2, {"states": np.zeros(2, np.int8)})
+    old.release()
+    with pytest.raises(UserError, match="another version of cable-sweep") as refused:
+        ChunkStore(tmp_path / "o.nc", mine).open(resume=True, overwrite=False, chunk_size=2)
+    assert "\n" not in str(refused.value)
