@@ -563,8 +563,8 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...], direction
     direction coordinate's (default: a stepped sweep's)."""
     from . import continuation as ct
     first = results[0]
-    solved = {"state", "jump", "modal_amplitude", "max_deflection", "peak_frequency", "envelope", *_REALS,
-              *_COUNTS, *BASE_OUTPUTS}
+    solved = {"state", "jump", "modal_amplitude", "max_deflection", "peak_frequency", "envelope",
+              *_REALS, *_COUNTS, *BASE_OUTPUTS}
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
     ds = first.drop_vars(per_point).merge(stacked)
