@@ -31,8 +31,8 @@ from . import excitation as ex
 # The state table lives in kernels/states.py (no Numba: the sweep layer reads it); the kernels
 # import it from here.
 from .states import (COMPLETED, DECAYED, DIVERGED, INVALID_INPUT, LONGITUDINAL_STATES,  # noqa: F401
-                     MAX_STEPS, MODULATED, OFF_MIDSPAN, RUNNING, SECOND_PASS, STATE_MEANINGS, STEADY,
-                     STEP_TOO_SMALL, TRANSVERSE_STATES, UNSETTLED)
+                     MAX_STEPS, MODULATED, OFF_MIDSPAN, RUNNING, SECOND_PASS, STATE_MEANINGS,
+                     STEADY, STEP_TOO_SMALL, TRANSVERSE_STATES, UNSETTLED)
 
 # Extremum kinds in the extrema buffer.
 MAXIMUM = 1.0

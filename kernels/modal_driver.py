@@ -29,8 +29,8 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
-from .layout import (AMPLITUDE, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS, PERIOD,
-                     RHS_EVALS, RTOL, SETTLING, SPAN_MAX, SWEPT, TAIL, TOL, T_END,
+from .layout import (AMPLITUDE, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS,
+                     PERIOD, RHS_EVALS, RTOL, SETTLING, SPAN_MAX, SWEPT, TAIL, TOL, T_END,
                      WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
@@ -270,11 +270,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         for c in range(n):
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
         located = True
-        for j in range(Qp.shape[1]):
-            Qp[1, j] = 0.0
-        for c in range(n):
-            for j in range(Qp.shape[1]):
-                Qp[1, j] += modal[2 * n + 1 + c] * QA[c, 1, j]
+        _project_rate(y, y_new, QA, modal, n, Qp)    # the rate's interpolant at x*
         x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
         if t + x * h >= t_tail:
             _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
@@ -288,9 +284,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
             modal[c] = max(modal[c], abs(dopri5.dense_value(y[c], h, QA[c, 0], x)))
         _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
     for i in range(n):
-        v0 = y[n + i]
-        v1 = y_new[n + i]
-        if not ((v0 > 0.0 and v1 <= 0.0) or (v0 < 0.0 and v1 >= 0.0)):
+        if not _turns(y[n + i], y_new[n + i]):
             continue
         if not located:
             for c in range(n):
@@ -319,18 +313,18 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def span_state(state, modal, y, n_modes, settings, reals):
+def span_state(state, modal, y, n_modes, settings, reals, stations):
     """The state judged from the whole response, and reals[SPAN_MAX]: a point whose midspan
     deflection decayed (DECAYED) while some mode's tail amplitude exceeds settings[TOL] x the
     largest mode's peak has not decayed: a mode with a node at midspan (an even one) kept
     moving; it is left OFF_MIDSPAN for `judge_off_midspan`. reals[SPAN_MAX] = the largest
     deflection over the span in the tail window (m): modal[2N] (`_observe_modes`), the span
     at the final state y (a growing response peaks there) and at least the midspan
-    amplitude; NaN where the point failed."""
+    amplitude; NaN where the point failed. stations: modes.span_stations(N)."""
     n = n_modes
     if state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS:
         return state
-    final = md.span_maximum(y, n, md.span_stations(n))
+    final = md.span_maximum(y, n, stations)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
     if state != mt.DECAYED:
         return state
@@ -389,14 +383,14 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base,
-              eighth, steady, weights):
+              eighth, steady, weights, stations):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the watched deflection's metrics
     (kernels.trajectory's accumulator; weights: its mode weights, modes.midspan_weights for
-    the midspan) and the modes' accumulator (modal, `modal_size`, m) on the fly; `track`,
-    centre, thr_fixed, thr_rel and the switches base, eighth (the method, as
-    settings[METHOD]) and steady: as transverse.integrate. Returns (accumulator, extrema
-    buffer, final state y)."""
+    the midspan) and the modes' accumulator (modal, `modal_size`, m; stations:
+    modes.span_stations(N)) on the fly; `track`, centre, thr_fixed, thr_rel and the switches
+    base, eighth (the method, as settings[METHOD]) and steady: as transverse.integrate.
+    Returns (accumulator, extrema buffer, final state y)."""
     n = n_modes
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
@@ -409,7 +403,6 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     md.prepare(row, n, pp)
     S = md.scratch(pp, n, T)
     p1 = observer_row(row, n)
-    stations = md.span_stations(n)
     K = np.empty((n_stages + 1, dim))
     K_mid = np.empty((n_stages + 1, 2))
     Km = np.empty((n_stages + 1, 2))
@@ -523,15 +516,16 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
             envelope[j] = math.nan
         return mt.INVALID_INPUT
     ext = np.empty(modal_size(n_modes))
+    stations = md.span_stations(n_modes)
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
                             settings[TOL], series, ext, base, eighth, steady,
-                            md.midspan_weights(n_modes))
+                            md.midspan_weights(n_modes), stations)
     resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(row, md.EXCITATION, 1, settings, acc, buf, state, reals, envelope)
     else:
-        state = span_state(state, ext, y, n_modes, settings, reals)
+        state = span_state(state, ext, y, n_modes, settings, reals, stations)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for j in range(n_modes):
         modal[j] = math.nan if failed else ext[j]
@@ -549,14 +543,16 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base, e
     done = 0
     modal = np.empty(modal_size(n_modes))
     weights = md.midspan_weights(n_modes)
+    stations = md.span_stations(n_modes)
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
         first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
-                                np.empty(0), modal, base, eighth, steady, weights)
+                                np.empty(0), modal, base, eighth, steady, weights, stations)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
-                                 np.empty(0), modal, base, eighth, steady, weights)
+                                 np.empty(0), modal, base, eighth, steady, weights,
+                                 stations)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -576,6 +572,7 @@ def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, b
     n = n_modes
     done = 0
     ext = np.empty(modal_size(n))
+    stations = md.span_stations(n)
     own_reals = np.empty(N_REALS)
     own_counts = np.empty(N_COUNTS, np.int64)
     for i in range(params.shape[0]):
@@ -589,7 +586,7 @@ def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, b
         weights[k] = 1.0
         acc, buf, y = integrate(params[i], n, settings, settings[WANT_SETTLING] != 0.0, 0.0,
                                 0.0, settings[TOL], np.empty(0), ext, base, eighth, steady,
-                                weights)
+                                weights, stations)
         resting = at_rest(params[i], n, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
         state = classify_metrics(settings, acc, buf, own_reals, own_counts, base, resting)
         reals[i, PERIOD] = own_reals[PERIOD]

@@ -391,7 +391,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, series, modal,
-              final, buf, yl, ml, base):
+              final, buf, yl, ml, stations, base):
     """Classify lane j's finished trajectory (row `point`) as modal_driver.solve_point does."""
     acc = W[j::LANES]
     tj.end_series(acc, series[point])
@@ -402,7 +402,7 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
     state = classify_metrics(settings, acc, buf, reals[point], counts[point], base, resting)
     for c in range(MOD.shape[0]):
         ml[c] = MOD[c, j]
-    state = drv.span_state(state, ml, yl, n, settings, reals[point])
+    state = drv.span_state(state, ml, yl, n, settings, reals[point], stations)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for c in range(n):
         modal[point, c] = math.nan if failed else MOD[c, j]
@@ -538,7 +538,8 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     if step > 0.0:
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
-                              counts, series, modal, final, bufs[j], yl, ml, base)
+                              counts, series, modal, final, bufs[j], yl, ml, stations,
+                              base)
                     point[j] = -1
                 if next_point >= hi:
                     break

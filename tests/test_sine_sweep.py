@@ -355,8 +355,9 @@ def test_slow_sweep_approaches_steady_resonance():
 # -------------------------------------------------------------------- 3. the envelope
 
 @pytest.mark.parametrize("method", METHODS)
-@pytest.mark.parametrize("name", fast_first(["0.5 g up", "0.5 g down", "0.1 g up", "0.1 g down",
-                                             "quasi-static up", "quasi-static down"], "0.1 g up"))
+@pytest.mark.parametrize("name", fast_first(["0.5 g up", "0.5 g down", "0.1 g up",
+                                             "0.1 g down", "quasi-static up",
+                                             "quasi-static down"], "0.1 g up"))
 def test_envelope_matches_scipy_extrema_binned(name, method, references, runs):
     """The envelope against the SciPy extrema binned into the same bands: equal to 1e-4 in
     every band (20-35 Hz below resonance, the resonant bands, those above; the quasi-static
