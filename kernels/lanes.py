@@ -352,8 +352,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
             1.0 if rejected_before else 0.0)
         W[tj.REJECTED * L + j] += 1.0 if active & (not accepted) else 0.0
         W[tj.STEPS * L + j] += 1.0 if active & accepted else 0.0
-        tj.observe_step_end(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], h, t_new, qn, fv_new,
-                            t_tail, track, 0.0, 0.0, thr_rel, done, True, None)
+        tj.observe_step_end(W, j, L, W, W_P * L + j, L, W[tj.T * L + j], h, t_new, qn, vn,
+                            fv_new, t_tail, track, 0.0, 0.0, thr_rel, done, True, None)
         W[tj.T * L + j] = t_new if done else W[tj.T * L + j]
         W[tj.Q * L + j] = qn if done else q_old
         W[tj.V * L + j] = vn if done else v_old
@@ -367,13 +367,29 @@ def _observe_acceleration(W, settings, n_run):
     """trajectory.observe_acceleration for every lane whose attempt `_finish` accepted as an
     ordinary step (the flagged ones get it from record_step): the base-excitation metric, in
     a loop of its own so that `_finish` stays vectorised and scenes without base excitation
-    do not pay for it."""
+    do not pay for it. Returns how many lanes have an extremum to refine (ACC_TURN:
+    `_refine_acceleration`)."""
     L = LANES
+    n_turns = 0
     for j in range(n_run):
         done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
                 & (W[W_FLAG * L + j] == ORDINARY))
-        tj.observe_acceleration(W, j, L, W[tj.T * L + j],
-                                W[tj.FV * L + j] + W[W_AB * L + j], W[tj.T_TAIL * L + j], done)
+        fv = W[tj.FV * L + j]
+        turn = tj.observe_acceleration(W, j, L, W[tj.T * L + j], W[tj.Q * L + j],
+                                       W[tj.V * L + j], fv, fv + W[W_AB * L + j],
+                                       W[tj.T_TAIL * L + j], done)
+        n_turns += 1 if turn else 0
+    return n_turns
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _refine_acceleration(W, n_run):
+    """trajectory.refine_acceleration_peak for the lanes `_observe_acceleration` left with
+    ACC_TURN (about two steps a period in the tail window)."""
+    L = LANES
+    for j in range(n_run):
+        if W[tj.ACC_TURN * L + j] != 0.0:
+            tj.refine_acceleration_peak(W, j, L, W, W_P * L + j, L)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -565,7 +581,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
         n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth,
                                                parametric, base)
         if base is not None and n_near > 0:
-            _observe_acceleration(W, settings, n_run)
+            if _observe_acceleration(W, settings, n_run) > 0:
+                _refine_acceleration(W, n_run)
         if n_flagged == 0:
             continue
         if n_extrema > 0 and eighth is None:

@@ -311,14 +311,24 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
         FLAG[l] = 2.0 if event else 0.0
         MOVE[l] = 1.0 if done else 0.0
         n_flagged += 1 if event else 0
-        tj.observe_step_end(W, l, L, P1, l, L, t, H[l], t_new, qn, fv_new, t_tail, track, 0.0,
-                            0.0, thr_rel, done, True, base)
+        tj.observe_step_end(W, l, L, P1, l, L, t, H[l], t_new, qn, vn, fv_new, t_tail, track,
+                            0.0, 0.0, thr_rel, done, True, base)
         W[tj.T * L + l] = t_new if done else t
         W[tj.Q * L + l] = qn if done else q_old
         W[tj.V * L + l] = vn if done else v_old
         W[tj.FQ * L + l] = vn if done else W[tj.FQ * L + l]
         W[tj.FV * L + l] = fv_new if done else W[tj.FV * L + l]
     return n_flagged
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _refine_acceleration(W, P1, n_run):
+    """trajectory.refine_acceleration_peak for the lanes whose ordinary step `_finish` left
+    with ACC_TURN (an extremum of the absolute midspan acceleration to refine)."""
+    L = LANES
+    for l in range(n_run):
+        if W[tj.ACC_TURN * L + l] != 0.0:
+            tj.refine_acceleration_peak(W, l, L, P1, l, L)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -565,6 +575,8 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run)
+        if base is not None:
+            _refine_acceleration(W, P1, n_run)
         if n_flagged > 0:
             for j in range(n_run):
                 if FLAG[j] != 2.0:

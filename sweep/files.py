@@ -32,6 +32,23 @@ def fsync_directory(directory: str | os.PathLike) -> None:
             os.close(fd)
 
 
+def new_file_mode() -> int:
+    """The mode a new file gets from this process's umask (0o666 less it), as any tool's.
+
+    Read from /proc/self/status where the kernel reports it (Linux 4.7 and later): setting the
+    umask to read it back would change it for every thread of the process for an instant (a
+    file another thread creates then would get the wrong mode). Elsewhere it is read that way.
+    """
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status", encoding="ascii", errors="replace") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return 0o666 & ~int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_temporary(directory: str | os.PathLike, prefix: str, data: bytes,
                     mode: int | None = None) -> str:
     """`data` in a new temporary file of `directory` (created with O_EXCL under an

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .errors import UserError
-from .files import free_bytes, fsync_directory, mib
+from .files import free_bytes, fsync_directory, mib, new_file_mode
 from .store import store_path
 
 if TYPE_CHECKING:
@@ -153,7 +153,7 @@ def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = Fals
             raise UserError(f"output '{out}': the temporary file '{tmp}' was replaced while "
                             "it was written (someone else writes in this directory; choose "
                             "another -o path)")
-        os.fchmod(fd, 0o666 & ~_umask())      # as any tool's new file, not mkstemp's 0600
+        os.fchmod(fd, new_file_mode())      # as any tool's new file, not mkstemp's 0600
         os.fsync(fd)
         os.replace(tmp, out)
         fsync_directory(parent)
@@ -166,13 +166,6 @@ def write_netcdf(ds: xr.Dataset, path: str | os.PathLike, overwrite: bool = Fals
     finally:
         os.close(fd)
     return out
-
-
-def _umask() -> int:
-    """The process's umask (read by setting it, then setting it back)."""
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
 
 
 def _unlink_ours(tmp: Path, made: os.stat_result) -> None:

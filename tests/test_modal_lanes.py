@@ -166,8 +166,7 @@ def test_lanes_equal_the_scalar_modal_driver(name):
     # round-off is the error norm's, about eps / rtol (its sums cancel down to rtol x the
     # state), which a one-ulp nudge need not show: a mode's divergence stops the run at a
     # step's end (modal_driver: T_STOP = t_new; measured 2.7 eps / rtol), and the absolute
-    # acceleration is sampled at step ends and refined by a parabola through three of them
-    # (measured 0.1 eps / rtol).
+    # acceleration's extremum is refined on a polynomial through three step ends.
     step_end = 20.0 * np.finfo(float).eps / s[tk.RTOL]
     peak = np.abs(a[1][:, tk.PEAK])
     for col in range(tk.N_REALS):

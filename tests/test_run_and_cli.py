@@ -181,6 +181,27 @@ def test_summary_counts_states_by_their_flag_values():
 
 
 
+def test_the_umask_is_read_without_setting_it(monkeypatch):
+    """Setting the umask to read it would change it for every thread for an instant: where the
+    kernel reports it (/proc/self/status), the mode comes from there, os.umask untouched."""
+    from sweep.files import new_file_mode
+    try:
+        with open("/proc/self/status") as status:
+            if not any(line.startswith("Umask:") for line in status):
+                pytest.skip("this kernel does not report the umask")
+    except OSError:
+        pytest.skip("no /proc/self/status")
+    old = os.umask(0o027)
+    try:
+        def refuse(mask):
+            raise AssertionError("os.umask called")
+        monkeypatch.setattr(os, "umask", refuse)
+        assert new_file_mode() == 0o640
+        monkeypatch.undo()
+    finally:
+        os.umask(old)
+
+
 @pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
 def test_output_file_follows_the_umask(tmp_path, umask, mode):
     """The netCDF file gets the mode any tool's new file gets (0666 less the umask), not the

@@ -21,7 +21,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from ..errors import UserError
-from ..files import write_temporary
+from ..files import new_file_mode, write_temporary
 from .labels import _add_footer, _title
 from .branches import plot_branches, stepped_axis
 from .design import plot_design
@@ -326,14 +326,13 @@ def _write_all(rendered: list[tuple[Path, bytes]]) -> list[Path]:
     directory first (O_EXCL, unpredictable names, fsynced), then renamed over the targets.
     On any failure, removes every temporary and every file this call already renamed into
     place, and raises UserError naming the file (OSError) or re-raises."""
-    mask = os.umask(0o022)
-    os.umask(mask)
+    mode = new_file_mode()
     temps: list[str] = []
     done: list[Path] = []
     path = None
     try:
         for path, data in rendered:
-            temps.append(write_temporary(path.parent, f".{path.name}.", data, 0o666 & ~mask))
+            temps.append(write_temporary(path.parent, f".{path.name}.", data, mode))
         for (path, _data), tmp in zip(rendered, temps):
             os.replace(tmp, path)
             done.append(path)
