@@ -1,4 +1,4 @@
-"""Two versions of cable-sweep side by side on the reference sweep: the paired runs of RESULTS.md.
+"""Two versions of cable-sweep side by side: the paired runs of RESULTS.md.
 
 Each pair runs both checkouts at the same time, one pinned to each core (`taskset`), then
 swapped, so that both see the same machine at the same moment (a VM's timings wander by several
@@ -8,6 +8,11 @@ reference sweep (benchmarks/reference_sweep.py's scene, `sweep.run.solve_points`
 
     python benchmarks/before_after.py BEFORE_ROOT AFTER_ROOT [--method rk45|dop853]
         [--driver lanes|scalar] [--repeats 40] [--pairs 2]
+        [--scene NAME --set KEY=VALUE ...]
+
+With --scene, each run is instead `sweep.run` of that built-in scene (its own method and
+driver unless --set says otherwise) on one thread, with the --set overrides (TOML values, as
+`sweep run --set`), after one warm-up run: the whole run as a user makes it.
 
 BEFORE_ROOT and AFTER_ROOT are repository checkouts (e.g. `git clone . /tmp/before && git -C
 /tmp/before checkout REV`); each is imported from its own directory. Needs 2 cores and taskset.
@@ -41,10 +46,32 @@ print(best)
 """
 
 
+SCENE_RUN = """
+import sys, time
+root, name, repeats = sys.argv[1], sys.argv[2], int(sys.argv[3])
+sys.path[:0] = [root]
+import sweep
+from sweep.scene.overrides import parse_override
+overrides = {"run.threads": 1, **dict(parse_override(item) for item in sys.argv[4:])}
+scene = sweep.load_scene(name, overrides=overrides)
+sweep.run(scene)
+best = float("inf")
+for _ in range(repeats):
+    start = time.perf_counter()
+    sweep.run(scene)
+    best = min(best, time.perf_counter() - start)
+print(best)
+"""
+
+
 def pair(roots: tuple[str, str], cores: tuple[int, int], args: argparse.Namespace) -> list[float]:
     """Best times (s) of both roots, run at once on the given cores."""
-    procs = [subprocess.Popen(["taskset", "-c", str(core), sys.executable, "-c", ONE_RUN, root,
-                               args.method, args.driver, str(args.repeats)],
+    if args.scene:
+        command = ["-c", SCENE_RUN, "ROOT", args.scene, str(args.repeats), *args.set]
+    else:
+        command = ["-c", ONE_RUN, "ROOT", args.method, args.driver, str(args.repeats)]
+    procs = [subprocess.Popen(["taskset", "-c", str(core), sys.executable,
+                               *[root if c == "ROOT" else c for c in command]],
                               cwd=root, stdout=subprocess.PIPE, text=True)
              for root, core in zip(roots, cores)]
     return [float(p.communicate()[0].split()[-1]) for p in procs]
@@ -58,6 +85,9 @@ def main() -> None:
     p.add_argument("--driver", choices=("lanes", "scalar"), default="lanes")
     p.add_argument("--repeats", type=int, default=40)
     p.add_argument("--pairs", type=int, default=2)
+    p.add_argument("--scene", help="time `sweep.run` of this built-in scene instead")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a scene override (with --scene), as `sweep run --set`")
     args = p.parse_args()
     roots = (str(Path(args.before).resolve()), str(Path(args.after).resolve()))
     before, after = [], []
@@ -67,7 +97,9 @@ def main() -> None:
             before.append(b)
             after.append(a)
     ratios = ", ".join(f"{a / b:.3f}" for a, b in zip(after, before))
-    print(f"{args.driver} {args.method}, 1 thread, best of {args.repeats} each run")
+    what = (f"{args.scene} {' '.join(args.set)}" if args.scene
+            else f"{args.driver} {args.method}")
+    print(f"{what}, 1 thread, best of {args.repeats} each run")
     print(f"before: best {min(before):.4f} s  runs {', '.join(f'{b:.4f}' for b in before)}")
     print(f"after:  best {min(after):.4f} s  runs {', '.join(f'{a:.4f}' for a in after)}")
     print(f"after / before: best {min(after) / min(before):.3f}; per pair {ratios}")
