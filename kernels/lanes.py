@@ -512,7 +512,7 @@ def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, para
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth,
-                parametric, base, steady):
+                parametric, base, steady, halt):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
 
@@ -523,6 +523,12 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     specialisation, compiled without the others' code. `base` likewise: None, or True when
     settings[BASE] is 1 (oscillator's base-excitation switch); `steady` True when
     settings[STOP_STEADY] is 1 (the early stop, trajectory.record_step).
+
+    halt (1,): once another thread sets halt[0] != 0 (an interrupt), the call returns after
+    the attempt in hand, the rows in flight left unsolved (their `states` untouched; a lane's
+    trajectory of several modes can last seconds, so waiting for them took up to 10 s). Each
+    row's state is written after all its other outputs, so a watcher reading `states` sees a
+    row's state only once the row is final.
     """
     L = LANES
     rtol = max(settings[RTOL], MIN_RTOL)
@@ -542,6 +548,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     n_run = min(L, hi - lo)   # lanes the vector loops cover: the active ones, rounded up to SIMD
                               # width (min() keeps it a run-time int: one compiled _prepare)
     while True:
+        if halt[0] != 0:
+            return                # an interrupt: the rows in flight are left unsolved
         _prepare(W, settings, n_run)
         top = 0
         for j in range(L):

@@ -600,14 +600,17 @@ def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, b
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
-                final, base, eighth, steady):
+                final, base, eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
     kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
     max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
-    failed: where a stepped sweep's next point starts). Releases the GIL (sweep.threads runs
-    blocks on threads)."""
+    failed: where a stepped sweep's next point starts). halt: as kernels.lanes.solve_block's
+    (an interrupt starts no further row). Releases the GIL (sweep.threads runs blocks on
+    threads)."""
     none = np.empty(0)
     for i in range(lo, hi):
+        if halt[0] != 0:
+            return
         states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
                                 modal[i], final[i], none, base, eighth, steady)
 

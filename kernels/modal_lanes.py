@@ -468,14 +468,15 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, final,
-                base, eighth, steady):
+                base, eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
     state). base: None, or True when settings[BASE] is 1; eighth: None, or True when
     settings[METHOD] is 1 (DOP853); steady: None, or True when settings[STOP_STEADY] is 1 (the
-    early stop). Releases the GIL (sweep.threads runs blocks
-    on threads)."""
+    early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows in flight
+    unsolved).
+    Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
     n = n_modes
     dim = 2 * n
@@ -531,6 +532,8 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     next_point = lo
     n_run = min(L, hi - lo)
     while True:
+        if halt[0] != 0:
+            return                # an interrupt: the rows in flight are left unsolved
         _prepare(W, H, FLAG, settings, n_run)
         top = 0
         for j in range(L):

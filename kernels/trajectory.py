@@ -475,9 +475,8 @@ def absolute_acceleration_at(acc, a, sa, p, o, s, t):
 
 
 PEAK_ITERATIONS = 6     # successive parabolas at most, refining an acceleration extremum
-PEAK_VALUE_TOL = 1e-8   # ... until one changes the extremum's value by less than this fraction
-                        # (the next would change it by ~1e-12 or less: far below the
-                        # interpolant's error)
+PEAK_VALUE_TOL = 1e-12  # ... until one changes the extremum's value by less than this fraction
+                        # (1e-8 stopped short: 6.5e-9 off at rtol 1e-10, measured)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

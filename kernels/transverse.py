@@ -262,7 +262,7 @@ def swept_outputs(p, o, s, settings, acc, buf, state, reals, envelope):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, parametric, base,
-                eighth, steady):
+                eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
@@ -272,10 +272,13 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, paramet
     settle_second_pass. base: oscillator's base-excitation switch, None or True (True when
     settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one); eighth
     likewise, True when settings[METHOD] is 1 (DOP853); steady, True when settings[STOP_STEADY]
-    is 1 (solver.stop_when_steady).
+    is 1 (solver.stop_when_steady). halt: as kernels.lanes.solve_block's (an interrupt starts
+    no further row).
     """
     none = np.empty(0)
     for i in range(lo, hi):
+        if halt[0] != 0:
+            return
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], none,
                                 parametric, base, eighth, steady)
 

@@ -9,10 +9,13 @@ took ~3 s on a cold cache), and a point's result never depends on the blocks or 
 threads.
 
 Blocks are also sized by time: once a thread has timed a block, its next one takes about
-BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points), so however slow the points, finished
-blocks come back every two seconds or sooner. A caller's `on_block(lo, hi)` hears of each one
-as soon as its rows are final (a checkpoint, a progress bar), and a `stop` event ends the solve
-after the blocks in hand (an interrupt).
+BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points). A block of slow points (several modes:
+64 of them took 17 s) is not waited for: a watcher thread looks every WATCH_SECONDS at the rows
+of the blocks in progress, and a caller's `on_block(lo, hi)` hears of rows as soon as they are
+final (a checkpoint, a progress bar), every WATCH_SECONDS or so, whatever the block. A `stop`
+event (an interrupt) reaches the kernels through their `halt` flag, which the watcher sets:
+they return at once (the lanes drivers) or before their next row (the scalar ones), the rows
+not finished left unsolved for a resume to compute.
 
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
 `kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one.
@@ -37,6 +40,7 @@ BLOCK_SECONDS = 2.0    # a timed block takes about this long on one thread (s)
 MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
                        # its end, which costs more the fewer points each lane gets)
 SOLO_BLOCK = 8192      # at most, on one thread (nothing to balance: fewer drains)
+WATCH_SECONDS = 0.25   # the watcher reports final rows and passes on an interrupt this often (s)
 
 
 def thread_count(threads: int = 0) -> int:
@@ -83,9 +87,11 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
-    called (from the thread that solved it) once rows lo..hi-1 are final; with `stop` set, no
-    new block starts and the call returns with the rows of the blocks it did not start unsolved
-    (on_block says which are solved).
+    called once rows lo..hi-1 are final, every row once, in order within a block (from the
+    solving thread or the watcher: `Watch`), within about WATCH_SECONDS of their turning so;
+    with `stop` set, no new block starts, the kernels stop within about WATCH_SECONDS (the
+    lanes drivers) or before their next row (the scalar ones), and the call returns with the
+    rows it did not finish unsolved (on_block says which are solved).
     """
     from sweep.kernels import lanes
     from sweep.kernels import metrics as mt
@@ -112,23 +118,25 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     elif driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
             call(tk.solve_block, params, settings, lo, hi, states, reals, counts, series,
-                 parametric, base, eighth, steady)
+                 parametric, base, eighth, steady, watch.halt)
     else:
         pi = True if settings[tk.CONTROLLER] != 0.0 else None
 
         def kernel(lo: int, hi: int) -> None:
             call(lanes.solve_block, params, settings, lo, hi, states, reals, counts, series,
-                 pi, eighth, parametric, base, steady)
+                 pi, eighth, parametric, base, steady, watch.halt)
 
     def solve_block(lo: int, hi: int) -> None:
+        watch.begin(lo, hi)
         kernel(lo, hi)
-        if np.any(states[lo:hi] == mt.SECOND_PASS):
+        if not watch.halted() and np.any(states[lo:hi] == mt.SECOND_PASS):
             call(tk.settle_second_pass, params[lo:hi], settings, states[lo:hi], reals[lo:hi],
                  counts[lo:hi], parametric, base, eighth, steady)
-        if on_block is not None:
-            on_block(lo, hi)
+        watch.end(lo)
 
-    run_blocks(solve_block, params.shape[0], threads, stop, one_at_a_time=swept)
+    watch = Watch(states, on_block, stop)
+    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+               tick=watch.tick)
 
 
 def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
@@ -159,6 +167,7 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
         raise ValueError("a swept base frequency takes driver 'scalar'")
 
     def solve_block(lo: int, hi: int) -> None:
+        watch.begin(lo, hi)
         if swept:
             for i in range(lo, hi):
                 call(modal_driver.solve_swept_block, params, n_modes,
@@ -166,17 +175,21 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
                      series, modal, final, envelope, base, eighth, steady)
         else:
             call(kernel.solve_block, params, n_modes, settings, lo, hi, states, reals,
-                 counts, series, modal, final, base, eighth, steady)
+                 counts, series, modal, final, base, eighth, steady, watch.halt)
+        if watch.halted():
+            watch.end(lo)                # the follow-up passes are left to a resume
+            return
         if np.any(states[lo:hi] == mt.OFF_MIDSPAN):
             call(modal_driver.judge_off_midspan, params[lo:hi], n_modes, settings,
                  states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth, steady)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
             call(modal_driver.settle_second_pass, params[lo:hi], n_modes, settings,
                  states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)
-        if on_block is not None:
-            on_block(lo, hi)
+        watch.end(lo)
 
-    run_blocks(solve_block, params.shape[0], threads, stop, one_at_a_time=swept)
+    watch = Watch(states, on_block, stop)
+    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+               tick=watch.tick)
 
 
 def method_switch(settings: np.ndarray) -> bool | None:
@@ -205,11 +218,34 @@ def swept_settings(settings: np.ndarray, durations: np.ndarray | None, i: int) -
 
 
 def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
-               stop: threading.Event | None, one_at_a_time: bool = False) -> None:
+               stop: threading.Event | None, one_at_a_time: bool = False,
+               tick: Callable[[], None] | None = None) -> None:
     """Run solve_block(lo, hi) over blocks covering rows 0..n-1 on `threads` threads (0: all),
     guided scheduling and timed blocks (module docstring); with `stop` set no new block starts.
     one_at_a_time: every block one row, a thread for every row (points that each take long:
-    a sine sweep's)."""
+    a sine sweep's). tick(): called every WATCH_SECONDS from a thread of its own while the
+    blocks run (`Watch.tick`)."""
+    if tick is None:
+        _run_blocks(solve_block, n, threads, stop, one_at_a_time)
+        return
+    done = threading.Event()
+
+    def watcher() -> None:
+        while not done.wait(WATCH_SECONDS):
+            tick()
+
+    watching = threading.Thread(target=watcher, name="cable-sweep-watch", daemon=True)
+    watching.start()
+    try:
+        _run_blocks(solve_block, n, threads, stop, one_at_a_time)
+    finally:
+        done.set()
+        watching.join()
+
+
+def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
+                stop: threading.Event | None, one_at_a_time: bool) -> None:
+    """`run_blocks` without the watcher."""
     per_thread = 1 if one_at_a_time else LANES_PER_THREAD
     n_threads = max(1, min(thread_count(threads), -(-n // per_thread)))
     stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
@@ -240,3 +276,55 @@ def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
         except BaseException:
             stop.set()
             raise
+
+
+class Watch:
+    """The rows of the blocks in progress, for a watcher thread: which are final (their state
+    written, >= 0: the kernels write a row's state after every other output of it, and rows
+    still NOT_SOLVED, SECOND_PASS or OFF_MIDSPAN are not), reported to on_block(lo, hi) in
+    order, each row once, whichever thread gets there first; and an interrupt (`stop`) passed
+    to the kernels through `halt`."""
+
+    def __init__(self, states: np.ndarray, on_block: Callable[[int, int], None] | None,
+                 stop: threading.Event | None) -> None:
+        from sweep.kernels import states as st
+        self.states, self.on_block = states, on_block
+        self.stop = stop or threading.Event()
+        self.halt = np.zeros(1, np.int8)     # read by the kernels between rows
+        self.lock = threading.Lock()
+        self.blocks: dict[int, list[int]] = {}   # a block's first row -> [its end, reported to]
+        self.not_solved = st.NOT_SOLVED
+
+    def begin(self, lo: int, hi: int) -> None:
+        """Rows lo..hi-1 start (from the solving thread)."""
+        self.states[lo:hi] = self.not_solved
+        with self.lock:
+            self.blocks[lo] = [hi, lo]
+
+    def end(self, lo: int) -> None:
+        """The block that starts at `lo` is done (its follow-up passes too): its final rows are
+        reported, and it is forgotten (from the solving thread)."""
+        with self.lock:
+            self._report(lo)
+            del self.blocks[lo]
+
+    def halted(self) -> bool:
+        """Whether an interrupt has reached the kernels."""
+        return bool(self.halt[0])
+
+    def tick(self) -> None:
+        """Pass an interrupt on to the kernels; report the rows that have turned final."""
+        if self.stop.is_set():
+            self.halt[0] = 1
+        with self.lock:
+            for lo in list(self.blocks):
+                self._report(lo)
+
+    def _report(self, lo: int) -> None:
+        hi, reported = self.blocks[lo]
+        pending = np.flatnonzero(self.states[reported:hi] < 0)
+        final = reported + int(pending[0] if pending.size else hi - reported)
+        if final > reported:
+            self.blocks[lo][1] = final
+            if self.on_block is not None:
+                self.on_block(reported, final)

@@ -18,7 +18,8 @@ import xarray as xr
 import sweep
 from sweep.cli import main as sweep_main
 
-from conftest import stderr_lines
+from conftest import fast_first, stderr_lines
+from sweep.kernels.states import NOT_SOLVED
 
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
@@ -303,7 +304,81 @@ def test_blocks_are_reported_once_each_and_stop_ends_the_solve(threads):
         solved[lo:hi] = True
     assert 0 < solved.sum() < 600
     np.testing.assert_array_equal(part["states"][solved], whole["states"][solved])
-    assert np.all(part["states"][~solved] == -1)
+    # rows never reached: untouched, or marked not solved where their block had begun
+    assert np.all(np.isin(part["states"][~solved], (-1, NOT_SOLVED)))
+
+
+SLOW_MODES = """
+name = "slow-blocks"
+[model]
+modes = 5
+[cable]
+youngs_modulus = 1.1e11
+density = 8900.0
+area = 6e-6
+inertia = 2.865e-12
+damping_ratio = 0.02
+[load]
+amplitude = 0.0
+[base]
+acceleration_g = 1.0
+[solver]
+t_end = 4.0
+rtol = 1e-9
+[axes]
+length = {{start = 0.4, stop = 0.8, num = 8}}
+base_frequency_ratio = {{start = 0.8, stop = 3.0, num = {n}}}
+"""
+
+
+@pytest.mark.parametrize("driver", fast_first(["lanes", "scalar"], "lanes"))
+def test_slow_blocks_report_rows_as_they_finish_and_an_interrupt_stops_inside_a_block(driver):
+    """Five modes on one thread: the first block is 64 slow points (MIN_TIMED_BLOCK; a block
+    of these took 17 s on harness-base-sine), so before, nothing was reported (stored) and an
+    interrupt was not heard until the block ended. The watcher reports rows within the block,
+    each once and in order, results equal to a run without it; with `stop` set at the first
+    report, the kernel returns within the block (the lanes: at once, their rows in flight
+    unsolved; the scalar driver before its next row), part of the block unsolved and what was
+    reported equal to the whole run's."""
+    import threading
+
+    from sweep.execute import modes_outputs
+    from sweep.models import transverse as tm
+    from sweep.threads import MIN_TIMED_BLOCK, solve_modes
+    n = MIN_TIMED_BLOCK // 8
+    inputs = tm.resolve(sweep.load_scene_text(SLOW_MODES.format(n=n)))
+    rows = tm.modal_rows(inputs, np.arange(8 * n))
+    s = inputs.settings
+
+    def run(**kwargs) -> dict:
+        out = modes_outputs(8 * n, 0, 5)
+        solve_modes(rows, 5, s, out["states"], out["reals"], out["counts"], out["series"],
+                    out["modal"], out["final"], driver=driver, threads=1, **kwargs)
+        return out
+
+    whole = run()
+    seen = []
+    got = run(on_block=lambda lo, hi: seen.append((lo, hi)))
+    assert len(seen) > 1, seen                         # within the one block
+    assert all(type(lo) is int and type(hi) is int for lo, hi in seen)   # the store's JSON
+    assert [lo for lo, _ in seen] == [0] + [hi for _, hi in seen[:-1]] and seen[-1][1] == 8 * n
+    for name in whole:
+        np.testing.assert_array_equal(got[name], whole[name], err_msg=name)
+
+    stop = threading.Event()
+    seen = []
+    part = run(stop=stop, on_block=lambda lo, hi: (seen.append((lo, hi)), stop.set()))
+    solved = seen[-1][1]
+    assert [lo for lo, _ in seen] == [0] + [hi for _, hi in seen[:-1]]
+    assert 0 < solved < 8 * n
+    for name in whole:
+        np.testing.assert_array_equal(part[name][:solved], whole[name][:solved], err_msg=name)
+    # past the reported rows: some left in flight (NOT_SOLVED); any that did finish out of
+    # order are left unreported (a resume computes them again), their results still the same
+    rest = part["states"][solved:]
+    assert np.any(rest == NOT_SOLVED)
+    done = np.flatnonzero(rest != NOT_SOLVED) + solved
+    np.testing.assert_array_equal(part["states"][done], whole["states"][done])
 
 
 def test_finished_blocks_reach_the_store_by_time_and_the_rest_is_computed_on_resume(tmp_path,

@@ -40,7 +40,8 @@ def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int)
            np.full((n, tk.N_COUNTS), -1, np.int64), np.full((n, n_samples), -1.0),
            np.full((n, n_modes), -1.0), np.full((n, 2 * n_modes), -1.0))
     call(driver.solve_block, rows, n_modes, s, 0, n, *out,
-         True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s))
+         True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
+         np.zeros(1, np.int8))
     return out
 
 
@@ -189,7 +190,7 @@ def test_a_block_inside_a_table_and_idle_lanes():
     whole = solve(modal_lanes, rows, n, s, n_samples)
     part = tuple(np.full_like(x, 7) for x in whole)
     call(modal_lanes.solve_block, rows, n, s, 5, 12, *part, True, method_switch(s),
-         early_stop(s))
+         early_stop(s), np.zeros(1, np.int8))
     for x, y in zip(whole, part):
         np.testing.assert_array_equal(y[5:12], x[5:12])
         assert np.all(y[:5] == 7) and np.all(y[12:] == 7)
