@@ -316,16 +316,17 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                 "finished chunks, in OUT.nc.chunks/, and 'sweep run ... -o OUT.nc --resume' "
                 "finishes it)")
     store = store_path(output)
+    how = ("interrupted" if getattr(exc, "signum", 2) == 2
+           else f"{signal.Signals(exc.signum).name} received")
     if not store.exists():
-        return ("interrupted before any chunk was kept (a stepped sweep, [continuation], keeps "
-                "none: its steps are solved in order); nothing kept, no output written")
+        return (f"{how} before any point was finished: nothing kept, no output written (a "
+                "first run compiles for a minute or so before it solves anything; run the "
+                "same command again)")
     words = list(sys.argv[1:] if argv is None else argv)
     command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
     kept = (f"{exc.kept:,} of {exc.total:,} {getattr(exc, 'unit', 'points')} are kept"
             if hasattr(exc, "kept")
             else "finished chunks are kept")
-    how = ("interrupted" if getattr(exc, "signum", 2) == 2
-           else f"{signal.Signals(exc.signum).name} received")
     return f"{how}: {kept} in {store}/; finish the run with: {command}"
 
 

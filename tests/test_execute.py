@@ -199,6 +199,21 @@ def test_ctrl_c_without_an_output_file_says_nothing_was_kept(capsys):
     assert "not kept" in line and "-o OUT.nc" in line and "--resume" in line
 
 
+def test_a_signal_before_anything_finished_says_so_whatever_the_scene(tmp_path):
+    """With -o but nothing finished yet (a first run still compiling): nothing kept, said
+    once, the signal named; not the old line blaming a stepped sweep."""
+    import signal as sig
+
+    from sweep.cli import _interrupted, _parser
+    from sweep.execute import RunInterrupted
+    out = str(tmp_path / "out.nc")
+    args = _parser().parse_args(["run", "harness-base-sine", "-o", out])
+    line = _interrupted(RunInterrupted(0, 533, None, sig.SIGTERM), args,
+                        ["run", "harness-base-sine", "-o", out])
+    assert line.startswith("SIGTERM received before any point was finished: nothing kept")
+    assert "stepped" not in line and "\n" not in line
+
+
 def _chunk_compiling_a_fresh_function(rows: np.ndarray, threads: int = 0) -> dict:
     """A chunk kernel whose first call compiles: a Numba function made anew (no cache)."""
     import numba
