@@ -61,8 +61,8 @@ ATOL_V = 22         # absolute tolerance on q' (m/s)
 ACC_AMP = 23        # max |q'' + a_b| over the tail window so far (m/s^2; base excitation only)
 # The last three step-end samples of the absolute acceleration (base excitation only), newest
 # first: sample k's fields at ACC_SAMPLES + k * SAMPLE_SIZE + (S_T, S_A, S_Q, S_V, S_F). A local
-# extremum among three consecutive steps' ends is refined on their quintic Hermite
-# interpolants (`refine_acceleration_peak`), which need q, q' and q'' at the three ends.
+# extremum among three consecutive steps' ends is refined on the polynomial through q, q' and q''
+# at the three ends (`samples_interpolant`, `refine_acceleration_peak`).
 ACC_SAMPLES = 24
 S_T = 0             # the step end's time (s)
 S_A = 1             # q'' + a_b there (m/s^2); NaN: no sample (not a consecutive step's end)
@@ -528,11 +528,22 @@ def refine_acceleration_peak(acc, a, sa, p, o, s):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def observe_tail_start(acc, p, o, s, t_tail):
+def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv):
     """The absolute acceleration |q'' + a_b| (m/s^2) where the tail window starts, at t_tail
-    (s) inside the last sampled step (the step-end samples and their refinement see only what
-    lies after it), on the samples' interpolant: into ACC_AMP. A trajectory's own
-    accumulator acc (record_step's); p[o + column * s] its row."""
+    (s) inside the step just sampled, from t (s) where the state was (q m, q' = v m/s,
+    q'' = fv m/s^2): the step-end samples and their refinement see only what lies after it.
+    Read on the samples' interpolant, into ACC_AMP. Where the middle sample is not that step's
+    start (the lanes sample only near the tail: a step that grew tenfold can straddle its start
+    unsampled before), the step's start becomes the middle sample, the oldest none. A
+    trajectory's own accumulator acc (record_step's); p[o + column * s] its row."""
+    middle = ACC_SAMPLES + SAMPLE_SIZE
+    if acc[middle + S_T] != t or math.isnan(acc[middle + S_A]):
+        acc[middle + S_T] = t
+        acc[middle + S_Q] = q
+        acc[middle + S_V] = v
+        acc[middle + S_F] = fv
+        acc[middle + S_A] = fv + base_acceleration(t, p, o, s, None)
+        acc[middle + SAMPLE_SIZE + S_A] = math.nan
     samples_interpolant(acc, 0, 1)
     at_start = absolute_acceleration_at(acc, 0, 1, p, o, s, t_tail)
     acc[ACC_AMP] = max(acc[ACC_AMP], abs(at_start))
@@ -614,6 +625,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     t_new = acc[T_NEW]
     q_old = acc[Q]
     v_old = acc[V]
+    fv_old = acc[FV]
     t_tail = acc[T_TAIL]
     bound = p[o + BOUND * s]
 
@@ -678,7 +690,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
         if acc[ACC_TURN] != 0.0:
             refine_acceleration_peak(acc, 0, 1, p, o, s)
         if t < t_tail <= t_new:
-            observe_tail_start(acc, p, o, s, t_tail)
+            observe_tail_start(acc, p, o, s, t_tail, t, q_old, v_old, fv_old)
 
     if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
