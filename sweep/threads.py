@@ -290,7 +290,8 @@ class Watch:
         from sweep.kernels import states as st
         self.states, self.on_block = states, on_block
         self.stop = stop or threading.Event()
-        self.halt = np.zeros(1, np.int8)     # read by the kernels between rows
+        self.halt = np.zeros(1, np.int8)     # read by the lanes drivers every attempt, the
+                                             # scalar ones between rows
         self.lock = threading.Lock()
         self.blocks: dict[int, list[int]] = {}   # a block's first row -> [its end, reported to]
         self.not_solved = st.NOT_SOLVED
