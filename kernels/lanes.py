@@ -368,7 +368,7 @@ def _observe_acceleration(W, settings, n_run):
     ordinary step (the flagged ones get it from record_step): the base-excitation metric, in
     a loop of its own so that `_finish` stays vectorised and scenes without base excitation
     do not pay for it. Returns how many lanes have an extremum to refine (ACC_TURN:
-    `_refine_acceleration`)."""
+    trajectory.refine_marked_lanes)."""
     L = LANES
     n_turns = 0
     for j in range(n_run):
@@ -380,16 +380,6 @@ def _observe_acceleration(W, settings, n_run):
                                        W[tj.T_TAIL * L + j], done)
         n_turns += 1 if turn else 0
     return n_turns
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def _refine_acceleration(W, n_run):
-    """trajectory.refine_acceleration_peak for the lanes `_observe_acceleration` left with
-    ACC_TURN (about two steps a period in the tail window)."""
-    L = LANES
-    for j in range(n_run):
-        if W[tj.ACC_TURN * L + j] != 0.0:
-            tj.refine_acceleration_peak(W, j, L, W, W_P * L + j, L)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -590,7 +580,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                                                parametric, base)
         if base is not None and n_near > 0:
             if _observe_acceleration(W, settings, n_run) > 0:
-                _refine_acceleration(W, n_run)
+                tj.refine_marked_lanes(W, L, W, W_P * L, n_run)
         if n_flagged == 0:
             continue
         if n_extrema > 0 and eighth is None:

@@ -321,16 +321,6 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     return n_flagged
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def _refine_acceleration(W, P1, n_run):
-    """trajectory.refine_acceleration_peak for the lanes whose ordinary step `_finish` left
-    with ACC_TURN (an extremum of the absolute midspan acceleration to refine)."""
-    L = LANES
-    for l in range(n_run):
-        if W[tj.ACC_TURN * L + l] != 0.0:
-            tj.refine_acceleration_peak(W, l, L, P1, l, L)
-
-
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
@@ -474,9 +464,8 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
     state). base: None, or True when settings[BASE] is 1; eighth: None, or True when
     settings[METHOD] is 1 (DOP853); steady: None, or True when settings[STOP_STEADY] is 1 (the
-    early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows in flight
-    unsolved).
-    Releases the GIL (sweep.threads runs blocks on threads)."""
+    early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows
+    in flight unsolved). Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
     n = n_modes
     dim = 2 * n
@@ -579,7 +568,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                             n_run, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run)
         if base is not None:
-            _refine_acceleration(W, P1, n_run)
+            tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
         if n_flagged > 0:
             for j in range(n_run):
                 if FLAG[j] != 2.0:

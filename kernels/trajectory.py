@@ -528,6 +528,16 @@ def refine_acceleration_peak(acc, a, sa, p, o, s):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def refine_marked_lanes(W, L, p, p_first, n_run):
+    """`refine_acceleration_peak` for each of the first n_run lanes of a lock-step driver that
+    `observe_acceleration` marked (ACC_TURN), one by one, outside the vector loops: lane j's
+    accumulator at W[j + slot * L], its row at p[p_first + j + column * L]."""
+    for j in range(n_run):
+        if W[j + ACC_TURN * L] != 0.0:
+            refine_acceleration_peak(W, j, L, p, p_first + j, L)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv):
     """The absolute acceleration |q'' + a_b| (m/s^2) where the tail window starts, at t_tail
     (s) inside the step just sampled, from t (s) where the state was (q m, q' = v m/s,

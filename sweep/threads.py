@@ -129,14 +129,17 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     def solve_block(lo: int, hi: int) -> None:
         watch.begin(lo, hi)
         kernel(lo, hi)
-        if not watch.halted() and np.any(states[lo:hi] == mt.SECOND_PASS):
+        if watch.halted():
+            watch.end(lo)                # the follow-up pass is left to a resume
+            return
+        if np.any(states[lo:hi] == mt.SECOND_PASS):
             call(tk.settle_second_pass, params[lo:hi], settings, states[lo:hi], reals[lo:hi],
                  counts[lo:hi], parametric, base, eighth, steady)
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
     run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.tick)
+               tick=watch.ticker())
 
 
 def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
@@ -189,7 +192,7 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
 
     watch = Watch(states, on_block, stop)
     run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.tick)
+               tick=watch.ticker())
 
 
 def method_switch(settings: np.ndarray) -> bool | None:
@@ -289,6 +292,7 @@ class Watch:
                  stop: threading.Event | None) -> None:
         from sweep.kernels import states as st
         self.states, self.on_block = states, on_block
+        self.caller_stop = stop is not None
         self.stop = stop or threading.Event()
         self.halt = np.zeros(1, np.int8)     # read by the lanes drivers every attempt, the
                                              # scalar ones between rows
@@ -308,6 +312,11 @@ class Watch:
         with self.lock:
             self._report(lo)
             del self.blocks[lo]
+
+    def ticker(self) -> Callable[[], None] | None:
+        """`tick`, for run_blocks, where there is anyone to tell or anything to stop (a caller's
+        on_block or stop); None otherwise (a stepped sweep's dwells: no watcher thread)."""
+        return self.tick if self.on_block is not None or self.caller_stop else None
 
     def halted(self) -> bool:
         """Whether an interrupt has reached the kernels."""
