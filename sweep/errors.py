@@ -42,18 +42,22 @@ def escape(text: str) -> str:
 
 
 def _shorten(item: str, limit: int) -> str:
-    """An (escaped) item of at most about ``limit`` characters: its head, '...', its length."""
+    """An (escaped) item of at most about ``limit`` characters: its head, '...', its tail (a
+    path's tail is its file name), then its length."""
     if len(item) <= limit:
         return item
     quote = item[0] if item[0] in "'\"" and item[-1] == item[0] and len(item) > 1 else ""
     body = item[len(quote):len(item) - len(quote)]
-    return f"{quote}{body[:limit - 20]}...{quote} ({len(body):,} characters)"
+    head = (limit - 20) // 3
+    tail = limit - 20 - head
+    return f"{quote}{body[:head]}...{body[-tail:]}{quote} ({len(body):,} characters)"
 
 
 def one_line(message: object) -> str:
     """A message as one safe, short line: non-printable characters escaped (`escape`), each
-    quoted item or word longer than MAX_QUOTED characters cut to its head with '...' and its
-    full length, and the whole at most about MAX_LINE characters (head and tail kept)."""
+    quoted item or word longer than MAX_QUOTED characters cut to its head and its longer tail
+    with '...' between and its full length, and the whole at most about MAX_LINE characters
+    (head and tail kept)."""
     text = escape(" ".join(str(message).replace("\r\n", "\n").split("\n")))
     if len(text) > MAX_QUOTED:
         text = _ITEM.sub(lambda m: _shorten(m.group(0), MAX_QUOTED), text)

@@ -520,3 +520,15 @@ def test_a_scene_name_with_terminal_codes_is_escaped_in_the_summary(workdir, cap
                  "--set", "solver.t_end=0.05"]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "fig\\x1b[2J5: 4 points" in out, out
+
+
+def test_a_long_path_in_an_error_line_keeps_its_file_name(tmp_path, workdir, capsys):
+    """A path longer than the line quotes whole is cut in its middle: the file name at its end
+    stays readable (a deep temporary folder once hid it)."""
+    deep = tmp_path.joinpath(*(["a-rather-long-folder-name"] * 6))
+    deep.mkdir(parents=True)
+    scene = deep / "the-scene-saved-as-latin-1.toml"
+    scene.write_bytes("name = 'caf\u00e9'\n".encode("latin-1"))
+    line = run_in_process(["run", str(scene)], ["the-scene-saved-as-latin-1.toml", "UTF-8",
+                                                 "characters)"], workdir, capsys)
+    assert len(line) < 400, line
