@@ -44,6 +44,7 @@ from bench_common import markdown_table  # noqa: E402
 
 import sweep  # noqa: E402
 from sweep.kernels import layout as tk  # noqa: E402
+from sweep.models.basis import pinned_sines  # noqa: E402
 from sweep.models import transverse as tm  # noqa: E402
 from sweep.threads import solve_modes  # noqa: E402
 
@@ -98,7 +99,8 @@ def solve(driver: str, rows: np.ndarray, n: int, s: np.ndarray, threads: int) ->
     modal_amp = np.empty((m, n))
     final = np.empty((m, 2 * n))
     began = time.perf_counter()
-    solve_modes(rows, n, s, states, reals, counts, series, modal_amp, final, driver=driver,
+    solve_modes(rows, pinned_sines(n).kernel_arrays(), s, states, reals, counts, series,
+                modal_amp, final, driver=driver,
                 threads=threads)
     return time.perf_counter() - began, counts
 

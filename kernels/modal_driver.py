@@ -6,7 +6,7 @@ whole state (the tableaux of kernels.dopri5 and kernels.dop853, looped over as S
 the attempts are those of solve_ivp on the same system.
 
 The metrics are the one-mode trajectory's (kernels.trajectory, the same accumulator and the
-same Observer) applied to the midspan deflection q_mid = sum q_n sin(n pi / 2): every
+same Observer) applied to the midspan deflection q_mid = sum q_n phi_n(1/2): every
 Runge-Kutta stage, solution and dense output is linear in the state, so the step's stage
 derivatives projected on q_mid (K_mid) are exactly the stages of q_mid, and its interpolants
 (RK45's quartic, DOP853's quintic Hermite) are exactly those of q_mid. On top, each mode's
@@ -178,7 +178,7 @@ def modal_size(n_modes):
     amplitude max |q_n| over the tail window (slots 0..N-1, m), each mode's peak max |q_n| at
     the accepted steps' ends over the whole run (N..2N-1, m), the largest deflection over
     the span in the tail window (slot 2N, m; `_observe_span`) and the mode shapes at its
-    place x*, sin(n pi x* / l) (2N + 1..3N; the midspan's until the tail window starts)."""
+    place x*, phi_n(x* / l) (2N + 1..3N; the midspan's until the tail window starts)."""
     return 3 * n_modes + 1
 
 
@@ -207,7 +207,7 @@ def _turns(r0, r1):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, stations, Qp):
+def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
     """The largest deflection over the span near the fraction x of the accepted step (every
     mode's interpolant in QA), into modal[2N] (m), and its place x* into modal's mode
     shapes: the span's maximum at x, at its place (modes.span_argmax), then at the instant
@@ -216,18 +216,18 @@ def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, stations, Qp):
     n = n_modes
     for c in range(n):
         qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
-    top, where = md.span_argmax(qx, n, stations)
+    top, where = md.span_argmax(qx, n, basis)
     best = where
     for _ in range(2):
         for c in range(n):
-            modal[2 * n + 1 + c] = math.sin((c + 1.0) * math.pi * where)
+            modal[2 * n + 1 + c] = md.shape_at(basis[4], c, where)[0]
         r0, r1 = _project_rate(y, y_new, QA, modal, n, Qp)
         if not _turns(r0, r1):
             break
         x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
         for c in range(n):
             qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
-        value, where = md.span_argmax(qx, n, stations)
+        value, where = md.span_argmax(qx, n, basis)
         if value > top:
             top = value
             best = where
@@ -237,19 +237,19 @@ def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, stations, Qp):
         best = -1.0
     if best >= 0.0:
         for c in range(n):
-            modal[2 * n + 1 + c] = math.sin((c + 1.0) * math.pi * best)
+            modal[2 * n + 1 + c] = md.shape_at(basis[4], c, best)[0]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
-                   stations, Qp):
+                   basis, Qp):
     """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each
     mode's peak at the step's end; in the tail window each mode's tail amplitude max |q_i|
     (the step's end, the tail's start inside the step, and an extremum of q_i inside the
     step, on its own interpolant) and the span's largest deflection at those instants (the
     tail's start and every mode's extremum: where the span's maximum in time lies, to second
     order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every mode's
-    interpolant, scratch; qx (N), Qp (2, terms): scratch; stations: modes.span_stations(N).
+    interpolant, scratch; qx (N), Qp (2, terms): scratch; basis: the span's (kernels.modes).
     And where the deflection at the place x* of the largest so far turns inside the step (a
     crest there that no mode's extremum marks), the span there too."""
     n = n_modes
@@ -273,7 +273,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         _project_rate(y, y_new, QA, modal, n, Qp)    # the rate's interpolant at x*
         x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
         if t + x * h >= t_tail:
-            _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
+            _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
     if t < t_tail:                                   # the tail starts inside the step
         if not located:
             for c in range(n):
@@ -282,7 +282,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         x = (t_tail - t) / h
         for c in range(n):
             modal[c] = max(modal[c], abs(dopri5.dense_value(y[c], h, QA[c, 0], x)))
-        _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
+        _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
     for i in range(n):
         if not _turns(y[n + i], y_new[n + i]):
             continue
@@ -293,12 +293,12 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         x = dopri5.dense_root(y[n + i], h, QA[i, 1], 0.0, 0.0, 1.0)   # q_i' = 0
         if t + x * h >= t_tail:
             modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
-            _observe_span(y, y_new, h, QA, x, n, qx, modal, stations, Qp)
+            _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
-                  stations, Qp):
+                  basis, Qp):
     """After trajectory.record_step on the step [t, t_new]: where the early stop
     (solver.stop_when_steady) moved the tail window to start inside it (acc[T_TAIL] is no
     longer t_tail), each mode's tail amplitude and the span's restart there, as the midspan's
@@ -309,22 +309,22 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
         modal[i] = 0.0
     modal[2 * n_modes] = 0.0
     _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, QA,
-                   qx, stations, Qp)
+                   qx, basis, Qp)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def span_state(state, modal, y, n_modes, settings, reals, stations):
+def span_state(state, modal, y, n_modes, settings, reals, basis):
     """The state judged from the whole response, and reals[SPAN_MAX]: a point whose midspan
     deflection decayed (DECAYED) while some mode's tail amplitude exceeds settings[TOL] x the
     largest mode's peak has not decayed: a mode with a node at midspan (an even one) kept
     moving; it is left OFF_MIDSPAN for `judge_off_midspan`. reals[SPAN_MAX] = the largest
     deflection over the span in the tail window (m): modal[2N] (`_observe_modes`), the span
     at the final state y (a growing response peaks there) and at least the midspan
-    amplitude; NaN where the point failed. stations: modes.span_stations(N)."""
+    amplitude; NaN where the point failed. basis: the span's (kernels.modes)."""
     n = n_modes
     if state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS:
         return state
-    final = md.span_maximum(y, n, stations)
+    final = md.span_maximum(y, n, basis)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
     if state != mt.DECAYED:
         return state
@@ -338,15 +338,15 @@ def span_state(state, modal, y, n_modes, settings, reals, stations):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weights, stations,
+def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weights, basis,
           base):
     """Set up a trajectory at t = 0 from raw row `row` for both multi-mode drivers: the initial
     state y and f = f(0, y) (length 2N each, written here), SciPy's initial step, the watched
     deflection's accumulator acc (trajectory.begin; p1: `observer_row`; weights: the
-    deflection's mode weights, modes.midspan_weights for the midspan), the modes'
+    deflection's mode weights, the basis' midspan values for the midspan), the modes'
     accumulator modal (`modal_size`) and the divergence test of every mode at t = 0. pp, S, T:
-    the prepared row, the right-hand side's scratch and the tables (modes.prepare, scratch,
-    tables); stations: modes.span_stations(N)."""
+    the prepared row, the right-hand side's scratch and the basis' tables (modes.prepare,
+    scratch); basis: the span's (kernels.modes)."""
     n = n_modes
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
     t_end = settings[T_END]
@@ -371,8 +371,8 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     for i in range(n):
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
         modal[n + i] = abs(y[i])
-    modal[2 * n] = md.span_maximum(y, n, stations) if t_tail <= 0.0 else 0.0
-    midspan = md.midspan_weights(n)
+    modal[2 * n] = md.span_maximum(y, n, basis) if t_tail <= 0.0 else 0.0
+    midspan = basis[2]
     for i in range(n):
         modal[2 * n + 1 + i] = midspan[i]
     for i in range(n):
@@ -383,12 +383,12 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base,
-              eighth, steady, weights, stations):
+              eighth, steady, weights, basis):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the watched deflection's metrics
-    (kernels.trajectory's accumulator; weights: its mode weights, modes.midspan_weights for
-    the midspan) and the modes' accumulator (modal, `modal_size`, m; stations:
-    modes.span_stations(N)) on the fly; `track`, centre, thr_fixed, thr_rel and the switches
+    (kernels.trajectory's accumulator; weights: its mode weights, the basis' midspan values
+    for the midspan) and the modes' accumulator (modal, `modal_size`, m; basis:
+    the span's basis, kernels.modes) on the fly; `track`, centre, thr_fixed, thr_rel and the switches
     base, eighth (the method, as settings[METHOD]) and steady: as transverse.integrate.
     Returns (accumulator, extrema buffer, final state y)."""
     n = n_modes
@@ -398,9 +398,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     A = dop853.A if eighth else dopri5.A
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
-    T = md.tables(n)
+    T = basis[0]
     pp = np.empty(md.prepared_size(n))
-    md.prepare(row, n, pp)
+    md.prepare(row, n, pp, basis[3])
     S = md.scratch(pp, n, T)
     p1 = observer_row(row, n)
     K = np.empty((n_stages + 1, dim))
@@ -416,7 +416,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     acc = np.empty(tj.N_SLOTS)
     buf = tj.new_buffer()
 
-    start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, weights, stations, base)
+    start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, weights, basis, base)
     atol_q = acc[tj.ATOL_Q]
     atol_v = acc[tj.ATOL_V]
 
@@ -438,7 +438,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
             break
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
-                       stations, Qc)
+                       basis, Qc)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
             K_mid[j, 1] = _project(K[j], weights, n, n)
@@ -449,7 +449,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series, track,
                        centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
-                      stations, Qc)
+                      basis, Qc)
         for i in range(dim):
             y[i] = y_new[i]
         K[0, :] = K[n_stages, :]
@@ -458,17 +458,17 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def at_rest(row, n_modes, t, y, band, base):
+def at_rest(row, basis, t, y, band, base):
     """Whether the final state y at time t lies within `band` (m) of a stable equilibrium:
     per mode, linearised about the final q (stiffness k_i = -d q_i''/d q_i by a central
     difference), the equilibrium lies d_i = (restoring force_i) / k_i away and the motion about
     it has amplitude sqrt(d_i^2 + (q_i'/sqrt(k_i))^2); at rest when the root sum of squares of
     these over the modes is <= band. Any k_i <= 0: not at rest (kernels.transverse.at_rest
-    for one mode)."""
-    n = n_modes
-    T = md.tables(n)
+    for one mode). basis: the span's (kernels.modes)."""
+    n = basis[3].shape[1]
+    T = basis[0]
     pp = np.empty(md.prepared_size(n))
-    md.prepare(row, n, pp)
+    md.prepare(row, n, pp, basis[3])
     S = md.scratch(pp, n, T)
     z = np.empty(2 * n)
     f = np.empty(2 * n)
@@ -496,11 +496,12 @@ def at_rest(row, n_modes, t, y, band, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, n_modes, settings, reals, counts, series, modal, final, envelope, base,
+def solve_point(row, basis, settings, reals, counts, series, modal, final, envelope, base,
                 eighth, steady):
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
     mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
-    parameters give INVALID_INPUT, NaN metrics."""
+    parameters give INVALID_INPUT, NaN metrics. basis: the span's (kernels.modes)."""
+    n_modes = basis[3].shape[1]
     if not valid(row, n_modes):
         for j in range(N_REALS):
             reals[j] = math.nan
@@ -516,16 +517,14 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
             envelope[j] = math.nan
         return mt.INVALID_INPUT
     ext = np.empty(modal_size(n_modes))
-    stations = md.span_stations(n_modes)
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                            settings[TOL], series, ext, base, eighth, steady,
-                            md.midspan_weights(n_modes), stations)
-    resting = at_rest(row, n_modes, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
+                            settings[TOL], series, ext, base, eighth, steady, basis[2], basis)
+    resting = at_rest(row, basis, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(row, md.EXCITATION, 1, settings, acc, buf, state, reals, envelope)
     else:
-        state = span_state(state, ext, y, n_modes, settings, reals, stations)
+        state = span_state(state, ext, y, n_modes, settings, reals, basis)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for j in range(n_modes):
         modal[j] = math.nan if failed else ext[j]
@@ -535,24 +534,24 @@ def solve_point(row, n_modes, settings, reals, counts, series, modal, final, env
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, n_modes, settings, states, reals, counts, base, eighth,
+def settle_second_pass(params, basis, settings, states, reals, counts, base, eighth,
                        steady):
     """Finish the points left SECOND_PASS (at rest away from zero), as
     kernels.transverse.settle_second_pass does for one mode: integrate again to find the
     final midspan value, then track |q_mid - final| against the band."""
+    n_modes = basis[3].shape[1]
     done = 0
     modal = np.empty(modal_size(n_modes))
-    weights = md.midspan_weights(n_modes)
-    stations = md.span_stations(n_modes)
+    weights = basis[2]
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
         first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
-                                np.empty(0), modal, base, eighth, steady, weights, stations)
+                                np.empty(0), modal, base, eighth, steady, weights, basis)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
                                  np.empty(0), modal, base, eighth, steady, weights,
-                                 stations)
+                                 basis)
         reals[i, SETTLING] = second[tj.LAST_ABOVE]
         counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
         states[i] = mt.STEADY
@@ -561,7 +560,7 @@ def settle_second_pass(params, n_modes, settings, states, reals, counts, base, e
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, base, eighth,
+def judge_off_midspan(params, basis, settings, states, reals, counts, modal, base, eighth,
                       steady):
     """Finish the points a driver left OFF_MIDSPAN (`span_state`: the midspan deflection
     decayed while a mode with a node at midspan kept moving): integrate again watching the
@@ -569,10 +568,9 @@ def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, b
     its state, response period and settling time; the midspan's amplitude, peak and
     acceleration stay. A mode found at rest away from zero is STEADY (no settling time).
     Returns how many points it judged."""
-    n = n_modes
+    n = basis[3].shape[1]
     done = 0
     ext = np.empty(modal_size(n))
-    stations = md.span_stations(n)
     own_reals = np.empty(N_REALS)
     own_counts = np.empty(N_COUNTS, np.int64)
     for i in range(params.shape[0]):
@@ -586,8 +584,8 @@ def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, b
         weights[k] = 1.0
         acc, buf, y = integrate(params[i], n, settings, settings[WANT_SETTLING] != 0.0, 0.0,
                                 0.0, settings[TOL], np.empty(0), ext, base, eighth, steady,
-                                weights, stations)
-        resting = at_rest(params[i], n, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
+                                weights, basis)
+        resting = at_rest(params[i], basis, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
         state = classify_metrics(settings, acc, buf, own_reals, own_counts, base, resting)
         reals[i, PERIOD] = own_reals[PERIOD]
         reals[i, SETTLING] = own_reals[SETTLING]
@@ -599,27 +597,28 @@ def judge_off_midspan(params, n_modes, settings, states, reals, counts, modal, b
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
+def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, modal,
                 final, base, eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
     kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
     max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
-    failed: where a stepped sweep's next point starts). halt: as kernels.lanes.solve_block's
+    failed: where a stepped sweep's next point starts). basis: the span's mode shapes
+    (kernels.modes; N = its number of modes). halt: as kernels.lanes.solve_block's
     (an interrupt starts no further row). Releases the GIL (sweep.threads runs blocks on
     threads)."""
     none = np.empty(0)
     for i in range(lo, hi):
         if halt[0] != 0:
             return
-        states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
+        states[i] = solve_point(params[i], basis, settings, reals[i], counts[i], series[i],
                                 modal[i], final[i], none, base, eighth, steady)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_swept_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal,
+def solve_swept_block(params, basis, settings, lo, hi, states, reals, counts, series, modal,
                       final, envelope, base, eighth, steady):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope of the midspan deflection: envelope (n, n_bands) (m; n_bands may be 0)."""
     for i in range(lo, hi):
-        states[i] = solve_point(params[i], n_modes, settings, reals[i], counts[i], series[i],
+        states[i] = solve_point(params[i], basis, settings, reals[i], counts[i], series[i],
                                 modal[i], final[i], envelope[i], base, eighth, steady)

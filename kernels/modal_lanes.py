@@ -350,7 +350,7 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
-               series, modal, final, T, pp, yl, fl, stations, base):
+               series, modal, final, T, pp, yl, fl, basis, base):
     """Give lane j the trajectory of row `point`, set up by the scalar driver's own
     modal_driver.start (f(0), SciPy's initial step, the midspan accumulator, each mode's tail
     amplitude and divergence at t = 0). An invalid row is answered at once
@@ -371,7 +371,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
             final[point, c] = math.nan
         states[point] = mt.INVALID_INPUT
         return False
-    md.prepare(row, n, pp)
+    md.prepare(row, n, pp, basis[3])
     S = md.scratch(pp, n, T)
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
@@ -380,7 +380,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
         P1[c * L + j] = p1[c]
     mod = np.empty(MOD.shape[0])
     drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod,
-              md.midspan_weights(n), stations, base)
+              basis[2], basis, base)
     for c in range(dim):
         Y[c, j] = yl[c]
         K[0, c, j] = fl[c]
@@ -391,18 +391,18 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, series, modal,
-              final, buf, yl, ml, stations, base):
+              final, buf, yl, ml, basis, base):
     """Classify lane j's finished trajectory (row `point`) as modal_driver.solve_point does."""
     acc = W[j::LANES]
     tj.end_series(acc, series[point])
     for c in range(2 * n):
         yl[c] = Y[c, j]
-    resting = drv.at_rest(params[point], n, acc[tj.T], yl, settings[TOL] * acc[tj.TAIL_AMP],
-                          base)
+    resting = drv.at_rest(params[point], basis, acc[tj.T], yl,
+                          settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals[point], counts[point], base, resting)
     for c in range(MOD.shape[0]):
         ml[c] = MOD[c, j]
-    state = drv.span_state(state, ml, yl, n, settings, reals[point], stations)
+    state = drv.span_state(state, ml, yl, n, settings, reals[point], basis)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for c in range(n):
         modal[point, c] = math.nan if failed else MOD[c, j]
@@ -413,7 +413,7 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, buf, series, i,
-                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, stations,
+                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis,
                   Kmid, Qc, base, steady):
     """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
     modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
@@ -440,7 +440,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     for c in range(MOD.shape[0]):
         ml[c] = MOD[c, j]
     t_tail = acc[tj.T_TAIL]
-    drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, stations,
+    drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, basis,
                        Qc)
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
@@ -450,24 +450,25 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
                    0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx,
-                      stations, Qc)
+                      basis, Qc)
     for c in range(MOD.shape[0]):
         MOD[c, j] = ml[c]
     return True                  # (a midspan divergence moves on, as in the scalar driver)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series, modal, final,
+def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, modal, final,
                 base, eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
-    state). base: None, or True when settings[BASE] is 1; eighth: None, or True when
+    state). basis: the span's mode shapes (kernels.modes; N = its number of modes). base:
+    None, or True when settings[BASE] is 1; eighth: None, or True when
     settings[METHOD] is 1 (DOP853); steady: None, or True when settings[STOP_STEADY] is 1 (the
     early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows
     in flight unsolved). Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
-    n = n_modes
+    n = basis[3].shape[1]
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
     track = settings[WANT_SETTLING] != 0.0
@@ -478,9 +479,9 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     A = dop853.A if eighth else dopri5.A
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
-    T = md.tables(n)
+    T = basis[0]
     nodes = T.shape[2]
-    weights = md.midspan_weights(n)
+    weights = basis[2]
     W = np.zeros(tj.N_SLOTS * L)
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
@@ -491,7 +492,6 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
     KM = np.zeros((n_stages + 1, 2, L))
     QV = np.zeros((2, L))
     MOD = np.zeros((drv.modal_size(n), L))
-    stations = md.span_stations(n)
     PP = np.zeros((md.prepared_size(n), L))
     P1 = np.zeros(N_PARAMS * L)
     FLD = np.zeros((4, nodes, L))
@@ -540,14 +540,14 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     if step > 0.0:
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
-                              counts, series, modal, final, bufs[j], yl, ml, stations,
+                              counts, series, modal, final, bufs[j], yl, ml, basis,
                               base)
                     point[j] = -1
                 if next_point >= hi:
                     break
                 if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, MOD,
                               states, reals, counts, series, modal, final, T, pp, yl, fl,
-                              stations, base):
+                              basis, base):
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()
                     capacity[j] = bufs[j].shape[0]
@@ -578,7 +578,7 @@ def solve_block(params, n_modes, settings, lo, hi, states, reals, counts, series
                     capacity[j] = bufs[j].shape[0]
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
                                  weights, bufs[j], series, point[j], track, thr_rel, eighth,
-                                 n_stages, Kl, yl, ynl, ml, Km, QA, qx, stations, Kmid,
+                                 n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis, Kmid,
                                  Qc, base, steady):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)

@@ -122,20 +122,29 @@ def modes_outputs(n: int, n_samples: int, n_modes: int, n_bands: int = -1) -> di
             "final": np.empty((n, 2 * n_modes))}
 
 
-def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, n_modes: int,
+def modes_of(basis: tuple[np.ndarray, ...]) -> int:
+    """The number of modes of a basis as the kernels take it (sweep.models.basis
+    Basis.kernel_arrays(): its ratios, item 3, are (2, N))."""
+    return int(basis[3].shape[1])
+
+
+def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
+                basis: tuple[np.ndarray, ...],
                 driver: str = "lanes", n_bands: int = -1, per_point_end: bool = False,
                 threads: int = 0,
                 on_block: Callable[[int, int, dict], None] | None = None,
                 stop: threading.Event | None = None) -> dict[str, np.ndarray]:
     """The multi-mode kernel (kernels.modal_driver) over `params` rows (kernels.modes columns
-    for n_modes modes); outputs by name (`modes_outputs`); driver "lanes" or "scalar"
-    (threads.solve_modes); n_bands, per_point_end, on_block and stop as `transverse_chunk`'s."""
+    for the N modes of `basis`, the mode shapes as the kernels take them:
+    sweep.models.basis.Basis.kernel_arrays()); outputs by name (`modes_outputs`); driver
+    "lanes" or "scalar" (threads.solve_modes); n_bands, per_point_end, on_block and stop as
+    `transverse_chunk`'s."""
     from sweep.kernels import modes as md
 
     from .threads import solve_modes
-    out = modes_outputs(params.shape[0], n_samples, n_modes, n_bands)
+    out = modes_outputs(params.shape[0], n_samples, modes_of(basis), n_bands)
     report = None if on_block is None else (lambda lo, hi: on_block(lo, hi, out))
-    solve_modes(params, n_modes, settings, out["states"], out["reals"], out["counts"],
+    solve_modes(params, basis, settings, out["states"], out["reals"], out["counts"],
                 out["series"], out["modal"], out["final"], driver=driver, threads=threads,
                 on_block=report, stop=stop, envelope=out.get("envelope"),
                 durations=_ends(params, md.EXCITATION) if per_point_end else None)
@@ -590,8 +599,8 @@ def chunk_template(chunk_fn: Callable[..., dict], args: tuple) -> dict[str, np.n
         n_samples, n_bands = args[1], (args[3] if len(args) > 3 else -1)
         return transverse_outputs(0, n_samples, n_bands)
     if chunk_fn is modes_chunk:
-        n_samples, n_modes, n_bands = args[1], args[2], (args[4] if len(args) > 4 else -1)
-        return modes_outputs(0, n_samples, n_modes, n_bands)
+        n_samples, basis, n_bands = args[1], args[2], (args[4] if len(args) > 4 else -1)
+        return modes_outputs(0, n_samples, modes_of(basis), n_bands)
     if chunk_fn is stepped_chunk:
         kernel, kernel_args, dwells = args[0], args[1], args[2]
         return {k: np.empty((0, dwells) + v.shape[1:], v.dtype)

@@ -142,15 +142,17 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                tick=watch.ticker())
 
 
-def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: np.ndarray,
+def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.ndarray,
+                states: np.ndarray,
                 reals: np.ndarray, counts: np.ndarray, series: np.ndarray, modal: np.ndarray,
                 final: np.ndarray, *, driver: str = "lanes", threads: int = 0,
                 on_block: Callable[[int, int], None] | None = None,
                 stop: threading.Event | None = None, envelope: np.ndarray | None = None,
                 durations: np.ndarray | None = None) -> None:
-    """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for n_modes
-    modes in, the same outputs plus modal (n, n_modes), each mode's tail amplitude (m), and
-    final (n, 2 n_modes), the final state (m, m/s).
+    """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for the N
+    modes of `basis` in (the mode shapes as the kernels take them:
+    sweep.models.basis.Basis.kernel_arrays()), the same outputs plus modal (n, N), each mode's
+    tail amplitude (m), and final (n, 2 N), the final state (m, m/s).
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
     (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off. A swept base
     frequency takes the scalar driver, with envelope and durations as `solve_transverse`'s."""
@@ -173,20 +175,20 @@ def solve_modes(params: np.ndarray, n_modes: int, settings: np.ndarray, states: 
         watch.begin(lo, hi)
         if swept:
             for i in range(lo, hi):
-                call(modal_driver.solve_swept_block, params, n_modes,
+                call(modal_driver.solve_swept_block, params, basis,
                      swept_settings(settings, durations, i), i, i + 1, states, reals, counts,
                      series, modal, final, envelope, base, eighth, steady)
         else:
-            call(kernel.solve_block, params, n_modes, settings, lo, hi, states, reals,
+            call(kernel.solve_block, params, basis, settings, lo, hi, states, reals,
                  counts, series, modal, final, base, eighth, steady, watch.halt)
         if watch.halted():
             watch.end(lo)                # the follow-up passes are left to a resume
             return
         if np.any(states[lo:hi] == mt.OFF_MIDSPAN):
-            call(modal_driver.judge_off_midspan, params[lo:hi], n_modes, settings,
+            call(modal_driver.judge_off_midspan, params[lo:hi], basis, settings,
                  states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth, steady)
         if np.any(states[lo:hi] == mt.SECOND_PASS):
-            call(modal_driver.settle_second_pass, params[lo:hi], n_modes, settings,
+            call(modal_driver.settle_second_pass, params[lo:hi], basis, settings,
                  states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)
         watch.end(lo)
 

@@ -367,7 +367,7 @@ def test_slow_blocks_report_rows_as_they_finish_and_an_interrupt_stops_inside_a_
 
     def run(**kwargs) -> dict:
         out = modes_outputs(8 * n, 0, 5)
-        solve_modes(rows, 5, s, out["states"], out["reals"], out["counts"], out["series"],
+        solve_modes(rows, inputs.basis.kernel_arrays(), s, out["states"], out["reals"], out["counts"], out["series"],
                     out["modal"], out["final"], driver=driver, threads=1, **kwargs)
         return out
 

@@ -21,6 +21,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
 from sweep.models import transverse as tm
+from sweep.models.basis import pinned_sines
 from sweep.specialise import call
 from sweep.threads import early_stop, method_switch
 
@@ -39,7 +40,7 @@ def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int)
     out = (np.full(n, 99, np.int8), np.full((n, tk.N_REALS), -1.0),
            np.full((n, tk.N_COUNTS), -1, np.int64), np.full((n, n_samples), -1.0),
            np.full((n, n_modes), -1.0), np.full((n, 2 * n_modes), -1.0))
-    call(driver.solve_block, rows, n_modes, s, 0, n, *out,
+    call(driver.solve_block, rows, pinned_sines(n_modes).kernel_arrays(), s, 0, n, *out,
          True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
          np.zeros(1, np.int8))
     return out
@@ -189,7 +190,7 @@ def test_a_block_inside_a_table_and_idle_lanes():
     rows, n, s, n_samples = case_rows("n3-base-dop853")
     whole = solve(modal_lanes, rows, n, s, n_samples)
     part = tuple(np.full_like(x, 7) for x in whole)
-    call(modal_lanes.solve_block, rows, n, s, 5, 12, *part, True, method_switch(s),
+    call(modal_lanes.solve_block, rows, pinned_sines(n).kernel_arrays(), s, 5, 12, *part, True, method_switch(s),
          early_stop(s), np.zeros(1, np.int8))
     for x, y in zip(whole, part):
         np.testing.assert_array_equal(y[5:12], x[5:12])

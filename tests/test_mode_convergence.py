@@ -50,7 +50,9 @@ def _solve_modes(rows, n_modes, s):
     reals = np.empty((n, tk.N_REALS))
     counts = np.empty((n, tk.N_COUNTS), np.int64)
     modal_amp = np.empty((n, n_modes))
-    call(modal_driver.solve_block, rows, n_modes, s, 0, n, states, reals, counts,
+    from sweep.models.basis import pinned_sines
+    call(modal_driver.solve_block, rows, pinned_sines(n_modes).kernel_arrays(), s, 0, n,
+         states, reals, counts,
          np.empty((n, 0)), modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None,
          method_switch(s), early_stop(s), np.zeros(1, np.int8))
     return states, reals, counts, modal_amp

@@ -372,11 +372,12 @@ def test_span_maximum_is_the_dense_grids_maximum(n_modes):
     rng = np.random.default_rng(n_modes)
     x = np.linspace(0.0, 1.0, 200001)
     shapes = np.sin(np.outer(np.arange(1, n_modes + 1), x) * math.pi)
-    stations = md.span_stations(n_modes)
+    from sweep.models.basis import pinned_sines
+    basis = pinned_sines(n_modes).kernel_arrays()
     for _ in range(200):
         q = rng.normal(size=n_modes) * rng.choice([1e-6, 1e-3, 1.0], size=n_modes)
         grid = float(np.max(np.abs(q @ shapes)))
-        value = md.span_maximum(q, n_modes, stations)
+        value = md.span_maximum(q, n_modes, basis)
         miss = np.sum(np.abs(q) * (np.arange(1, n_modes + 1) * math.pi) ** 2) \
             * (0.5 * (x[1] - x[0])) ** 2 / 2
         assert grid * (1 - 1e-12) <= value <= grid + miss, (q, value, grid)

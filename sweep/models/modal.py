@@ -341,10 +341,11 @@ def _is_dataarray(value: Any) -> bool:
     return xr is not None and isinstance(value, xr.DataArray)
 
 
-def modal_frequencies(natural_frequency: Any, n_modes: int) -> xr.DataArray:
-    """n^2 f1 (Hz) for n = 1..n_modes on a dimension `mode`: the linear natural frequencies of
-    the unloaded span's modes (w_n = n^2 w1), natural_frequency being f1 (Hz, a float or a
+def modal_frequencies(natural_frequency: Any, ratios: np.ndarray) -> xr.DataArray:
+    """ratios[n - 1] f1 (Hz) for n = 1..N on a dimension `mode`: the linear natural frequencies
+    of the unloaded span's modes, ratios being a basis' w_n / w_p (pinned sines: n^2,
+    sweep/models/basis.py) and natural_frequency the pinned span's f1 (Hz, a float or a
     DataArray over some axes)."""
     import xarray as xr
-    n = xr.DataArray(np.arange(1, n_modes + 1), dims="mode")
-    return (n * n * natural_frequency).astype(float)
+    ratio = xr.DataArray(np.asarray(ratios, float), dims="mode")
+    return (ratio * natural_frequency).astype(float)

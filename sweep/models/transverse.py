@@ -27,6 +27,7 @@ from ..runner import RunOptions, check_memory, placer, point_order, solve_chunke
 from ..scene import Scene
 from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
 from . import excitation, modal
+from .basis import Basis, pinned_sines
 
 KIND = "transverse"
 MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
@@ -200,7 +201,8 @@ class Inputs:
     sample times (s; empty when none are stored); driver, method, controller: solver.driver,
     solver.method, solver.controller; wanted: the outputs.* switches that are on (dotted
     keys); has_base: the scene has base excitation; origin: its provenance; n_modes:
-    model.modes; modal_q0, modal_v0: the initial modal deflections (m) and velocities (m/s),
+    model.modes; basis: the span's mode shapes (sweep/models/basis.py; pinned sines);
+    modal_q0, modal_v0: the initial modal deflections (m) and velocities (m/s),
     n_modes scalars or axis parameters each (mode 1's from initial.displacement and
     initial.velocity, the others 0, unless the scene gives initial.modal_displacement or
     initial.modal_velocity); continuation, direction, jump_ratio: the stepped sweep's axis
@@ -223,6 +225,7 @@ class Inputs:
     has_base: bool
     origin: Provenance
     n_modes: int = 1
+    basis: Basis | None = None
     modal_q0: tuple = ()
     modal_v0: tuple = ()
     continuation: str | None = None
@@ -258,6 +261,7 @@ def resolve(scene: Scene) -> Inputs:
                   driver=scene.get("solver.driver"), method=scene.get("solver.method"),
                   controller=scene.get("solver.controller"), wanted=wanted,
                   has_base=scene.has_base, origin=provenance(scene), n_modes=n_modes,
+                  basis=pinned_sines(n_modes),
                   modal_q0=initial[0], modal_v0=initial[1],
                   continuation=scene.get("continuation.axis"),
                   direction=scene.get("continuation.direction"),
@@ -474,7 +478,7 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
         load_phase=md.LOAD_PHASE, base_omega=md.BASE_OMEGA, load_omega=md.OMEGA,
         final="final")
     return _System(lambda points: modal_rows(inputs, points), modes_chunk,
-                   (settings, n_samples, n, inputs.driver) + swept,
+                   (settings, n_samples, inputs.basis.kernel_arrays(), inputs.driver) + swept,
                    lambda m: modes_outputs(m, n_samples, n, n_bands), carry)
 
 
@@ -602,19 +606,20 @@ def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
 
 
 def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...],
-                  coeffs: dict[str, Any], coords: dict[str, xr.DataArray]
+                  coeffs: dict[str, Any], coords: dict[str, xr.DataArray], basis: Basis
                   ) -> dict[str, xr.DataArray]:
     """The outputs of a multi-mode run (docs/model.md sec. 7): modal_amplitude, each mode's
     max |q_n| over the tail window (m, over dims and `mode`; NaN where the point failed), and
-    modal_frequency, n^2 f1 (Hz, over `mode` and the axes f1 depends on)."""
+    modal_frequency, the basis' w_n / w_p times the pinned span's f1 (Hz, over `mode` and the
+    axes f1 depends on; pinned sines: n^2 f1)."""
     n_modes = amplitudes.shape[1]
     amplitude = xr.DataArray(amplitudes.reshape(shape + (n_modes,)), dims=dims + (MODE_DIM,),
                              attrs={"units": "m", "long_name": "modal amplitude: max |q_n| over "
-                                    "the tail window, q_n the coefficient of sin(n pi x/l)"})
+                                    f"the tail window, q_n the coefficient of {basis.mode_text}"})
     frequency = modal.modal_frequencies(derived(coeffs["natural_frequency"], coords),
-                                        n_modes).transpose(..., MODE_DIM)
+                                        basis.frequency_ratio).transpose(..., MODE_DIM)
     frequency.attrs = {"units": "Hz", "long_name": "linear natural frequency of mode n of the "
-                                                  "unloaded span, n^2 f1"}
+                                                  f"unloaded span, {basis.frequency_text}"}
     return {"modal_amplitude": amplitude, "modal_frequency": frequency}
 
 
@@ -700,7 +705,7 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                                              "long_name": long_name.format(method=short)})
     data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
     if result.modal is not None:
-        data.update(modal_outputs(result.modal, dims, shape, coeffs, coords))
+        data.update(modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis))
         if not inputs.swept and "outputs.amplitude" in inputs.wanted:
             data["max_deflection"] = xr.DataArray(
                 result.reals[:, tk.SPAN_MAX].reshape(shape), dims=dims,

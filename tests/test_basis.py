@@ -1,0 +1,143 @@
+"""The Galerkin basis (sweep/models/basis.py): the mode shapes the multi-mode kernels read.
+
+1. pinned sines: the closed-form basis against the shapes and integrals written out here;
+2. the general basis (beam-function shapes, Gauss-Legendre quadrature) against the textbook
+   clamped-clamped values (docs/model.md sec. 10: Thomson App. D, Rao Table 8.1);
+3. the kernels take any basis: the pinned span built through the general path (its tables by
+   quadrature, not closed forms) gives the closed-form basis' results, through the same
+   compiled driver (nothing in the kernels knows which basis they run).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import sweep
+from sweep.kernels import layout as tk
+from sweep.models import transverse as tm
+from sweep.models.basis import from_shapes, pinned_sines, shape_values
+from sweep.specialise import call
+from sweep.threads import early_stop, method_switch
+
+
+def test_pinned_sines_are_the_closed_forms():
+    """Tables, participations, frequencies, midspan and stations of N = 4 pinned sines against
+    sin(n pi s) and its derivatives written out here (numpy, not the basis' own loops)."""
+    n = 4
+    b = pinned_sines(n)
+    m = 3 * n + 1
+    xi = np.arange(1, m) * math.pi / m
+    k = np.arange(1, n + 1)[:, None]
+    expected = [k * np.cos(k * xi), -k ** 2 * np.sin(k * xi), -k ** 3 * np.cos(k * xi),
+                k ** 4 * np.sin(k * xi), 2.0 / m * np.sin(k * xi)]
+    for got, want in zip(b.tables, expected):
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
+    np.testing.assert_array_equal(b.midspan, [1.0, 0.0, -1.0, 0.0])      # exact zeros
+    np.testing.assert_array_equal(b.frequency_ratio, [1.0, 4.0, 9.0, 16.0])
+    np.testing.assert_allclose(b.participation_ratio, [1.0, 0.0, 1.0 / 3.0, 0.0], rtol=1e-15)
+    s = np.arange(b.stations.shape[0]) / (b.stations.shape[0] - 1)
+    np.testing.assert_allclose(b.stations, np.sin(np.outer(s, k[:, 0]) * math.pi), atol=1e-15)
+
+
+def test_beam_function_derivatives_are_the_shapes_slopes():
+    """shape_values' derivatives 1..4 against central differences of the order below, for a
+    shape using all four terms of the beam-function form."""
+    shapes = np.array([[7.2, 0.3, -1.1, 0.8, -0.6]])
+    s = np.linspace(0.05, 0.95, 19)
+    h = 1e-5
+    for order in range(1, 5):
+        fd = (shape_values(shapes, s + h, order - 1) - shape_values(shapes, s - h, order - 1)) / (2 * h)
+        exact = shape_values(shapes, s, order)
+        np.testing.assert_allclose(exact, fd, rtol=1e-7, atol=1e-7 * np.abs(exact).max())
+
+
+def clamped_mode_1() -> np.ndarray:
+    """The clamped-clamped first mode cosh(b s) - cos(b s) - sigma (sinh(b s) - sin(b s)),
+    written in the beam-function form (cosh and sinh as decaying exponentials), normalised to
+    1 at midspan; b l = 4.730040745, sigma = (cosh b - cos b) / (sinh b - sin b)."""
+    beta = 4.730040745
+    sigma = (math.cosh(beta) - math.cos(beta)) / (math.sinh(beta) - math.sin(beta))
+    # cosh x - sigma sinh x = (1 - sigma)/2 e^x + (1 + sigma)/2 e^-x, e^(b s) = e^b e^-(b(1-s))
+    row = np.array([[beta, -1.0, sigma, (1.0 + sigma) / 2.0,
+                     (1.0 - sigma) / 2.0 * math.exp(beta)]])
+    mid = shape_values(row, np.array([0.5]))[0, 0]
+    row[0, 1:] /= mid
+    return row
+
+
+def test_a_clamped_mode_by_quadrature_matches_the_textbook_values():
+    """docs/model.md sec. 10's table for the clamped-clamped first mode on l = 1 (normalised to
+    max |phi| = 1, at midspan): int phi^2 = 0.39648, int phi'^2 = 4.8777, G / int phi^2 =
+    1.3195, phi''(0) = 28.18, phi''(1/2) = -17.13, f1 / f1 pinned = 2.267; the clamped ends
+    hold phi = phi' = 0. Through from_shapes (Gauss-Legendre) and shape_values."""
+    row = clamped_mode_1()
+    ends = np.array([0.0, 1.0])
+    np.testing.assert_allclose(shape_values(row, ends), 0.0, atol=1e-9)
+    np.testing.assert_allclose(shape_values(row, ends, 1), 0.0, atol=1e-8)
+    b = from_shapes("clamped-clamped", row, 40)
+    x, w = np.polynomial.legendre.leggauss(40)
+    s, w = (x + 1) / 2, w / 2
+    phi = shape_values(row, s)[0]
+    slope = shape_values(row, s, 1)[0]
+    assert abs(phi ** 2 @ w - 0.39648) < 1e-5
+    assert abs(slope ** 2 @ w - 4.8777) < 1e-4
+    assert abs(b.participation_ratio[0] * 4 / math.pi - 1.3195) < 1e-4
+    assert abs(b.frequency_ratio[0] - 2.267) < 1e-3
+    curvature = shape_values(row, np.array([0.0, 0.5]), 2)[0]
+    assert abs(curvature[0] - 28.18) < 0.01 and abs(curvature[1] + 17.13) < 0.01
+    assert b.midspan[0] == pytest.approx(1.0, abs=1e-14)
+    # the kernel's fields are derivatives in xi = pi s
+    np.testing.assert_allclose(b.tables[1, 0], shape_values(row, s, 2)[0] / math.pi ** 2)
+
+
+MODES_SCENE = """
+name = "basis-check"
+[model]
+modes = 3
+membrane = 0.25
+[cable]
+damping_ratio = 0.02
+length = 0.3
+[load]
+amplitude = 0.0
+[base]
+acceleration_g = {level}
+frequency_ratio = {ratio}
+[solver]
+t_end = 0.4
+rtol = 1e-10
+"""
+
+
+@pytest.mark.parametrize("level, ratio", [(2.0, 0.7), (8.0, 1.05), (4.0, 2.8)])
+def test_the_driver_runs_a_quadrature_basis_as_it_runs_the_closed_form_one(level, ratio):
+    """Three modes of a base-excited, nonlinear span below, near and above its first resonance:
+    the pinned sines' closed-form basis against the same shapes given to the general path
+    (from_shapes: 24 Gauss-Legendre nodes, its own masses, participations and frequencies),
+    both through modal_driver.solve_block as compiled once. Modal amplitudes agree to 1e-9
+    relative (what round-off in a different quadrature makes of a trajectory at rtol 1e-10),
+    so a new basis needs no kernel code."""
+    from sweep.kernels import modal_driver
+    inputs = tm.resolve(sweep.load_scene_text(MODES_SCENE.format(level=level, ratio=ratio)))
+    rows = tm.modal_rows(inputs, np.arange(1))
+    s = inputs.settings
+    closed = pinned_sines(3)
+    general = from_shapes("pinned, by quadrature", closed.shapes, 24)
+    results = []
+    for basis in (closed, general):
+        states = np.empty(1, np.int8)
+        reals = np.empty((1, tk.N_REALS))
+        counts = np.empty((1, tk.N_COUNTS), np.int64)
+        modal = np.empty((1, 3))
+        call(modal_driver.solve_block, rows, basis.kernel_arrays(), s, 0, 1, states, reals,
+             counts, np.empty((1, 0)), modal, np.empty((1, 6)), True, method_switch(s),
+             early_stop(s), np.zeros(1, np.int8))
+        results.append((states[0], reals[0, tk.AMPLITUDE], modal[0]))
+    (s0, a0, m0), (s1, a1, m1) = results
+    assert s0 == s1
+    assert abs(a1 / a0 - 1) < 1e-9, (a0, a1)
+    assert abs(m1[0] / m0[0] - 1) < 1e-9 and abs(m1[2] / m0[2] - 1) < 1e-8, (m0, m1)
+    assert m1[1] < 1e-12 * m1[0] and m0[1] < 1e-12 * m0[0]        # the even mode stays at rest
