@@ -115,6 +115,14 @@ def _parser() -> argparse.ArgumentParser:
     design.add_argument("-o", "--output", metavar="OUT.nc",
                         help="netCDF file to write the spans to (atomically)")
     design.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    compile_ = sub.add_parser(
+        "compile", help="compile the kernels scenes need, ahead of their first run (after "
+                        "installing, in an image): a scene's first run then starts at once")
+    compile_.add_argument("scenes", nargs="*", metavar="SCENE",
+                          help="built-in scene names or .toml files (default: every built-in "
+                               "scene)")
+    compile_.add_argument("--set", dest="overrides", action="append", default=[],
+                          metavar="KEY=VALUE", help="override a dotted scene key, as for run")
     sub.add_parser("scenes", help="list the built-in scenes")
     keys = sub.add_parser("keys", help="every scene key: type, default, units, allowed values")
     keys.add_argument("which", nargs="?", default=None, metavar="SECTION | KEY",
@@ -270,6 +278,28 @@ def _design(args: argparse.Namespace) -> int:
     return 0
 
 
+def _compile(args: argparse.Namespace) -> int:
+    from . import builtin_scenes
+    from .scene import load_scene, parse_override
+    from .warmup import warm_up
+    overrides = dict(parse_override(item) for item in args.overrides)
+    names = args.scenes or list(builtin_scenes())
+    scenes = [load_scene(name, overrides=overrides) for name in names]   # every error first
+    from .numba_start import start_without_scipy
+    start_without_scipy()
+    for name, scene in zip(names, scenes):
+        started = time.perf_counter()
+        seconds = warm_up(scene)
+        shown = _one_line(name)
+        if seconds > 0.0:
+            print(f"{shown}: compiled in {seconds:.1f} s ({time.perf_counter() - started:.1f} s "
+                  "with its few points)", flush=True)
+        else:
+            print(f"{shown}: nothing to compile (every kernel it needs is in Numba's cache)",
+                  flush=True)
+    return 0
+
+
 def _scenes() -> int:
     from .scene import builtin_scenes
     scenes = builtin_scenes()
@@ -349,6 +379,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             from .execute import terminate_raises
             with terminate_raises():
                 return _modes(args)
+        if args.command == "compile":
+            return _compile(args)
         return _scenes()
     except UserError as exc:
         print(f"sweep: error: {_one_line(exc)}", file=sys.stderr)
