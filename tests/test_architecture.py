@@ -97,3 +97,31 @@ def test_importing_sweep_does_not_import_numba():
             "print(sorted(m for m in sys.modules if m == 'numba' or m.startswith('numba.')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", out.stdout
+
+
+def _sweep_graph() -> dict[str, set[str]]:
+    known = _modules(ROOT / "sweep", "sweep")
+    known.update(_modules(ROOT / "kernels", "sweep.kernels"))
+    return {name: _imports(name, path, known) for name, path in known.items()
+            if not name.startswith("sweep.kernels")}
+
+
+def test_the_layers_know_what_the_architecture_says_they_know():
+    """docs/architecture.md sec. 1: the runner knows no physics (no model, no kernel); the
+    execution layer holds each kernel family's chunk call but no model, except the stepped
+    sweep's line solver (models/continuation.py); the models are the only sweep modules that
+    read the Basis; scene/ takes its physics rules from the models (sweep.models.rules) and the
+    models read Scenes: the two packages import each other, with no module cycle."""
+    graph = _sweep_graph()
+    models = {n for n in graph if n.startswith("sweep.models")}
+    kernels = lambda deps: {d for d in deps if d.startswith("sweep.kernels")}  # noqa: E731
+    assert not graph["sweep.runner"] & models and not kernels(graph["sweep.runner"])
+    for layer in ("sweep.execute", "sweep.threads", "sweep.store", "sweep.dask_worker"):
+        assert graph[layer] & models <= {"sweep.models.continuation"}, (layer, graph[layer])
+    assert {n for n, deps in graph.items() if "sweep.models.basis" in deps} <= models
+    # the checks see what they check: the execution layer does import the line solver
+    assert "sweep.models.continuation" in graph["sweep.execute"]
+    scene_uses = set().union(*(graph[n] for n in graph if n.startswith("sweep.scene")))
+    assert "sweep.models.rules" in scene_uses
+    assert any("sweep.scene" in graph[n] or any(d.startswith("sweep.scene.") for d in graph[n])
+               for n in models)
