@@ -26,11 +26,11 @@ from __future__ import annotations
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
-from .specialise import call
+from .specialise import call, entry_point
 
 MIN_BLOCK = 128        # points per block, at least (smaller blocks leave lanes idle as they drain)
 MAX_BLOCK = 1024       # at most
@@ -40,6 +40,21 @@ BLOCK_SECONDS = 2.0    # a timed block takes about this long on one thread (s)
 MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
                        # its end, which costs more the fewer points each lane gets)
 SOLO_BLOCK = 8192      # at most, on one thread (nothing to balance: fewer drains)
+COMPILE_AHEAD = threading.Event()
+"""Set by sweep.warmup (`sweep compile`): the follow-up passes a block needs only when some
+point ends in a particular way (a second pass, a mode judged off midspan) are compiled even
+where no point needs them, so that a later run compiles nothing."""
+
+
+def _follow_up(kernel: Any, needed: bool, *args: Any) -> None:
+    """kernel(*args) through `call` where needed; otherwise, with COMPILE_AHEAD set, only its
+    entry point compiled (or loaded from the cache)."""
+    if needed:
+        call(kernel, *args)
+    elif COMPILE_AHEAD.is_set():
+        entry_point(kernel, *args)
+
+
 WATCH_SECONDS = 0.25   # the watcher reports final rows and passes on an interrupt this often (s)
 
 
@@ -132,9 +147,9 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         if watch.halted():
             watch.end(lo)                # the follow-up pass is left to a resume
             return
-        if np.any(states[lo:hi] == mt.SECOND_PASS):
-            call(tk.settle_second_pass, params[lo:hi], settings, states[lo:hi], reals[lo:hi],
-                 counts[lo:hi], parametric, base, eighth, steady)
+        _follow_up(tk.settle_second_pass, bool(np.any(states[lo:hi] == mt.SECOND_PASS)),
+                   params[lo:hi], settings, states[lo:hi], reals[lo:hi], counts[lo:hi],
+                   parametric, base, eighth, steady)
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
@@ -184,12 +199,13 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         if watch.halted():
             watch.end(lo)                # the follow-up passes are left to a resume
             return
-        if np.any(states[lo:hi] == mt.OFF_MIDSPAN):
-            call(modal_driver.judge_off_midspan, params[lo:hi], basis, settings,
-                 states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth, steady)
-        if np.any(states[lo:hi] == mt.SECOND_PASS):
-            call(modal_driver.settle_second_pass, params[lo:hi], basis, settings,
-                 states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)
+        off = bool(np.any(states[lo:hi] == mt.OFF_MIDSPAN))
+        _follow_up(modal_driver.judge_off_midspan, off, params[lo:hi], basis, settings,
+                   states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth,
+                   steady)
+        second = bool(np.any(states[lo:hi] == mt.SECOND_PASS))
+        _follow_up(modal_driver.settle_second_pass, second, params[lo:hi], basis, settings,
+                   states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)

@@ -7,9 +7,9 @@ values, so the scene's own run on a few of its points compiles and caches everyt
 run needs: run it after installing, in a container image or before a batch of jobs, and the
 first real run starts at once.
 
-Not compiled ahead: the follow-up passes a run only needs when some point ends in a particular
-way (the second pass of a point at rest away from zero, a mode judged off midspan); they are
-short and compile when first needed.
+The follow-up passes a run needs only when some point ends in a particular way (the second
+pass of a point at rest away from zero, a mode judged off midspan) are compiled too, needed or
+not (sweep.threads.COMPILE_AHEAD).
 """
 
 from __future__ import annotations
@@ -37,10 +37,16 @@ def reduced(scene: Scene) -> Scene:
 
 def warm_up(scene: Scene, threads: int | None = None) -> float:
     """Run `reduced(scene)` once and discard its result, so that Numba compiles (or loads)
-    every kernel the scene's run needs and keeps them in its cache. Returns the seconds spent
+    every kernel the scene's run needs, its follow-up passes included, and keeps them in its
+    cache. Returns the seconds spent
     compiling (0 when everything came from the cache)."""
     from .execute import announce_compilation
     from .run import run
-    with announce_compilation(False) as clock:
-        run(reduced(scene), threads=threads, progress=False)
+    from .threads import COMPILE_AHEAD
+    COMPILE_AHEAD.set()
+    try:
+        with announce_compilation(False) as clock:
+            run(reduced(scene), threads=threads, progress=False)
+    finally:
+        COMPILE_AHEAD.clear()
     return clock.seconds

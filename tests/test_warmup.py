@@ -50,6 +50,24 @@ def test_the_warm_up_runs_a_few_points_of_the_same_scene():
                                                               "damping_ratio": [0.01]}
 
 
+def test_the_warm_up_compiles_the_follow_up_passes_no_point_needed():
+    """paper-fig5's points are all steady about zero: none needs the second pass, yet the
+    warm-up compiles its entry point (and a plain run does not)."""
+    from sweep import specialise
+    from sweep.kernels import transverse
+    from sweep.warmup import warm_up
+
+    def second_pass_entries() -> int:
+        return sum(1 for kernel, _ in specialise._ENTRIES
+                   if kernel is transverse.settle_second_pass)
+
+    specialise._ENTRIES.clear()
+    sweep.run(reduced(sweep.load_scene("paper-fig5")), progress=False)
+    assert second_pass_entries() == 0
+    warm_up(sweep.load_scene("paper-fig5"))
+    assert second_pass_entries() == 1
+
+
 def test_compile_says_one_line_a_scene_and_refuses_a_bad_name_in_one_line(tmp_path):
     ok = sweep_cli(["compile", "paper-fig5"], tmp_path)
     assert ok.returncode == 0, ok.stderr
