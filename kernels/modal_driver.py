@@ -220,7 +220,7 @@ def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
     best = where
     for _ in range(2):
         for c in range(n):
-            modal[2 * n + 1 + c] = md.shape_at(basis[4], c, where)[0]
+            modal[2 * n + 1 + c] = md.shape_at(basis[md.SHAPES], c, where)[0]
         r0, r1 = _project_rate(y, y_new, QA, modal, n, Qp)
         if not _turns(r0, r1):
             break
@@ -237,7 +237,7 @@ def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
         best = -1.0
     if best >= 0.0:
         for c in range(n):
-            modal[2 * n + 1 + c] = md.shape_at(basis[4], c, best)[0]
+            modal[2 * n + 1 + c] = md.shape_at(basis[md.SHAPES], c, best)[0]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -372,7 +372,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
         modal[n + i] = abs(y[i])
     modal[2 * n] = md.span_maximum(y, n, basis) if t_tail <= 0.0 else 0.0
-    midspan = basis[2]
+    midspan = basis[md.MIDSPAN]
     for i in range(n):
         modal[2 * n + 1 + i] = midspan[i]
     for i in range(n):
@@ -387,9 +387,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the watched deflection's metrics
     (kernels.trajectory's accumulator; weights: its mode weights, the basis' midspan values
-    for the midspan) and the modes' accumulator (modal, `modal_size`, m; basis:
-    the span's basis, kernels.modes) on the fly; `track`, centre, thr_fixed, thr_rel and the switches
-    base, eighth (the method, as settings[METHOD]) and steady: as transverse.integrate.
+    for the midspan) and the modes' accumulator (modal, `modal_size`, m; basis: the span's,
+    kernels.modes) on the fly; `track`, centre, thr_fixed, thr_rel and the switches base,
+    eighth (the method, as settings[METHOD]) and steady: as transverse.integrate.
     Returns (accumulator, extrema buffer, final state y)."""
     n = n_modes
     dim = 2 * n
@@ -398,9 +398,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     A = dop853.A if eighth else dopri5.A
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
-    T = basis[0]
+    T = basis[md.TABLES]
     pp = np.empty(md.prepared_size(n))
-    md.prepare(row, n, pp, basis[3])
+    md.prepare(row, n, pp, basis[md.RATIOS])
     S = md.scratch(pp, n, T)
     p1 = observer_row(row, n)
     K = np.empty((n_stages + 1, dim))
@@ -465,10 +465,10 @@ def at_rest(row, basis, t, y, band, base):
     it has amplitude sqrt(d_i^2 + (q_i'/sqrt(k_i))^2); at rest when the root sum of squares of
     these over the modes is <= band. Any k_i <= 0: not at rest (kernels.transverse.at_rest
     for one mode). basis: the span's (kernels.modes)."""
-    n = basis[3].shape[1]
-    T = basis[0]
+    n = md.basis_modes(basis)
+    T = basis[md.TABLES]
     pp = np.empty(md.prepared_size(n))
-    md.prepare(row, n, pp, basis[3])
+    md.prepare(row, n, pp, basis[md.RATIOS])
     S = md.scratch(pp, n, T)
     z = np.empty(2 * n)
     f = np.empty(2 * n)
@@ -501,7 +501,7 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
     mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
     parameters give INVALID_INPUT, NaN metrics. basis: the span's (kernels.modes)."""
-    n_modes = basis[3].shape[1]
+    n_modes = md.basis_modes(basis)
     if not valid(row, n_modes):
         for j in range(N_REALS):
             reals[j] = math.nan
@@ -518,7 +518,8 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
         return mt.INVALID_INPUT
     ext = np.empty(modal_size(n_modes))
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                            settings[TOL], series, ext, base, eighth, steady, basis[2], basis)
+                            settings[TOL], series, ext, base, eighth, steady,
+                            basis[md.MIDSPAN], basis)
     resting = at_rest(row, basis, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
@@ -539,10 +540,10 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
     """Finish the points left SECOND_PASS (at rest away from zero), as
     kernels.transverse.settle_second_pass does for one mode: integrate again to find the
     final midspan value, then track |q_mid - final| against the band."""
-    n_modes = basis[3].shape[1]
+    n_modes = md.basis_modes(basis)
     done = 0
     modal = np.empty(modal_size(n_modes))
-    weights = basis[2]
+    weights = basis[md.MIDSPAN]
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
@@ -568,7 +569,7 @@ def judge_off_midspan(params, basis, settings, states, reals, counts, modal, bas
     its state, response period and settling time; the midspan's amplitude, peak and
     acceleration stay. A mode found at rest away from zero is STEADY (no settling time).
     Returns how many points it judged."""
-    n = basis[3].shape[1]
+    n = md.basis_modes(basis)
     done = 0
     ext = np.empty(modal_size(n))
     own_reals = np.empty(N_REALS)

@@ -371,7 +371,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
             final[point, c] = math.nan
         states[point] = mt.INVALID_INPUT
         return False
-    md.prepare(row, n, pp, basis[3])
+    md.prepare(row, n, pp, basis[md.RATIOS])
     S = md.scratch(pp, n, T)
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
@@ -380,7 +380,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
         P1[c * L + j] = p1[c]
     mod = np.empty(MOD.shape[0])
     drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod,
-              basis[2], basis, base)
+              basis[md.MIDSPAN], basis, base)
     for c in range(dim):
         Y[c, j] = yl[c]
         K[0, c, j] = fl[c]
@@ -468,7 +468,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows
     in flight unsolved). Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
-    n = basis[3].shape[1]
+    n = md.basis_modes(basis)
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
     track = settings[WANT_SETTLING] != 0.0
@@ -479,9 +479,9 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     A = dop853.A if eighth else dopri5.A
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
-    T = basis[0]
+    T = basis[md.TABLES]
     nodes = T.shape[2]
-    weights = basis[2]
+    weights = basis[md.MIDSPAN]
     W = np.zeros(tj.N_SLOTS * L)
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded

@@ -72,6 +72,20 @@ FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", 
                "bound", "q_scale", "v_scale", "participation", "load_phase") + ex.NAMES
 
 
+# The items of the `basis` tuple every modal kernel takes (module docstring).
+TABLES = 0          # (5, N, nodes): the shapes' derivatives at the nodes, projection weights
+STATIONS = 1        # (M + 1, N): the shapes at stations along the span
+MIDSPAN = 2         # (N,): phi_n(1/2)
+RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
+SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def basis_modes(basis):
+    """N, the number of modes of a basis tuple (callable from Python and from the kernels)."""
+    return basis[RATIOS].shape[1]
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def n_columns(n_modes):
     """Columns of a raw row for n_modes modes (callable from Python and from the kernels)."""
@@ -151,8 +165,8 @@ def span_argmax(q, n_modes, basis):
     interval. A value found, so never above the true maximum; the refinement makes it exact to
     round-off when the stations bracket the maximum's hump (tests/test_modes.py checks it
     against a dense grid)."""
-    stations = basis[1]
-    shapes = basis[4]
+    stations = basis[STATIONS]
+    shapes = basis[SHAPES]
     m = stations.shape[0] - 1
     best = 0.0
     where = 0.5

@@ -124,8 +124,9 @@ def modes_outputs(n: int, n_samples: int, n_modes: int, n_bands: int = -1) -> di
 
 def modes_of(basis: tuple[np.ndarray, ...]) -> int:
     """The number of modes of a basis as the kernels take it (sweep.models.basis
-    Basis.kernel_arrays(): its ratios, item 3, are (2, N))."""
-    return int(basis[3].shape[1])
+    Basis.kernel_arrays()), read as kernels.modes.basis_modes reads it."""
+    from sweep.kernels import modes as md
+    return int(basis[md.RATIOS].shape[1])
 
 
 def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,

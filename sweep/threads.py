@@ -18,7 +18,8 @@ they return at once (the lanes drivers) or before their next row (the scalar one
 not finished left unsolved for a resume to compute.
 
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
-`kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one.
+`kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one (or
+ahead of a run: COMPILE_AHEAD).
 """
 
 from __future__ import annotations
@@ -45,6 +46,8 @@ COMPILE_AHEAD = threading.Event()
 point ends in a particular way (a second pass, a mode judged off midspan) are compiled even
 where no point needs them, so that a later run compiles nothing."""
 
+WATCH_SECONDS = 0.25   # the watcher reports final rows and passes on an interrupt this often (s)
+
 
 def _follow_up(kernel: Any, needed: bool, *args: Any) -> None:
     """kernel(*args) through `call` where needed; otherwise, with COMPILE_AHEAD set, only its
@@ -53,9 +56,6 @@ def _follow_up(kernel: Any, needed: bool, *args: Any) -> None:
         call(kernel, *args)
     elif COMPILE_AHEAD.is_set():
         entry_point(kernel, *args)
-
-
-WATCH_SECONDS = 0.25   # the watcher reports final rows and passes on an interrupt this often (s)
 
 
 def thread_count(threads: int = 0) -> int:

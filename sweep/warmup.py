@@ -38,8 +38,7 @@ def reduced(scene: Scene) -> Scene:
 def warm_up(scene: Scene, threads: int | None = None) -> float:
     """Run `reduced(scene)` once and discard its result, so that Numba compiles (or loads)
     every kernel the scene's run needs, its follow-up passes included, and keeps them in its
-    cache. Returns the seconds spent
-    compiling (0 when everything came from the cache)."""
+    cache. Returns the seconds spent compiling (0 when everything came from the cache)."""
     from .execute import announce_compilation
     from .run import run
     from .threads import COMPILE_AHEAD

@@ -54,6 +54,20 @@ def test_beam_function_derivatives_are_the_shapes_slopes():
         np.testing.assert_allclose(exact, fd, rtol=1e-7, atol=1e-7 * np.abs(exact).max())
 
 
+def test_the_kernels_shapes_are_the_bases_shapes():
+    """The beam-function form is written twice, in NumPy for building a basis
+    (basis.shape_values) and in the kernels for the span's Newton step (modes.shape_at, no
+    NumPy import there): both agree on shapes using every term, to round-off, and shape_at's
+    are checked against central differences through shape_values above."""
+    from sweep.kernels import modes as md
+    shapes = np.array([[7.2, 0.3, -1.1, 0.8, -0.6], [3.0 * math.pi, 0.0, 1.0, 0.0, 0.0]])
+    for x in (0.0, 0.13, 0.5, 0.91, 1.0):
+        for i in range(2):
+            got = md.shape_at(shapes, i, x)
+            want = [shape_values(shapes, np.array([x]), k)[i, 0] for k in range(3)]
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13 * max(map(abs, want)))
+
+
 def clamped_mode_1() -> np.ndarray:
     """The clamped-clamped first mode cosh(b s) - cos(b s) - sigma (sinh(b s) - sin(b s)),
     written in the beam-function form (cosh and sinh as decaying exponentials), normalised to
