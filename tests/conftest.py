@@ -70,6 +70,14 @@ def paper_row():
                      omega=1.86 * np.pi, v0=0.0321, bound=l)
 
 
+TABLE1_CABLE = """youngs_modulus = 1.1e11
+density = 8900.0
+area = 6e-6
+inertia = 2.865e-12"""
+"""The paper's Table 1 cable (SI) as [cable] keys of a scene, with the bending moment of inertia
+of the solid round 6 mm^2 section (docs/model.md sec. 1): scene templates put it under [cable]."""
+
+
 COMPILE_LINES = ("compiling the Numba kernels", "compiled in ")
 """The lines a cold start prints on stderr, terminal or not (sweep.execute)."""
 

@@ -13,6 +13,7 @@ import xarray as xr
 from scipy.optimize import brentq
 
 import sweep
+from conftest import TABLE1_CABLE
 from sweep.cli import main
 from sweep.design import max_span, refine_span
 
@@ -31,10 +32,7 @@ coefficients = "consistent"
 membrane = {membrane}
 modes = 1
 [cable]
-youngs_modulus = 1.1e11
-density = 8900.0
-area = 6e-6
-inertia = 2.865e-12
+{table1}
 damping_ratio = 0.02
 {cable}
 [load]
@@ -71,8 +69,8 @@ def _run(tmp: Path, name: str, *, membrane: float = 0.0, cable: str = "",
          base: str = f"acceleration_g = {LEVEL_G}\nfrequency = {BASE_FREQUENCY}",
          axes: str, solver: str = "t_end = 5.0", output: bool = True) -> tuple[xr.Dataset, Path]:
     path = tmp / f"{name}.toml"
-    path.write_text(SCENE.format(name=name, membrane=membrane, cable=cable, base=base,
-                                 axes=axes, solver=solver))
+    path.write_text(SCENE.format(table1=TABLE1_CABLE, name=name, membrane=membrane,
+                                 cable=cable, base=base, axes=axes, solver=solver))
     out = tmp / f"{name}.nc"
     ds = sweep.run(sweep.load_scene(str(path)), output=out if output else None, progress=False)
     return ds, out

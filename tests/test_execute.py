@@ -18,7 +18,7 @@ import xarray as xr
 import sweep
 from sweep.cli import main as sweep_main
 
-from conftest import fast_first, stderr_lines
+from conftest import TABLE1_CABLE, fast_first, stderr_lines
 from sweep.kernels.states import NOT_SOLVED
 
 PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
@@ -328,10 +328,7 @@ name = "slow-blocks"
 [model]
 modes = 5
 [cable]
-youngs_modulus = 1.1e11
-density = 8900.0
-area = 6e-6
-inertia = 2.865e-12
+{cable}
 damping_ratio = 0.02
 [load]
 amplitude = 0.0
@@ -361,7 +358,7 @@ def test_slow_blocks_report_rows_as_they_finish_and_an_interrupt_stops_inside_a_
     from sweep.models import transverse as tm
     from sweep.threads import MIN_TIMED_BLOCK, solve_modes
     n = MIN_TIMED_BLOCK // 8
-    inputs = tm.resolve(sweep.load_scene_text(SLOW_MODES.format(n=n)))
+    inputs = tm.resolve(sweep.load_scene_text(SLOW_MODES.format(n=n, cable=TABLE1_CABLE)))
     rows = tm.modal_rows(inputs, np.arange(8 * n))
     s = inputs.settings
 

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import sweep
+from conftest import TABLE1_CABLE
 from sweep.kernels import layout as tk
 from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
@@ -51,10 +52,7 @@ name = "modal-lanes"
 [model]
 modes = {n}
 [cable]
-youngs_modulus = 1.1e11
-density = 8900.0
-area = 6e-6
-inertia = 2.865e-12
+{table1}
 damping_ratio = 0.02
 [solver]
 t_end = {t_end}
@@ -119,7 +117,7 @@ def case_rows(name: str) -> tuple[np.ndarray, int, np.ndarray, int]:
     in the middle of the block."""
     n, method, series, settling, rtol, t_end, axes = CASES[name]
     q0 = [1e-4 * (-0.5) ** i for i in range(n)]
-    text = CABLE.format(n=n, t_end=t_end, rtol=rtol, method=method,
+    text = CABLE.format(table1=TABLE1_CABLE, n=n, t_end=t_end, rtol=rtol, method=method,
                         series="true" if series else "false", q0=q0) + axes
     rows, s, n_samples = scene_rows(text, n)
     s[tk.WANT_SETTLING] = 1.0 if settling else 0.0
