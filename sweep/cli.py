@@ -354,9 +354,7 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                 "same command again)")
     words = list(sys.argv[1:] if argv is None else argv)
     command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
-    kept = (f"{exc.kept:,} of {exc.total:,} {getattr(exc, 'unit', 'points')} are kept"
-            if hasattr(exc, "kept")
-            else "finished chunks are kept")
+    kept = exc.kept_text() if hasattr(exc, "kept_text") else "finished chunks are kept"
     return f"{how}: {kept} in {store}/; finish the run with: {command}"
 
 

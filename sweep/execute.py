@@ -40,16 +40,24 @@ class RunInterrupted(KeyboardInterrupt):
     chunk store `store` (None when the run had no output file, so nothing was kept)."""
 
     def __init__(self, kept: int, total: int, store: Path | None,
-                 signum: int = signal.SIGINT, unit: str = "points") -> None:
+                 signum: int = signal.SIGINT, unit: str = "points", partway: int = 0) -> None:
         self.kept, self.total, self.store, self.signum = kept, total, store, signum
-        self.unit = unit
+        self.unit, self.partway = unit, partway
         if store is None:
             text = ("interrupted: results were not kept (a run with an output file keeps "
                     "every finished chunk, and resume=True finishes it)")
         else:
-            text = (f"interrupted: {kept:,} of {total:,} {unit} are kept in '{store}' "
+            text = (f"interrupted: {self.kept_text()} in '{store}' "
                     "(run again with resume=True to compute only the rest)")
         super().__init__(text)
+
+    def kept_text(self) -> str:
+        """'K of N points are kept' (and the lines kept part-way, their finished dwells)."""
+        if not self.partway:
+            return f"{self.kept:,} of {self.total:,} {self.unit} are kept"
+        return (f"{self.kept:,} of {self.total:,} {self.unit} are kept whole and "
+                f"{self.partway:,} part-way (a resumed line goes on from its last finished "
+                "dwell)")
 
 
 # --- chunk kernels (top-level functions: dask pickles them by name) -------------------------
@@ -152,10 +160,26 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     return out
 
 
+DWELLS_DONE, CARRIED = "dwells_done", "carried"    # a stepped chunk's progress, by line
+
+
+def _fits(resume: dict[str, np.ndarray], flat: dict[str, np.ndarray], m: int, width: int,
+          dwells: int) -> bool:
+    """Whether a stored progress holds exactly the arrays of this chunk of m lines (else its
+    lines start again)."""
+    want = {k: ((m, dwells) + v.shape[1:], v.dtype) for k, v in flat.items()}
+    want[DWELLS_DONE], want[CARRIED] = ((m,), np.dtype(np.int64)), ((m, width), np.dtype(float))
+    return (set(resume) == set(want)
+            and all(resume[k].shape == s and resume[k].dtype == t for k, (s, t) in want.items())
+            and bool(np.all((resume[DWELLS_DONE] >= 0) & (resume[DWELLS_DONE] <= dwells))))
+
+
 def stepped_chunk(lines: np.ndarray, kernel: Callable[..., dict], kernel_args: tuple,
                   dwells: int, orders: tuple, carry: Any, dwell: float, threads: int = 0,
                   on_block: Callable[[int, int, dict], None] | None = None,
-                  stop: threading.Event | None = None) -> dict[str, np.ndarray]:
+                  stop: threading.Event | None = None,
+                  on_progress: Callable[[Callable[[], tuple[dict, int, int]]], None] | None
+                  = None, resume: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
     """Stepped sweeps ([continuation], sweep/models/continuation.py) of whole lines: each row
     of `lines` is one line of `dwells` dwells in one direction, its direction's index into
     `orders` (the visiting orders of the dwells, continuation.dwell_order) in column 0, then
@@ -163,24 +187,61 @@ def stepped_chunk(lines: np.ndarray, kernel: Callable[..., dict], kernel_args: t
     `kernel` (transverse_chunk or modes_chunk, with kernel_args), the state and phases carried
     as `carry` says, dwell: the dwell time (s); the lines share `threads`. Returns the kernel's
     outputs with a dwell axis after the first: (lines, dwells, ...). A line is the unit of a
-    chunk (a dask task, a stored chunk): its dwells depend on each other. With `stop` set (an
-    interrupt) no new dwell starts, and an unfinished chunk reports nothing."""
+    chunk (a dask task, a stored chunk): its dwells depend on each other.
+
+    Progress within a chunk: after every dwell, on_progress(snapshot) hears that the lines
+    moved on; snapshot() returns a consistent copy of the outputs so far with each line's
+    finished dwells (DWELLS_DONE) and what its next dwell starts from (CARRIED: state, base
+    and load phase), and the numbers of lines whole and part-way. `resume`, such a copy from
+    an interrupted run, starts each line where it stopped: the line's results are the same to
+    the bit. With `stop` set (an interrupt) no new dwell starts; on_block(0, m, outputs) is
+    called only when every line is whole."""
     from .models import continuation as ct
     from .threads import thread_count
     m = lines.shape[0]
     rows = lines[:, 1:].reshape(m * dwells, -1)
     flat = {k: np.empty((m * dwells,) + v.shape[1:], v.dtype)
             for k, v in chunk_template(kernel, kernel_args).items()}
+    done = np.zeros(m, np.int64)
+    carried = np.zeros((m, len(carry.state) + 2))
+    resumed = resume is not None and _fits(resume, flat, m, carried.shape[1], dwells)
+    if resumed:
+        done[:] = resume[DWELLS_DONE]
+        carried[:] = resume[CARRIED]
+        for k, v in flat.items():
+            v[:] = resume[k].reshape(v.shape)
     direction = lines[:, 0].astype(int)
     line_points = np.arange(m * dwells).reshape(m, dwells)
-    groups = [(line_points[direction == d], np.asarray(order), flat)
-              for d, order in enumerate(orders) if np.any(direction == d)]
+    groups = []
+    for d, order in enumerate(orders):
+        which = (direction == d) & (done < dwells)
+        if np.any(which):
+            groups.append(ct.Lines(line_points[which], np.asarray(order), flat, done[which],
+                                   carried[which] if resumed else None))
+    lock = threading.Lock()
+
+    def snapshot() -> tuple[dict, int, int]:
+        with lock:
+            arrays = {k: v.reshape((m, dwells) + v.shape[1:]).copy() for k, v in flat.items()}
+            arrays[DWELLS_DONE], arrays[CARRIED] = done.copy(), carried.copy()
+        whole = int(np.count_nonzero(arrays[DWELLS_DONE] == dwells))
+        return arrays, whole, int(np.count_nonzero(arrays[DWELLS_DONE] > 0)) - whole
+
+    def record(group: ct.Lines, points: np.ndarray, out: dict, count: np.ndarray,
+               carried_now: np.ndarray) -> None:
+        with lock:
+            ct.write_outputs(group, points, out, count, carried_now)
+            at = points // dwells
+            done[at], carried[at] = count, carried_now
+        if on_progress is not None:
+            on_progress(snapshot)
+
     whole = ct.solve_lines(rows, groups, carry, dwell,
                            lambda batch: kernel(batch, *kernel_args, threads=1),
-                           workers=thread_count(threads), stop=stop)
+                           workers=thread_count(threads), stop=stop, record=record)
     out = {k: v.reshape((m, dwells) + v.shape[1:]) for k, v in flat.items()}
     if on_block is not None and whole:
-        on_block(0, m, out)          # interrupted part-way, no line is whole: nothing to keep
+        on_block(0, m, out)          # interrupted part-way: the progress holds what was done
     return out
 
 
@@ -321,7 +382,8 @@ def missing_ranges(n: int, done: dict[tuple[int, int], dict],
 class _Keeper:
     """The finished, not yet saved blocks of the chunk in hand: saved to the store at the first
     block end FLUSH_SECONDS after the last save, and whatever is left when the chunk ends or the
-    run stops."""
+    run stops. A chunk of lines (a stepped sweep) reports its progress instead, as a snapshot
+    of its part-way lines, saved the same way as the chunk's progress file."""
 
     def __init__(self, store: ChunkStore | None, progress: Progress) -> None:
         self.store, self.progress = store, progress
@@ -329,18 +391,30 @@ class _Keeper:
         self.base = 0
         self.arrays: dict = {}
         self.pending: list[tuple[int, int]] = []
+        self.snapshot: Callable[[], tuple[dict, int, int]] | None = None
+        self.size = 0
         self.saved = 0                   # points saved to the store by this run
+        self.whole = self.partway = 0    # lines whole or part-way in the last progress saved
         self.flushed = time.perf_counter()
 
-    def begin(self, base: int) -> None:
-        self.base, self.arrays, self.pending = base, {}, []
+    def begin(self, base: int, size: int = 0) -> None:
+        self.base, self.arrays, self.pending, self.size = base, {}, [], size
+        self.snapshot, self.whole, self.partway = None, 0, 0
 
     def finished(self, lo: int, hi: int, arrays: dict) -> None:
         """Rows lo..hi-1 of the chunk in hand are final (called from the solving thread)."""
         with self.lock:
             self.arrays = arrays
             self.pending.append((lo, hi))
+            self.snapshot = None             # the chunk file supersedes its progress
             self.progress.advance(hi - lo)
+            if time.perf_counter() - self.flushed >= FLUSH_SECONDS:
+                self._flush()
+
+    def progressed(self, snapshot: Callable[[], tuple[dict, int, int]]) -> None:
+        """The chunk in hand moved on; snapshot() gives its progress (stepped_chunk)."""
+        with self.lock:
+            self.snapshot = snapshot
             if time.perf_counter() - self.flushed >= FLUSH_SECONDS:
                 self._flush()
 
@@ -354,6 +428,10 @@ class _Keeper:
                 self.store.save(self.base + lo, self.base + hi,
                                 {k: v[lo:hi] for k, v in self.arrays.items()})
                 self.saved += hi - lo
+            if self.snapshot is not None:
+                arrays, self.whole, self.partway = self.snapshot()
+                self.store.save_progress(self.base, self.base + self.size, arrays)
+                self.snapshot = None
         self.pending = []
         self.flushed = time.perf_counter()
 
@@ -456,7 +534,7 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
             backend: str = "threads", threads: int = 0, scheduler: str | None = None,
             workers: int = 0, progress: bool = False, announce: bool | None = None,
             store: ChunkStore | None = None, done: dict | None = None,
-            unit: str = "points") -> int:
+            partial: dict | None = None, unit: str = "points") -> int:
     """Solve points 0..n-1 (solve order) chunk by chunk; returns the number of points computed.
 
     rows_for(lo, hi) builds the kernel's parameter rows of a chunk just before it runs, so the
@@ -464,7 +542,9 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
     output arrays by name, and place(lo, hi, arrays) stores them. A chunk_fn that takes
     `on_block` and `stop` (transverse_chunk) reports its finished blocks and stops early when
     asked. Chunks in `done` (from a store) are placed, not computed; finished work is also
-    written to `store` (see FLUSH_SECONDS). Chunks have at most chunk_size points.
+    written to `store` (see FLUSH_SECONDS). Chunks have at most chunk_size points. `partial`
+    (from a store: (lo, hi) -> arrays) holds chunks of lines left part-way, which a chunk_fn
+    taking `resume` (stepped_chunk) continues on the threads backend.
     On Ctrl-C the run stops after the work in hand, saves it and raises RunInterrupted.
     When the dask cluster fails (a worker that keeps dying, a lost scheduler, a malformed
     result) the run stops with the finished chunks kept and raises one UserError line.
@@ -494,16 +574,16 @@ def execute(chunk_fn: Callable[..., dict], rows_for: Callable[[int, int], np.nda
                     failure = exc
             else:
                 _execute_threads(chunk_fn, rows_for, args, gaps, chunk_size, threads, keeper,
-                                 place, stop, clock)
+                                 place, stop, clock, partial or {})
     finally:
         keeper.flush()                   # what was finished when something went wrong
         bar.close()
     if failure is not None:
         raise UserError(_stopped_line(failure, n - todo + keeper.saved, n, store)) from None
     if stop.is_set():
-        raise RunInterrupted(n - todo + keeper.saved, n,
+        raise RunInterrupted(n - todo + keeper.saved + keeper.whole, n,
                              store.directory if store is not None else None,
-                             received[0] if received else signal.SIGINT, unit)
+                             received[0] if received else signal.SIGINT, unit, keeper.partway)
     return todo
 
 
@@ -512,22 +592,28 @@ def _split(gaps: list[tuple[int, int]], size: int) -> list[tuple[int, int]]:
 
 
 def _execute_threads(chunk_fn, rows_for, args, gaps, chunk_size, threads, keeper, place, stop,
-                     clock) -> None:
+                     clock, partial) -> None:
     """Chunks one after another in this process. A chunk_fn that reports blocks gets chunks of
     chunk_size; another gets chunks sized from its measured speed (compiling excluded) to take
-    about CHUNK_SECONDS, growing at most fourfold from one chunk to the next."""
+    about CHUNK_SECONDS, growing at most fourfold from one chunk to the next. A chunk_fn that
+    takes `resume` (stepped_chunk) reports its progress and resumes a chunk from the progress
+    in `partial` ((lo, hi) -> arrays, from the store) that an interrupted run left."""
     from .threads import thread_count
     streams = "on_block" in inspect.signature(chunk_fn).parameters
+    resumes = "resume" in inspect.signature(chunk_fn).parameters
     size = chunk_size if streams else min(chunk_size, FIRST_CHUNK * thread_count(threads))
     for a, b in gaps:
         lo = a
         while lo < b and not stop.is_set():
             hi = min(b, lo + size)
             rows = rows_for(lo, hi)
-            keeper.begin(lo)
+            keeper.begin(lo, hi - lo)
             if streams:
+                more = {}
+                if resumes:
+                    more = {"on_progress": keeper.progressed, "resume": partial.get((lo, hi))}
                 arrays = chunk_fn(rows, *args, threads=threads, on_block=keeper.finished,
-                                  stop=stop)
+                                  stop=stop, **more)
                 if stop.is_set():
                     return                   # partly solved: the keeper has the finished rows
                 keeper.flush()

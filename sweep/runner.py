@@ -187,17 +187,23 @@ def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
                                                      (os.cpu_count() or 1))
     store = None
     done: dict = {}
+    partial: dict = {}
     if options.output is not None:
         store = ChunkStore(options.output, options.fingerprint)
         done, chunk = store.open(options.resume, options.overwrite, chunk, points=n)
+        partial = store.progress(done)
         check_disk(store, sum(v.nbytes for v in outputs.values()) / max(n, 1))
     computed = execute(chunk_fn, lambda lo, hi: rows_at(order[lo:hi]), n, args,
                        placer(outputs, order),
                        chunk_size=chunk, backend=options.backend, threads=options.threads,
                        scheduler=options.scheduler, workers=options.workers,
                        progress=options.progress, announce=options.announce, store=store,
-                       done=done, unit=unit)
+                       done=done, partial=partial, unit=unit)
     if options.resume:
+        from .execute import DWELLS_DONE
+        partway = sum(int(np.count_nonzero(a[DWELLS_DONE] > 0)) for a in partial.values())
         sys.stderr.write(f"resumed: {n - computed:,} of {n:,} {unit} were already done, "
-                         f"{computed:,} computed\n")
+                         f"{computed:,} computed"
+                         + (f" ({partway:,} of them from where they stopped)" if partway
+                            else "") + "\n")
     return outputs

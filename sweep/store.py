@@ -1,7 +1,10 @@
 """The chunk store behind --resume: the finished chunks of one run, on disk next to the output.
 
 `<output>.chunks/` holds `run.json` (the run's fingerprint and chunk size), a `lock` file and
-one `chunk-LO-HI.npz` per finished range of points (solve order, LO..HI-1). Each chunk file
+one `chunk-LO-HI.npz` per finished range of points (solve order, LO..HI-1), and a
+`progress-LO-HI.npz` for a chunk of stepped-sweep lines left part-way (each line's finished
+dwells and what its next dwell starts from; replaced as the lines move on, removed when the
+chunk is stored whole). Each chunk file
 carries what proves it belongs: its range, the run's fingerprint and a SHA-256 checksum of its
 arrays (names, dtypes, shapes and bytes). On resume a chunk that is damaged (empty, truncated,
 a flipped byte) or foreign (another range's, another run's, a link) is left out and its points
@@ -41,6 +44,7 @@ from .files import free_bytes, fsync_directory, mib, write_temporary
 STORE_SUFFIX = ".chunks"
 _META = "__chunk__"                      # the array in each chunk file that says what it is
 _CHUNK = re.compile(r"chunk-(\d{12})-(\d{12})\.npz")
+_PROGRESS = re.compile(r"progress-(\d{12})-(\d{12})\.npz")
 _FULL = (errno.ENOSPC, errno.EDQUOT)
 
 # Stores this process holds the lock of: directory -> the open lock file's descriptor.
@@ -83,6 +87,7 @@ class ChunkStore:
         self.points = 0                  # the run's number of points (space estimates)
         self.stored = 0                  # points held by chunk files
         self.bytes_per_point = 0.0       # of a chunk file (bytes), once one is written
+        self._last_bytes = 0
         self._key = Path(os.path.abspath(self.directory))
 
     def exists(self) -> bool:
@@ -148,8 +153,7 @@ class ChunkStore:
                  chunk_size: int) -> tuple[dict[tuple[int, int], dict], int]:
         meta = self.directory / "run.json"
         if existed and not resume:
-            if not overwrite and any(_CHUNK.fullmatch(e.name)
-                                     for e in os.scandir(self.directory)):
+            if not overwrite and self._holds_work():
                 self.release()
                 raise UserError(f"chunk store '{self.directory}': left by an interrupted run "
                                 "(use --resume to finish it, or --overwrite to start again)")
@@ -175,6 +179,11 @@ class ChunkStore:
         done = self._load_chunks()
         self.stored = sum(hi - lo for lo, hi in done)
         return done, chunk_size
+
+    def _holds_work(self) -> bool:
+        """Whether the store holds a chunk file or a progress file."""
+        return any(_CHUNK.fullmatch(e.name) or _PROGRESS.fullmatch(e.name)
+                   for e in os.scandir(self.directory))
 
     def _clear(self) -> None:
         """Everything in the store but its lock (which this run holds)."""
@@ -205,12 +214,14 @@ class ChunkStore:
                 raise OSError(errno.EINVAL, "not a regular file")
             return fh.read()
 
-    def _load_chunks(self) -> dict[tuple[int, int], dict]:
-        """The chunks that prove they belong; the others are removed and said so in one line."""
-        done: dict[tuple[int, int], dict] = {}
+    def _load_chunks(self, pattern: re.Pattern = _CHUNK,
+                     done: dict | None = None) -> dict[tuple[int, int], dict]:
+        """The chunks (files named by `pattern`) that prove they belong and overlap none of
+        `done`; the others are removed and said so in one line."""
+        found: dict[tuple[int, int], dict] = {}
         bad: list[str] = []
         for entry in sorted(os.scandir(self.directory), key=lambda e: e.name):
-            match = _CHUNK.fullmatch(entry.name)
+            match = pattern.fullmatch(entry.name)
             if not match:
                 continue
             lo, hi = int(match[1]), int(match[2])
@@ -220,12 +231,12 @@ class ChunkStore:
             except _Bad as exc:
                 reason = str(exc)
             else:
-                if any(a < hi and lo < b for a, b in done):
+                if any(a < hi and lo < b for a, b in list(found) + list(done or {})):
                     reason = "overlaps another chunk"
                 elif self.points and hi > self.points:
                     reason = f"lies outside the {self.points:,} points"
                 else:
-                    done[(lo, hi)] = arrays
+                    found[(lo, hi)] = arrays
             if reason is not None:
                 bad.append(f"{entry.name} {reason}")
                 with contextlib.suppress(OSError):
@@ -236,7 +247,12 @@ class ChunkStore:
                              f"chunk file{'s' if len(bad) > 1 else ''} not used ({shown}); "
                              "their points are computed again\n")
             sys.stderr.flush()
-        return done
+        return found
+
+    def progress(self, done: dict[tuple[int, int], dict]) -> dict[tuple[int, int], dict]:
+        """The progress files (chunks of lines left part-way) that prove they belong and
+        overlap no finished chunk of `done`, by range; the others are removed (one line)."""
+        return self._load_chunks(_PROGRESS, done)
 
     def _load(self, path: Path, lo: int, hi: int) -> dict[str, np.ndarray]:
         """The arrays of chunk file `path` named for points lo..hi-1, or _Bad saying why not."""
@@ -276,14 +292,23 @@ class ChunkStore:
     def save(self, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> None:
         """Write points lo..hi-1's arrays as one chunk file, atomically and durably. A full
         disk raises UserError naming the store and the space the run still needs."""
+        self._save(self.directory / f"chunk-{lo:012d}-{hi:012d}.npz", lo, hi, arrays)
+        self.bytes_per_point = max(self.bytes_per_point, self._last_bytes / max(hi - lo, 1))
+        self.stored += hi - lo
+        for entry in os.scandir(self.directory):     # the chunk's progress, now superseded
+            match = _PROGRESS.fullmatch(entry.name)
+            if match and lo <= int(match[1]) and int(match[2]) <= hi:
+                with contextlib.suppress(OSError):
+                    os.unlink(entry.path)
+
+    def _save(self, path: Path, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> None:
         import io
         meta = json.dumps({"lo": lo, "hi": hi, "fingerprint": self.fingerprint,
                            "checksum": checksum(arrays)})
         buffer = io.BytesIO()
         np.savez(buffer, **arrays, **{_META: np.array(meta)})
         data = buffer.getvalue()
-        self.bytes_per_point = max(self.bytes_per_point, len(data) / max(hi - lo, 1))
-        path = self.directory / f"chunk-{lo:012d}-{hi:012d}.npz"
+        self._last_bytes = len(data)
         try:
             self._write_atomic(path, data)
         except OSError as exc:
@@ -296,7 +321,10 @@ class ChunkStore:
             raise UserError(f"chunk store '{self.directory}': a chunk could not be written "
                             f"({exc.strerror or exc}; the points already stored are kept, "
                             "run again with --resume)") from exc
-        self.stored += hi - lo
+
+    def save_progress(self, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> None:
+        """Write the progress of the part-way chunk of lines lo..hi-1 (replacing the last)."""
+        self._save(self.directory / f"progress-{lo:012d}-{hi:012d}.npz", lo, hi, arrays)
 
     def space_needed(self) -> float:
         """Bytes the chunks not yet stored need (an estimate from the chunks written so far;
@@ -322,8 +350,7 @@ class ChunkStore:
         fd = _HELD.get(self._key)
         if fd is None:
             return
-        if discard_empty and not any(_CHUNK.fullmatch(e.name)
-                                     for e in os.scandir(self.directory)):
+        if discard_empty and not self._holds_work():
             shutil.rmtree(self.directory, ignore_errors=True)
         _HELD.pop(self._key, None)
         os.close(fd)

@@ -341,9 +341,57 @@ def test_an_interrupt_stops_a_stepped_sweep_between_dwells():
                 "final": np.zeros((batch.shape[0], 2))}
 
     order = np.arange(dwells)
-    assert ct.solve_lines(rows, [(lines, order, outputs)], carry, 1.0, solve,
+    assert ct.solve_lines(rows, [ct.Lines(lines, order, outputs)], carry, 1.0, solve,
                           stop=stop) is False
     assert calls == [n_lines, n_lines]       # the dwell in hand finishes, no other starts
     calls.clear()
-    assert ct.solve_lines(rows, [(lines, order, outputs)], carry, 1.0, solve) is True
+    assert ct.solve_lines(rows, [ct.Lines(lines, order, outputs)], carry, 1.0, solve) is True
     assert len(calls) == dwells
+
+
+def test_lines_resumed_at_different_dwells_share_each_call_and_end_as_if_never_stopped():
+    """Resumed lines (begun, carried: a stored progress) go on from their own dwell, side by
+    side in one kernel call a dwell, each leaving when done; every dwell's outputs and the
+    final carried state equal those of the lines swept from the start."""
+    from sweep.models import continuation as ct
+    carry = ct.Carry(state=(0, 1), base_phase=2, load_phase=3, base_omega=4, load_omega=5,
+                     final="final")
+    dwells, n_lines = 5, 3
+    rng = np.random.default_rng(7)
+    rows = rng.normal(size=(n_lines * dwells, 6))
+    lines = np.arange(n_lines * dwells).reshape(n_lines, dwells)
+    order = np.array([4, 2, 0, 1, 3])
+
+    def solve(batch):          # a state map that depends on the row, the state and the phases
+        final = np.column_stack([0.5 * batch[:, 0] + batch[:, 2] * batch[:, 5],
+                                 np.sin(batch[:, 1]) + batch[:, 3]])
+        return {"states": np.zeros(batch.shape[0], np.int8), "final": final}
+
+    def outputs():
+        return {"states": np.zeros(n_lines * dwells, np.int8),
+                "final": np.full((n_lines * dwells, 2), np.nan)}
+
+    whole, kept = outputs(), []
+    assert ct.solve_lines(rows, [ct.Lines(lines, order, whole)], carry, 0.3, solve,
+                          record=lambda g, p, o, d, c: (ct.write_outputs(g, p, o, d, c),
+                                                        kept.append((p, d, c))))
+    begun = np.array([0, 2, 4])
+    carried = np.zeros((n_lines, 4))
+    for points, done, c in kept:               # what a progress file holds after those dwells
+        at = points // dwells
+        mine = done == begun[at]
+        carried[at[mine]] = c[mine]
+    resumed = outputs()
+    for line, b in enumerate(begun):           # the finished dwells, as a progress file keeps
+        done_points = lines[line, order[:b]]
+        resumed["final"][done_points] = whole["final"][done_points]
+    sizes = []
+
+    def counted(batch):
+        sizes.append(batch.shape[0])
+        return solve(batch)
+
+    assert ct.solve_lines(rows, [ct.Lines(lines, order, resumed, begun, carried)], carry, 0.3,
+                          counted)
+    assert sizes == [3, 2, 2, 1, 1]            # 5, 3 and 1 dwells left: line 3 leaves first
+    np.testing.assert_array_equal(resumed["final"], whole["final"])

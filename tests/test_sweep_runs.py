@@ -99,3 +99,56 @@ def test_an_interrupted_run_keeps_its_chunks_and_resumes_to_the_same_result(case
     assert f"2 of 6 {unit} were already done" in capsys.readouterr().err   # 3 spans x 2 ways
     with xr.open_dataset(out) as written:
         _same(written, whole)
+
+
+def test_a_stepped_run_stopped_mid_line_resumes_each_line_from_its_last_dwell(tmp_path,
+                                                                             monkeypatch,
+                                                                             capsys):
+    """An interrupt part-way along the lines keeps every finished dwell (the chunk's progress:
+    outputs, dwells done, the carried state and phases), and --resume goes on from there: it
+    solves only the dwells left, and the result is the same to the bit as a run never
+    stopped."""
+    import signal
+    scene = sweep.load_scene_text(STEPPED, overrides={"run.threads": 1})
+    whole = sweep.run(scene)
+    real = ex.transverse_chunk
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(args[0].shape[0])
+        out = real(*args, **kwargs)
+        if interrupt and len(calls) == 4:
+            signal.raise_signal(signal.SIGINT)   # as Ctrl-C: the dwell in hand finishes
+        return out
+
+    monkeypatch.setattr(ex, "transverse_chunk", counted)
+    out = tmp_path / "out.nc"
+    interrupt = True
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        sweep.run(scene, output=out)
+    assert not out.exists()
+    # one thread: the up lines (3 spans) ran 4 of their 6 dwells, the down lines none
+    assert calls == [3, 3, 3, 3]
+    assert "0 of 6 lines are kept whole and 3 part-way" in str(stopped.value)
+    assert [p.name.startswith("progress-") for p in (tmp_path / "out.nc.chunks").glob("*.npz")] \
+        == [True]
+    import shutil
+    shutil.copytree(tmp_path / "out.nc.chunks", tmp_path / "kept")
+    calls.clear()
+    interrupt = False
+    ds = sweep.run(scene, output=out, resume=True)
+    assert calls == [3, 3] + [3] * 6           # the up lines' last 2 dwells, then the down lines
+    _same(ds, whole)
+    assert not (tmp_path / "out.nc.chunks").exists()
+    # a damaged progress file is not trusted: said in one line, its lines solved again
+    out.unlink()
+    shutil.copytree(tmp_path / "kept", tmp_path / "out.nc.chunks")
+    progress = next((tmp_path / "out.nc.chunks").glob("progress-*.npz"))
+    progress.write_bytes(progress.read_bytes()[:-100])
+    calls.clear()
+    capsys.readouterr()
+    ds = sweep.run(scene, output=out, resume=True)
+    assert calls == [3] * 12
+    _same(ds, whole)
+    warned = [line for line in capsys.readouterr().err.splitlines() if "not used" in line]
+    assert len(warned) == 1 and progress.name in warned[0]

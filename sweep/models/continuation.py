@@ -15,7 +15,7 @@ steps), its phases from zero: there is no final state to carry on.
 
 The other axes stay parallel: the lines (every combination of the other axes' values) are
 dealt out to the threads, each sweeping its share through every dwell with one kernel call a
-dwell (`solve_continued`), so a 100-length x 400-frequency stepped map still uses every core.
+dwell (`solve_lines`), so a 100-length x 400-frequency stepped map still uses every core.
 Directions: "up" (increasing axis values),
 "down" (decreasing) or "both" (a `direction` dimension, up then down, each from the initial
 conditions). Results are stored in the axis's own order whatever the direction.
@@ -85,49 +85,63 @@ def _wrap(phase: np.ndarray) -> np.ndarray:
     return np.remainder(phase + math.pi, 2.0 * math.pi) - math.pi
 
 
-def solve_continued(rows: np.ndarray, shape: tuple[int, ...], axis: int,
-                    orders: list[np.ndarray], carry: Carry, dwell: float,
-                    solve: Callable[[np.ndarray], dict], outputs: list[dict[str, np.ndarray]],
-                    advance: Callable[[int], None] | None = None,
-                    workers: int = 1) -> list[dict[str, np.ndarray]]:
-    """Solve every grid point of `rows` (the raw rows of all points, grid C order, shape
-    (prod(shape), columns)) as stepped sweeps along dimension `axis` of the grid, one for each
-    visiting order of its indices in `orders` (`dwell_order`: up, down), filling the matching
-    `outputs` (grid order, first axis = points; the names `solve` returns).
+@dataclass
+class Lines:
+    """Lines swept in one order: `points` (lines, dwells) are point indices into the rows,
+    one line a row, its dwells along it; `order` the visiting order of the dwells
+    (`dwell_order`); `outputs` (by name, first axis = points) receive each dwell's results.
+    Resumed lines have `begun` (one per line) dwells of `order` done already and start from
+    `carried` (lines, len(state) + 2): each line's state, base phase and load phase after
+    them."""
+    points: np.ndarray
+    order: np.ndarray
+    outputs: dict[str, np.ndarray]
+    begun: np.ndarray | None = None
+    carried: np.ndarray | None = None
+
+
+# record(lines, points, out, done, carried): a dwell of some of `lines` (a Lines) finished at
+# `points` with kernel outputs `out`; `done` dwells of each of those lines are now finished
+# and `carried` is what their next dwell starts from (as Lines.carried).
+Record = Callable[[Lines, np.ndarray, dict, np.ndarray, np.ndarray], None]
+
+
+def write_outputs(lines: Lines, points: np.ndarray, out: dict, done: np.ndarray,
+                  carried: np.ndarray) -> None:
+    """The plain Record: a dwell's results into its lines' outputs."""
+    for name, values in out.items():
+        lines.outputs[name][points] = values
+
+
+def solve_lines(rows: np.ndarray, groups: list[Lines], carry: Carry, dwell: float,
+                solve: Callable[[np.ndarray], dict], workers: int = 1,
+                stop: threading.Event | None = None, record: Record = write_outputs) -> bool:
+    """Sweep every line of `groups` through its dwells; `rows` are the kernel rows of all
+    points (a line's initial conditions are those of its first dwell's row).
 
     solve(rows) runs the kernel on a batch of rows (on one thread) and returns its outputs by
-    name; dwell: the dwell time solver.t_end (s); advance(points): progress, called after each
-    dwell; workers: threads. The work is cut into tasks, a direction and a share of the lines
-    (every combination of the other axes' values) each, the lines dealt out in turn so that
-    the shares cost alike (a short span takes more steps than a long one); each task sweeps its
-    lines through all the dwells, so no thread waits for another between dwells. A line's
-    results do not depend on its share or on the number of threads."""
-    n_points = rows.shape[0]
-    lines = np.moveaxis(np.arange(n_points).reshape(shape), axis, -1).reshape(-1, shape[axis])
-    solve_lines(rows, [(lines, order, out) for order, out in zip(orders, outputs)], carry,
-                dwell, solve, advance, workers)
-    return outputs
-
-
-def solve_lines(rows: np.ndarray, groups: list[tuple[np.ndarray, np.ndarray, dict]],
-                carry: Carry, dwell: float, solve: Callable[[np.ndarray], dict],
-                advance: Callable[[int], None] | None = None, workers: int = 1,
-                stop: threading.Event | None = None) -> bool:
-    """`solve_continued`'s work: each group (lines, order, outputs) is a set of lines (point
-    indices into `rows`, one line a row, its dwells along it) swept in `order`, filling
-    `outputs` at those points. The groups' lines are cut into tasks that the threads share.
-    With `stop` set (an interrupt) no new dwell starts: the lines are left unfinished.
-    Returns whether every line ran all its dwells."""
-    n_lines = sum(g[0].shape[0] for g in groups)
+    name; dwell: the dwell time solver.t_end (s); workers: threads; record: where each dwell's
+    results go (write_outputs; a stepped chunk also keeps the lines' progress, to resume a
+    line part-way). The work is cut into tasks, a group and a share of its lines each, the
+    lines dealt out in turn so that the shares cost alike (a short span takes more steps than
+    a long one); each task sweeps its lines through all the dwells, so no thread waits for
+    another between dwells. A line's results do not depend on its share or on the number of
+    threads. With `stop` set (an interrupt) no new dwell starts: the lines are left
+    unfinished. Returns whether every line ran all its dwells."""
+    n_lines = sum(g.points.shape[0] for g in groups)
     # shares of at least one lanes group each: fewer lines than that a call leaves lanes idle,
     # and two such calls side by side took longer than one thread doing both (measured)
     per_group = max(1, min(n_lines // (MIN_SHARE * len(groups)), -(-workers // len(groups))))
-    tasks = [(order, lines[i::per_group], out) for lines, order, out in groups
-             for i in range(per_group) if lines[i::per_group].shape[0]]
+    tasks = []
+    for g in groups:
+        for i in range(per_group):
+            if g.points[i::per_group].shape[0]:
+                tasks.append(Lines(g.points[i::per_group], g.order, g.outputs,
+                                   *[None if a is None else a[i::per_group]
+                                     for a in (g.begun, g.carried)]))
 
-    def run(task) -> bool:
-        order, share, out = task
-        return _sweep_lines(rows, share, order, carry, dwell, solve, out, advance, stop)
+    def run(task: Lines) -> bool:
+        return _sweep_lines(rows, task, carry, dwell, solve, record, stop)
 
     if workers <= 1 or len(tasks) == 1:
         return all([run(task) for task in tasks])
@@ -136,34 +150,38 @@ def solve_lines(rows: np.ndarray, groups: list[tuple[np.ndarray, np.ndarray, dic
         return all([future.result() for future in [pool.submit(run, task) for task in tasks]])
 
 
-def _sweep_lines(rows: np.ndarray, lines: np.ndarray, order: np.ndarray, carry: Carry,
-                 dwell: float, solve: Callable[[np.ndarray], dict],
-                 outputs: dict[str, np.ndarray], advance: Callable[[int], None] | None,
+def _sweep_lines(rows: np.ndarray, lines: Lines, carry: Carry, dwell: float,
+                 solve: Callable[[np.ndarray], dict], record: Record,
                  stop: threading.Event | None = None) -> bool:
-    """The dwells of `lines` (point indices, one line a row, dwells along it) in `order`; with
+    """The dwells of `lines` not yet done, in its order, one kernel call a dwell for all the
+    lines (resumed lines at different dwells side by side, each leaving when done); with
     `stop` set, no further dwell. Returns whether the lines ran all their dwells."""
     columns = list(carry.state)
-    start = rows[lines[:, order[0]]][:, columns]       # the scene's initial conditions
-    state = start.copy()
-    phase_b = np.zeros(lines.shape[0])
-    phase_w = np.zeros(lines.shape[0])
-    for k in order:
+    points, order = lines.points, lines.order
+    n = points.shape[0]
+    first = rows[points[:, order[0]]][:, columns]      # the scene's initial conditions
+    begun = np.zeros(n, np.int64) if lines.begun is None else np.asarray(lines.begun, np.int64)
+    carried = np.column_stack([first, np.zeros(n), np.zeros(n)])
+    if lines.carried is not None:
+        carried[begun > 0] = lines.carried[begun > 0]
+    for step in range(len(order) - int(begun.min(initial=len(order)))):
         if stop is not None and stop.is_set():
             return False
-        points = lines[:, k]
-        batch = rows[points].copy()
+        active = np.flatnonzero(begun + step < len(order))
+        at = points[active, order[begun[active] + step]]
+        state, phase_b, phase_w = (carried[active, :-2], carried[active, -2],
+                                   carried[active, -1])
+        batch = rows[at].copy()
         batch[:, columns] = state
         batch[:, carry.base_phase] = phase_b
         batch[:, carry.load_phase] = phase_w
         out = solve(batch)
-        for name, values in out.items():
-            outputs[name][points] = values
         failed = np.isin(out["states"], FAILED)
-        state = np.where(failed[:, None], start, carry.final_state(out))
-        phase_b = np.where(failed, 0.0, _wrap(phase_b + batch[:, carry.base_omega] * dwell))
-        phase_w = np.where(failed, 0.0, _wrap(phase_w + batch[:, carry.load_omega] * dwell))
-        if advance is not None:
-            advance(points.size)
+        carried[active] = np.column_stack([
+            np.where(failed[:, None], first[active], carry.final_state(out)),
+            np.where(failed, 0.0, _wrap(phase_b + batch[:, carry.base_omega] * dwell)),
+            np.where(failed, 0.0, _wrap(phase_w + batch[:, carry.load_omega] * dwell))])
+        record(lines, at, out, begun[active] + step + 1, carried[active])
     return True
 
 
