@@ -30,9 +30,10 @@ from . import excitation as ex
 
 # The state table lives in kernels/states.py (no Numba: the sweep layer reads it); the kernels
 # import it from here.
-from .states import (COMPLETED, DECAYED, DIVERGED, INVALID_INPUT, LONGITUDINAL_STATES,  # noqa: F401
-                     MAX_STEPS, MODULATED, OFF_MIDSPAN, RUNNING, SECOND_PASS, STATE_MEANINGS,
-                     STEADY, STEP_TOO_SMALL, TRANSVERSE_STATES, UNSETTLED)
+from .states import (COMPLETED, DECAYED, DIVERGED, HIDDEN_MODE, INVALID_INPUT,  # noqa: F401
+                     LONGITUDINAL_STATES, MAX_STEPS, MODULATED, OFF_MIDSPAN, RUNNING,
+                     SECOND_PASS, STATE_MEANINGS, STEADY, STEP_TOO_SMALL, TRANSVERSE_STATES,
+                     UNSETTLED)
 
 # Extremum kinds in the extrema buffer.
 MAXIMUM = 1.0
@@ -97,6 +98,20 @@ def tail_trend(buf, n, t_tail, t_end):
     modulation is faster than a quarter of the tail do not. Fast wiggles of the envelope (for
     example at the load frequency) stay inside a quarter and do not hide the drift.
     """
+    falling, rising = _quarter_trends(buf, n, t_tail, t_end)
+    return falling or rising
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def tail_rises(buf, n, t_tail, t_end):
+    """True when the envelope grows across the tail, quarter by quarter (`tail_trend`)."""
+    return _quarter_trends(buf, n, t_tail, t_end)[1]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _quarter_trends(buf, n, t_tail, t_end):
+    """(falling, rising): whether the max |q| of the extrema in each quarter of the tail
+    strictly falls, or strictly rises, from quarter to quarter."""
     quarter = np.zeros(4)
     width = (t_end - t_tail) / 4.0
     for i in range(n):
@@ -109,7 +124,7 @@ def tail_trend(buf, n, t_tail, t_end):
     for j in range(3):
         falling = falling and quarter[j + 1] < quarter[j]
         rising = rising and quarter[j + 1] > quarter[j]
-    return falling or rising
+    return falling, rising
 
 
 # Periodic orbits of higher order (period-k: k maxima per period whose levels differ).

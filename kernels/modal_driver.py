@@ -34,6 +34,12 @@ from .layout import (AMPLITUDE, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD, N_CO
                      WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
+NODE = 1e-9          # a mode whose |phi(1/2)| is below this (shapes of unit scale) has a node
+                     # at midspan
+HIDDEN_FLOOR = 1e-9  # such a mode is judged (`span_state`) above this x the largest mode's peak:
+                     # growing, it would reach any level (an even mode seeded by round-off
+                     # stays below)
+
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def observer_row(row, n_modes):
@@ -317,7 +323,10 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
     """The state judged from the whole response, and reals[SPAN_MAX]: a point whose midspan
     deflection decayed (DECAYED) while some mode's tail amplitude exceeds settings[TOL] x the
     largest mode's peak has not decayed: a mode with a node at midspan (an even one) kept
-    moving; it is left OFF_MIDSPAN for `judge_off_midspan`. reals[SPAN_MAX] = the largest
+    moving; it is left OFF_MIDSPAN for `judge_off_midspan`. A point whose midspan is STEADY
+    while a mode with a node at midspan has a tail amplitude above HIDDEN_FLOOR x that peak is
+    left HIDDEN_MODE for the same judge: that mode may be growing (an even mode inside its
+    parametric zone), unseen at midspan. reals[SPAN_MAX] = the largest
     deflection over the span in the tail window (m): modal[2N] (`_observe_modes`), the span
     at the final state y (a growing response peaks there) and at least the midspan
     amplitude; NaN where the point failed. basis: the span's (kernels.modes)."""
@@ -326,15 +335,24 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
         return state
     final = md.span_maximum(y, n, basis)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
-    if state != mt.DECAYED:
+    if state != mt.DECAYED and state != mt.STEADY:
         return state
     peak = 0.0
     for i in range(n):
         peak = max(peak, modal[n + i])
     for i in range(n):
-        if modal[i] > settings[TOL] * peak:
+        if state == mt.DECAYED and modal[i] > settings[TOL] * peak:
             return mt.OFF_MIDSPAN
+        if state == mt.STEADY and _hidden(basis, i) and modal[i] > HIDDEN_FLOOR * peak:
+            return mt.HIDDEN_MODE
     return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _hidden(basis, i):
+    """Whether mode i has a node at midspan (an even mode of a symmetric span): the midspan
+    deflection does not see it."""
+    return abs(basis[md.MIDSPAN][i]) < NODE
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -568,6 +586,12 @@ def judge_off_midspan(params, basis, settings, states, reals, counts, modal, bas
     mode with the largest tail amplitude (modal, (n, N), m) instead of the midspan, and take
     its state, response period and settling time; the midspan's amplitude, peak and
     acceleration stay. A mode found at rest away from zero is STEADY (no settling time).
+    And the points left HIDDEN_MODE (the midspan steady, a mode with a node there moving):
+    watch the largest such mode; its envelope rising across the tail (`metrics.tail_rises`),
+    the point is UNSETTLED (no settling time) whatever that mode's level; above the settling
+    band of the midspan amplitude, a steady mode makes the point settle once both have and a
+    modulated one makes it MODULATED; otherwise the point stays STEADY. Its amplitude, period
+    and the rest stay the midspan's.
     Returns how many points it judged."""
     n = md.basis_modes(basis)
     done = 0
@@ -575,11 +599,12 @@ def judge_off_midspan(params, basis, settings, states, reals, counts, modal, bas
     own_reals = np.empty(N_REALS)
     own_counts = np.empty(N_COUNTS, np.int64)
     for i in range(params.shape[0]):
-        if states[i] != mt.OFF_MIDSPAN:
+        hidden = states[i] == mt.HIDDEN_MODE
+        if states[i] != mt.OFF_MIDSPAN and not hidden:
             continue
-        k = 0
+        k = -1
         for c in range(n):
-            if modal[i, c] > modal[i, k]:
+            if (not hidden or _hidden(basis, c)) and (k < 0 or modal[i, c] > modal[i, k]):
                 k = c
         weights = np.zeros(n)
         weights[k] = 1.0
@@ -588,12 +613,24 @@ def judge_off_midspan(params, basis, settings, states, reals, counts, modal, bas
                                 weights, basis)
         resting = at_rest(params[i], basis, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
         state = classify_metrics(settings, acc, buf, own_reals, own_counts, base, resting)
+        state = mt.STEADY if state == mt.SECOND_PASS else state
+        counts[i, RHS_EVALS] += own_counts[RHS_EVALS]
+        done += 1
+        if hidden:
+            states[i] = mt.STEADY
+            if mt.tail_rises(buf, int(acc[tj.N_EXT]), acc[tj.T_TAIL], acc[tj.T_FINAL]):
+                states[i] = mt.UNSETTLED             # growing: at any level, for now
+                reals[i, SETTLING] = math.nan
+            elif modal[i, k] > settings[TOL] * reals[i, AMPLITUDE]:
+                if state == mt.STEADY:               # settled once both are
+                    reals[i, SETTLING] = max(reals[i, SETTLING], own_reals[SETTLING])
+                elif state == mt.MODULATED:
+                    states[i] = mt.MODULATED
+            continue
         reals[i, PERIOD] = own_reals[PERIOD]
         reals[i, SETTLING] = own_reals[SETTLING]
         reals[i, FAILURE_TIME] = own_reals[FAILURE_TIME]
-        counts[i, RHS_EVALS] += own_counts[RHS_EVALS]
-        states[i] = mt.STEADY if state == mt.SECOND_PASS else state
-        done += 1
+        states[i] = state
     return done
 
 

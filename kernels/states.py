@@ -19,6 +19,9 @@ SECOND_PASS = -2      # internal: STEADY at rest away from zero, its settling ti
                       # by transverse.settle_second_pass; never left in a result
 OFF_MIDSPAN = -3      # internal: the midspan deflection decayed while a mode with a node there
                       # kept moving; judged again on that mode by modal_driver.judge_off_midspan
+HIDDEN_MODE = -5      # internal: the midspan deflection steady while a mode with a node there
+                      # still moves (above the settling band of the peak); judged again on
+                      # that mode by modal_driver.judge_off_midspan
 NOT_SOLVED = -4       # internal: a row no kernel has finished yet (sweep.threads writes it before
                       # a block runs, and reports rows as they turn final); every final state is
                       # >= 0

@@ -199,7 +199,8 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         if watch.halted():
             watch.end(lo)                # the follow-up passes are left to a resume
             return
-        off = bool(np.any(states[lo:hi] == mt.OFF_MIDSPAN))
+        off = bool(np.any((states[lo:hi] == mt.OFF_MIDSPAN)
+                          | (states[lo:hi] == mt.HIDDEN_MODE)))
         _follow_up(modal_driver.judge_off_midspan, off, params[lo:hi], basis, settings,
                    states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth,
                    steady)
@@ -302,7 +303,8 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
 class Watch:
     """The rows of the blocks in progress, for a watcher thread: which are final (their state
     written, >= 0: the kernels write a row's state after every other output of it, and rows
-    still NOT_SOLVED, SECOND_PASS or OFF_MIDSPAN are not), reported to on_block(lo, hi) in
+    still NOT_SOLVED, SECOND_PASS, OFF_MIDSPAN or HIDDEN_MODE are not), reported to
+    on_block(lo, hi) in
     order, each row once, whichever thread gets there first; and an interrupt (`stop`) passed
     to the kernels through `halt`."""
 

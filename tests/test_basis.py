@@ -155,3 +155,80 @@ def test_the_driver_runs_a_quadrature_basis_as_it_runs_the_closed_form_one(level
     assert abs(a1 / a0 - 1) < 1e-9, (a0, a1)
     assert abs(m1[0] / m0[0] - 1) < 1e-9 and abs(m1[2] / m0[2] - 1) < 1e-8, (m0, m1)
     assert m1[1] < 1e-12 * m1[0] and m0[1] < 1e-12 * m0[0]        # the even mode stays at rest
+
+
+def _integrals(b, nodes=400):
+    """int phi_n^2, int phi_n'^2, int phi_n (N each) and A_ij = int phi_i' phi_j' of basis b,
+    by a Gauss-Legendre rule far finer than the basis' own."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    s, w = (x + 1.0) / 2.0, w / 2.0
+    phi, slope = shape_values(b.shapes, s), shape_values(b.shapes, s, 1)
+    return phi ** 2 @ w, slope ** 2 @ w, phi @ w, (slope * w) @ slope.T
+
+
+def test_the_clamped_basis_is_the_textbook_clamped_span():
+    """basis.clamped against MODEL's reference values (docs/model.md sec. 10: Thomson App. D,
+    Rao Table 8.1): the eigenvalues b_n l of cos(b l) cosh(b l) = 1, mode 1 scaled to max
+    |phi| = 1 (its integrals, participation, curvature at the clamp and at midspan), the
+    non-diagonal axial-load matrix A_ij of the unit-normalised modes 1-3 (the coupling of modes
+    1 and 3), the clamped ends themselves, and the basis' own quadrature against one twice as
+    fine (its projections exact)."""
+    from sweep.models.basis import clamped, from_shapes, quadrature_nodes
+    b = clamped(4)
+    beta = b.shapes[:, 0]
+    np.testing.assert_allclose(beta[:3], [4.730040745, 7.853204624, 10.99560784], rtol=1e-9)
+    np.testing.assert_allclose(np.cos(beta), 1.0 / np.cosh(beta), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(b.frequency_ratio[0], 22.3733 / math.pi ** 2, rtol=1e-5)
+    mass, stiff, area, a = _integrals(b)
+    assert mass[0] == pytest.approx(0.39648, abs=1e-5)
+    assert stiff[0] == pytest.approx(4.8777, abs=1e-4)
+    assert area[0] == pytest.approx(0.5232, abs=1e-4)
+    assert area[0] / mass[0] == pytest.approx(1.3195, abs=1e-4)
+    assert b.participation_ratio[0] == pytest.approx(1.3195 / (4.0 / math.pi), abs=1e-4)
+    assert b.participation_ratio[1] == pytest.approx(0.0, abs=1e-12)    # antisymmetric
+    curvature = shape_values(b.shapes, np.array([0.0, 0.5, 1.0]), 2)[0]
+    np.testing.assert_allclose(curvature, [28.18, -17.13, 28.18], atol=6e-3)
+    unit = a[:3, :3] / np.sqrt(np.outer(mass[:3], mass[:3]))
+    np.testing.assert_allclose(unit, [[12.303, 0.0, -9.731], [0.0, 46.050, 0.0],
+                                      [-9.731, 0.0, 98.905]], atol=6e-4)
+    ends = np.array([0.0, 1.0])
+    assert np.abs(shape_values(b.shapes, ends)).max() < 1e-12
+    assert np.abs(shape_values(b.shapes, ends, 1)).max() < 1e-9 * beta.max()
+    assert b.midspan[0] == pytest.approx(1.0, abs=1e-12)    # mode 1 peaks at midspan
+    assert np.abs(b.midspan[[1, 3]]).max() < 1e-12                    # antisymmetric: a node
+    fine = from_shapes("fine", b.shapes, 2 * quadrature_nodes(4))
+    phi_w = b.tables[4]                                   # weights w_j phi(s_j) / int phi^2
+    for order in range(4):
+        # the projections of every product of six shapes' derivatives the kernel forms
+        field = (b.tables[order] * phi_w).sum(axis=1)
+        np.testing.assert_allclose(field, (fine.tables[order] * fine.tables[4]).sum(axis=1),
+                                   rtol=1e-11, atol=1e-11)
+
+
+@pytest.mark.parametrize("stiffness, beta, end, mid, ratio", [
+    (1.0, 3.3988, 2.83, 10.55, 9.888), (3.0, 3.7097, 7.11, 11.59, 9.991),
+    (10.0, 4.1557, 14.98, 13.58, 10.458), (30.0, 4.4714, 21.82, 15.38, 11.223),
+    (100.0, 4.6413, 25.93, 16.50, 11.875)])
+def test_elastic_ends_are_the_rotational_spring_table(stiffness, beta, end, mid, ratio):
+    """basis.elastic_ends against MODEL's table (docs/model.md sec. 10.3, rotational springs
+    K = k_t l / EI at both ends): mode 1's b_1 l, f1 / f1 pinned = (b_1 l / pi)^2, the
+    curvatures at the end and at midspan per unit midspan amplitude, int phi'^2 / int phi^2;
+    and the end conditions phi = 0, phi'' = K phi' (s = 0), phi'' = -K phi' (s = 1)."""
+    from sweep.models.basis import elastic_ends
+    b = elastic_ends(3, stiffness)
+    assert b.shapes[0, 0] == pytest.approx(beta, abs=6e-5)
+    assert b.frequency_ratio[0] == pytest.approx((beta / math.pi) ** 2, rel=1e-4)
+    curvature = shape_values(b.shapes, np.array([0.0, 0.5]), 2)[0] / b.midspan[0]
+    assert curvature[0] == pytest.approx(end, abs=6e-3)
+    assert -curvature[1] == pytest.approx(mid, abs=6e-3)
+    mass, stiff, _, _ = _integrals(b)
+    assert stiff[0] / mass[0] == pytest.approx(ratio, abs=6e-4)
+    s = np.array([0.0, 1.0])
+    phi, d1, d2 = (shape_values(b.shapes, s, k) for k in range(3))
+    scale = np.abs(d2).max()
+    assert np.abs(phi).max() < 1e-12
+    np.testing.assert_allclose(d2[:, 0], stiffness * d1[:, 0], atol=1e-9 * scale)
+    np.testing.assert_allclose(d2[:, 1], -stiffness * d1[:, 1], atol=1e-9 * scale)
+    # between pinned (n pi) and clamped, mode by mode
+    assert np.all(b.shapes[:, 0] > np.arange(1, 4) * math.pi)
+    assert np.all(b.shapes[:, 0] < [4.7301, 7.8533, 10.9957])

@@ -1,5 +1,5 @@
-"""The multi-mode driver at N = 1 against the one-mode kernel, a divergence only an even mode
-shows, and the `sweep modes` convergence check (docs/model.md sec. 7).
+"""The multi-mode driver at N = 1 against the one-mode kernel, a divergence and a growth only
+an even mode shows, and the `sweep modes` convergence check (docs/model.md sec. 7).
 
 The one-mode kernel (kernels.transverse, from sweep/models/modal.py's closed-form K3 and K5)
 and the multi-mode driver (kernels.modal_driver, whose nonlinear terms are Eq.17 projected by
@@ -118,6 +118,65 @@ def test_a_growing_even_mode_diverges_though_the_midspan_stays_at_rest():
     assert states[0] == 5                                  # diverged
     assert 0.0 < reals[0, tk.FAILURE_TIME] < 5.0
     assert np.all(np.isnan(modal_amp[0]))
+
+
+HIDDEN = """
+name = "hidden-mode"
+[model]
+modes = 2
+[cable]
+damping_ratio = 0.005
+[load]
+type = "harmonic"
+frequency_ratio = 8.0           # W = 2 w_2: mode 2's principal parametric zone
+[base]
+acceleration_g = 0.2
+frequency_ratio = 0.5
+[initial]
+modal_displacement = [0.0, 1e-9]
+[solver]
+t_end = 20.0
+[axes]
+length = [0.5]
+load_amplitude = [2.2, 2.5, 2.9]
+"""
+
+
+def _quarters(amplitude: float) -> list[float]:
+    """max |q_2| (m) in each quarter of the tail window [10, 20] s, by SciPy on the independent
+    Galerkin reference (tests/galerkin.py), the scene HIDDEN at load amplitude P0 (N)."""
+    import galerkin as g
+    cable = g.Cable(length=0.5, damping_ratio=0.005)
+    sol = g.integrate(cable, 2, [0.0, 1e-9, 0.0, 0.0], 20.0, 3e-4, rtol=1e-8,
+                      load_amplitude=amplitude, load_omega=8.0 * cable.w1,
+                      base_acceleration=0.2 * 9.80665,
+                      base_frequency=0.5 * cable.w1 / (2.0 * math.pi))
+    q2 = np.abs(sol(np.linspace(10.0, 20.0, 40001))[1])
+    return [float(q2[i * 10000:(i + 1) * 10000].max()) for i in range(4)]
+
+
+@pytest.mark.slow
+def test_an_even_mode_growing_under_a_steady_midspan_makes_the_point_unsettled():
+    """Mode 2 has a node at midspan. Inside its parametric zone it grows from a seed while the
+    midspan (mode 1, driven below resonance) is steady: at 2.5 N the point was called steady
+    with q_2 still growing 44-fold over the tail. The point must be unsettled there, and stay
+    steady below the zone (2.2 N: q_2 decays) and where q_2 has settled on its own orbit
+    (2.9 N). Whether q_2 grows, decays or has settled is taken from SciPy on the independent
+    Galerkin reference, and the tail amplitudes are compared with it."""
+    ds = sweep.run(sweep.load_scene_text(HIDDEN), progress=False)
+    states = [str(s) for s in np.asarray(ds["state"].attrs["flag_meanings"].split())[
+        ds["state"].values.ravel()]]
+    assert states == ["steady", "unsettled", "steady"]
+    q2 = ds["modal_amplitude"].sel(mode=2).values.ravel()
+    for i, amplitude in enumerate((2.2, 2.5, 2.9)):
+        quarters = _quarters(amplitude)
+        growing = all(b > 1.5 * a for a, b in zip(quarters, quarters[1:]))
+        decaying = all(b < a / 1.5 for a, b in zip(quarters, quarters[1:]))
+        settled = max(quarters) < 1.001 * min(quarters)
+        assert (growing, decaying, settled) == [(False, True, False), (True, False, False),
+                                                (False, False, True)][i], quarters
+        assert q2[i] == pytest.approx(max(quarters), rel=0.05)
+    assert np.isnan(ds["settling_time"].values.ravel()[1])
 
 
 def _scene(modes, lengths=(0.4, 0.7), frequencies=(12.0, 40.0)):

@@ -527,3 +527,18 @@ def test_fast_sine_is_accurate_at_large_phases(top, fast_trig):
     for v in (top, -top, 0.5 * top + 0.3, 2 * math.pi * 100 * 130):
         assert abs(fast_sin.py_func(v) - math.sin(v)) <= 3 * math.ulp(abs(math.sin(v)))
         assert abs(fast_cos.py_func(v) - math.cos(v)) <= 3 * math.ulp(abs(math.cos(v)))
+
+
+@pytest.mark.parametrize("scene_name, key, value", [
+    ("paper-fig7", "outputs.bands_per_octave", 6),     # longitudinal, no [base]
+    ("paper-fig5", "outputs.bands_per_octave", 12),    # transverse, no [base]
+    ("paper-fig5", "outputs.envelope", True),
+    ("harness-parametric", "outputs.envelope", True),
+])
+def test_envelope_keys_without_a_sweep_are_refused_in_every_scene(scene_name, key, value):
+    """The envelope and its bands are refused where nothing sweeps, not only in a [base]
+    scene (a scene without [base] took them silently)."""
+    with pytest.raises(SceneError) as info:
+        sweep.load_scene(scene_name, overrides={key: value})
+    message = str(info.value)
+    assert "\n" not in message and key in message, message

@@ -134,7 +134,8 @@ def shape_values(shapes: np.ndarray, s: np.ndarray, derivative: int = 0) -> np.n
     return beta ** derivative * (trig + sign * c * e_left + d * e_right)
 
 
-def from_shapes(name: str, shapes: np.ndarray, nodes: int) -> Basis:
+def from_shapes(name: str, shapes: np.ndarray, nodes: int,
+                mode_text: str = "mode shape n") -> Basis:
     """A Basis of any beam-function shapes (rows (beta, A, B, C, D), each a linear mode of the
     span, w_n / w_p = (beta / pi)^2), its projections by Gauss-Legendre quadrature on `nodes`
     nodes of (0, 1), its participations and masses from the shapes (the same quadrature): the
@@ -158,4 +159,120 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int) -> Basis:
     midspan = shape_values(shapes, np.array([0.5]))[:, 0]
     return Basis(name=name, shapes=shapes, frequency_ratio=(shapes[:, 0] / math.pi) ** 2,
                  participation_ratio=gamma / (4.0 / math.pi),
-                 tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations))
+                 tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations),
+                 mode_text=mode_text)
+
+
+CLAMPED = math.inf
+"""The rotational stiffness K = k_t l / EI of a clamped end (no rotation)."""
+
+
+def _end_conditions(beta: float, stiffness: float) -> np.ndarray:
+    """The 4 x 4 matrix whose null vector is (A, B, C, D) of a mode with eigenvalue beta of a
+    span with w = 0 and a rotational spring K = `stiffness` (k_t l / EI) at both ends:
+    phi(0) = 0, phi''(0) = K phi'(0), phi(1) = 0, phi''(1) = -K phi'(1) (derivatives in s).
+    Rows scaled to stay bounded for any beta and K (CLAMPED: phi' = 0 at both ends)."""
+    e = math.exp(-beta)
+    c, s = math.cos(beta), math.sin(beta)
+    spring, slope = ((0.0, 1.0) if stiffness == CLAMPED
+                     else (beta / (beta + stiffness), stiffness / (beta + stiffness)))
+    return np.array([
+        [1.0, 0.0, 1.0, e],                                               # phi(0)
+        [-spring, -slope, spring + slope, (spring - slope) * e],          # phi'' - K phi' at 0
+        [c, s, e, 1.0],                                                   # phi(1)
+        [-spring * c - slope * s, -spring * s + slope * c,                # phi'' + K phi' at 1
+         (spring - slope) * e, spring + slope],
+    ])
+
+
+def _eigenvalues(n_modes: int, stiffness: float) -> np.ndarray:
+    """The first n_modes roots beta = b_n l of the end conditions' determinant: the n-th lies
+    in [n pi, the clamped span's] (pinned at K = 0, clamped as K -> inf), found by a scan of
+    that interval and bisection to round-off."""
+    def det(beta: float) -> float:
+        return float(np.linalg.det(_end_conditions(beta, stiffness)))
+
+    roots = []
+    for n in range(1, n_modes + 1):
+        if stiffness == 0.0:
+            roots.append(n * math.pi)
+            continue
+        lo, hi = n * math.pi, (n + 0.5) * math.pi + 0.02
+        grid = np.linspace(lo, hi, 401)
+        values = [det(b) for b in grid]
+        found = None
+        for k in range(len(grid) - 1):
+            if values[k] == 0.0:
+                found = grid[k]
+                break
+            if values[k] * values[k + 1] < 0.0:
+                a, b, fa = grid[k], grid[k + 1], values[k]
+                for _ in range(200):
+                    mid = 0.5 * (a + b)
+                    fm = det(mid)
+                    if mid in (a, b) or fm == 0.0:
+                        break
+                    if fa * fm < 0.0:
+                        b = mid
+                    else:
+                        a, fa = mid, fm
+                found = 0.5 * (a + b)
+                break
+        if found is None:
+            raise ValueError(f"no eigenvalue of mode {n} found for K = {stiffness}")
+        roots.append(found)
+    return np.array(roots)
+
+
+def _normalised(beta: float, stiffness: float) -> np.ndarray:
+    """The beam-function row (beta, A, B, C, D) of the mode with eigenvalue beta, scaled to
+    max |phi| = 1 over the span, signed so that phi'(0) + phi''(0) / beta > 0 (a sine's
+    sign)."""
+    _, _, vt = np.linalg.svd(_end_conditions(beta, stiffness))
+    row = np.concatenate([[beta], vt[-1]])
+    s = np.linspace(0.0, 1.0, 4097)
+    phi = shape_values(row[None, :], s)[0]
+    k = int(np.argmax(np.abs(phi)))
+    x = s[k]
+    for _ in range(8):                           # Newton on phi' = 0 at the largest value
+        d1 = shape_values(row[None, :], np.array([x]), 1)[0, 0]
+        d2 = shape_values(row[None, :], np.array([x]), 2)[0, 0]
+        if d2 == 0.0:
+            break
+        x = min(1.0, max(0.0, x - d1 / d2))
+    largest = abs(shape_values(row[None, :], np.array([x]))[0, 0])
+    start = shape_values(row[None, :], np.array([0.0]), 1)[0, 0] + \
+        shape_values(row[None, :], np.array([0.0]), 2)[0, 0] / beta
+    row[1:] *= math.copysign(1.0 / largest, start)
+    return row
+
+
+def quadrature_nodes(n_modes: int) -> int:
+    """Gauss-Legendre nodes for a beam-function basis of n_modes modes: its projections (a
+    product of six shapes, degree about 6 beta_N / pi in the trigonometric part) exact to
+    round-off with a wide margin (tests/test_basis.py doubles them)."""
+    return 8 * n_modes + 24
+
+
+def elastic_ends(n_modes: int, stiffness: float) -> Basis:
+    """The span's N lowest modes with a rotational spring of stiffness K = k_t l / EI
+    (dimensionless) at both ends and no deflection there (docs/model.md sec. 10): K = 0 is the
+    pinned span (use pinned_sines: its closed forms), CLAMPED the clamped one; each mode
+    scaled to max |phi| = 1, its projections by Gauss-Legendre quadrature."""
+    if n_modes < 1:
+        raise ValueError(f"n_modes = {n_modes}: at least one mode")
+    if not (stiffness >= 0.0):
+        raise ValueError(f"rotational stiffness K = {stiffness}: must be >= 0")
+    betas = _eigenvalues(n_modes, stiffness)
+    shapes = np.array([_normalised(b, stiffness) for b in betas])
+    if stiffness == CLAMPED:
+        return from_shapes(f"clamped-clamped beam functions, n = 1..{n_modes}", shapes,
+                           quadrature_nodes(n_modes), mode_text="clamped-clamped mode n")
+    return from_shapes(f"elastic ends K = k_t l / EI = {stiffness:g}, n = 1..{n_modes}",
+                       shapes, quadrature_nodes(n_modes),
+                       mode_text=f"mode n of the span with rotational springs K = {stiffness:g}")
+
+
+def clamped(n_modes: int) -> Basis:
+    """The clamped-clamped span's N lowest modes (elastic_ends with K -> inf)."""
+    return elastic_ends(n_modes, CLAMPED)

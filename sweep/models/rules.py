@@ -203,6 +203,7 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
     named = [(f"axis '{schema.BY_DOTTED[d].axis}'" if schema.BY_DOTTED[d].axis in axes
               else f"scene key '{d}'")
              for d in BASE_KEYS if _present(d, given, axes)]
+    _check_envelope(given, axes)
     if not named and not has_table:
         return
     where = named[0] if named else "scene section '[base]'"
@@ -225,6 +226,18 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
               f"{', '.join(dict.fromkeys(_spelling(d) for d in pair))} (as a key or axis)",
               BASE_FIX if not file_has_base else f"add {example} to the [base] table")
     _check_sweep(given, axes)
+
+
+def _check_envelope(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """The envelope outputs need a sweep, and its bands an envelope, whatever the scene."""
+    if not given.get("outputs.envelope"):
+        _refuse_without(given, ("outputs.bands_per_octave",), "sets the envelope's bands, but "
+                        "the scene asks for no envelope", "add outputs.envelope = true (a sweep's "
+                        "response envelope), or remove the key")
+    elif not any(_present(d, given, axes) for d in SWEEP_KEYS):
+        _fail("scene key 'outputs.envelope'", "needs a swept base frequency (the envelope is "
+              "read against the sweep's frequency)", "add [base] sweep = { start = 5.0, stop "
+              "= 100.0, rate = 2.0 }, or remove the key")
 
 
 def _spelling(dotted: str) -> str:
@@ -259,16 +272,7 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     if not swept and given.get(SWEEP_DIRECTION) is not None:
         _fail(f"scene key '{SWEEP_DIRECTION}'", "needs a sweep (start, stop and rate)",
               "write sweep = { start = 5.0, stop = 100.0, rate = 2.0, direction = 'both' }")
-    if not given.get("outputs.envelope"):
-        _refuse_without(given, ("outputs.bands_per_octave",), "sets the envelope's bands, but "
-                        "the scene asks for no envelope", "add outputs.envelope = true (a sweep's "
-                        "response envelope), or remove the key")
     if not swept:
-        for dotted in ("outputs.envelope",):
-            if given.get(dotted):
-                _fail(f"scene key '{dotted}'", "needs a swept base frequency (the envelope is "
-                      "read against the sweep's frequency)", "add [base] sweep = { start = "
-                      "5.0, stop = 100.0, rate = 2.0 }, or remove the key")
         return
     where = "scene key 'base.sweep'"
     missing = [d.rpartition(".")[2] for d in SWEEP_KEYS if d not in swept]
