@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import datetime
 import math
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import xarray as xr
@@ -291,6 +291,22 @@ def _margins(ds: xr.Dataset, fmin: float | None, amax: float | None, qname: str 
     return margins
 
 
+def _frequency_span(f1: Callable[[float], float], lo: float, hi: float, fmin: float,
+                    tol: float) -> float:
+    """The length in [lo, hi] (m) where f1(length) (Hz, falling with length) crosses fmin, by
+    bisection to a thousandth of `tol`: for ends whose f1 is not ~ l^-2 (elastic clamps,
+    K = k_t l / EI)."""
+    for _ in range(MAX_BISECTIONS):
+        if not hi - lo > 1e-3 * tol:
+            break
+        mid = 0.5 * (lo + hi)
+        if f1(mid) >= fmin:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
 def _interpolate(la: float, lb: float, va: float, vb: float, limit: float, how: str) -> float:
     """Where, between the passing la and failing lb, the criterion's value crosses its limit:
     `log` (log v against log l), `linear` (v - limit linear in l); la where it cannot be
@@ -426,9 +442,8 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     nonfrequency = [k for k in CRITERIA if k != "min_frequency"]
     runs = 0
 
-    def fails(point: dict[str, Any], length: float) -> list[str]:
-        """The non-frequency criteria the engine's one-length run at `length` fails."""
-        nonlocal runs
+    def scene_at(point: dict[str, Any], length: float) -> dict[str, Any]:
+        """The overrides that make the stored scene the one-length run at `point`."""
         overrides: dict[str, Any] = {f"axes.{LENGTH}": [float(length)], **here}
         for a, v in point.items():
             if a == POINT_DIM:               # the parameter set's values, as scalars
@@ -436,8 +451,13 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                                   for k, values in stored.points.items()})
             elif a != stepped:
                 overrides[f"axes.{a}"] = [v.item() if hasattr(v, "item") else v]
-        one = run(load_scene_text(text, source="the result's scene", overrides=overrides),
-                  progress=False)
+        return overrides
+
+    def fails(point: dict[str, Any], length: float) -> list[str]:
+        """The non-frequency criteria the engine's one-length run at `length` fails."""
+        nonlocal runs
+        one = run(load_scene_text(text, source="the result's scene",
+                                  overrides=scene_at(point, length)), progress=False)
         runs += 1
         if stepped is not None:
             one = one.sel({stepped: [point[stepped]]})
@@ -448,6 +468,15 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         margins = _margins(one, None, amax, qname, like)
         return [k for k in nonfrequency if k in margins
                 and not np.all(margins[k][0] >= 0.0)]
+
+    def frequency_at(point: dict[str, Any], length: float) -> float:
+        """The closed-form f1 (Hz) of the stored scene at `length` and `point`: no run."""
+        from .grid import coordinates, parameters
+        from .models.modal import oscillator
+        scene = load_scene_text(text, source="the result's scene", overrides=scene_at(
+            point, length))
+        f1 = oscillator(parameters(scene, coordinates(scene)))["natural_frequency"]
+        return float(np.min(np.asarray(f1, float)))
 
     spans = grid["max_span"].values.copy().reshape(-1)
     limited = grid["limited_by"].values.copy().reshape(-1)
@@ -473,6 +502,9 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         if "min_frequency" in failing:
             f = margins["min_frequency"][1]
             l_f = _interpolate(lo, hi, f[a], f[b], fmin, "log")
+            if stored.get("clamps.rotation") == "elastic":    # f1 not ~ l^-2: K ~ l
+                l_f = _frequency_span(lambda length: frequency_at(point, length), lo, hi,
+                                      fmin, tol)
         others_fail = [k for k in failing if k != "min_frequency"]
         if not others_fail:                      # the frequency alone: exact, no run
             spans[flat_i], limited[flat_i] = l_f, "min_frequency"
@@ -503,6 +535,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     grid.attrs["refinement"] = (
         f"bisection on length with engine runs of the result's scene until the bracket is "
         f"below {tol:g} m, max_span its passing end (conservative); min_frequency by "
-        f"log f vs log l interpolation, exact for the unloaded f1 ~ l^-2, no run")
+        f"log f vs log l interpolation, exact for the unloaded f1 ~ l^-2 (elastic clamps: "
+        f"bisection on the closed-form f1), no run")
     grid.attrs["history"] += f"; refined by bisection ({runs} engine runs, tolerance {tol:g} m)"
     return grid

@@ -130,11 +130,12 @@ def modes_outputs(n: int, n_samples: int, n_modes: int, n_bands: int = -1) -> di
             "final": np.empty((n, 2 * n_modes))}
 
 
-def modes_of(basis: tuple[np.ndarray, ...]) -> int:
+def modes_of(basis: tuple[np.ndarray, ...] | list) -> int:
     """The number of modes of a basis as the kernels take it (sweep.models.basis
-    Basis.kernel_arrays()), read as kernels.modes.basis_modes reads it."""
+    Basis.kernel_arrays(), or a list of them: a BasisFamily's), read as
+    kernels.modes.basis_modes reads it."""
     from sweep.kernels import modes as md
-    return int(basis[md.RATIOS].shape[1])
+    return int((basis[0] if isinstance(basis, list) else basis)[md.RATIOS].shape[1])
 
 
 def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
@@ -147,8 +148,12 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     for the N modes of `basis`, the mode shapes as the kernels take them:
     sweep.models.basis.Basis.kernel_arrays()); outputs by name (`modes_outputs`); driver
     "lanes" or "scalar" (threads.solve_modes); n_bands, per_point_end, on_block and stop as
-    `transverse_chunk`'s."""
+    `transverse_chunk`'s. `basis` a list (a BasisFamily's): each row's last column is its
+    basis' index, and the rows of each basis go to the kernel together."""
     from sweep.kernels import modes as md
+    if isinstance(basis, list):
+        return _family_chunk(params, settings, n_samples, basis, driver, n_bands,
+                             per_point_end, threads, on_block, stop)
 
     from .threads import solve_modes
     out = modes_outputs(params.shape[0], n_samples, modes_of(basis), n_bands)
@@ -158,6 +163,45 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
                 on_block=report, stop=stop, envelope=out.get("envelope"),
                 durations=_ends(params, md.EXCITATION) if per_point_end else None)
     return out
+
+
+def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, family: list,
+                  driver: str, n_bands: int, per_point_end: bool, threads: int,
+                  on_block: Callable[[int, int, dict], None] | None,
+                  stop: threading.Event | None) -> dict[str, np.ndarray]:
+    """`modes_chunk` of rows whose basis varies (the last column: an index into `family`):
+    one kernel call per basis on its rows, whose finished rows are reported under their
+    places in `params`."""
+    index = params[:, -1].astype(np.int64)
+    rows = np.ascontiguousarray(params[:, :-1])
+    out = modes_outputs(params.shape[0], n_samples, modes_of(family), n_bands)
+    lock = threading.Lock()
+    for b in np.unique(index):
+        if stop is not None and stop.is_set():
+            break
+        at = np.flatnonzero(index == b)
+
+        def report(lo: int, hi: int, part: dict, at: np.ndarray = at) -> None:
+            with lock:
+                for name, values in part.items():
+                    out[name][at[lo:hi]] = values[lo:hi]
+                for a, z in _runs(at[lo:hi]):
+                    on_block(a, z, out)
+
+        part = modes_chunk(rows[at], settings, n_samples, family[b], driver, n_bands,
+                           per_point_end, threads, report if on_block is not None else None,
+                           stop)
+        for name, values in part.items():
+            out[name][at] = values
+    return out
+
+
+def _runs(indices: np.ndarray) -> list[tuple[int, int]]:
+    """Increasing `indices` as ranges (lo, hi) of consecutive values."""
+    if indices.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(indices) != 1) + 1
+    return [(int(part[0]), int(part[-1]) + 1) for part in np.split(indices, breaks)]
 
 
 DWELLS_DONE, CARRIED = "dwells_done", "carried"    # a stepped chunk's progress, by line

@@ -53,6 +53,7 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params["coefficients"] = scene.get("model.coefficients")
     params["paper_parametric"] = scene.get("model.paper_parametric")
     params["load_type"] = scene.get("load.type")
+    params["clamps_rotation"] = scene.get("clamps.rotation")
     params["divergence_bound"] = scene.get("metrics.divergence_bound")
     params["base_levels_g"] = scene.get("base.levels_g")
     params["base_sweep_ramp_cycles"] = scene.get("base.sweep.ramp_cycles")

@@ -72,8 +72,18 @@ KEYS: tuple[Key, ...] = (
     Key("model", "paper_parametric", "str", "printed", choices=("printed", "corrected"),
         long_name="paper preset: Eq.32's parametric (cos) terms as printed or 10x-corrected"),
     Key("model", "modes", "int", 1, units="1", minimum=1, maximum=12,
-        long_name="transverse: Galerkin modes kept, sin(n pi x/l) for n = 1..modes, coupled by "
-                  "the nonlinear terms (1: the paper's one-mode model)"),
+        long_name="transverse: Galerkin modes kept, the span's own n = 1..modes (sin(n pi x/l) "
+                  "between pins, beam functions between clamps), coupled by the nonlinear terms "
+                  "(1: the paper's one-mode model)"),
+    # [clamps]: what each clamp holds of the span (docs/model.md sec. 10)
+    Key("clamps", "rotation", "str", "pinned", choices=("pinned", "clamped", "elastic"),
+        long_name="what each clamp holds of the span's rotation: nothing (pinned, modes "
+                  "sin(n pi x/l)), all of it (clamped) or a rotational spring (elastic, "
+                  "clamps.rotational_stiffness)"),
+    Key("clamps", "rotational_stiffness", "float", None, units="N m rad-1", minimum=0.0,
+        long_name="rotational stiffness k_t of each clamp (rotation = 'elastic'); K = k_t l / EI "
+                  "runs from pinned (0) to clamped (infinite)",
+        axis="clamp_rotational_stiffness"),
     # [cable]
     Key("cable", "youngs_modulus", "float", 1.1e11, units="Pa", minimum=0.0, exclusive_min=True,
         long_name="Young's modulus", axis="youngs_modulus"),

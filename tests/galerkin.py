@@ -249,3 +249,59 @@ def absolute_tail_maximum(sol: OdeSolution, f: Callable, n_modes: int, base_acce
                                 options={"xatol": 1e-14})
         peak = max(peak, -float(found.fun))
     return peak
+
+
+# --- any end conditions: the span's own modes as callables ---------------------------------
+
+def clamped_shapes(n_modes: int, length: float) -> list[Callable[[np.ndarray, int], np.ndarray]]:
+    """The clamped-clamped span's modes phi_n(x) = cosh(b x) - cos(b x) - s_n (sinh(b x) -
+    sin(b x)), s_n = (cosh b l - cos b l) / (sinh b l - sin b l), cos(b l) cosh(b l) = 1 (the
+    textbook form, docs/model.md sec. 10.1), as functions phi(x, k) giving the k-th derivative
+    (1/m^k) at x (m); b_n l by brentq near (2n + 1) pi / 2. Written from the textbook, not from
+    sweep.models.basis."""
+    shapes = []
+    for n in range(1, n_modes + 1):
+        guess = (2 * n + 1) * math.pi / 2.0
+        bl = brentq(lambda z: math.cos(z) * math.cosh(z) - 1.0, guess - 0.3, guess + 0.3,
+                    xtol=1e-15)
+        b = bl / length
+        s = (math.cosh(bl) - math.cos(bl)) / (math.sinh(bl) - math.sin(bl))
+
+        def phi(x, k, b=b, s=s):
+            z = b * np.asarray(x, dtype=float)
+            hyper = [np.cosh(z), np.sinh(z)][k % 2] - s * [np.sinh(z), np.cosh(z)][k % 2]
+            trig = [np.cos(z), -np.sin(z), -np.cos(z), np.sin(z)][k % 4] \
+                - s * [np.sin(z), np.cos(z), -np.sin(z), -np.cos(z)][k % 4]
+            return b ** k * (hyper - trig)
+        shapes.append(phi)
+    return shapes
+
+
+def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration: float = 0.0,
+               base_frequency: float = 0.0, nodes: int = 96) -> Callable:
+    """SciPy right-hand side of the Galerkin equations on the span's own linear modes `shapes`
+    (clamped_shapes' callables; omegas: their natural angular frequencies, rad/s): Eq.17's
+    residual R (module docstring, no end load) at Gauss-Legendre nodes, projected on each mode
+    and divided by rho A int phi_n^2; modal damping 2 zeta w_n; base participation int phi_n /
+    int phi_n^2; a_b = A sin(2 pi f t)."""
+    n_modes = len(shapes)
+    l = cable.length
+    g, weights = np.polynomial.legendre.leggauss(nodes)
+    x, weights = 0.5 * l * (g + 1.0), 0.5 * l * weights
+    d = [np.array([phi(x, k) for phi in shapes]) for k in range(5)]     # (N, M) each
+    mass = (d[0] ** 2) @ weights
+    gamma = (d[0] @ weights) / mass
+    project = (d[0] * weights).T / (cable.density * cable.area * mass)   # (M, N)
+    ei, ea = cable.youngs_modulus * cable.inertia, cable.youngs_modulus * cable.area
+    damping = 2.0 * cable.damping_ratio * np.asarray(omegas)
+    omega_b = 2.0 * math.pi * base_frequency
+
+    def f(t: float, y: np.ndarray) -> np.ndarray:
+        q, v = y[:n_modes], y[n_modes:]
+        w1, w2, w3, w4 = (q @ d[k] for k in range(1, 5))
+        r = (ei * w4 - 3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1
+             - 4.0 * cable.membrane * ea * w2 * w1 ** 2 - 3.0 * ei * w4 * w1 ** 2
+             + 10.5 * ei * w2 ** 3 * w1 ** 2)
+        a = -damping * v - r @ project - gamma * base_acceleration * math.sin(omega_b * t)
+        return np.concatenate((v, a))
+    return f

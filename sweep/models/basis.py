@@ -30,6 +30,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -134,8 +136,8 @@ def shape_values(shapes: np.ndarray, s: np.ndarray, derivative: int = 0) -> np.n
     return beta ** derivative * (trig + sign * c * e_left + d * e_right)
 
 
-def from_shapes(name: str, shapes: np.ndarray, nodes: int,
-                mode_text: str = "mode shape n") -> Basis:
+def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mode shape n",
+                frequency_text: str = "(b_n / b_1)^2 f1") -> Basis:
     """A Basis of any beam-function shapes (rows (beta, A, B, C, D), each a linear mode of the
     span, w_n / w_p = (beta / pi)^2), its projections by Gauss-Legendre quadrature on `nodes`
     nodes of (0, 1), its participations and masses from the shapes (the same quadrature): the
@@ -160,7 +162,7 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int,
     return Basis(name=name, shapes=shapes, frequency_ratio=(shapes[:, 0] / math.pi) ** 2,
                  participation_ratio=gamma / (4.0 / math.pi),
                  tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations),
-                 mode_text=mode_text)
+                 mode_text=mode_text, frequency_text=frequency_text)
 
 
 CLAMPED = math.inf
@@ -267,12 +269,149 @@ def elastic_ends(n_modes: int, stiffness: float) -> Basis:
     shapes = np.array([_normalised(b, stiffness) for b in betas])
     if stiffness == CLAMPED:
         return from_shapes(f"clamped-clamped beam functions, n = 1..{n_modes}", shapes,
-                           quadrature_nodes(n_modes), mode_text="clamped-clamped mode n")
+                           quadrature_nodes(n_modes), mode_text="clamped-clamped mode n",
+                           frequency_text="(b_n / b_1)^2 f1, cos(b l) cosh(b l) = 1")
     return from_shapes(f"elastic ends K = k_t l / EI = {stiffness:g}, n = 1..{n_modes}",
                        shapes, quadrature_nodes(n_modes),
-                       mode_text=f"mode n of the span with rotational springs K = {stiffness:g}")
+                       mode_text=f"mode n of the span with rotational springs K = {stiffness:g}",
+                       frequency_text="(b_n / b_1)^2 f1 of the span with rotational springs")
 
 
 def clamped(n_modes: int) -> Basis:
     """The clamped-clamped span's N lowest modes (elastic_ends with K -> inf)."""
     return elastic_ends(n_modes, CLAMPED)
+
+
+BUCKLING_MODES = 8
+"""Modes of the basis from which a span's buckling load is taken (`buckling_factor`): the
+clamped span's is then within 1e-4 of the exact 4 pi^2 EI / l^2."""
+
+
+def one_mode_integrals(basis: Basis) -> dict[str, float]:
+    """The integrals of mode 1 (s = x / l, derivatives in s, each over int phi^2) that make the
+    one-mode equation of the span (docs/model.md secs. 2 and 10): beta = b_1 l; load =
+    int phi'' phi; stretch = int phi'' phi'^2 phi (the membrane and the load's cubic term);
+    curvature = int (3 phi''^3 + 11 phi'' phi''' phi' + 3 phi'''' phi'^2) phi (the cubic
+    curvature terms); quintic = int phi''^3 phi'^2 phi; gamma = int phi / int phi^2 (base
+    participation); slope = max |phi'| (the mode's largest slope per unit amplitude). By
+    Gauss-Legendre on 4 x the basis' own nodes; pinned sines give -pi^2, -pi^4 / 4, 5 pi^6 /
+    4, -pi^8 / 8, 4 / pi and pi."""
+    row = basis.shapes[:1]
+    x, w = np.polynomial.legendre.leggauss(4 * quadrature_nodes(basis.n_modes))
+    s, w = (x + 1.0) / 2.0, w / 2.0
+    d = [shape_values(row, s, k)[0] for k in range(5)]
+    mass = d[0] ** 2 @ w
+    fine = np.linspace(0.0, 1.0, 4097)
+    return {
+        "beta": float(row[0, 0]),
+        "load": float(d[2] * d[0] @ w / mass),
+        "stretch": float(d[2] * d[1] ** 2 * d[0] @ w / mass),
+        "curvature": float((3.0 * d[2] ** 3 + 11.0 * d[2] * d[3] * d[1]
+                            + 3.0 * d[4] * d[1] ** 2) * d[0] @ w / mass),
+        "quintic": float(d[2] ** 3 * d[1] ** 2 * d[0] @ w / mass),
+        "gamma": float(d[0] @ w / mass),
+        "slope": float(np.abs(shape_values(row, fine, 1)).max()),
+    }
+
+
+def buckling_factor(basis: Basis) -> float:
+    """Pcr l^2 / EI of the span whose modes `basis` holds: the least P with (B - P A) q = 0,
+    B = diag(beta_n^4 int phi_n^2) and A_ij = int phi_i' phi_j' (s units) over its modes
+    (Galerkin: an upper bound that the symmetric modes converge to from above)."""
+    x, w = np.polynomial.legendre.leggauss(quadrature_nodes(basis.n_modes))
+    s, w = (x + 1.0) / 2.0, w / 2.0
+    phi, slope = shape_values(basis.shapes, s), shape_values(basis.shapes, s, 1)
+    stiffness = np.diag(basis.shapes[:, 0] ** 4 * (phi ** 2 @ w))
+    axial = (slope * w) @ slope.T
+    return float(np.min(np.linalg.eigvals(np.linalg.solve(axial, stiffness)).real))
+
+
+ROTATIONS = ("pinned", "clamped", "elastic")
+"""What a clamp holds of the span's rotation (scene key clamps.rotation)."""
+
+
+def end_stiffness(rotation: str, rotational_stiffness: Any, length: Any, bending: Any) -> Any:
+    """K = k_t l / EI (1) of a span's ends: 0 pinned, CLAMPED clamped, else from the clamps'
+    rotational stiffness k_t (N m/rad), the length l (m) and the bending stiffness EI (N m^2);
+    element-wise on numbers, arrays or DataArrays."""
+    if rotation == "pinned":
+        return 0.0
+    if rotation == "clamped":
+        return CLAMPED
+    return rotational_stiffness * length / bending
+
+
+@lru_cache(maxsize=4096)
+def _ends_of(stiffness: float, n_modes: int = 1) -> tuple[Basis, dict[str, float]]:
+    b = pinned_sines(n_modes) if stiffness == 0.0 else elastic_ends(n_modes, stiffness)
+    return b, {**one_mode_integrals(b),
+               "buckling": buckling_factor(b if n_modes >= BUCKLING_MODES
+                                           else _ends_of(stiffness, BUCKLING_MODES)[0])}
+
+
+def span_basis(stiffness: float, n_modes: int) -> Basis:
+    """The basis of N modes of a span with ends K = `stiffness` (pinned_sines for 0; cached:
+    a grid has few distinct K)."""
+    return _ends_of(float(stiffness), int(n_modes))[0]
+
+
+def span_ends(stiffness: Any) -> dict[str, Any]:
+    """Mode 1's integrals (`one_mode_integrals`) and the buckling factor Pcr l^2 / EI of spans
+    with ends K = `stiffness` (a number, an array or a DataArray of them), each of the same
+    shape as `stiffness`: what sweep.models.modal takes as a span's ends."""
+    if np.ndim(stiffness) == 0 and not hasattr(stiffness, "dims"):
+        return _ends_of(float(stiffness))[1]
+    values = np.asarray(stiffness, float)
+    unique, where = np.unique(values, return_inverse=True)
+    tables = [_ends_of(float(k))[1] for k in unique]
+    out = {}
+    for name in tables[0]:
+        column = np.array([t[name] for t in tables])[where].reshape(values.shape)
+        out[name] = stiffness.copy(data=column) if hasattr(stiffness, "dims") else column
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class BasisFamily:
+    """The bases of N modes of spans whose ends differ over a grid (elastic clamps: K = k_t l /
+    EI varies with the length, the cable and the clamps' stiffness): one Basis for each
+    distinct K (`stiffness`, increasing). The kernels take one basis a call: a point's row
+    carries its index into `bases` (sweep.execute.modes_chunk groups the rows by it)."""
+
+    stiffness: np.ndarray
+    bases: tuple[Basis, ...]
+
+    @classmethod
+    def of(cls, stiffness: Any, n_modes: int) -> "BasisFamily":
+        """The family of the distinct values of `stiffness` (an array or DataArray of K)."""
+        values = np.unique(np.asarray(stiffness, float))
+        return cls(values, tuple(span_basis(k, n_modes) for k in values))
+
+    @property
+    def n_modes(self) -> int:
+        return self.bases[0].n_modes
+
+    @property
+    def mode_text(self) -> str:
+        return "mode n of the span with rotational springs K = k_t l / EI at its clamps"
+
+    @property
+    def frequency_text(self) -> str:
+        return "(b_n / b_1)^2 f1, b_n of the span's rotational springs"
+
+    def index(self, stiffness: np.ndarray) -> np.ndarray:
+        """Each K's index into `bases` (K computed as the family's were: the same bits)."""
+        at = np.searchsorted(self.stiffness, stiffness)
+        at = np.minimum(at, self.stiffness.size - 1)
+        if not np.array_equal(self.stiffness[at], stiffness):
+            raise ValueError("a span's rotational stiffness K is not one of the family's")
+        return at
+
+    def kernel_arrays(self) -> list[tuple[np.ndarray, ...]]:
+        """One Basis.kernel_arrays() per K, in `bases` order (sweep.execute.modes_chunk)."""
+        return [b.kernel_arrays() for b in self.bases]
+
+    def frequency_ratios(self, stiffness: Any) -> np.ndarray:
+        """w_n / w_1 (N) of each K of `stiffness` (its shape + (N,))."""
+        table = np.array([b.frequency_ratio / b.frequency_ratio[0] for b in self.bases])
+        return table[self.index(np.asarray(stiffness, float))]

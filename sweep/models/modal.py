@@ -69,6 +69,9 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
     Returns the load-independent part (k, g, h), the load-proportional parts (k_load,
     g_load), the unloaded natural angular frequency w1 (rad/s) and the buckling load (N).
     """
+    ends = span_ends_of(p)
+    if ends is not None:
+        return _consistent_ends(p, ends)
     k = np.pi / p["length"]
     ei = p["youngs_modulus"] * p["inertia"]
     rho_a = p["density"] * p["area"]
@@ -86,6 +89,44 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
         "omega_1": w1,
         "buckling_load": ei * k ** 2,
         "omega_ref": w1,
+    }
+
+
+def span_ends_of(p: Mapping[str, Any]) -> dict[str, Any] | None:
+    """The ends of p's span as `_consistent_ends` takes them (sweep.models.basis.span_ends:
+    mode 1's integrals and the buckling factor, over the points where K = k_t l / EI varies),
+    or None for pinned ends (p's clamps_rotation, default pinned: the closed forms)."""
+    rotation = p.get("clamps_rotation") or "pinned"
+    if rotation == "pinned":
+        return None
+    from .basis import end_stiffness, span_ends
+    return span_ends(end_stiffness(rotation, p.get("clamp_rotational_stiffness"), p["length"],
+                                   p["youngs_modulus"] * p["inertia"]))
+
+
+def _consistent_ends(p: Mapping[str, Any], ends: Mapping[str, Any]) -> dict[str, Any]:
+    """`consistent` for a span whose clamps are not pins (docs/model.md sec. 10): the same
+    projection of Eq.17 on the span's own first mode phi(x / l), from its integrals `ends`
+    (sweep.models.basis.one_mode_integrals, each a number or an array over the points, plus
+    "buckling": Pcr l^2 / EI, basis.buckling_factor); q is the deflection at the mode's
+    largest, its midspan. Pinned sines' integrals give `consistent`'s closed forms."""
+    l = p["length"]
+    ei = p["youngs_modulus"] * p["inertia"]
+    rho_a = p["density"] * p["area"]
+    w1_sq = ei / rho_a * power(ends["beta"] / l, 4)
+    load = p["load_amplitude"]
+    stretch = ends["stretch"] / power(l, 4)
+    return {
+        "mass": 1.0,
+        "k": w1_sq,
+        "g": -4.0 * p["membrane"] * p["youngs_modulus"] / p["density"] * stretch
+        - ei / rho_a * ends["curvature"] / power(l, 6),
+        "h": 10.5 * ei / rho_a * ends["quintic"] / power(l, 8),
+        "k_load": load * ends["load"] / (rho_a * l * l),
+        "g_load": -2.0 * load / rho_a * stretch,
+        "omega_1": np.sqrt(w1_sq),
+        "buckling_load": ei * ends["buckling"] / (l * l),
+        "omega_ref": np.sqrt(w1_sq),
     }
 
 
@@ -196,14 +237,20 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     else:
         out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
                    omega=0.0)
-    out["escape_barrier"] = escape_barrier(out["k0"], out["g0"], out["h"], p["length"])
+    ends = span_ends_of(p) if p["coefficients"] == "consistent" else None
+    out["escape_barrier"] = escape_barrier(
+        out["k0"], out["g0"], out["h"], p["length"] if ends is None
+        else p["length"] * np.pi / ends["slope"])
     base = base_excitation(p, c["omega_1"])
+    if ends is not None:
+        base["participation"] = base["participation"] * ends["gamma"] / PARTICIPATION
     out.update(base)                     # its base_phase 0: a stepped sweep carries the phases
     out["load_phase"] = 0.0              # (continuation.py)
     swept = p.get("base_sweep_start") is not None
     level, omega_b = base["base_accel"], base["base_omega"]
-    if base["participation"] != 0.0 and not swept:
-        out.update(base_response(level, omega_b, c["omega_1"], p["damping_ratio"]))
+    if np.any(base["participation"] != 0.0) and not swept:
+        out.update(base_response(level, omega_b, c["omega_1"], p["damping_ratio"],
+                                 base["participation"]))
     if swept:                     # the scales of the sweep's largest level, lowest frequency
         start, stop, rate = p["base_sweep_start"], p["base_sweep_stop"], p["base_sweep_rate"]
         out["sweep_duration"] = excitation.sweep_duration(start, stop, rate)
@@ -260,7 +307,8 @@ def _level(p: Mapping[str, Any]) -> Any:
     return p["base_acceleration_g"] * STANDARD_GRAVITY
 
 
-def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> dict[str, Any]:
+def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any,
+                  participation: Any = PARTICIPATION) -> dict[str, Any]:
     """Derived quantities of base excitation A sin(w t) (docs/model.md sec. 5), element-wise.
 
     accel: A (m/s^2); omega: w (rad/s); omega_1: the unloaded w1 (rad/s); damping_ratio: zeta.
@@ -274,7 +322,7 @@ def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> d
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         denominator = np.sqrt((omega_1 ** 2 - omega ** 2) ** 2
                               + (2.0 * damping_ratio * omega_1 * omega) ** 2)
-        linear = PARTICIPATION * accel / denominator
+        linear = participation * accel / denominator
         q_factor = 0.5 / (np.float64(damping_ratio) if isinstance(damping_ratio, (int, float))
                           else damping_ratio)
     return {
@@ -320,7 +368,9 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
         "k_sq": k ** 2,
         "omega": one_mode["omega"],
         "bound": one_mode["bound"],
-        "participation": one_mode["participation"],
+        # the kernel's reference: 4/pi, times each mode's basis ratio Gamma_n / (4/pi)
+        "participation": np.where(np.asarray(one_mode["participation"]) != 0.0,
+                                  PARTICIPATION, 0.0)[()],
         "load_phase": 0.0,
         **{name: one_mode[name] for name in EXCITATION_NAMES},
     }

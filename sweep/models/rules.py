@@ -402,6 +402,7 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                 _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
                       f"remove the {axis} axis, or use load.type = 'harmonic'")
     _check_load_frequency_axis(given, axes)
+    _check_clamps(given, axes)
     _check_modes(given, axes)
     _check_continuation(given, axes)
     _check_stability(given, axes)
@@ -413,6 +414,35 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
                       "Eq.32 bakes in the Table 1 cable; use coefficients = 'consistent' "
                       "to sweep it")
         _check_paper_cable(given)
+
+
+ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
+
+
+def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Rules of [clamps] (docs/model.md sec. 10): a rotational stiffness with elastic clamps
+    only, and always with them; ends other than pins need the consistent coefficients (Eq.32
+    is the pinned span's) and have no Floquet chart yet (it takes the pinned modes)."""
+    rotation = given.get("clamps.rotation", "pinned")
+    stiffness = _present(ROTATIONAL_STIFFNESS, given, axes)
+    if rotation != "elastic" and stiffness:
+        _fail(_where(ROTATIONAL_STIFFNESS, axes), f"is for clamps.rotation = 'elastic' (a "
+              f"rotational spring); the scene's clamps are '{rotation}'",
+              "add rotation = 'elastic' to [clamps], or remove the stiffness")
+    if rotation == "elastic" and not stiffness:
+        _fail("scene key 'clamps.rotation'", "'elastic' clamps need their rotational stiffness",
+              "add rotational_stiffness = 0.5 (N m/rad, each clamp) to [clamps], or an axis "
+              "clamp_rotational_stiffness")
+    if rotation == "pinned":
+        return
+    if given.get("model.coefficients") == "paper":
+        _fail("scene key 'clamps.rotation'", f"model.coefficients = 'paper' is the pinned span's "
+              f"Eq.32; '{rotation}' clamps need the consistent coefficients",
+              "use model.coefficients = 'consistent', or clamps.rotation = 'pinned'")
+    if given.get("outputs.stability"):
+        _fail("scene key 'outputs.stability'", f"the Floquet chart takes the pinned span's "
+              f"modes; '{rotation}' clamps couple them (not yet charted)",
+              "remove outputs.stability, or use clamps.rotation = 'pinned'")
 
 
 def _check_load_frequency_axis(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
@@ -562,6 +592,12 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
         _fail("scene key 'continuation.axis'", "only for model.kind = 'transverse' (a stepped "
               "sweep carries a span's transverse state); a longitudinal scene would ignore it",
               "remove [continuation]")
+    _refuse_without(given, ("clamps.rotation",), "only for model.kind = 'transverse' (the "
+                    "clamps' hold on the span's rotation sets its bending modes); a "
+                    "longitudinal scene would ignore it", "remove [clamps]")
+    if given.get(ROTATIONAL_STIFFNESS) is not None:
+        _fail(f"scene key '{ROTATIONAL_STIFFNESS}'", "only for model.kind = 'transverse'",
+              "remove [clamps]")
     _refuse_without(given, ("model.modes", "solver.stop_when_steady"),
                     "only for model.kind = 'transverse' (Galerkin modes, the steady early "
                     "stop); a longitudinal scene would ignore it", "remove the key")
@@ -742,6 +778,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     if params["inertia"] is None:
         params["inertia"] = default_inertia(params["area"])
     params.update(coefficients=values["model.coefficients"], load_type=values["load.type"],
+                  clamps_rotation=values.get("clamps.rotation"),
                   paper_parametric=values["model.paper_parametric"],
                   divergence_bound=values["metrics.divergence_bound"],
                   base_levels_g=values.get(BASE_TABLE_KEY))

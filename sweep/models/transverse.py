@@ -27,7 +27,7 @@ from ..runner import RunOptions, check_memory, placer, point_order, solve_chunke
 from ..scene import Scene
 from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
 from . import excitation, modal
-from .basis import Basis, pinned_sines
+from .basis import Basis, BasisFamily, end_stiffness, span_basis
 
 KIND = "transverse"
 MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
@@ -201,7 +201,8 @@ class Inputs:
     sample times (s; empty when none are stored); driver, method, controller: solver.driver,
     solver.method, solver.controller; wanted: the outputs.* switches that are on (dotted
     keys); has_base: the scene has base excitation; origin: its provenance; n_modes:
-    model.modes; basis: the span's mode shapes (sweep/models/basis.py; pinned sines);
+    model.modes; basis: the span's mode shapes (sweep/models/basis.py: one Basis, or a
+    BasisFamily where elastic ends vary over the grid);
     modal_q0, modal_v0: the initial modal deflections (m) and velocities (m/s),
     n_modes scalars or axis parameters each (mode 1's from initial.displacement and
     initial.velocity, the others 0, unless the scene gives initial.modal_displacement or
@@ -225,7 +226,7 @@ class Inputs:
     has_base: bool
     origin: Provenance
     n_modes: int = 1
-    basis: Basis | None = None
+    basis: Basis | BasisFamily | None = None
     modal_q0: tuple = ()
     modal_v0: tuple = ()
     continuation: str | None = None
@@ -235,6 +236,24 @@ class Inputs:
     bands: tuple[int, int, int] | None = None
     per_point_end: bool = False
     sweep_direction: str | None = None
+
+
+def end_stiffness_of(params: dict[str, Any], rotation: str = "elastic") -> Any:
+    """K = k_t l / EI (1) of the span's ends from `params` (grid.parameters, or their values
+    at points: the same bits either way)."""
+    return end_stiffness(rotation, params["clamp_rotational_stiffness"], params["length"],
+                         params["youngs_modulus"] * params["inertia"])
+
+
+def _basis(rotation: str, params: dict[str, Any], n_modes: int) -> Basis | BasisFamily:
+    """The span's modes: one Basis for pinned or clamped ends; for elastic ones a Basis per
+    distinct K over the grid (a BasisFamily; one basis when K does not vary)."""
+    if rotation != "elastic":
+        return span_basis(end_stiffness(rotation, None, None, None), n_modes)
+    stiffness = end_stiffness_of(params)
+    if np.ndim(stiffness) == 0:
+        return span_basis(float(stiffness), n_modes)
+    return BasisFamily.of(stiffness, n_modes)
 
 
 def resolve(scene: Scene) -> Inputs:
@@ -261,7 +280,7 @@ def resolve(scene: Scene) -> Inputs:
                   driver=scene.get("solver.driver"), method=scene.get("solver.method"),
                   controller=scene.get("solver.controller"), wanted=wanted,
                   has_base=scene.has_base, origin=provenance(scene), n_modes=n_modes,
-                  basis=pinned_sines(n_modes),
+                  basis=_basis(scene.get("clamps.rotation"), params, n_modes),
                   modal_q0=initial[0], modal_v0=initial[1],
                   continuation=scene.get("continuation.axis"),
                   direction=scene.get("continuation.direction"),
@@ -444,7 +463,11 @@ def modal_rows(inputs: Inputs, points: np.ndarray) -> np.ndarray:
     at = grid.point_values(params, dims, shape, points)
     columns = modal.modes_columns(at, modal.oscillator(at), n, values_at(inputs.modal_q0),
                                   values_at(inputs.modal_v0))
-    return grid.rows(columns, names, points.size)
+    rows = grid.rows(columns, names, points.size)
+    if isinstance(inputs.basis, BasisFamily):     # each row's basis, in a last column
+        index = inputs.basis.index(np.broadcast_to(end_stiffness_of(at), points.shape))
+        rows = np.ascontiguousarray(np.hstack([rows, index[:, None].astype(float)]))
+    return rows
 
 
 def _system(inputs: Inputs, settings: np.ndarray) -> _System:
@@ -606,18 +629,26 @@ def base_outputs(acceleration: np.ndarray, dims: tuple[str, ...],
 
 
 def modal_outputs(amplitudes: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...],
-                  coeffs: dict[str, Any], coords: dict[str, xr.DataArray], basis: Basis
+                  coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
+                  basis: Basis | BasisFamily, params: dict[str, Any] | None = None
                   ) -> dict[str, xr.DataArray]:
     """The outputs of a multi-mode run (docs/model.md sec. 7): modal_amplitude, each mode's
     max |q_n| over the tail window (m, over dims and `mode`; NaN where the point failed), and
-    modal_frequency, the basis' w_n / w_p times the pinned span's f1 (Hz, over `mode` and the
-    axes f1 depends on; pinned sines: n^2 f1)."""
+    modal_frequency, the basis' w_n / w_1 times the span's f1 (Hz, over `mode` and the axes
+    f1 depends on; pinned sines: n^2 f1; a BasisFamily's ratios over the axes K depends on)."""
     n_modes = amplitudes.shape[1]
     amplitude = xr.DataArray(amplitudes.reshape(shape + (n_modes,)), dims=dims + (MODE_DIM,),
                              attrs={"units": "m", "long_name": "modal amplitude: max |q_n| over "
                                     f"the tail window, q_n the coefficient of {basis.mode_text}"})
-    frequency = modal.modal_frequencies(derived(coeffs["natural_frequency"], coords),
-                                        basis.frequency_ratio).transpose(..., MODE_DIM)
+    f1 = derived(coeffs["natural_frequency"], coords)
+    if isinstance(basis, BasisFamily):
+        stiffness = end_stiffness_of(params)
+        ratios = xr.DataArray(basis.frequency_ratios(stiffness),
+                              dims=tuple(stiffness.dims) + (MODE_DIM,))
+        frequency = (f1 * ratios).transpose(..., MODE_DIM)
+    else:
+        frequency = modal.modal_frequencies(f1, basis.frequency_ratio / basis.frequency_ratio[0]
+                                            ).transpose(..., MODE_DIM)
     frequency.attrs = {"units": "Hz", "long_name": "linear natural frequency of mode n of the "
                                                   f"unloaded span, {basis.frequency_text}"}
     return {"modal_amplitude": amplitude, "modal_frequency": frequency}
@@ -705,7 +736,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                                              "long_name": long_name.format(method=short)})
     data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
     if result.modal is not None:
-        data.update(modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis))
+        data.update(modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis,
+                                  inputs.params))
         if not inputs.swept and "outputs.amplitude" in inputs.wanted:
             data["max_deflection"] = xr.DataArray(
                 result.reals[:, tk.SPAN_MAX].reshape(shape), dims=dims,

@@ -1,0 +1,300 @@
+"""Clamped and elastic ends ([clamps], docs/model.md sec. 10): the span's own modes through the
+same engine, against references written here from the textbook, not from sweep.models.basis:
+
+1. the linearised clamped span under base excitation: the closed-form steady response of its
+   modes (b_n l from cos(b l) cosh(b l) = 1, shapes and participations by quadrature of the
+   textbook cosh/cos form), below, at and above resonance, one mode and three;
+2. the nonlinear clamped span (stretching and curvature terms of Eq.17) against SciPy's DOP853
+   on Galerkin equations projected on the textbook shapes (tests/galerkin.py);
+3. elastic ends: f1 and the linear response from MODEL's rotational-spring eigenvalues;
+4. bad [clamps] input, one line each.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+import pytest
+
+import sweep
+from sweep.errors import SceneError
+
+import galerkin as g
+
+LENGTH = 0.4
+ZETA = 0.02
+
+
+def scene(rotation: str = "clamped", modes: int = 1, level_g: float = 1e-5,
+          ratio: float = 1.0, t_end: float = 4.0, extra: str = "") -> sweep.Scene:
+    return sweep.load_scene_text(scene_text(rotation, modes, level_g, ratio, t_end, extra))
+
+
+def scene_text(rotation: str = "clamped", modes: int = 1, level_g: float = 1e-5,
+               ratio: float = 1.0, t_end: float = 4.0, extra: str = "") -> str:
+    return f"""
+name = "clamps-check"
+[model]
+modes = {modes}
+[clamps]
+rotation = "{rotation}"
+{extra}
+[cable]
+damping_ratio = {ZETA}
+inertia = 2.865e-12
+[base]
+acceleration_g = {level_g}
+frequency_ratio = {ratio}
+[solver]
+t_end = {t_end}
+rtol = 1e-10
+[metrics]
+tail = 0.25
+[axes]
+length = [{LENGTH}]
+"""
+
+
+def _one(ds, name: str) -> float:
+    """The value of variable `name` at the scene's one point."""
+    return float(ds[name].squeeze())
+
+
+def _textbook(n_modes: int, cable: g.Cable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(w_n (rad/s), Gamma_n = int phi / int phi^2, phi_n(l/2)) of the clamped span's modes
+    1..N from tests/galerkin.py's textbook shapes (their b_n l from cos(b l) cosh(b l) = 1),
+    by a fine Gauss-Legendre rule."""
+    shapes = g.clamped_shapes(n_modes, cable.length)
+    x, w = np.polynomial.legendre.leggauss(200)
+    x, w = 0.5 * cable.length * (x + 1.0), 0.5 * cable.length * w
+    phi = np.array([s(x, 0) for s in shapes])
+    gamma = (phi @ w) / (phi ** 2 @ w)
+    mid = np.array([float(s(cable.length / 2.0, 0)) for s in shapes])
+    # w_n^2 = EI b_n^4 / rho A, b_n^4 = (4th derivative of phi) / phi, anywhere phi is not 0
+    b4 = np.array([float(s(x[7], 4) / s(x[7], 0)) for s in shapes])
+    ei_rho = cable.youngs_modulus * cable.inertia / (cable.density * cable.area)
+    return np.sqrt(b4 * ei_rho), gamma, mid
+
+
+def _linear_midspan(n_modes: int, ratio: float, level_g: float) -> tuple[float, float]:
+    """(mode 1's steady amplitude, the midspan's) of the linearised clamped span at
+    f = ratio f1, A = level_g g: q_n = Gamma_n A / (w_n^2 - w^2 + 2 i zeta w_n w), midspan =
+    |sum phi_n(l/2) q_n| (the modes' phases added), mode 1 scaled to its midspan value."""
+    cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
+    omega_n, gamma, mid = _textbook(n_modes, cable)
+    omega = ratio * omega_n[0]
+    accel = level_g * 9.80665
+    q = gamma * accel / (omega_n ** 2 - omega ** 2 + 2j * ZETA * omega_n * omega)
+    return abs(q[0] * mid[0]), abs(np.sum(q * mid))
+
+
+@pytest.mark.parametrize("modes", [1, 3])
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 1.6])
+def test_the_linear_clamped_span_is_the_textbook_response(modes, ratio):
+    """At 1e-5 g the clamped span is linear to 1e-7: its midspan amplitude, and mode 1's
+    (modal_amplitude, scaled to the midspan), equal the closed-form steady response of the
+    textbook modes below (0.5 f1), at and above (1.6 f1) resonance, f1 the clamped span's own
+    (natural_frequency = (4.73004 / pi)^2 x the pinned span's)."""
+    ds = sweep.run(scene(modes=modes, ratio=ratio), progress=False)
+    cable = g.Cable(length=LENGTH)
+    omega_n, _, _ = _textbook(3, cable)
+    assert _one(ds, "natural_frequency") == pytest.approx(omega_n[0] / (2 * math.pi),
+                                                           rel=1e-9)
+    assert _one(ds, "buckling_load") == pytest.approx(
+        4 * math.pi ** 2 * cable.youngs_modulus * cable.inertia / LENGTH ** 2, rel=2e-4)
+    mode1, midspan = _linear_midspan(modes, ratio, 1e-5)
+    assert str(ds["state"].attrs["flag_meanings"].split()[int(ds["state"].squeeze())]) == "steady"
+    assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-4)
+    if modes > 1:
+        assert float(ds["modal_amplitude"].sel(mode=1).squeeze()) == pytest.approx(mode1, rel=1e-4)
+        np.testing.assert_allclose(ds["modal_frequency"].values.ravel(),
+                                   omega_n / (2 * math.pi), rtol=1e-9)
+    else:
+        assert _one(ds, "linear_amplitude") == pytest.approx(mode1, rel=1e-9)
+
+
+def _scipy_midspan(n_modes: int, level_g: float, ratio: float, t_end: float) -> float:
+    """Tail max |w(l/2, t)| (m) over [0.75 t_end, t_end] of the clamped span from rest, by
+    SciPy DOP853 on Galerkin equations over the textbook modes (tests/galerkin.py)."""
+    from scipy.integrate import solve_ivp
+    cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
+    omega_n, _, mid = _textbook(n_modes, cable)
+    shapes = g.clamped_shapes(n_modes, LENGTH)
+    f = g.shapes_rhs(cable, shapes, omega_n, level_g * 9.80665,
+                     ratio * omega_n[0] / (2 * math.pi))
+    sol = solve_ivp(f, (0.0, t_end), np.zeros(2 * n_modes), method="DOP853", rtol=1e-11,
+                    atol=1e-16, dense_output=True).sol
+    t = np.linspace(0.75 * t_end, t_end, 20001)
+    return g._tail_max(lambda s: mid @ sol(s)[:n_modes], lambda s: mid @ sol(s)[n_modes:], t)
+
+
+@pytest.mark.parametrize("modes", [1, pytest.param(3, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("ratio", [0.9, 1.2])
+def test_the_nonlinear_clamped_span_matches_scipy_on_the_textbook_modes(modes, ratio):
+    """At 2 g near resonance the clamped span is far from linear (its stretching hardens it:
+    the amplitude differs from the linear one by > 5 %); the engine's midspan amplitude
+    equals SciPy's on Galerkin equations over the textbook cosh/cos modes, projected by
+    quadrature in the test, to 1e-6."""
+    ds = sweep.run(scene(modes=modes, ratio=ratio, level_g=2.0, t_end=1.5), progress=False)
+    reference = _scipy_midspan(modes, 2.0, ratio, 1.5)
+    assert abs(_linear_midspan(modes, ratio, 2.0)[1] / reference - 1.0) > 0.05
+    assert _one(ds, "amplitude") == pytest.approx(reference, rel=1e-6)
+
+
+@pytest.mark.parametrize("overrides, words", [
+    ({"clamps.rotation": "elastic"}, ["clamps.rotation", "rotational_stiffness"]),
+    ({"clamps.rotational_stiffness": 0.5}, ["clamps.rotational_stiffness", "elastic"]),
+    ({"clamps.rotation": "clamped", "clamps.rotational_stiffness": 0.5},
+     ["rotational_stiffness", "'clamped'"]),
+    ({"axes.clamp_rotational_stiffness": [0.1, 1.0]}, ["clamp_rotational_stiffness", "elastic"]),
+    ({"clamps.rotation": "hinged"}, ["clamps.rotation", "hinged"]),
+    ({"clamps.rotation": "elastic", "clamps.rotational_stiffness": -1.0},
+     ["clamps.rotational_stiffness"]),
+])
+def test_bad_clamps_are_one_clear_line(overrides, words):
+    with pytest.raises(SceneError) as info:
+        sweep.load_scene("harness-base-sine", overrides=overrides)
+    message = str(info.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+@pytest.mark.parametrize("name, overrides, words", [
+    ("paper-fig5", {"clamps.rotation": "clamped"}, ["clamps.rotation", "paper"]),
+    ("paper-fig7", {"clamps.rotation": "clamped"}, ["clamps.rotation", "transverse"]),
+    ("harness-stability", {"clamps.rotation": "clamped"}, ["outputs.stability", "Floquet"]),
+])
+def test_clamps_a_scene_cannot_honour_are_refused(name, overrides, words):
+    """The paper's Eq.32 is the pinned span's, a longitudinal scene has no bending modes, and
+    the Floquet chart takes the pinned modes: each refuses other clamps in one line."""
+    with pytest.raises(SceneError) as info:
+        sweep.load_scene(name, overrides=overrides)
+    message = str(info.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message, message
+
+
+# --- elastic ends: a rotational spring K = k_t l / EI at each clamp -------------------------
+
+EI = 1.1e11 * 2.865e-12        # N m^2 of the scene's cable
+
+
+def _symmetric_modes(stiffness: float, count: int) -> list[tuple[float, Callable]]:
+    """The symmetric modes of the span with springs K at both ends, written about midspan
+    (u = s - 1/2): phi = cos(b u) + c cosh(b u), c = -cos(b/2) / cosh(b/2) (phi = 0 at the
+    ends), b the roots of phi''(end) + K phi'(end) = 0 at u = 1/2 (brentq on a scan): another
+    formulation than sweep.models.basis's (its 4 x 4 determinant over the whole span).
+    Returns (b, phi(s)) for the first `count`."""
+    from scipy.optimize import brentq
+
+    def parts(b: float, u: np.ndarray):
+        c = -math.cos(b / 2) / math.cosh(b / 2)
+        return (np.cos(b * u) + c * np.cosh(b * u),
+                b * (-np.sin(b * u) + c * np.sinh(b * u)),
+                b * b * (-np.cos(b * u) + c * np.cosh(b * u)))
+
+    def residual(b: float) -> float:
+        _, d1, d2 = parts(b, np.array(0.5))
+        return float(d2 + stiffness * d1) / (b * b + stiffness * b)
+
+    grid = np.linspace(0.5, 40.0, 40000)
+    values = [residual(b) for b in grid]
+    roots = []
+    for k in range(len(grid) - 1):
+        if values[k] * values[k + 1] < 0 and abs(values[k] - values[k + 1]) < 1.0:
+            roots.append(brentq(residual, grid[k], grid[k + 1], xtol=1e-14))
+        if len(roots) == count:
+            break
+    return [(b, lambda s, b=b: parts(b, np.asarray(s) - 0.5)[0]) for b in roots]
+
+
+@pytest.mark.parametrize("stiffness, table", [(1.0, 1.170), (10.0, 1.750), (100.0, 2.183)])
+def test_elastic_ends_give_the_spring_table_frequency(stiffness, table):
+    """f1 over the pinned span's f1 (MODEL's rotational-spring table, 3 digits) equals
+    (b_1 l / pi)^2 of the symmetric formulation written here, to 1e-9."""
+    ds = sweep.run(scene("elastic", t_end=0.2,
+                         extra=f"rotational_stiffness = {stiffness * EI / LENGTH!r}"),
+                   progress=False)
+    pinned = sweep.run(scene("pinned", t_end=0.2), progress=False)
+    ratio = _one(ds, "natural_frequency") / _one(pinned, "natural_frequency")
+    assert ratio == pytest.approx(table, abs=6e-4)
+    b1 = _symmetric_modes(stiffness, 1)[0][0]
+    assert ratio == pytest.approx((b1 / math.pi) ** 2, rel=1e-9)
+
+
+@pytest.mark.parametrize("modes", [1, 3])
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 1.6])
+def test_the_linear_elastic_span_is_the_closed_form_response(modes, ratio):
+    """K = 10: the linearised span's midspan amplitude against the closed-form steady response
+    of the symmetric modes written here (their b, participations int phi / int phi^2 and
+    midspan values by quadrature; the antisymmetric ones are not excited), below, at and
+    above its own resonance."""
+    stiffness = 10.0
+    ds = sweep.run(scene("elastic", modes=modes, ratio=ratio,
+                         extra=f"rotational_stiffness = {stiffness * EI / LENGTH!r}"),
+                   progress=False)
+    symmetric = _symmetric_modes(stiffness, 2 if modes == 3 else 1)
+    x, w = np.polynomial.legendre.leggauss(200)
+    s, w = (x + 1.0) / 2.0, w / 2.0
+    rho_a = 8900.0 * 6e-6
+    omega_n = np.array([(b / LENGTH) ** 2 * math.sqrt(EI / rho_a) for b, _ in symmetric])
+    gamma = np.array([(phi(s) @ w) / (phi(s) ** 2 @ w) for _, phi in symmetric])
+    mid = np.array([float(phi(0.5)) for _, phi in symmetric])
+    omega = ratio * omega_n[0]
+    q = gamma * 1e-5 * 9.80665 / (omega_n ** 2 - omega ** 2 + 2j * ZETA * omega_n * omega)
+    assert _one(ds, "amplitude") == pytest.approx(abs(np.sum(q * mid)), rel=1e-4)
+
+
+def test_an_elastic_grid_is_its_points_run_alone():
+    """Where K varies over the grid (lengths x spring stiffness) each point's modes are its
+    own: every point of the grid equals the same point run alone, to the bit, and f1 rises
+    with the spring from the pinned span's towards the clamped one's."""
+    base = {"clamps.rotation": "elastic", "model.modes": 3, "solver.t_end": 0.6,
+            "base.acceleration_g": 0.5, "base.frequency_ratio": 0.9}
+    text = scene_text("elastic", modes=3)
+    grid = sweep.run(sweep.load_scene_text(text, overrides={
+        **base, "axes.length": [0.3, 0.45], "axes.clamp_rotational_stiffness": [0.1, 10.0]}),
+        progress=False)
+    for length in (0.3, 0.45):
+        for k_t in (0.1, 10.0):
+            alone = sweep.run(sweep.load_scene_text(text, overrides={
+                **base, "axes.length": [length], "clamps.rotational_stiffness": k_t}),
+                progress=False)
+            at = grid.sel(length=length, clamp_rotational_stiffness=k_t)
+            for name in ("amplitude", "modal_amplitude", "natural_frequency", "n_steps"):
+                np.testing.assert_array_equal(at[name].values,
+                                              alone[name].squeeze("length").values, name)
+    f1 = grid["natural_frequency"].sel(length=0.45).values
+    pinned = sweep.run(sweep.load_scene_text(text, overrides={
+        **base, "clamps.rotation": "pinned", "axes.length": [0.45]}), progress=False)
+    f_pinned = _one(pinned, "natural_frequency")
+    assert f_pinned < f1[0] < f1[1] < 2.267 * f_pinned
+
+
+def test_design_refines_an_elastic_span_on_its_own_frequency(tmp_path):
+    """With elastic clamps K = k_t l / EI grows with the span, so f1 is not ~ l^-2 and the
+    log-log interpolation that is exact between pins is not: --refine finds the length where
+    the span's own f1 (from the symmetric formulation written here) crosses the limit, to the
+    tolerance."""
+    from sweep.design import refine_span
+    k_t = 1.0
+    text = scene_text("elastic", t_end=0.2, extra=f"rotational_stiffness = {k_t}")
+    ds = sweep.run(sweep.load_scene_text(text, overrides={"axes.length": [0.2, 0.3, 0.4]}),
+                   output=tmp_path / "r.nc", progress=False)
+    out = refine_span(ds, min_frequency=60.0, tolerance=1e-5)
+    span = float(out["max_span"])
+    assert str(out["limited_by"].values) == "min_frequency"
+    rho_a = 8900.0 * 6e-6
+
+    def f1(length: float) -> float:
+        b = _symmetric_modes(k_t * length / EI, 1)[0][0]
+        return (b / length) ** 2 * math.sqrt(EI / rho_a) / (2 * math.pi)
+
+    assert f1(span) >= 60.0 > f1(span + 2e-5)
+    grid_guess = float(np.exp(np.interp(np.log(60.0), np.log(ds["natural_frequency"].values[::-1]),
+                                        np.log(ds["length"].values[::-1]))))
+    assert abs(grid_guess - span) > 1e-4       # the pinned span's shortcut would miss it
