@@ -62,6 +62,7 @@ description = "Benchmark: RHS evaluations per second, form {form}"
 [model]
 kind = "transverse"
 coefficients = "consistent"
+membrane = 0.375
 
 [cable]
 inertia = 2.865e-12

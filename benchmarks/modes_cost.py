@@ -52,6 +52,7 @@ SCENE = """
 name = "modes-cost"
 [model]
 modes = {n}
+membrane = 0.375
 [cable]
 youngs_modulus = 1.1e11
 density = 8900.0

@@ -52,6 +52,7 @@ SCENE = """
 name = "tolerance-sample"
 [model]
 coefficients = "consistent"
+membrane = 0.375
 [solver]
 t_end = 5.0
 """

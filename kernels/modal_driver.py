@@ -419,7 +419,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     T = basis[md.TABLES]
     pp = np.empty(md.prepared_size(n))
     md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, T)
+    S = md.scratch(pp, n, T, basis[md.COUPLING])
     p1 = observer_row(row, n)
     K = np.empty((n_stages + 1, dim))
     K_mid = np.empty((n_stages + 1, 2))
@@ -487,7 +487,7 @@ def at_rest(row, basis, t, y, band, base):
     T = basis[md.TABLES]
     pp = np.empty(md.prepared_size(n))
     md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, T)
+    S = md.scratch(pp, n, T, basis[md.COUPLING])
     z = np.empty(2 * n)
     f = np.empty(2 * n)
     for i in range(n):

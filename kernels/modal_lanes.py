@@ -92,12 +92,13 @@ def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
-             base):
+             base, CP):
     """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
     rk_step: K[1..n_stages] and YN = y_new, K[n_stages] = f(t + h, y_new); K[0] = f(t, y)
     given) and SciPy's error norm over the 2N components (ERR): RK45's RMS, or DOP853's
     combination of its fifth- and third-order estimates (`eighth`). The absolute tolerances are
-    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n')."""
+    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP: the basis' coupling
+    (kernels.modes.lanes_derivative)."""
     L = LANES
     dim = 2 * n
     n_stages = B.shape[0]
@@ -106,11 +107,11 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
         c = C[s]
         for l in range(n_run):
             TT[l] = W[tj.T * L + l] + c * H[l]
-        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base)
+        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP)
     _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
     for l in range(n_run):
         TT[l] = W[tj.T * L + l] + H[l]
-    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base)
+    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP)
     # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
     for l in range(n_run):
         ST[0, l] = 0.0
@@ -372,7 +373,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
         states[point] = mt.INVALID_INPUT
         return False
     md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, T)
+    S = md.scratch(pp, n, T, basis[md.COUPLING])
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
     p1 = drv.observer_row(row, n)
@@ -560,7 +561,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
-                 n_run, base)
+                 n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
         _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run)

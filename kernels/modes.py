@@ -62,14 +62,16 @@ Q_SCALE = 8         # the point's displacement scale (sweep.models.modal.state_s
 V_SCALE = 9         # its velocity scale                                            (m/s)
 PARTICIPATION = 10  # 4 / pi (0 without base excitation); mode n: times its basis ratio
 LOAD_PHASE = 11     # phi_W: P(t) = P0 cos(W t + phi_W)                                    (rad)
-EXCITATION = 12     # the base excitation block (kernels.excitation): a_b(t), fixed or swept
+TENSION = 12        # k_s k^4 l / (2 rho A): the uniform stretching tension's factor  (1/(s^2 m^2))
+EXCITATION = 13     # the base excitation block (kernels.excitation): a_b(t), fixed or swept
 BASE_ACCEL = EXCITATION + ex.ACCEL   # A, base acceleration amplitude                     (m/s^2)
 BASE_OMEGA = EXCITATION + ex.OMEGA   # w_b, base angular frequency (a sweep's start)      (rad/s)
 BASE_PHASE = EXCITATION + ex.PHASE   # phi_b (a stepped sweep's carried phase)            (rad)
 N_FIXED = EXCITATION + ex.SIZE       # then q_n(0) (m) for n = 1..N, then q_n'(0) (m/s)
 
 FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", "omega",
-               "bound", "q_scale", "v_scale", "participation", "load_phase") + ex.NAMES
+               "bound", "q_scale", "v_scale", "participation", "load_phase",
+               "tension") + ex.NAMES
 
 
 # The items of the `basis` tuple every modal kernel takes (module docstring).
@@ -78,6 +80,7 @@ STATIONS = 1        # (M + 1, N): the shapes at stations along the span
 MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
 SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
+COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -106,7 +109,8 @@ S_OMEGA = 4
 S_LOAD_PHASE = 5
 S_LOAD_MEAN = 6     # the axial load's linear term P(t) k^2 / rho A: constant part    (1/s^2)
 S_LOAD_COS = 7      # and the part times cos(W t + phi_W)                             (1/s^2)
-S_EXCITATION = 8    # the excitation block, copied from the raw row
+S_TENSION = 8       # the uniform tension's factor (TENSION)                          (1/(s^2 m^2))
+S_EXCITATION = 9    # the excitation block, copied from the raw row
 S_BASE_ACCEL = S_EXCITATION + ex.ACCEL
 S_BASE_OMEGA = S_EXCITATION + ex.OMEGA
 S_BASE_PHASE = S_EXCITATION + ex.PHASE
@@ -235,6 +239,7 @@ def prepare(row, n_modes, pp, ratios):
     pp[s + S_LOAD_PHASE] = row[LOAD_PHASE]
     pp[s + S_LOAD_MEAN] = row[LOAD_MEAN]
     pp[s + S_LOAD_COS] = row[LOAD_COS]
+    pp[s + S_TENSION] = row[TENSION]
     for c in range(ex.SIZE):
         pp[s + S_EXCITATION + c] = row[EXCITATION + c]
 
@@ -251,13 +256,16 @@ _CONTRACT = {"contract"}
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base):
+def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
     (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis' tables
     (sweep.models.basis: the shapes' derivatives at the quadrature nodes and the projection
     weights); FLD (4, nodes, lanes) and SC (4, lanes): scratch. fast: None (libm's cos and
-    sin) or True (vecmath's vectorisable ones); base: None (no base excitation term) or True.
+    sin) or True (vecmath's vectorisable ones); base: None (no base excitation term) or True;
+    CP: the basis' coupling A_ij / pi^2 (basis[COUPLING]), for the uniform stretching tension
+    N = k_s e, e = (k^2 l / 2) sum CP_ij q_i q_j, which adds -N k^2 b / rho A to F (a lane whose
+    TENSION is 0 has none; when no lane has one it is not computed).
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode
     there: the nonlinear terms and the axial load's linear term P(t) w_xx (for pinned sines a
@@ -275,6 +283,21 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base):
         cw = math.cos(x) if fast is None else fast_cos(x)
         SC[0, l] = PP[sc + S_LOAD_MEAN, l] + PP[sc + S_LOAD_COS, l] * cw
         SC[1, l] = PP[sc + S_BETA_M0, l] + PP[sc + S_BETA_M1, l] * cw
+    tension = False
+    for l in range(n_run):
+        tension = tension or PP[sc + S_TENSION, l] != 0.0
+    if tension:                         # the uniform tension N = k_s e, e = int w_x^2 / 2
+        for l in range(n_run):
+            SC[3, l] = 0.0
+        for i in range(n):
+            for k in range(n):
+                a_ik = CP[i, k]
+                if a_ik == 0.0:
+                    continue
+                for l in range(n_run):
+                    SC[3, l] += a_ik * X[i, l] * X[k, l]
+        for l in range(n_run):
+            SC[0, l] -= PP[sc + S_TENSION, l] * SC[3, l]
     if base is not None:
         if fast is None:                # libm, and any excitation (kernels.excitation)
             flat = PP.reshape(PP.size)
@@ -339,23 +362,25 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def scratch(pp, n_modes, T):
-    """The one-state right-hand side's working arrays for prepared row pp (`derivative`)."""
+def scratch(pp, n_modes, T, CP):
+    """The one-state right-hand side's working arrays for prepared row pp (`derivative`), and
+    the basis' coupling CP (basis[COUPLING])."""
     PP = np.empty((pp.shape[0], 1))
     for c in range(pp.shape[0]):
         PP[c, 0] = pp[c]
     return (PP, np.empty((2 * n_modes, 1)), np.empty((1, 2 * n_modes, 1)), np.empty(1),
-            np.empty((4, T.shape[2], 1)), np.empty((4, 1)))
+            np.empty((4, T.shape[2], 1)), np.empty((4, 1)), CP)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s): `lanes_derivative` with
-    one lane and libm's cos and sin. S: `scratch`(prepared row, N, T); T: the basis' tables."""
-    PP, X, K, tt, FLD, SC = S
+    one lane and libm's cos and sin. S: `scratch`(prepared row, N, T, the basis' coupling);
+    T: the basis' tables."""
+    PP, X, K, tt, FLD, SC, CP = S
     for c in range(2 * n_modes):
         X[c, 0] = y[c]
     tt[0] = t
-    lanes_derivative(tt, X, K, 0, PP, n_modes, T, FLD, SC, 1, None, base)
+    lanes_derivative(tt, X, K, 0, PP, n_modes, T, FLD, SC, 1, None, base, CP)
     for c in range(2 * n_modes):
         dy[c] = K[0, c, 0]

@@ -67,8 +67,14 @@ KEYS: tuple[Key, ...] = (
         long_name="which vibration problem is solved"),
     Key("model", "coefficients", "str", "consistent", choices=("consistent", "paper"),
         long_name="transverse modal coefficients: re-derived (consistent) or Eq.32 as printed (paper)"),
-    Key("model", "membrane", "float", 0.375, units="1", minimum=0.0,
-        long_name="membrane stretching coefficient alpha", axis="membrane"),
+    Key("model", "membrane", "float", None, units="1", minimum=0.0,
+        long_name="the paper's local membrane stretching 4 alpha EA w_xx w_x^2: its alpha (3/8 "
+                  "as Eq.17 implies); absent: the uniform tension between the clamps "
+                  "(clamps.axial_stiffness)", axis="membrane",
+        help="the paper's local membrane stretching 4 alpha EA w_xx w_x^2, alpha = 3/8 as its "
+        "Eq.17 implies (the built-in scenes give it); absent: the span stretches as a whole, "
+        "the uniform tension N = k_s e between axially restrained clamps (clamps."
+        "axial_stiffness; docs/model.md sec. 10)"),
     Key("model", "paper_parametric", "str", "printed", choices=("printed", "corrected"),
         long_name="paper preset: Eq.32's parametric (cos) terms as printed or 10x-corrected"),
     Key("model", "modes", "int", 1, units="1", minimum=1, maximum=12,
@@ -84,6 +90,10 @@ KEYS: tuple[Key, ...] = (
         long_name="rotational stiffness k_t of each clamp (rotation = 'elastic'); K = k_t l / EI "
                   "runs from pinned (0) to clamped (infinite)",
         axis="clamp_rotational_stiffness"),
+    Key("clamps", "axial_stiffness", "float", None, units="N m-1", minimum=0.0,
+        long_name="axial stiffness k_a of each clamp, in series with the span's EA / l for the "
+                  "stretching tension (default: immovable clamps; 0: the cable slides through "
+                  "them and does not stretch)", axis="clamp_axial_stiffness"),
     # [cable]
     Key("cable", "youngs_modulus", "float", 1.1e11, units="Pa", minimum=0.0, exclusive_min=True,
         long_name="Young's modulus", axis="youngs_modulus"),

@@ -277,13 +277,29 @@ def clamped_shapes(n_modes: int, length: float) -> list[Callable[[np.ndarray, in
     return shapes
 
 
+def sine_shapes(n_modes: int, length: float) -> list[Callable[[np.ndarray, int], np.ndarray]]:
+    """The pinned span's modes sin(n pi x / l) as clamped_shapes gives its own: phi(x, k), the
+    k-th derivative (1/m^k) at x (m)."""
+    def make(n: int):
+        b = n * math.pi / length
+
+        def phi(x, k):
+            z = b * np.asarray(x, dtype=float)
+            return b ** k * [np.sin(z), np.cos(z), -np.sin(z), -np.cos(z)][k % 4]
+        return phi
+    return [make(n) for n in range(1, n_modes + 1)]
+
+
 def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration: float = 0.0,
-               base_frequency: float = 0.0, nodes: int = 96) -> Callable:
+               base_frequency: float = 0.0, nodes: int = 96,
+               tension_stiffness: float | None = None) -> Callable:
     """SciPy right-hand side of the Galerkin equations on the span's own linear modes `shapes`
-    (clamped_shapes' callables; omegas: their natural angular frequencies, rad/s): Eq.17's
-    residual R (module docstring, no end load) at Gauss-Legendre nodes, projected on each mode
-    and divided by rho A int phi_n^2; modal damping 2 zeta w_n; base participation int phi_n /
-    int phi_n^2; a_b = A sin(2 pi f t)."""
+    (clamped_shapes' or sine_shapes' callables; omegas: their natural angular frequencies,
+    rad/s): Eq.17's residual R (module docstring, no end load) at Gauss-Legendre nodes,
+    projected on each mode and divided by rho A int phi_n^2; modal damping 2 zeta w_n; base
+    participation int phi_n / int phi_n^2; a_b = A sin(2 pi f t). tension_stiffness k_s (N/m):
+    the stretching is the uniform tension N = k_s e, e = (1/2) int w_x^2 dx (R gains - N w_xx)
+    instead of the local membrane term (cable.membrane is then not used)."""
     n_modes = len(shapes)
     l = cable.length
     g, weights = np.polynomial.legendre.leggauss(nodes)
@@ -299,9 +315,12 @@ def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration
     def f(t: float, y: np.ndarray) -> np.ndarray:
         q, v = y[:n_modes], y[n_modes:]
         w1, w2, w3, w4 = (q @ d[k] for k in range(1, 5))
-        r = (ei * w4 - 3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1
-             - 4.0 * cable.membrane * ea * w2 * w1 ** 2 - 3.0 * ei * w4 * w1 ** 2
-             + 10.5 * ei * w2 ** 3 * w1 ** 2)
+        if tension_stiffness is None:
+            stretch = -4.0 * cable.membrane * ea * w2 * w1 ** 2
+        else:
+            stretch = -tension_stiffness * 0.5 * (w1 ** 2 @ weights) * w2
+        r = (ei * w4 - 3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1 + stretch
+             - 3.0 * ei * w4 * w1 ** 2 + 10.5 * ei * w2 ** 3 * w1 ** 2)
         a = -damping * v - r @ project - gamma * base_acceleration * math.sin(omega_b * t)
         return np.concatenate((v, a))
     return f

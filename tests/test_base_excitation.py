@@ -68,7 +68,7 @@ def span(length: float, membrane: float) -> dict[str, float]:
 def scene(values: dict, axes: dict | None = None, overrides: dict | None = None) -> sweep.Scene:
     """A scene of the Table 1 cable from dotted keys (`values`) and axes, as TOML text."""
     values = {"cable.youngs_modulus": E, "cable.density": RHO, "cable.area": AREA,
-              "cable.inertia": INERTIA, **values}
+              "cable.inertia": INERTIA, "model.membrane": 0.375, **values}
     sections: dict[str, list[str]] = {}
     for key, value in values.items():
         section, name = key.split(".")

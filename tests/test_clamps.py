@@ -115,15 +115,26 @@ def test_the_linear_clamped_span_is_the_textbook_response(modes, ratio):
         assert _one(ds, "linear_amplitude") == pytest.approx(mode1, rel=1e-9)
 
 
-def _scipy_midspan(n_modes: int, level_g: float, ratio: float, t_end: float) -> float:
-    """Tail max |w(l/2, t)| (m) over [0.75 t_end, t_end] of the clamped span from rest, by
-    SciPy DOP853 on Galerkin equations over the textbook modes (tests/galerkin.py)."""
+EA = 1.1e11 * 6e-6             # N of the scene's cable
+
+
+def _scipy_midspan(n_modes: int, level_g: float, ratio: float, t_end: float,
+                   clamped: bool = True, tension: float | None = EA / LENGTH) -> float:
+    """Tail max |w(l/2, t)| (m) over [0.75 t_end, t_end] of the span from rest, by SciPy
+    DOP853 on Galerkin equations over the textbook modes (tests/galerkin.py: clamped cosh/cos
+    or pinned sines), stretching by the uniform tension k_s e (tension = k_s, N/m; default the
+    immovable clamps' EA / l) or, tension None, by the paper's local term (alpha 3/8)."""
     from scipy.integrate import solve_ivp
     cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
-    omega_n, _, mid = _textbook(n_modes, cable)
-    shapes = g.clamped_shapes(n_modes, LENGTH)
+    if clamped:
+        omega_n, _, mid = _textbook(n_modes, cable)
+        shapes = g.clamped_shapes(n_modes, LENGTH)
+    else:
+        n = np.arange(1, n_modes + 1)
+        omega_n, mid = n ** 2 * cable.w1, np.sin(n * math.pi / 2).round()
+        shapes = g.sine_shapes(n_modes, LENGTH)
     f = g.shapes_rhs(cable, shapes, omega_n, level_g * 9.80665,
-                     ratio * omega_n[0] / (2 * math.pi))
+                     ratio * omega_n[0] / (2 * math.pi), tension_stiffness=tension)
     sol = solve_ivp(f, (0.0, t_end), np.zeros(2 * n_modes), method="DOP853", rtol=1e-11,
                     atol=1e-16, dense_output=True).sol
     t = np.linspace(0.75 * t_end, t_end, 20001)
@@ -133,14 +144,46 @@ def _scipy_midspan(n_modes: int, level_g: float, ratio: float, t_end: float) -> 
 @pytest.mark.parametrize("modes", [1, pytest.param(3, marks=pytest.mark.slow)])
 @pytest.mark.parametrize("ratio", [0.9, 1.2])
 def test_the_nonlinear_clamped_span_matches_scipy_on_the_textbook_modes(modes, ratio):
-    """At 2 g near resonance the clamped span is far from linear (its stretching hardens it:
-    the amplitude differs from the linear one by > 5 %); the engine's midspan amplitude
-    equals SciPy's on Galerkin equations over the textbook cosh/cos modes, projected by
-    quadrature in the test, to 1e-6."""
+    """At 2 g near resonance the clamped span is far from linear (its stretching, the uniform
+    tension between immovable clamps, hardens it: the amplitude differs from the linear one by
+    > 5 %); the engine's midspan amplitude equals SciPy's on Galerkin equations over the
+    textbook cosh/cos modes, projected by quadrature in the test, to 1e-6."""
     ds = sweep.run(scene(modes=modes, ratio=ratio, level_g=2.0, t_end=1.5), progress=False)
     reference = _scipy_midspan(modes, 2.0, ratio, 1.5)
     assert abs(_linear_midspan(modes, ratio, 2.0)[1] / reference - 1.0) > 0.05
     assert _one(ds, "amplitude") == pytest.approx(reference, rel=1e-6)
+
+
+# --- stretching: the uniform tension between axially restrained clamps ----------------------
+
+@pytest.mark.parametrize("rotation", ["pinned", "clamped"])
+@pytest.mark.parametrize("axial, modes", [(None, 1), (None, 3), (2e5, 3), (0.0, 3),
+                                          (2e5, 1)])
+def test_the_uniform_tension_matches_scipy(rotation, axial, modes):
+    """The span stretches as a whole between its clamps: N = k_s e, e = (1/2) int w_x^2 dx,
+    1 / k_s = l / EA + 2 / k_a (immovable clamps: k_s = EA / l; k_a = 0: no stretching). The
+    midspan amplitude at 1 g and resonance against SciPy on Galerkin equations whose tension is
+    integrated in the test (tests/galerkin.py), to 1e-6, pinned and clamped, one mode and
+    three (modes 1 and 3 couple through the tension)."""
+    extra = "" if axial is None else f"axial_stiffness = {axial!r}"
+    ds = sweep.run(scene(rotation, modes=modes, level_g=1.0, ratio=1.0, t_end=1.5,
+                         extra=extra), progress=False)
+    k_s = EA / LENGTH if axial is None else EA * axial / (axial * LENGTH + 2.0 * EA)
+    reference = _scipy_midspan(modes, 1.0, 1.0, 1.5, clamped=rotation == "clamped",
+                               tension=k_s)
+    assert _one(ds, "amplitude") == pytest.approx(reference, rel=1e-6)
+
+
+def test_one_pinned_mode_between_immovable_clamps_has_the_classical_coefficient():
+    """One pinned mode: the uniform tension between immovable clamps is the local term with
+    alpha = 1/4 (the classical coefficient, docs/model.md sec. 10.4), to round-off, where the
+    paper's 3/8 gives a stiffer span."""
+    text = scene_text("pinned", level_g=1.0, ratio=1.0, t_end=1.5)
+    uniform = _one(sweep.run(sweep.load_scene_text(text), progress=False), "amplitude")
+    quarter, paper = (_one(sweep.run(sweep.load_scene_text(text, overrides={
+        "model.membrane": alpha}), progress=False), "amplitude") for alpha in (0.25, 0.375))
+    assert uniform == pytest.approx(quarter, rel=1e-12)
+    assert paper < 0.95 * uniform
 
 
 @pytest.mark.parametrize("overrides, words", [

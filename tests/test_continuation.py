@@ -81,6 +81,7 @@ def scene_text(freqs, level_g: float, direction: str, modes: int = 1) -> str:
 name = "stepped-test"
 [model]
 modes = {modes}
+membrane = {ALPHA}
 [cable]
 inertia = {INERTIA}
 damping_ratio = {ZETA}

@@ -34,7 +34,15 @@ EXTRA_LINES = ["[axes]", "[cable]", "x = 1", '"\\u001b[31m" = 1', "[[cable]]", "
                "[run]\nbackend = \"dask\"\nworkers = 100000",
                "[axes]\nlength = {start = 0.1, stop = 1.0, num = 10000000}\n"
                "frequency_ratio = {start = 0.5, stop = 3.0, num = 10000000}",
-               "[outputs]\nbands_per_octave = 0\nstability = true"]
+               "[outputs]\nbands_per_octave = 0\nstability = true",
+               # [clamps] (issue 35): ends, springs and their axes, hostile values
+               "[clamps]\nrotation = \"elastic\"\nrotational_stiffness = 1e308",
+               "[clamps]\nrotation = \"elastic\"\nrotational_stiffness = 5e-324",
+               "[clamps]\nrotation = \"clamped\"", "[clamps]\nrotation = \"elastic\"",
+               "[clamps]\nrotational_stiffness = 0.0",
+               "[axes]\nclamp_rotational_stiffness = [0.0, 1e300]",
+               "[clamps]\nrotation = \"elastic\"\n[axes]\nclamp_rotational_stiffness = "
+               "{start = 5e-324, stop = 1e308, num = 3}"]
 
 
 def _check(text: str) -> None:

@@ -124,6 +124,7 @@ HIDDEN = """
 name = "hidden-mode"
 [model]
 modes = 2
+membrane = 0.375
 [cable]
 damping_ratio = 0.005
 [load]
@@ -184,6 +185,7 @@ def _scene(modes, lengths=(0.4, 0.7), frequencies=(12.0, 40.0)):
 name = "modes-check"
 [model]
 modes = {modes}
+membrane = 0.375
 [cable]
 inertia = 2.865e-12
 damping_ratio = 0.02
@@ -236,6 +238,8 @@ def test_sweep_modes_refuses_what_it_cannot_compare(tmp_path, capsys):
 
 SWEPT_SCENE = """
 name = "modes-sweep"
+[model]
+membrane = 0.375
 [load]
 amplitude = 0.0
 [cable]

@@ -49,7 +49,8 @@ def scene(values: dict, axes: dict | None = None) -> sweep.Scene:
     """A scene of the Table 1 cable from dotted keys (`values`, lists allowed) and axes, as
     TOML text."""
     values = {"cable.youngs_modulus": E, "cable.density": RHO, "cable.area": AREA,
-              "cable.inertia": INERTIA, "cable.length": LENGTH, **values}
+              "cable.inertia": INERTIA, "cable.length": LENGTH, "model.membrane": 0.375,
+              **values}
     sections: dict[str, list[str]] = {}
     for key, value in values.items():
         section, name = key.split(".")

@@ -159,6 +159,7 @@ def scene(base: str, extra: str = "", length: float = LENGTH, rtol: float = 1e-1
     return sweep.load_scene_text(f"""name = "sine-sweep-test"
 [model]
 modes = {modes}
+membrane = {ALPHA!r}
 [cable]
 length = {length!r}
 damping_ratio = {ZETA!r}

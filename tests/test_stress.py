@@ -42,6 +42,8 @@ def barrier_closed_form(length: float) -> float:
 def test_softening_quintic_escapes_just_past_its_barrier_only():
     qb = barrier_closed_form(1.0)
     ds = run(f"""
+[model]
+membrane = 0.375
 [cable]
 inertia = 5.73e-12
 [load]

@@ -78,11 +78,13 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
     w1_sq = ei / rho_a * power(k, 4)
     w1 = np.sqrt(w1_sq)
     load = p["load_amplitude"]
+    alpha, k_s = stretching(p)
+    membrane = (alpha * p["youngs_modulus"] / p["density"] * power(k, 4) if k_s is None
+                else k_s * np.pi ** 4 / (4.0 * rho_a * power(p["length"], 3)))
     return {
         "mass": 1.0,
         "k": w1_sq,
-        "g": p["membrane"] * p["youngs_modulus"] / p["density"] * power(k, 4)
-        - 1.25 * ei / rho_a * power(k, 6),
+        "g": membrane - 1.25 * ei / rho_a * power(k, 6),
         "h": -21.0 / 16.0 * ei / rho_a * power(k, 8),
         "k_load": -load * k ** 2 / rho_a,
         "g_load": load * power(k, 4) / (2.0 * rho_a),
@@ -90,6 +92,22 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
         "buckling_load": ei * k ** 2,
         "omega_ref": w1,
     }
+
+
+def stretching(p: Mapping[str, Any]) -> tuple[Any, Any]:
+    """How p's span stretches (docs/model.md sec. 10.4): (alpha, None), the paper's local
+    membrane term 4 alpha EA w_xx w_x^2 where the scene gives model.membrane (p's membrane),
+    or (0, k_s), the uniform tension N = k_s e of a span between axially restrained clamps,
+    e = (1/2) int w_x^2 dx its elongation and 1 / k_s = l / EA + 2 / k_a (N/m; k_a = p's
+    clamp_axial_stiffness, None: immovable clamps, k_s = EA / l; 0: the cable slides, no
+    stretching)."""
+    if p.get("membrane") is not None:
+        return p["membrane"], None
+    ea = p["youngs_modulus"] * p["area"]
+    k_a = p.get("clamp_axial_stiffness")
+    if k_a is None:
+        return 0.0, ea / p["length"]
+    return 0.0, ea * k_a / (k_a * p["length"] + 2.0 * ea)
 
 
 def span_ends_of(p: Mapping[str, Any]) -> dict[str, Any] | None:
@@ -116,11 +134,13 @@ def _consistent_ends(p: Mapping[str, Any], ends: Mapping[str, Any]) -> dict[str,
     w1_sq = ei / rho_a * power(ends["beta"] / l, 4)
     load = p["load_amplitude"]
     stretch = ends["stretch"] / power(l, 4)
+    alpha, k_s = stretching(p)
+    membrane = (-4.0 * alpha * p["youngs_modulus"] / p["density"] * stretch if k_s is None
+                else k_s * ends["load"] ** 2 * ends["mass"] / (2.0 * rho_a * power(l, 3)))
     return {
         "mass": 1.0,
         "k": w1_sq,
-        "g": -4.0 * p["membrane"] * p["youngs_modulus"] / p["density"] * stretch
-        - ei / rho_a * ends["curvature"] / power(l, 6),
+        "g": membrane - ei / rho_a * ends["curvature"] / power(l, 6),
         "h": 10.5 * ei / rho_a * ends["quintic"] / power(l, 8),
         "k_load": load * ends["load"] / (rho_a * l * l),
         "g_load": -2.0 * load / rho_a * stretch,
@@ -358,13 +378,15 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
     w1_sq = p["youngs_modulus"] * p["inertia"] / rho_a * power(k, 4)
     w1 = np.sqrt(w1_sq)
     load = p["load_amplitude"] * k ** 2 / rho_a
+    alpha, k_s = stretching(p)
     harmonic = p["load_type"] == "harmonic"
     out = {
         "w1_sq": w1_sq,
         "damping": 2.0 * p["damping_ratio"] * w1,
         "load_mean": 0.0 if harmonic else load,
         "load_cos": load if harmonic else 0.0,
-        "membrane": 4.0 * p["membrane"] * p["youngs_modulus"] / p["density"] * power(k, 4),
+        "membrane": 4.0 * alpha * p["youngs_modulus"] / p["density"] * power(k, 4),
+        "tension": 0.0 if k_s is None else k_s * power(k, 4) * p["length"] / (2.0 * rho_a),
         "k_sq": k ** 2,
         "omega": one_mode["omega"],
         "bound": one_mode["bound"],

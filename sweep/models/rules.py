@@ -423,6 +423,13 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): a rotational stiffness with elastic clamps
     only, and always with them; ends other than pins need the consistent coefficients (Eq.32
     is the pinned span's) and have no Floquet chart yet (it takes the pinned modes)."""
+    if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
+                                                                    axes):
+        _fail(f"{_where('clamps.axial_stiffness', axes)} and "
+              f"{_where('model.membrane', axes)}", "two stretchings: the clamps' axial stiffness "
+              "sets the uniform tension between them, model.membrane the paper's local term",
+              "remove model.membrane (the span then stretches as a whole between the clamps) or "
+              "the axial stiffness")
     rotation = given.get("clamps.rotation", "pinned")
     stiffness = _present(ROTATIONAL_STIFFNESS, given, axes)
     if rotation != "elastic" and stiffness:
@@ -595,9 +602,10 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     _refuse_without(given, ("clamps.rotation",), "only for model.kind = 'transverse' (the "
                     "clamps' hold on the span's rotation sets its bending modes); a "
                     "longitudinal scene would ignore it", "remove [clamps]")
-    if given.get(ROTATIONAL_STIFFNESS) is not None:
-        _fail(f"scene key '{ROTATIONAL_STIFFNESS}'", "only for model.kind = 'transverse'",
-              "remove [clamps]")
+    for dotted in (ROTATIONAL_STIFFNESS, "clamps.axial_stiffness"):
+        if given.get(dotted) is not None:
+            _fail(f"scene key '{dotted}'", "only for model.kind = 'transverse'",
+                  "remove [clamps]")
     _refuse_without(given, ("model.modes", "solver.stop_when_steady"),
                     "only for model.kind = 'transverse' (Galerkin modes, the steady early "
                     "stop); a longitudinal scene would ignore it", "remove the key")
