@@ -48,7 +48,9 @@ STOP_TIME = 9       # with STOP_STEADY: when a point found steady ended (s, befo
                     # for a point that ran to t_end
 SPAN_MAX = 10       # multi-mode: max |w(x, t)| over the span and the tail window (m), the
                     # largest deflection anywhere (>= AMPLITUDE); NaN for one mode
-N_REALS = 11
+CLAMP_BEND = 11     # multi-mode: max |sum phi_n''(e) q_n| over both clamps e and the tail
+                    # window (m): the curvature at a clamp times l^2; NaN for one mode
+N_REALS = 12
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -29,9 +29,9 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
-from .layout import (AMPLITUDE, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD, N_COUNTS, N_REALS,
-                     PERIOD, RHS_EVALS, RTOL, SETTLING, SPAN_MAX, SWEPT, TAIL, TOL, T_END,
-                     WANT_SETTLING)
+from .layout import (AMPLITUDE, CLAMP_BEND, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD,
+                     N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING, SPAN_MAX, SWEPT, TAIL,
+                     TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
 NODE = 1e-9          # a mode whose |phi(1/2)| is below this (shapes of unit scale) has a node
@@ -183,8 +183,16 @@ def modal_size(n_modes):
     """Length of the modes' accumulator `modal` of both multi-mode drivers: each mode's tail
     amplitude max |q_n| over the tail window (slots 0..N-1, m), each mode's peak max |q_n| at
     the accepted steps' ends over the whole run (N..2N-1, m), the largest deflection over
-    the span in the tail window (slot 2N, m; `_observe_span`) and the mode shapes at its
-    place x*, phi_n(x* / l) (2N + 1..3N; the midspan's until the tail window starts)."""
+    the span in the tail window (slot 2N, m; `_observe_span`), the mode shapes at its
+    place x*, phi_n(x* / l) (2N + 1..3N; the midspan's until the tail window starts), and the
+    largest |sum phi_n''(e) q_n| at each clamp e = 0, 1 in the tail window (CLAMP_SLOT(N) + e,
+    m: the curvature there times l^2; `_observe_clamps`)."""
+    return 3 * n_modes + 3
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def clamp_slot(n_modes):
+    """The first of the two clamp curvature slots of the modes' accumulator (`modal_size`)."""
     return 3 * n_modes + 1
 
 
@@ -300,6 +308,60 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         if t + x * h >= t_tail:
             modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
             _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
+    if md.bends_at_clamps(basis):
+        _observe_clamps(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, Qp,
+                        located)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _observe_clamps(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, Qp,
+                    located):
+    """The curvature at each clamp, c_e(t) = sum phi_n''(e) q_n(t) (e = 0, 1; times l^2, m),
+    over the accepted step [t, t_new] ending in the tail window: its largest |c_e| into
+    modal[clamp_slot(N) + e] at the step's end, at the tail's start inside the step and at
+    an extremum inside the step (the root of its interpolated rate), on every mode's
+    interpolant (QA; `located`: already computed)."""
+    curvature = basis[md.CLAMPS]
+    slot = clamp_slot(n)
+    for e in range(2):
+        c1 = 0.0
+        r0 = 0.0
+        r1 = 0.0
+        for c in range(n):
+            c1 += curvature[e, c] * y_new[c]
+            r0 += curvature[e, c] * y[n + c]
+            r1 += curvature[e, c] * y_new[n + c]
+        modal[slot + e] = max(modal[slot + e], abs(c1))
+        inside = t < t_tail
+        turns = _turns(r0, r1)
+        if not (inside or turns):
+            continue
+        if not located:
+            for c in range(n):
+                _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
+            located = True
+        if inside:
+            modal[slot + e] = max(modal[slot + e],
+                                  abs(_combined(curvature[e], y, h, QA, (t_tail - t) / h, n)))
+        if turns:
+            for j in range(Qp.shape[1]):
+                Qp[1, j] = 0.0
+            for c in range(n):
+                for j in range(Qp.shape[1]):
+                    Qp[1, j] += curvature[e, c] * QA[c, 1, j]
+            x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
+            if t + x * h >= t_tail:
+                modal[slot + e] = max(modal[slot + e],
+                                      abs(_combined(curvature[e], y, h, QA, x, n)))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _combined(weights, y, h, QA, x, n):
+    """sum weights[c] q_c at the fraction x of the step, on every mode's interpolant."""
+    v = 0.0
+    for c in range(n):
+        v += weights[c] * dopri5.dense_value(y[c], h, QA[c, 0], x)
+    return v
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -314,6 +376,8 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
     for i in range(n_modes):
         modal[i] = 0.0
     modal[2 * n_modes] = 0.0
+    modal[clamp_slot(n_modes)] = 0.0
+    modal[clamp_slot(n_modes) + 1] = 0.0
     _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, QA,
                    qx, basis, Qp)
 
@@ -335,6 +399,7 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
         return state
     final = md.span_maximum(y, n, basis)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
+    reals[CLAMP_BEND] = max(modal[clamp_slot(n)], modal[clamp_slot(n) + 1])
     if state != mt.DECAYED and state != mt.STEADY:
         return state
     peak = 0.0
@@ -390,6 +455,12 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
         modal[n + i] = abs(y[i])
     modal[2 * n] = md.span_maximum(y, n, basis) if t_tail <= 0.0 else 0.0
+    curvature = basis[md.CLAMPS]
+    for e in range(2):
+        c0 = 0.0
+        for i in range(n):
+            c0 += curvature[e, i] * y[i]
+        modal[clamp_slot(n) + e] = abs(c0) if t_tail <= 0.0 else 0.0
     midspan = basis[md.MIDSPAN]
     for i in range(n):
         modal[2 * n + 1 + i] = midspan[i]

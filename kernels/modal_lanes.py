@@ -249,11 +249,13 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, an extremum of q_n or a
     divergence (|q_n| > bound, or q_n' not finite), or, ending in the tail window, a crest of
     the deflection at the place x* of the span's largest (its mode shapes in MOD, as
-    modal_driver._observe_modes tests it): the scalar path's turn; else 0."""
+    modal_driver._observe_modes tests it) or of the curvature at a clamp (CV: the basis'
+    phi_n'' there, kernels.modes.CLAMPS; all 0 for pinned sines, then not tested): the scalar
+    path's turn; else 0."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
@@ -273,6 +275,28 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run):
         crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
         tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
         EV[l] = 1.0 if crest & tail else EV[l]
+    if not _bends(CV):
+        return
+    for e in range(2):
+        for l in range(n_run):
+            r0 = 0.0
+            r1 = 0.0
+            for i in range(n):
+                r0 += CV[e, i] * Y[n + i, l]
+                r1 += CV[e, i] * YN[n + i, l]
+            crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
+            tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
+            EV[l] = 1.0 if crest & tail else EV[l]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _bends(CV):
+    """Whether some mode bends at a clamp (CV, kernels.modes.CLAMPS, not all 0)."""
+    for e in range(2):
+        for i in range(CV.shape[1]):
+            if CV[e, i] != 0.0:
+                return True
+    return False
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -323,11 +347,12 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
-    same once t_new >= the lane's tail start."""
+    same once t_new >= the lane's tail start; so the curvature at each clamp (CV, as
+    `_mode_events`) in its slots (modal_driver.clamp_slot)."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
@@ -336,6 +361,17 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run):
             q = abs(YN[i, l])
             MOD[i, l] = max(MOD[i, l], q) if take else MOD[i, l]
             MOD[n + i, l] = max(MOD[n + i, l], q) if ordinary else MOD[n + i, l]
+    if not _bends(CV):
+        return
+    slot = drv.clamp_slot(n)
+    for e in range(2):
+        for l in range(n_run):
+            c = 0.0
+            for i in range(n):
+                c += CV[e, i] * YN[i, l]
+            take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
+                    & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
+            MOD[slot + e, l] = max(MOD[slot + e, l], abs(c)) if take else MOD[slot + e, l]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -564,10 +600,10 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS])
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS])
         if base is not None:
             tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
         if n_flagged > 0:

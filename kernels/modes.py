@@ -81,6 +81,18 @@ MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
 SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
+CLAMPS = 6          # (2, N): phi_n''(0) and phi_n''(1) (in s = x / l), the curvature at the clamps
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def bends_at_clamps(basis):
+    """Whether some mode has a curvature at a clamp (not pinned sines, whose are all 0)."""
+    k = basis[CLAMPS]
+    for e in range(2):
+        for i in range(k.shape[1]):
+            if k[e, i] != 0.0:
+                return True
+    return False
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

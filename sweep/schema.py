@@ -105,6 +105,10 @@ KEYS: tuple[Key, ...] = (
     Key("cable", "inertia", "float", None, units="m4", minimum=0.0, exclusive_min=True,
         long_name="bending second moment of area, EI/E (default A^2/(4 pi), a solid round "
                   "section; a stranded cable's is smaller: give a measured EI/E)", axis="inertia"),
+    Key("cable", "diameter", "float", None, units="m", minimum=0.0, exclusive_min=True,
+        long_name="outer diameter d: the outer fibre lies d/2 from the neutral axis (the bending "
+                  "strain at the clamp); default that of the solid round section, "
+                  "sqrt(4 A / pi)", axis="diameter"),
     Key("cable", "damping_ratio", "float", 0.0, units="1", minimum=0.0,
         long_name="modal viscous damping ratio", axis="damping_ratio"),
     Key("cable", "length", "float", 1.0, units="m", minimum=0.0, exclusive_min=True,

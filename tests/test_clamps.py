@@ -341,3 +341,78 @@ def test_design_refines_an_elastic_span_on_its_own_frequency(tmp_path):
     grid_guess = float(np.exp(np.interp(np.log(60.0), np.log(ds["natural_frequency"].values[::-1]),
                                         np.log(ds["length"].values[::-1]))))
     assert abs(grid_guess - span) > 1e-4       # the pinned span's shortcut would miss it
+
+
+def test_the_file_says_what_the_clamps_hold_and_how_the_span_stretches(tmp_path):
+    """Global attributes `clamps` and `stretching` name the ends and the stretching a run used
+    (with the values given), and the mode coordinate names the span's own modes."""
+    import xarray as xr
+    cases = [("clamped", "axial_stiffness = 2e5", 3, ["clamped", "no rotation"],
+              ["uniform tension", "200000 N/m"]),
+             ("elastic", "rotational_stiffness = 0.5", 1, ["elastic", "0.5 N m/rad"],
+              ["uniform tension", "immovable"]),
+             ("pinned", "", 1, ["pinned", "sin(n pi x/l)"], ["uniform tension", "immovable"])]
+    for rotation, extra, modes, clamps, stretching in cases:
+        out = tmp_path / f"{rotation}.nc"
+        sweep.run(scene(rotation, modes=modes, t_end=0.2, extra=extra), output=out,
+                  progress=False)
+        with xr.open_dataset(out) as ds:
+            for word in clamps:
+                assert word in ds.attrs["clamps"], ds.attrs["clamps"]
+            for word in stretching:
+                assert word in ds.attrs["stretching"], ds.attrs["stretching"]
+            if modes > 1:
+                assert "clamped-clamped" in ds["mode"].attrs["long_name"]
+    paper = sweep.run(sweep.load_scene_text(scene_text("pinned", t_end=0.2).replace(
+        "[model]", "[model]\nmembrane = 0.375")), progress=False)
+    assert "local membrane" in paper.attrs["stretching"] and "0.375" in paper.attrs["stretching"]
+
+
+# --- bending at the clamp -------------------------------------------------------------------
+
+def _scipy_clamp_curvature(n_modes: int, level_g: float, ratio: float, t_end: float) -> float:
+    """max |w_xx(0, t)| (1/m) over [0.75 t_end, t_end] of the clamped span between immovable
+    clamps from rest: SciPy DOP853 on the textbook modes (as _scipy_midspan), the curvature at
+    the clamp sum q_n phi_n''(0) from the textbook shapes' own second derivative there."""
+    from scipy.integrate import solve_ivp
+    cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
+    omega_n, _, _ = _textbook(n_modes, cable)
+    shapes = g.clamped_shapes(n_modes, LENGTH)
+    at_clamp = np.array([float(s(0.0, 2)) for s in shapes])
+    f = g.shapes_rhs(cable, shapes, omega_n, level_g * 9.80665,
+                     ratio * omega_n[0] / (2 * math.pi), tension_stiffness=EA / LENGTH)
+    sol = solve_ivp(f, (0.0, t_end), np.zeros(2 * n_modes), method="DOP853", rtol=1e-11,
+                    atol=1e-16, dense_output=True).sol
+    t = np.linspace(0.75 * t_end, t_end, 20001)
+    return g._tail_max(lambda s: at_clamp @ sol(s)[:n_modes],
+                       lambda s: at_clamp @ sol(s)[n_modes:], t)
+
+
+@pytest.mark.parametrize("modes", [1, 3])
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 1.6])
+def test_the_bending_at_the_clamp_matches_scipy(modes, ratio):
+    """clamp_moment / EI, the largest curvature at a clamp over the tail window, equals SciPy's
+    on the textbook modes (their own phi''(0)) to 1e-6 below, at and above resonance, at 2 g
+    (nonlinear); clamp_bending_strain is (d / 2) times it, d the solid section's by default
+    and the scene's cable.diameter when given."""
+    ds = sweep.run(scene(modes=modes, ratio=ratio, level_g=2.0, t_end=1.5), progress=False)
+    reference = _scipy_clamp_curvature(modes, 2.0, ratio, 1.5)
+    kappa = _one(ds, "clamp_moment") / EI
+    assert kappa == pytest.approx(reference, rel=1e-6)
+    assert _one(ds, "clamp_bending_strain") == pytest.approx(
+        math.sqrt(4 * 6e-6 / math.pi) / 2 * kappa, rel=1e-12)
+    thick = sweep.run(sweep.load_scene_text(scene_text(
+        modes=modes, ratio=ratio, level_g=2.0, t_end=1.5).replace(
+        "[cable]", "[cable]\ndiameter = 0.004")), progress=False)
+    assert _one(thick, "clamp_bending_strain") == pytest.approx(0.002 * kappa, rel=1e-9)
+
+
+def test_pinned_clamps_bend_nothing_and_take_no_diameter():
+    """Pinned ends have no curvature at the clamps: no clamp outputs, and a diameter (used only
+    for the strain there) is refused in one line."""
+    ds = sweep.run(scene("pinned", t_end=0.2), progress=False)
+    assert "clamp_bending_strain" not in ds and "clamp_moment" not in ds
+    with pytest.raises(SceneError) as info:
+        sweep.load_scene_text(scene_text("pinned", t_end=0.2).replace(
+            "[cable]", "[cable]\ndiameter = 0.004"))
+    assert "cable.diameter" in str(info.value) and "\n" not in str(info.value)

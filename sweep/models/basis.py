@@ -23,7 +23,7 @@ what the System's right-hand side and its Observer need of them, all dimensionle
   largest deflection over the span, refined on the shapes themselves).
 
 `Basis.kernel_arrays()` is the tuple the kernels take (kernels/modes.py: T, stations, midspan,
-ratios, shapes, coupling). The kernels know nothing of sines: a new end condition is a new Basis.
+ratios, shapes, coupling, clamps). The kernels know nothing of sines: a new end condition is a new Basis.
 """
 
 from __future__ import annotations
@@ -52,7 +52,8 @@ class Basis:
     w_j phi_n(s_j) / int phi_n^2; midspan (N,): phi_n(1/2); stations ((M + 1), N): phi_n at
     s_k = k / M, M = SPAN_STATIONS_PER_MODE N; coupling (N, N): A_ij / pi^2, A_ij = int phi_i'
     phi_j' ds (the span's elongation is (l k^2 / 2) q^T coupling q, k = pi / l: the uniform
-    stretching tension's). name: what the modes are; mode_text and
+    stretching tension's); clamps (2, N): phi_n''(0) and phi_n''(1), the curvature at the
+    clamps per unit q_n (times 1 / l^2). name: what the modes are; mode_text and
     frequency_text: mode n and its frequency in words, for the dataset's long names."""
 
     name: str
@@ -63,6 +64,7 @@ class Basis:
     midspan: np.ndarray
     stations: np.ndarray
     coupling: np.ndarray
+    clamps: np.ndarray
     mode_text: str = "mode shape n"
     frequency_text: str = "(beta_n l / pi)^2 f1 of the pinned span"
     _arrays: tuple = field(default=(), repr=False)
@@ -72,15 +74,16 @@ class Basis:
         return int(self.shapes.shape[0])
 
     def kernel_arrays(self) -> tuple[np.ndarray, ...]:
-        """(T, stations, midspan, ratios, shapes, coupling): the basis as kernels/modes.py
-        reads it; ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi)."""
+        """(T, stations, midspan, ratios, shapes, coupling, clamps): the basis as
+        kernels/modes.py reads it; ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi)."""
         if not self._arrays:
             ratios = np.ascontiguousarray(np.stack([self.frequency_ratio,
                                                     self.participation_ratio]), np.float64)
             arrays = tuple(np.ascontiguousarray(a, np.float64) for a in (
                 self.tables, self.stations, self.midspan)) + (
                 ratios, np.ascontiguousarray(self.shapes, np.float64),
-                np.ascontiguousarray(self.coupling, np.float64))
+                np.ascontiguousarray(self.coupling, np.float64),
+                np.ascontiguousarray(self.clamps, np.float64))
             object.__setattr__(self, "_arrays", arrays)
         return self._arrays
 
@@ -122,7 +125,7 @@ def pinned_sines(n_modes: int) -> Basis:
                  frequency_ratio=(orders * orders).astype(float),
                  participation_ratio=np.where(orders % 2 == 1, 1.0 / orders, 0.0),
                  tables=tables, midspan=midspan, stations=stations,
-                 coupling=np.diag(orders * orders / 2.0),
+                 coupling=np.diag(orders * orders / 2.0), clamps=np.zeros((2, n)),
                  mode_text="sin(n pi x/l)", frequency_text="n^2 f1")
 
 
@@ -167,7 +170,7 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     slope = shape_values(shapes, s, 1)
     coupling = (slope * w) @ slope.T / math.pi ** 2
     return Basis(name=name, shapes=shapes, frequency_ratio=(shapes[:, 0] / math.pi) ** 2,
-                 coupling=coupling,
+                 coupling=coupling, clamps=shape_values(shapes, np.array([0.0, 1.0]), 2).T,
                  participation_ratio=gamma / (4.0 / math.pi),
                  tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations),
                  mode_text=mode_text, frequency_text=frequency_text)
@@ -301,7 +304,8 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     int phi'' phi; stretch = int phi'' phi'^2 phi (the membrane and the load's cubic term);
     curvature = int (3 phi''^3 + 11 phi'' phi''' phi' + 3 phi'''' phi'^2) phi (the cubic
     curvature terms); quintic = int phi''^3 phi'^2 phi; gamma = int phi / int phi^2 (base
-    participation); slope = max |phi'| (the mode's largest slope per unit amplitude); mass =
+    participation); slope = max |phi'| (the mode's largest slope per unit amplitude);
+    clamp_curvature = |phi''(0)| (the curvature at the clamps per unit amplitude); mass =
     int phi^2 itself (not divided). By
     Gauss-Legendre on 4 x the basis' own nodes; pinned sines give -pi^2, -pi^4 / 4, 5 pi^6 /
     4, -pi^8 / 8, 4 / pi and pi."""
@@ -321,6 +325,7 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
         "quintic": float(d[2] ** 3 * d[1] ** 2 * d[0] @ w / mass),
         "gamma": float(d[0] @ w / mass),
         "slope": float(np.abs(shape_values(row, fine, 1)).max()),
+        "clamp_curvature": float(abs(shape_values(row, np.array([0.0]), 2)[0, 0])),
     }
 
 

@@ -441,6 +441,10 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "add rotational_stiffness = 0.5 (N m/rad, each clamp) to [clamps], or an axis "
               "clamp_rotational_stiffness")
     if rotation == "pinned":
+        if _present("cable.diameter", given, axes):
+            _fail(_where("cable.diameter", axes), "is used for the bending strain at clamps that "
+                  "hold the span's rotation; pinned clamps bend it nowhere there",
+                  "add [clamps] rotation = 'clamped' or 'elastic', or remove the diameter")
         return
     if given.get("model.coefficients") == "paper":
         _fail("scene key 'clamps.rotation'", f"model.coefficients = 'paper' is the pinned span's "
@@ -602,7 +606,7 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     _refuse_without(given, ("clamps.rotation",), "only for model.kind = 'transverse' (the "
                     "clamps' hold on the span's rotation sets its bending modes); a "
                     "longitudinal scene would ignore it", "remove [clamps]")
-    for dotted in (ROTATIONAL_STIFFNESS, "clamps.axial_stiffness"):
+    for dotted in (ROTATIONAL_STIFFNESS, "clamps.axial_stiffness", "cable.diameter"):
         if given.get(dotted) is not None:
             _fail(f"scene key '{dotted}'", "only for model.kind = 'transverse'",
                   "remove [clamps]")

@@ -363,6 +363,7 @@ def stability_dataset(inputs: Inputs, coeffs: dict[str, Any], stable: dict[str, 
     attrs = global_attrs(inputs.origin, inputs.shape, elapsed,
                          f"{system} linearised about q = 0, Floquet multipliers over one load "
                          f"period (fixed-step DOP853 eighth order)")
+    attrs.update(span_attrs(inputs.params))
     return xr.Dataset(data, coords=dict(inputs.coords), attrs=attrs)
 
 
@@ -744,6 +745,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                 attrs={"units": "m", "long_name": "largest deflection anywhere on the span: "
                        "max |w(x, t)| over 0 <= x <= l and the tail window (amplitude is the "
                        "midspan's)"})
+    if (not inputs.swept and "outputs.amplitude" in inputs.wanted
+            and (inputs.params.get("clamps_rotation") or "pinned") != "pinned"):
+        data.update(clamp_outputs(inputs, result, coords))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                derived(coeffs["base_accel"], coords))
@@ -758,7 +762,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     if result.modal is not None:
         all_coords[MODE_DIM] = xr.DataArray(
             np.arange(1, result.modal.shape[1] + 1, dtype=np.int32), dims=MODE_DIM,
-            attrs={"units": "1", "long_name": "Galerkin mode number n of sin(n pi x/l)"})
+            attrs={"units": "1", "long_name": "Galerkin mode number n of "
+                                              f"{inputs.basis.mode_text}"})
     if result.series.shape[1] > 0:
         all_coords[TIME_DIM] = elapsed_time(result.sample_times)
         data["displacement"] = xr.DataArray(
@@ -768,4 +773,66 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
               f"transverse Galerkin model, {inputs.n_modes} coupled modes")
     attrs = global_attrs(inputs.origin, shape, elapsed,
                          f"{system}, {method}, {CONTROLLERS[inputs.controller]}")
+    attrs.update(span_attrs(inputs.params))
     return xr.Dataset(data, coords=all_coords, attrs=attrs)
+
+
+def clamp_outputs(inputs: Inputs, result: KernelResult, coords: dict[str, xr.DataArray]
+                  ) -> dict[str, xr.DataArray]:
+    """The bending at the clamps, where a stranded wire breaks (docs/model.md sec. 10): the
+    largest curvature there over the tail window, kappa = max |w_xx(0 or l, t)| (1/m), as the
+    outer fibre's strain (d / 2) kappa (`clamp_bending_strain`, d the cable's diameter) and
+    the clamp's moment EI kappa (`clamp_moment`, N m). Several modes: from the kernel's clamp
+    observer (kernels/modal_driver.py); one mode: |phi''(0)| q / l^2 at the tail's largest q
+    (the curvature is the mode's times q)."""
+    dims, shape, p = inputs.dims, inputs.shape, inputs.params
+    length = derived(p["length"], coords)
+    if result.modal is not None:
+        bend = xr.DataArray(result.reals[:, tk.CLAMP_BEND].reshape(shape), dims=dims)
+    else:
+        ends = modal.span_ends_of(p)
+        bend = (xr.DataArray(result.reals[:, tk.AMPLITUDE].reshape(shape), dims=dims)
+                * derived(ends["clamp_curvature"], coords))
+    kappa = (bend / length ** 2).transpose(*dims)
+    area = derived(p["area"], coords)
+    diameter = (derived(p["diameter"], coords) if p.get("diameter") is not None
+                else np.sqrt(4.0 * area / np.pi))
+    bending = derived(p["youngs_modulus"] * p["inertia"], coords)
+    strain = (0.5 * diameter * kappa).transpose(*dims)
+    strain.attrs = {"units": "1", "long_name": "bending strain of the outer fibre at the clamp: "
+                    "(d / 2) max |w_xx| at either clamp over the tail window (d the cable's "
+                    "diameter; the stretching's N / EA not included)"}
+    moment = (bending * kappa).transpose(*dims)
+    moment.attrs = {"units": "N m", "long_name": "bending moment at the clamp: EI max |w_xx| at "
+                    "either clamp over the tail window"}
+    return {"clamp_bending_strain": strain, "clamp_moment": moment}
+
+
+def span_attrs(params: dict[str, Any]) -> dict[str, str]:
+    """What the clamps hold and how the span stretches, in words (global attributes `clamps`
+    and `stretching`; docs/model.md sec. 10), from the parameters by axis name."""
+    def value(name: str, units: str) -> str:
+        v = params.get(name)
+        return f"over the axis {name}" if hasattr(v, "dims") else f"{float(v):g} {units}"
+    rotation = params.get("clamps_rotation") or "pinned"
+    clamps = {"pinned": "pinned: no deflection and no moment at the clamps, modes sin(n pi x/l)",
+              "clamped": "clamped: no deflection and no rotation at the clamps, beam-function "
+                         "modes (cos(b l) cosh(b l) = 1)"}.get(rotation)
+    if clamps is None:
+        clamps = ("elastic: rotational springs at the clamps, k_t "
+                  f"{value('clamp_rotational_stiffness', 'N m/rad')} each (K = k_t l / EI)")
+    if params.get("coefficients") == "paper":
+        return {"clamps": clamps, "stretching": "the paper's Eq.32 as printed (its numbers hold "
+                "the local membrane term with alpha = 3/8)"}
+    alpha, k_s = modal.stretching(params)
+    if k_s is None:
+        stretching = (f"the paper's local membrane term 4 alpha EA w_xx w_x^2, alpha "
+                      f"{value('membrane', '')}".rstrip() + " (model.membrane)")
+    elif params.get("clamp_axial_stiffness") is None:
+        stretching = ("the uniform tension N = k_s e of the span's elongation e = (1/2) int "
+                      "w_x^2 dx between immovable clamps, k_s = EA / l")
+    else:
+        stretching = ("the uniform tension N = k_s e of the span's elongation e = (1/2) int "
+                      "w_x^2 dx, 1 / k_s = l / EA + 2 / k_a, clamps of axial stiffness k_a "
+                      f"{value('clamp_axial_stiffness', 'N/m')} each (0: no stretching)")
+    return {"clamps": clamps, "stretching": stretching}
