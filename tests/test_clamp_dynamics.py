@@ -1,0 +1,114 @@
+"""The stretching between the clamps and the bending at them ([clamps], docs/model.md sec. 10),
+nonlinear, against SciPy's DOP853 on Galerkin equations over the textbook modes written in
+tests/galerkin.py (clamped cosh/cos shapes, pinned sines), whose stretching tension is
+integrated in the test and whose curvature at the clamp is the shapes' own second derivative:
+
+1. the uniform tension N = k_s e between immovable, elastic and sliding clamps, pinned and
+   clamped, one mode and three; one pinned mode has the classical coefficient alpha = 1/4;
+2. the curvature at the clamp (clamp_moment / EI, clamp_bending_strain) and the midspan
+   amplitude, below, at and above resonance, one mode and three.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import sweep
+from sweep.errors import SceneError
+
+import galerkin as g
+from test_clamps import EI, LENGTH, ZETA, _linear_midspan, _one, _textbook, scene, scene_text
+
+EA = 1.1e11 * 6e-6             # N of the scene's cable
+
+
+def _scipy(n_modes: int, level_g: float, ratio: float, t_end: float, clamped: bool = True,
+           tension: float | None = EA / LENGTH) -> tuple[float, float]:
+    """(tail max |w(l/2, t)| (m), tail max |w_xx(0, t)| (1/m)) over [0.75 t_end, t_end] of the
+    span from rest under base excitation level_g at ratio x its f1, by SciPy DOP853 on
+    Galerkin equations over the textbook modes (clamped cosh/cos or pinned sines), stretching
+    by the uniform tension k_s e (tension = k_s, N/m; default the immovable clamps' EA / l)."""
+    from scipy.integrate import solve_ivp
+    cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
+    if clamped:
+        omega_n, _, mid = _textbook(n_modes, cable)
+        shapes = g.clamped_shapes(n_modes, LENGTH)
+    else:
+        n = np.arange(1, n_modes + 1)
+        omega_n, mid = n ** 2 * cable.w1, np.sin(n * math.pi / 2).round()
+        shapes = g.sine_shapes(n_modes, LENGTH)
+    at_clamp = np.array([float(s(0.0, 2)) for s in shapes])
+    f = g.shapes_rhs(cable, shapes, omega_n, level_g * 9.80665,
+                     ratio * omega_n[0] / (2 * math.pi), tension_stiffness=tension)
+    sol = solve_ivp(f, (0.0, t_end), np.zeros(2 * n_modes), method="DOP853", rtol=1e-10,
+                    atol=1e-15, dense_output=True).sol
+    t = np.linspace(0.75 * t_end, t_end, 20001)
+    n = n_modes
+    return (g._tail_max(lambda s: mid @ sol(s)[:n], lambda s: mid @ sol(s)[n:], t),
+            g._tail_max(lambda s: at_clamp @ sol(s)[:n], lambda s: at_clamp @ sol(s)[n:], t))
+
+
+@pytest.mark.parametrize("rotation", ["pinned", "clamped"])
+@pytest.mark.parametrize("axial, modes", [(None, 1), (None, 3), (2e5, 3), (0.0, 3),
+                                          (2e5, 1)])
+def test_the_uniform_tension_matches_scipy(rotation, axial, modes):
+    """The span stretches as a whole between its clamps: N = k_s e, e = (1/2) int w_x^2 dx,
+    1 / k_s = l / EA + 2 / k_a (immovable clamps: k_s = EA / l; k_a = 0: no stretching). The
+    midspan amplitude at 1 g and resonance against SciPy with the tension integrated in the
+    test, to 1e-6, pinned and clamped, one mode and three (modes 1 and 3 couple through it)."""
+    extra = "" if axial is None else f"axial_stiffness = {axial!r}"
+    ds = sweep.run(scene(rotation, modes=modes, level_g=1.0, ratio=1.0, t_end=1.5,
+                         extra=extra), progress=False)
+    k_s = EA / LENGTH if axial is None else EA * axial / (axial * LENGTH + 2.0 * EA)
+    midspan, _ = _scipy(modes, 1.0, 1.0, 1.5, clamped=rotation == "clamped", tension=k_s)
+    assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
+
+
+def test_one_pinned_mode_between_immovable_clamps_has_the_classical_coefficient():
+    """One pinned mode: the uniform tension between immovable clamps is the local term with
+    alpha = 1/4 (the classical coefficient, docs/model.md sec. 10.4), to round-off, where the
+    paper's 3/8 gives a stiffer span."""
+    text = scene_text("pinned", level_g=1.0, ratio=1.0, t_end=1.5)
+    uniform = _one(sweep.run(sweep.load_scene_text(text), progress=False), "amplitude")
+    quarter, paper = (_one(sweep.run(sweep.load_scene_text(text, overrides={
+        "model.membrane": alpha}), progress=False), "amplitude") for alpha in (0.25, 0.375))
+    assert uniform == pytest.approx(quarter, rel=1e-12)
+    assert paper < 0.95 * uniform
+
+
+@pytest.mark.parametrize("modes", [1, 3])
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 1.6])
+def test_the_clamped_span_and_its_clamp_bending_match_scipy(modes, ratio):
+    """The clamped span at 2 g, between immovable clamps: below (0.5 f1), at and above (1.6
+    f1) resonance, one mode and three. Its midspan amplitude and clamp_moment / EI, the largest
+    curvature at a clamp over the tail window, equal SciPy's on the textbook modes (their own
+    phi''(0)) to 1e-6; near resonance the stretching moves the amplitude more than 5 % from
+    the linear one. clamp_bending_strain is (d / 2) times the curvature, d the solid section's
+    by default and the scene's cable.diameter when given."""
+    ds = sweep.run(scene(modes=modes, ratio=ratio, level_g=2.0, t_end=1.5), progress=False)
+    midspan, curvature = _scipy(modes, 2.0, ratio, 1.5)
+    if ratio == 1.0:
+        assert abs(_linear_midspan(modes, ratio, 2.0)[1] / midspan - 1.0) > 0.05
+    assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
+    kappa = _one(ds, "clamp_moment") / EI
+    assert kappa == pytest.approx(curvature, rel=1e-6)
+    assert _one(ds, "clamp_bending_strain") == pytest.approx(
+        math.sqrt(4 * 6e-6 / math.pi) / 2 * kappa, rel=1e-12)
+    thick = sweep.run(sweep.load_scene_text(scene_text(
+        modes=modes, ratio=ratio, level_g=2.0, t_end=1.5).replace(
+        "[cable]", "[cable]\ndiameter = 0.004")), progress=False)
+    assert _one(thick, "clamp_bending_strain") == pytest.approx(0.002 * kappa, rel=1e-9)
+
+
+def test_pinned_clamps_bend_nothing_and_take_no_diameter():
+    """Pinned ends have no curvature at the clamps: no clamp outputs, and a diameter (used only
+    for the strain there) is refused in one line."""
+    ds = sweep.run(scene("pinned", t_end=0.2), progress=False)
+    assert "clamp_bending_strain" not in ds and "clamp_moment" not in ds
+    with pytest.raises(SceneError) as info:
+        sweep.load_scene_text(scene_text("pinned", t_end=0.2).replace(
+            "[cable]", "[cable]\ndiameter = 0.004"))
+    assert "cable.diameter" in str(info.value) and "\n" not in str(info.value)
