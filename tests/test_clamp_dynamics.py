@@ -112,3 +112,17 @@ def test_pinned_clamps_bend_nothing_and_take_no_diameter():
         sweep.load_scene_text(scene_text("pinned", t_end=0.2).replace(
             "[cable]", "[cable]\ndiameter = 0.004"))
     assert "cable.diameter" in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("method, driver", [("dop853", "lanes"), ("rk45", "scalar")])
+def test_each_method_and_driver_gives_the_clamped_span_and_its_bending(method, driver):
+    """The other method (DOP853) and the other driver (scalar) on the clamped span between
+    immovable clamps at resonance, three modes: midspan amplitude and curvature at the clamp
+    against the same SciPy reference, to 1e-6."""
+    text = scene_text(modes=3, ratio=1.0, level_g=2.0, t_end=1.5)
+    ds = sweep.run(sweep.load_scene_text(text, overrides={"solver.method": method,
+                                                          "solver.driver": driver}),
+                   progress=False)
+    midspan, curvature = _scipy(3, 2.0, 1.0, 1.5)
+    assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
+    assert _one(ds, "clamp_moment") / EI == pytest.approx(curvature, rel=1e-6)
