@@ -30,14 +30,16 @@ from .schema import BY_DOTTED
 
 METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
            "absolute_acceleration", "transmissibility", "peak_frequency", "envelope",
-           "growth_rate", "floquet_multiplier", "modal_amplitude", "max_deflection")
+           "growth_rate", "floquet_multiplier", "modal_amplitude", "max_deflection",
+           "clamp_bending_strain", "clamp_moment")
 """The result variables compared, where both runs have them: the time-domain metrics of
 every kind of run (fixed frequency, stepped, swept: its peak, peak frequency and envelope)
-and a stability chart's Floquet results."""
+and a stability chart's Floquet results; the bending at the clamps where they hold rotation
+(it converges more slowly with the modes than the midspan: the shape sharpens there)."""
 SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled", "completed")
 """States whose metrics mean something (the failure states have NaN metrics)."""
 TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude",
-                "max_deflection")
+                "max_deflection", "clamp_bending_strain", "clamp_moment")
 """Metrics of the tail window, not compared where either run decayed: a decayed point's tail
 is below metrics.tolerance x its peak by definition, and what is left of it there (its rate
 of decay, round-off near the absolute tolerance) is no answer to compare."""

@@ -126,3 +126,21 @@ def test_each_method_and_driver_gives_the_clamped_span_and_its_bending(method, d
     midspan, curvature = _scipy(3, 2.0, 1.0, 1.5)
     assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
     assert _one(ds, "clamp_moment") / EI == pytest.approx(curvature, rel=1e-6)
+
+
+def test_sweep_modes_compares_the_bending_at_the_clamp(tmp_path, capsys):
+    """`sweep modes` on clamped ends reports the clamp's bending beside the midspan: its line
+    gives the largest relative change of clamp_bending_strain between the two runs, recomputed
+    here from two plain runs (the curvature at a clamp converges more slowly with the modes)."""
+    from sweep.cli import main
+    path = tmp_path / "clamped.toml"
+    path.write_text(scene_text(modes=1, ratio=1.0, level_g=2.0, t_end=1.5))
+    assert main(["modes", str(path), "-q", "--tolerance", "0.001"]) == 0
+    out = capsys.readouterr().out
+    coarse, fine = (sweep.run(sweep.load_scene(str(path), overrides={"model.modes": n}),
+                              progress=False) for n in (1, 3))
+    f, c = (_one(ds, "clamp_bending_strain") for ds in (fine, coarse))
+    change = abs(f - c) / abs(f)
+    line = next(line for line in out.splitlines()
+                if line.strip().startswith("clamp_bending_strain "))
+    assert float(line.split()[1]) == pytest.approx(change, rel=1e-2)
