@@ -4,7 +4,8 @@
 
 The right-hand side is base excitation of the clamps (docs/model.md sec. 5): both clamps move
 transversely with acceleration A sin(w_b t), q is the deflection relative to them and Gamma =
-4/pi the participation factor of sin(pi x / l); A = 0 without a [base] table.
+4/pi the participation factor of sin(pi x / l) (of the span's own first mode where the clamps
+are not pins, docs/model.md sec. 10); A = 0 without a [base] table.
 
 Every function here works element-wise on floats, NumPy arrays or xarray DataArrays, so the
 derived quantities keep exactly the dimensions of the axes they depend on.
@@ -65,7 +66,9 @@ def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
     """Coefficients of the re-derived modal equation (docs/model.md sec. 2), m = 1.
 
     p: youngs_modulus (Pa), density (kg/m^3), area (m^2), inertia (m^4), length (m),
-    membrane (alpha, 1), load_amplitude (N, compression > 0).
+    membrane (alpha, 1; None: the uniform tension, `stretching`), load_amplitude (N,
+    compression > 0), and the clamps (clamps_rotation, clamp_rotational_stiffness,
+    clamp_axial_stiffness; pinned by default: these closed forms, else `_consistent_ends`).
     Returns the load-independent part (k, g, h), the load-proportional parts (k_load,
     g_load), the unloaded natural angular frequency w1 (rad/s) and the buckling load (N).
     """
