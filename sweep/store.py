@@ -87,7 +87,6 @@ class ChunkStore:
         self.points = 0                  # the run's number of points (space estimates)
         self.stored = 0                  # points held by chunk files
         self.bytes_per_point = 0.0       # of a chunk file (bytes), once one is written
-        self._last_bytes = 0
         self._key = Path(os.path.abspath(self.directory))
 
     def exists(self) -> bool:
@@ -292,8 +291,9 @@ class ChunkStore:
     def save(self, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> None:
         """Write points lo..hi-1's arrays as one chunk file, atomically and durably. A full
         disk raises UserError naming the store and the space the run still needs."""
-        self._save(self.directory / f"chunk-{lo:012d}-{hi:012d}.npz", lo, hi, arrays)
-        self.bytes_per_point = max(self.bytes_per_point, self._last_bytes / max(hi - lo, 1))
+        data = self._encode(lo, hi, arrays)
+        self.bytes_per_point = max(self.bytes_per_point, len(data) / max(hi - lo, 1))
+        self._write(self.directory / f"chunk-{lo:012d}-{hi:012d}.npz", data)
         self.stored += hi - lo
         for entry in os.scandir(self.directory):     # the chunk's progress, now superseded
             match = _PROGRESS.fullmatch(entry.name)
@@ -301,14 +301,17 @@ class ChunkStore:
                 with contextlib.suppress(OSError):
                     os.unlink(entry.path)
 
-    def _save(self, path: Path, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> None:
+    def _encode(self, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> bytes:
+        """lo..hi-1's arrays as the bytes of a chunk file: the arrays and what proves them."""
         import io
         meta = json.dumps({"lo": lo, "hi": hi, "fingerprint": self.fingerprint,
                            "checksum": checksum(arrays)})
         buffer = io.BytesIO()
         np.savez(buffer, **arrays, **{_META: np.array(meta)})
-        data = buffer.getvalue()
-        self._last_bytes = len(data)
+        return buffer.getvalue()
+
+    def _write(self, path: Path, data: bytes) -> None:
+        """`data` as file `path`, atomically; a full disk or another failure is one line."""
         try:
             self._write_atomic(path, data)
         except OSError as exc:
@@ -324,7 +327,8 @@ class ChunkStore:
 
     def save_progress(self, lo: int, hi: int, arrays: dict[str, np.ndarray]) -> None:
         """Write the progress of the part-way chunk of lines lo..hi-1 (replacing the last)."""
-        self._save(self.directory / f"progress-{lo:012d}-{hi:012d}.npz", lo, hi, arrays)
+        self._write(self.directory / f"progress-{lo:012d}-{hi:012d}.npz",
+                    self._encode(lo, hi, arrays))
 
     def space_needed(self) -> float:
         """Bytes the chunks not yet stored need (an estimate from the chunks written so far;

@@ -341,10 +341,6 @@ def buckling_factor(basis: Basis) -> float:
     return float(np.min(np.linalg.eigvals(np.linalg.solve(axial, stiffness)).real))
 
 
-ROTATIONS = ("pinned", "clamped", "elastic")
-"""What a clamp holds of the span's rotation (scene key clamps.rotation)."""
-
-
 def end_stiffness(rotation: str, rotational_stiffness: Any, length: Any, bending: Any) -> Any:
     """K = k_t l / EI (1) of a span's ends: 0 pinned, CLAMPED clamped, else from the clamps'
     rotational stiffness k_t (N m/rad), the length l (m) and the bending stiffness EI (N m^2);
@@ -357,17 +353,20 @@ def end_stiffness(rotation: str, rotational_stiffness: Any, length: Any, bending
 
 
 @lru_cache(maxsize=4096)
-def _ends_of(stiffness: float, n_modes: int = 1) -> tuple[Basis, dict[str, float]]:
-    b = pinned_sines(n_modes) if stiffness == 0.0 else elastic_ends(n_modes, stiffness)
-    return b, {**one_mode_integrals(b),
-               "buckling": buckling_factor(b if n_modes >= BUCKLING_MODES
-                                           else _ends_of(stiffness, BUCKLING_MODES)[0])}
+def _basis_of(stiffness: float, n_modes: int) -> Basis:
+    return pinned_sines(n_modes) if stiffness == 0.0 else elastic_ends(n_modes, stiffness)
+
+
+@lru_cache(maxsize=4096)
+def _ends_of(stiffness: float) -> dict[str, float]:
+    return {**one_mode_integrals(_basis_of(stiffness, 1)),
+            "buckling": buckling_factor(_basis_of(stiffness, BUCKLING_MODES))}
 
 
 def span_basis(stiffness: float, n_modes: int) -> Basis:
     """The basis of N modes of a span with ends K = `stiffness` (pinned_sines for 0; cached:
     a grid has few distinct K)."""
-    return _ends_of(float(stiffness), int(n_modes))[0]
+    return _basis_of(float(stiffness), int(n_modes))
 
 
 def span_ends(stiffness: Any) -> dict[str, Any]:
@@ -375,10 +374,10 @@ def span_ends(stiffness: Any) -> dict[str, Any]:
     with ends K = `stiffness` (a number, an array or a DataArray of them), each of the same
     shape as `stiffness`: what sweep.models.modal takes as a span's ends."""
     if np.ndim(stiffness) == 0 and not hasattr(stiffness, "dims"):
-        return _ends_of(float(stiffness))[1]
+        return _ends_of(float(stiffness))
     values = np.asarray(stiffness, float)
     unique, where = np.unique(values, return_inverse=True)
-    tables = [_ends_of(float(k))[1] for k in unique]
+    tables = [_ends_of(float(k)) for k in unique]
     out = {}
     for name in tables[0]:
         column = np.array([t[name] for t in tables])[where].reshape(values.shape)

@@ -62,17 +62,18 @@ def power(x: Any, n: int) -> Any:
         square = square * square
 
 
-def consistent(p: Mapping[str, Any]) -> dict[str, Any]:
+def consistent(p: Mapping[str, Any], ends: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """Coefficients of the re-derived modal equation (docs/model.md sec. 2), m = 1.
 
     p: youngs_modulus (Pa), density (kg/m^3), area (m^2), inertia (m^4), length (m),
     membrane (alpha, 1; None: the uniform tension, `stretching`), load_amplitude (N,
     compression > 0), and the clamps (clamps_rotation, clamp_rotational_stiffness,
-    clamp_axial_stiffness; pinned by default: these closed forms, else `_consistent_ends`).
+    clamp_axial_stiffness; pinned by default: these closed forms, else `_consistent_ends`);
+    ends: `span_ends_of`(p) where the caller has it already.
     Returns the load-independent part (k, g, h), the load-proportional parts (k_load,
     g_load), the unloaded natural angular frequency w1 (rad/s) and the buckling load (N).
     """
-    ends = span_ends_of(p)
+    ends = span_ends_of(p) if ends is None else ends
     if ends is not None:
         return _consistent_ends(p, ends)
     k = np.pi / p["length"]
@@ -237,7 +238,8 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     without a [base] table): the columns base_accel = A (m/s^2), base_omega = 2 pi f (rad/s),
     participation = 4/pi, zeros without base; and `base_response`'s derived quantities.
     """
-    c = consistent(p) if p["coefficients"] == "consistent" else paper(p)
+    ends = span_ends_of(p) if p["coefficients"] == "consistent" else None
+    c = consistent(p, ends) if p["coefficients"] == "consistent" else paper(p)
     out = {
         "mass": c["mass"],
         "damping": 2.0 * p["damping_ratio"] * c["mass"] * c["omega_1"],
@@ -260,7 +262,6 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     else:
         out.update(k0=c["k"] + c["k_load"], k1=0.0, g0=c["g"] + c["g_load"], g1=0.0,
                    omega=0.0)
-    ends = span_ends_of(p) if p["coefficients"] == "consistent" else None
     out["escape_barrier"] = escape_barrier(
         out["k0"], out["g0"], out["h"], p["length"] if ends is None
         else p["length"] * np.pi / ends["slope"])

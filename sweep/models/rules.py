@@ -420,9 +420,11 @@ ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
 
 
 def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
-    """Rules of [clamps] (docs/model.md sec. 10): a rotational stiffness with elastic clamps
-    only, and always with them; ends other than pins need the consistent coefficients (Eq.32
-    is the pinned span's) and have no Floquet chart yet (it takes the pinned modes)."""
+    """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
+    or model.membrane, not both); a rotational stiffness with elastic clamps only, and always
+    with them; a diameter (the strain at the clamp) only with clamps that hold rotation; ends
+    other than pins need the consistent coefficients (Eq.32 is the pinned span's) and have no
+    Floquet chart yet (it takes the pinned modes)."""
     if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
                                                                     axes):
         _fail(f"{_where('clamps.axial_stiffness', axes)} and "

@@ -238,10 +238,10 @@ class Inputs:
     sweep_direction: str | None = None
 
 
-def end_stiffness_of(params: dict[str, Any], rotation: str = "elastic") -> Any:
-    """K = k_t l / EI (1) of the span's ends from `params` (grid.parameters, or their values
-    at points: the same bits either way)."""
-    return end_stiffness(rotation, params["clamp_rotational_stiffness"], params["length"],
+def end_stiffness_of(params: dict[str, Any]) -> Any:
+    """K = k_t l / EI (1) of elastic ends from `params` (grid.parameters, or their values at
+    points: the same bits either way)."""
+    return end_stiffness("elastic", params["clamp_rotational_stiffness"], params["length"],
                          params["youngs_modulus"] * params["inertia"])
 
 
