@@ -50,7 +50,14 @@ SPAN_MAX = 10       # multi-mode: max |w(x, t)| over the span and the tail windo
                     # largest deflection anywhere (>= AMPLITUDE); NaN for one mode
 CLAMP_BEND = 11     # multi-mode: max |sum phi_n''(e) q_n| over both clamps e and the tail
                     # window (m): the curvature at a clamp times l^2; NaN for one mode
-N_REALS = 12
+MID_BEND = 12       # multi-mode: max |sum phi_n''(1/2) q_n| over the tail window (m): the
+                    # curvature at midspan times l^2; NaN for one mode
+STRETCH = 13        # multi-mode: max q^T C q over the tail window (m^2; C = A / pi^2, the
+                    # span's elongation is pi^2 / (2 l) times it); NaN for one mode
+CLAMP_SHEAR = 14    # multi-mode: max |F_e| over both clamps e and the tail window (m; the
+                    # transverse reaction is EI / l^3 times it: kernels.modes.span_loads); NaN
+                    # for one mode
+N_REALS = 15
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -29,9 +29,9 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
-from .layout import (AMPLITUDE, CLAMP_BEND, FAILURE_TIME, FIRST_STEP, MAX_STEP, METHOD,
-                     N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING, SPAN_MAX, SWEPT, TAIL,
-                     TOL, T_END, WANT_SETTLING)
+from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, FAILURE_TIME, FIRST_STEP, MAX_STEP,
+                     METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
+                     SPAN_MAX, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
 NODE = 1e-9          # a mode whose |phi(1/2)| is below this (shapes of unit scale) has a node
@@ -184,16 +184,41 @@ def modal_size(n_modes):
     amplitude max |q_n| over the tail window (slots 0..N-1, m), each mode's peak max |q_n| at
     the accepted steps' ends over the whole run (N..2N-1, m), the largest deflection over
     the span in the tail window (slot 2N, m; `_observe_span`), the mode shapes at its
-    place x*, phi_n(x* / l) (2N + 1..3N; the midspan's until the tail window starts), and the
-    largest |sum phi_n''(e) q_n| at each clamp e = 0, 1 in the tail window (CLAMP_SLOT(N) + e,
-    m: the curvature there times l^2; `_observe_clamps`)."""
-    return 3 * n_modes + 3
+    place x*, phi_n(x* / l) (2N + 1..3N; the midspan's until the tail window starts), the
+    largest |sum phi_n''(s) q_n| at each clamp s = 0, 1 and at midspan s = 1/2 in the tail
+    window (clamp_slot(N) + 0, 1, 2, m: the curvature there times l^2; `_observe_bends`),
+    the largest stretch E and clamp shears |F_0|, |F_1| there (load_slot(N) + 0, 1, 2;
+    kernels.modes.span_loads; `_observe_loads`), and the shear factor kappa of the point's
+    prepared row (factor_slot(N), 1/m^2, kernels.modes.shear_factor, set by `start`)."""
+    return 3 * n_modes + 8
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def observer_scratch(n_modes):
+    """Length of the observers' scratch qx: the modes' values at an instant (0..N-1, for
+    `_observe_span`), then `_observe_loads`' (N..3N-1: q and its rate there; then three
+    blocks of 6: kernels.modes.span_loads at the step's start, end and inside)."""
+    return 3 * n_modes + 18
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def clamp_slot(n_modes):
-    """The first of the two clamp curvature slots of the modes' accumulator (`modal_size`)."""
+    """The first of the three curvature slots of the modes' accumulator (`modal_size`): the
+    clamps at s = 0 and 1, then midspan (kernels.modes BEND_0, BEND_1, BEND_MID)."""
     return 3 * n_modes + 1
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def load_slot(n_modes):
+    """The first of the three load slots of the modes' accumulator (`modal_size`): the
+    largest stretch E and clamp shears |F_0|, |F_1| in the tail window (kernels.modes.span_loads)."""
+    return 3 * n_modes + 4
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def factor_slot(n_modes):
+    """The slot of the shear factor kappa (kernels.modes.shear_factor) in the accumulator."""
+    return 3 * n_modes + 7
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -308,22 +333,24 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         if t + x * h >= t_tail:
             modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
             _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
-    if md.bends_at_clamps(basis):
-        _observe_clamps(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, Qp,
-                        located)
+    located = _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
+                             Qp, located)
+    _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, located,
+                   qx)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _observe_clamps(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, Qp,
-                    located):
-    """The curvature at each clamp, c_e(t) = sum phi_n''(e) q_n(t) (e = 0, 1; times l^2, m),
-    over the accepted step [t, t_new] ending in the tail window: its largest |c_e| into
-    modal[clamp_slot(N) + e] at the step's end, at the tail's start inside the step and at
-    an extremum inside the step (the root of its interpolated rate), on every mode's
-    interpolant (QA; `located`: already computed)."""
+def _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, Qp,
+                   located):
+    """The curvature at each clamp and at midspan, c_e(t) = sum phi_n''(s_e) q_n(t) (s_e = 0,
+    1, 1/2: kernels.modes BEND_0, BEND_1, BEND_MID; times l^2, m), over the accepted step
+    [t, t_new] ending in the tail window: its largest |c_e| into modal[clamp_slot(N) + e] at
+    the step's end, at the tail's start inside the step and at an extremum inside the step
+    (the root of its interpolated rate), on every mode's interpolant (QA; `located`: already
+    computed). Returns whether the interpolants are now computed."""
     curvature = basis[md.CLAMPS]
     slot = clamp_slot(n)
-    for e in range(2):
+    for e in range(md.N_BENDS):
         c1 = 0.0
         r0 = 0.0
         r1 = 0.0
@@ -353,6 +380,77 @@ def _observe_clamps(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, 
             if t + x * h >= t_tail:
                 modal[slot + e] = max(modal[slot + e],
                                       abs(_combined(curvature[e], y, h, QA, x, n)))
+    return located
+
+
+ROOT_ITERATIONS = 48
+"""Bisection steps that locate a load's maximum inside a step (to 2^-48 of the step)."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _loads_at(y, h, QA, x, n, basis, kappa, qv, out):
+    """kernels.modes.span_loads at the fraction x of the step, on every mode's interpolant
+    (QA); qv (2N): scratch for q and its rate there."""
+    for c in range(n):
+        qv[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
+        qv[n + c] = dopri5.dense_value(y[n + c], h, QA[c, 1], x)
+    md.span_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n, kappa, out)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _load_rises(out, k):
+    """d|L_k|/dt's sign as a number for load k of kernels.modes.span_loads' out (k = 0: the
+    stretch E >= 0, its rate; 1, 2: a shear F, F F')."""
+    return out[1] if k == 0 else out[2 * k] * out[2 * k + 1]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
+                   located, qx):
+    """The largest stretch E and clamp shears |F_0|, |F_1| (kernels.modes.span_loads) over
+    the accepted step [t, t_new] ending in the tail window, into modal[load_slot(N) + k]: at
+    the step's end, at the tail's start inside the step and, where |L_k| rises at the step's
+    start and falls at its end, at its maximum inside the step (bisection on its rate, on
+    every mode's interpolant: the loads are not linear in q, so no root of one polynomial
+    gives it). qx: scratch (`observer_scratch`)."""
+    slot = load_slot(n)
+    kappa = modal[factor_slot(n)]
+    rows = basis[md.CLAMPS]
+    qv = qx[n:3 * n]
+    a = qx[3 * n:3 * n + 6]
+    b = qx[3 * n + 6:3 * n + 12]
+    m = qx[3 * n + 12:3 * n + 18]
+    md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, a)
+    md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, b)
+    inside = t < t_tail
+    need = inside
+    for k in range(3):
+        modal[slot + k] = max(modal[slot + k], abs(b[2 * k]))
+        need = need or (_load_rises(a, k) > 0.0 and _load_rises(b, k) <= 0.0)
+    if not need:
+        return
+    if not located:
+        for c in range(n):
+            _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
+    if inside:
+        _loads_at(y, h, QA, (t_tail - t) / h, n, basis, kappa, qv, m)
+        for k in range(3):
+            modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
+    for k in range(3):
+        if not (_load_rises(a, k) > 0.0 and _load_rises(b, k) <= 0.0):
+            continue
+        lo = 0.0
+        hi = 1.0
+        for _ in range(ROOT_ITERATIONS):
+            mid = 0.5 * (lo + hi)
+            _loads_at(y, h, QA, mid, n, basis, kappa, qv, m)
+            if _load_rises(m, k) > 0.0:
+                lo = mid
+            else:
+                hi = mid
+        if t + lo * h >= t_tail:
+            _loads_at(y, h, QA, lo, n, basis, kappa, qv, m)
+            modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -376,8 +474,8 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
     for i in range(n_modes):
         modal[i] = 0.0
     modal[2 * n_modes] = 0.0
-    modal[clamp_slot(n_modes)] = 0.0
-    modal[clamp_slot(n_modes) + 1] = 0.0
+    for k in range(6):
+        modal[clamp_slot(n_modes) + k] = 0.0
     _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, QA,
                    qx, basis, Qp)
 
@@ -400,6 +498,9 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
     final = md.span_maximum(y, n, basis)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
     reals[CLAMP_BEND] = max(modal[clamp_slot(n)], modal[clamp_slot(n) + 1])
+    reals[MID_BEND] = modal[clamp_slot(n) + 2]
+    reals[STRETCH] = modal[load_slot(n)]
+    reals[CLAMP_SHEAR] = max(modal[load_slot(n) + 1], modal[load_slot(n) + 2])
     if state != mt.DECAYED and state != mt.STEADY:
         return state
     peak = 0.0
@@ -456,11 +557,17 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[n + i] = abs(y[i])
     modal[2 * n] = md.span_maximum(y, n, basis) if t_tail <= 0.0 else 0.0
     curvature = basis[md.CLAMPS]
-    for e in range(2):
+    for e in range(md.N_BENDS):
         c0 = 0.0
         for i in range(n):
             c0 += curvature[e, i] * y[i]
         modal[clamp_slot(n) + e] = abs(c0) if t_tail <= 0.0 else 0.0
+    kappa = md.shear_factor(pp, n)
+    modal[factor_slot(n)] = kappa
+    loads = np.empty(6)
+    md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, loads)
+    for k in range(3):
+        modal[load_slot(n) + k] = abs(loads[2 * k]) if t_tail <= 0.0 else 0.0
     midspan = basis[md.MIDSPAN]
     for i in range(n):
         modal[2 * n + 1 + i] = midspan[i]
@@ -498,7 +605,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
     Qc = np.empty((2, terms))
     QA = np.empty((n, 2, terms))
-    qx = np.empty(n)
+    qx = np.empty(observer_scratch(n))
     y = np.empty(dim)
     y_new = np.empty(dim)
     stage = np.empty(dim)

@@ -249,13 +249,14 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, an extremum of q_n or a
     divergence (|q_n| > bound, or q_n' not finite), or, ending in the tail window, a crest of
     the deflection at the place x* of the span's largest (its mode shapes in MOD, as
-    modal_driver._observe_modes tests it) or of the curvature at a clamp (CV: the basis'
-    phi_n'' there, kernels.modes.CLAMPS; all 0 for pinned sines, then not tested): the scalar
-    path's turn; else 0."""
+    modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV:
+    the basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a
+    maximum of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis'
+    coupling; MOD's shear factor): the scalar path's turn; else 0."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
@@ -275,9 +276,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV):
         crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
         tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
         EV[l] = 1.0 if crest & tail else EV[l]
-    if not _bends(CV):
-        return
-    for e in range(2):
+    for e in range(md.N_BENDS):
         for l in range(n_run):
             r0 = 0.0
             r1 = 0.0
@@ -287,16 +286,17 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV):
             crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             EV[l] = 1.0 if crest & tail else EV[l]
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _bends(CV):
-    """Whether some mode bends at a clamp (CV, kernels.modes.CLAMPS, not all 0)."""
-    for e in range(2):
-        for i in range(CV.shape[1]):
-            if CV[e, i] != 0.0:
-                return True
-    return False
+    a = np.empty(6)
+    b = np.empty(6)
+    kappa_at = drv.factor_slot(n)
+    for l in range(n_run):
+        if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
+            continue
+        md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], a)
+        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], b)
+        for k in range(3):
+            if drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0:
+                EV[l] = 1.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -347,12 +347,13 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
-    same once t_new >= the lane's tail start; so the curvature at each clamp (CV, as
-    `_mode_events`) in its slots (modal_driver.clamp_slot)."""
+    same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
+    their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
+    theirs (modal_driver.load_slot)."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
@@ -361,10 +362,8 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV):
             q = abs(YN[i, l])
             MOD[i, l] = max(MOD[i, l], q) if take else MOD[i, l]
             MOD[n + i, l] = max(MOD[n + i, l], q) if ordinary else MOD[n + i, l]
-    if not _bends(CV):
-        return
     slot = drv.clamp_slot(n)
-    for e in range(2):
+    for e in range(md.N_BENDS):
         for l in range(n_run):
             c = 0.0
             for i in range(n):
@@ -372,6 +371,17 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV):
             take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
                     & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
             MOD[slot + e, l] = max(MOD[slot + e, l], abs(c)) if take else MOD[slot + e, l]
+    b = np.empty(6)
+    loads = drv.load_slot(n)
+    kappa_at = drv.factor_slot(n)
+    for l in range(n_run):
+        take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
+                & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
+        if not take:
+            continue
+        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], b)
+        for k in range(3):
+            MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -545,7 +555,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     ynl = np.empty(dim)
     fl = np.empty(dim)
     ml = np.empty(drv.modal_size(n))
-    qx = np.empty(n)
+    qx = np.empty(drv.observer_scratch(n))
     Kl = np.empty((n_stages + 1, dim))
     Km = np.empty((n_stages + 1, 2))
     terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
@@ -600,10 +610,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS])
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS],
+                     basis[md.COUPLING])
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS])
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING])
         if base is not None:
             tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
         if n_flagged > 0:

@@ -81,18 +81,66 @@ MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
 SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
-CLAMPS = 6          # (2, N): phi_n''(0) and phi_n''(1) (in s = x / l), the curvature at the clamps
+CLAMPS = 6          # (7, N): the shapes' values the load observers watch (rows below; s = x / l)
+
+# Rows of basis[CLAMPS]: what the load observers of the modal drivers read (per unit q_n).
+BEND_0 = 0          # phi_n''(0): the curvature at the clamp x = 0 (times 1 / l^2)
+BEND_1 = 1          # phi_n''(1): at the clamp x = l
+BEND_MID = 2        # phi_n''(1/2): at midspan
+SHEAR_0 = 3         # phi_n'''(0): the shear's shape at x = 0 (times 1 / l^3)
+SHEAR_1 = 4         # phi_n'''(1)
+SLOPE_0 = 5         # phi_n'(0): the slope at x = 0 (times 1 / l)
+SLOPE_1 = 6         # phi_n'(1)
+N_BENDS = 3         # rows 0..2: the curvatures, linear in q, watched alike
+N_OBSERVED = 7
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def bends_at_clamps(basis):
-    """Whether some mode has a curvature at a clamp (not pinned sines, whose are all 0)."""
-    k = basis[CLAMPS]
-    for e in range(2):
-        for i in range(k.shape[1]):
-            if k[e, i] != 0.0:
-                return True
-    return False
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def span_loads(rows, coupling, q, v, n_modes, kappa, out):
+    """The stretching and the clamps' shear as the load observers watch them, for the modes'
+    q (m) and rates v (m/s): out = (E, E', F_0, F_0', F_1, F_1') with E = q^T C q (m^2; C =
+    `coupling`, A_ij / pi^2: the span's elongation is (pi^2 / 2 l) E, its uniform tension
+    N = k_s pi^2 E / (2 l)) and F_e = s3_e . q - kappa E s1_e . q (m; s3_e, s1_e: `rows`'
+    SHEAR_e and SLOPE_e): the transverse reaction at clamp e, V = -EI w''' + N w', is
+    -(EI / l^3) F_e there (kappa = k_s pi^2 l / (2 EI), 1/m^2); E' and F_e' their rates (/s)."""
+    e = 0.0
+    de = 0.0
+    for i in range(n_modes):
+        ci = 0.0
+        di = 0.0
+        for j in range(n_modes):
+            c = coupling[i, j]
+            ci += c * q[j]
+            di += c * v[j]
+        e += q[i] * ci
+        de += q[i] * di + v[i] * ci
+    out[0] = e
+    out[1] = de
+    for end in range(2):
+        s3 = 0.0
+        d3 = 0.0
+        s1 = 0.0
+        d1 = 0.0
+        for i in range(n_modes):
+            a = rows[SHEAR_0 + end, i]
+            b = rows[SLOPE_0 + end, i]
+            s3 += a * q[i]
+            d3 += a * v[i]
+            s1 += b * q[i]
+            d1 += b * v[i]
+        out[2 + 2 * end] = s3 - kappa * e * s1
+        out[3 + 2 * end] = d3 - kappa * (de * s1 + e * d1)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def shear_factor(pp, n_modes):
+    """kappa = k_s pi^2 l / (2 EI) (1/m^2) of a prepared row (`span_loads`): pi^2 S_TENSION /
+    w_p^2, w_p^2 = S_BETA_B^2 / S_BETA_Q; 0 without the uniform tension."""
+    s = 3 * n_modes
+    tension = pp[s + S_TENSION]
+    if tension == 0.0:
+        return 0.0
+    return math.pi * math.pi * tension * pp[s + S_BETA_Q] / (pp[s + S_BETA_B] * pp[s + S_BETA_B])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

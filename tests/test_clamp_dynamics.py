@@ -27,10 +27,21 @@ EA = 1.1e11 * 6e-6             # N of the scene's cable
 
 def _scipy(n_modes: int, level_g: float, ratio: float, t_end: float, clamped: bool = True,
            tension: float | None = EA / LENGTH) -> tuple[float, float]:
-    """(tail max |w(l/2, t)| (m), tail max |w_xx(0, t)| (1/m)) over [0.75 t_end, t_end] of the
-    span from rest under base excitation level_g at ratio x its f1, by SciPy DOP853 on
-    Galerkin equations over the textbook modes (clamped cosh/cos or pinned sines), stretching
-    by the uniform tension k_s e (tension = k_s, N/m; default the immovable clamps' EA / l)."""
+    """(tail max |w(l/2, t)| (m), tail max |w_xx(0, t)| (1/m)) over [0.75 t_end, t_end]
+    (`_scipy_peaks`)."""
+    peaks = _scipy_peaks(n_modes, level_g, ratio, t_end, clamped, tension)
+    return peaks["midspan"], peaks["clamp_curvature"]
+
+
+def _scipy_peaks(n_modes: int, level_g: float, ratio: float, t_end: float,
+                 clamped: bool = True, tension: float | None = EA / LENGTH) -> dict[str, float]:
+    """Tail maxima over [0.75 t_end, t_end] of the span from rest under base excitation
+    level_g at ratio x its f1, by SciPy DOP853 on Galerkin equations over the textbook modes
+    (clamped cosh/cos or pinned sines), stretching by the uniform tension k_s e (tension = k_s,
+    N/m; default the immovable clamps' EA / l): |w(l/2)| (m, midspan), |w_xx(0)| (1/m,
+    clamp_curvature), |w_xx(l/2)| (midspan_curvature), N = k_s (1/2) int w_x^2 dx (N, tension,
+    the integral by Gauss-Legendre here) and the reaction |-EI w_xxx + N w_x| at either clamp
+    (N, force), each located at the sign change of its own rate (brentq)."""
     from scipy.integrate import solve_ivp
     cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
     if clamped:
@@ -47,8 +58,38 @@ def _scipy(n_modes: int, level_g: float, ratio: float, t_end: float, clamped: bo
                     atol=1e-15, dense_output=True).sol
     t = np.linspace(0.75 * t_end, t_end, 20001)
     n = n_modes
-    return (g._tail_max(lambda s: mid @ sol(s)[:n], lambda s: mid @ sol(s)[n:], t),
-            g._tail_max(lambda s: at_clamp @ sol(s)[:n], lambda s: at_clamp @ sol(s)[n:], t))
+    x, w = np.polynomial.legendre.leggauss(60)
+    x, w = 0.5 * LENGTH * (x + 1.0), 0.5 * LENGTH * w
+    slopes = np.array([s(x, 1) for s in shapes])
+    axial = (slopes * w) @ slopes.T                        # int phi_i' phi_j' dx (1/m)
+    k_s = 0.0 if tension is None else tension
+    bend_mid = np.array([float(s(LENGTH / 2.0, 2)) for s in shapes])
+    ends = [(np.array([float(s(e, 3)) for s in shapes]), np.array([float(s(e, 1)) for s in shapes]))
+            for e in (0.0, LENGTH)]
+
+    def linear(weights: np.ndarray) -> float:
+        return g._tail_max(lambda s: weights @ sol(s)[:n], lambda s: weights @ sol(s)[n:], t)
+
+    def tension_of(s):
+        y = sol(s)
+        q, v = y[:n], y[n:]
+        return (k_s * 0.5 * np.einsum("i...,ij,j...->...", q, axial, q),
+                k_s * np.einsum("i...,ij,j...->...", q, axial, v))
+
+    def force(s, e):
+        y = sol(s)
+        q, v = y[:n], y[n:]
+        third, slope = ends[e]
+        big_n, rate_n = tension_of(s)
+        value = -EI * (third @ q) + big_n * (slope @ q)
+        rate = -EI * (third @ v) + rate_n * (slope @ q) + big_n * (slope @ v)
+        return value, value * rate                     # d|V|/dt has the sign of V V'
+
+    return {"midspan": linear(mid), "clamp_curvature": linear(at_clamp),
+            "midspan_curvature": linear(bend_mid),
+            "tension": g._tail_max(lambda s: tension_of(s)[0], lambda s: tension_of(s)[1], t),
+            "force": max(g._tail_max(lambda s, e=e: force(s, e)[0],
+                                     lambda s, e=e: force(s, e)[1], t) for e in (0, 1))}
 
 
 @pytest.mark.parametrize("rotation", ["pinned", "clamped"])
@@ -89,12 +130,14 @@ def test_the_clamped_span_and_its_clamp_bending_match_scipy(modes, ratio):
     the linear one. clamp_bending_strain is (d / 2) times the curvature, d the solid section's
     by default and the scene's cable.diameter when given."""
     ds = sweep.run(scene(modes=modes, ratio=ratio, level_g=2.0, t_end=1.5), progress=False)
-    midspan, curvature = _scipy(modes, 2.0, ratio, 1.5)
+    peaks = _scipy_peaks(modes, 2.0, ratio, 1.5)
+    midspan, curvature = peaks["midspan"], peaks["clamp_curvature"]
     if ratio == 1.0:
         assert abs(_linear_midspan(modes, ratio, 2.0)[1] / midspan - 1.0) > 0.05
     assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
     kappa = _one(ds, "clamp_moment") / EI
     assert kappa == pytest.approx(curvature, rel=1e-6)
+    _check_loads(ds, peaks)
     assert _one(ds, "clamp_bending_strain") == pytest.approx(
         math.sqrt(4 * 6e-6 / math.pi) / 2 * kappa, rel=1e-12)
     thick = sweep.run(sweep.load_scene_text(scene_text(
@@ -103,14 +146,47 @@ def test_the_clamped_span_and_its_clamp_bending_match_scipy(modes, ratio):
     assert _one(thick, "clamp_bending_strain") == pytest.approx(0.002 * kappa, rel=1e-9)
 
 
-def test_pinned_clamps_bend_nothing_and_take_no_diameter():
-    """Pinned ends have no curvature at the clamps: no clamp outputs, and a diameter (used only
-    for the strain there) is refused in one line."""
+def _check_loads(ds, peaks: dict[str, float]) -> None:
+    """The span's loads against SciPy's peaks (`_scipy_peaks`), to 1e-6: the midspan bending
+    strain (d / 2 the solid section's), the stretching tension and strain, the clamp's
+    reaction, and max_strain from its parts."""
+    d = math.sqrt(4 * 6e-6 / math.pi)
+    assert _one(ds, "midspan_bending_strain") == pytest.approx(
+        d / 2 * peaks["midspan_curvature"], rel=1e-6)
+    assert _one(ds, "axial_tension") == pytest.approx(peaks["tension"], rel=1e-6)
+    assert _one(ds, "axial_strain") == pytest.approx(peaks["tension"] / EA, rel=1e-6)
+    assert _one(ds, "clamp_force") == pytest.approx(peaks["force"], rel=1e-6)
+    bending = max(peaks["clamp_curvature"], peaks["midspan_curvature"]) * d / 2
+    assert _one(ds, "max_strain") == pytest.approx(bending + peaks["tension"] / EA, rel=1e-6)
+
+
+@pytest.mark.parametrize("modes, ratio", [(1, 1.0), (3, 0.5), (3, 1.0)])
+def test_a_pinned_span_reports_its_tension_reaction_and_midspan_strain(modes, ratio):
+    """Pinned ends between immovable clamps: no bending at the clamps, but the midspan bending
+    strain, the stretching tension and the clamp's reaction (whose stretching part N w_x is
+    largest at a pin) against SciPy on sines, below and at resonance, one mode and three."""
+    ds = sweep.run(scene("pinned", modes=modes, ratio=ratio, level_g=2.0, t_end=1.5),
+                   progress=False)
+    peaks = _scipy_peaks(modes, 2.0, ratio, 1.5, clamped=False)
+    assert peaks["clamp_curvature"] == 0.0 and "clamp_bending_strain" not in ds
+    assert _one(ds, "amplitude") == pytest.approx(peaks["midspan"], rel=1e-6)
+    _check_loads(ds, peaks)
+
+
+def test_pinned_clamps_bend_nothing_and_the_paper_membrane_takes_no_diameter():
+    """Pinned ends have no curvature at the clamps: no clamp bending outputs; the midspan strain
+    takes the scene's diameter; under the paper's local membrane term a pinned span reports no
+    strain, so a diameter there is refused in one line."""
+    text = scene_text("pinned", t_end=0.2)
     ds = sweep.run(scene("pinned", t_end=0.2), progress=False)
     assert "clamp_bending_strain" not in ds and "clamp_moment" not in ds
+    thick = sweep.run(sweep.load_scene_text(text.replace("[cable]", "[cable]\ndiameter = 0.004")),
+                      progress=False)
+    assert _one(thick, "midspan_bending_strain") == pytest.approx(
+        _one(ds, "midspan_bending_strain") * 0.004 / math.sqrt(4 * 6e-6 / math.pi), rel=1e-12)
     with pytest.raises(SceneError) as info:
-        sweep.load_scene_text(scene_text("pinned", t_end=0.2).replace(
-            "[cable]", "[cable]\ndiameter = 0.004"))
+        sweep.load_scene_text(text.replace("[cable]", "[cable]\ndiameter = 0.004"),
+                              overrides={"model.membrane": 0.375})
     assert "cable.diameter" in str(info.value) and "\n" not in str(info.value)
 
 
@@ -123,9 +199,10 @@ def test_each_method_and_driver_gives_the_clamped_span_and_its_bending(method, d
     ds = sweep.run(sweep.load_scene_text(text, overrides={"solver.method": method,
                                                           "solver.driver": driver}),
                    progress=False)
-    midspan, curvature = _scipy(3, 2.0, 1.0, 1.5)
-    assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
-    assert _one(ds, "clamp_moment") / EI == pytest.approx(curvature, rel=1e-6)
+    peaks = _scipy_peaks(3, 2.0, 1.0, 1.5)
+    assert _one(ds, "amplitude") == pytest.approx(peaks["midspan"], rel=1e-6)
+    assert _one(ds, "clamp_moment") / EI == pytest.approx(peaks["clamp_curvature"], rel=1e-6)
+    _check_loads(ds, peaks)
 
 
 def test_sweep_modes_compares_the_bending_at_the_clamp(tmp_path, capsys):

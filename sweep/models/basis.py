@@ -52,8 +52,9 @@ class Basis:
     w_j phi_n(s_j) / int phi_n^2; midspan (N,): phi_n(1/2); stations ((M + 1), N): phi_n at
     s_k = k / M, M = SPAN_STATIONS_PER_MODE N; coupling (N, N): A_ij / pi^2, A_ij = int phi_i'
     phi_j' ds (the span's elongation is (l k^2 / 2) q^T coupling q, k = pi / l: the uniform
-    stretching tension's); clamps (2, N): phi_n''(0) and phi_n''(1), the curvature at the
-    clamps per unit q_n (times 1 / l^2). name: what the modes are; mode_text and
+    stretching tension's); clamps (7, N): what the load observers watch per unit q_n
+    (`OBSERVED`): phi_n'' at both clamps and at midspan (the curvature times l^2), phi_n'''
+    and phi_n' at both clamps (the shear and the slope). name: what the modes are; mode_text and
     frequency_text: mode n and its frequency in words, for the dataset's long names."""
 
     name: str
@@ -125,7 +126,7 @@ def pinned_sines(n_modes: int) -> Basis:
                  frequency_ratio=(orders * orders).astype(float),
                  participation_ratio=np.where(orders % 2 == 1, 1.0 / orders, 0.0),
                  tables=tables, midspan=midspan, stations=stations,
-                 coupling=np.diag(orders * orders / 2.0), clamps=np.zeros((2, n)),
+                 coupling=np.diag(orders * orders / 2.0), clamps=_pinned_rows(n),
                  mode_text="sin(n pi x/l)", frequency_text="n^2 f1")
 
 
@@ -142,6 +143,28 @@ def shape_values(shapes: np.ndarray, s: np.ndarray, derivative: int = 0) -> np.n
             (a * sin - b * cos)][derivative % 4]
     sign = -1.0 if derivative % 2 else 1.0
     return beta ** derivative * (trig + sign * c * e_left + d * e_right)
+
+
+OBSERVED = ((2, 0.0), (2, 1.0), (2, 0.5), (3, 0.0), (3, 1.0), (1, 0.0), (1, 1.0))
+"""(derivative in s, place s) of each row of Basis.clamps: kernels/modes.py's BEND_0, BEND_1,
+BEND_MID, SHEAR_0, SHEAR_1, SLOPE_0, SLOPE_1."""
+
+
+def observed_rows(shapes: np.ndarray) -> np.ndarray:
+    """The rows of Basis.clamps (`OBSERVED`, (7, N)) of beam-function shapes: the curvature at
+    both clamps and at midspan, the third derivative and the slope at both clamps (per unit
+    q_n, in s = x / l)."""
+    return np.array([shape_values(shapes, np.array([s]), k)[:, 0] for k, s in OBSERVED])
+
+
+def _pinned_rows(n: int) -> np.ndarray:
+    """`observed_rows` of sin(n pi s) in closed form: phi'' = 0 at the clamps, -(n pi)^2
+    sin(n pi / 2) at midspan; phi''' = -(n pi)^3 cos(n pi s); phi' = n pi cos(n pi s)."""
+    k = np.arange(1, n + 1) * math.pi
+    sign = np.where(np.arange(1, n + 1) % 2 == 0, 1.0, -1.0)          # cos(n pi)
+    mid = np.array([0.0 if i % 2 else (1.0 if (i // 2) % 2 == 0 else -1.0) for i in range(n)])
+    zero = np.zeros(n)
+    return np.array([zero, zero, -k ** 2 * mid, -k ** 3, -k ** 3 * sign, k, k * sign])
 
 
 def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mode shape n",
@@ -170,7 +193,7 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     slope = shape_values(shapes, s, 1)
     coupling = (slope * w) @ slope.T / math.pi ** 2
     return Basis(name=name, shapes=shapes, frequency_ratio=(shapes[:, 0] / math.pi) ** 2,
-                 coupling=coupling, clamps=shape_values(shapes, np.array([0.0, 1.0]), 2).T,
+                 coupling=coupling, clamps=observed_rows(shapes),
                  participation_ratio=gamma / (4.0 / math.pi),
                  tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations),
                  mode_text=mode_text, frequency_text=frequency_text)
@@ -305,7 +328,10 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     curvature = int (3 phi''^3 + 11 phi'' phi''' phi' + 3 phi'''' phi'^2) phi (the cubic
     curvature terms); quintic = int phi''^3 phi'^2 phi; gamma = int phi / int phi^2 (base
     participation); slope = max |phi'| (the mode's largest slope per unit amplitude);
-    clamp_curvature = |phi''(0)| (the curvature at the clamps per unit amplitude); mass =
+    clamp_curvature = |phi''(0)| (the curvature at the clamps per unit amplitude);
+    midspan_curvature = |phi''(1/2)|; clamp_shear = |phi'''(0)| and clamp_slope = |phi'(0)|
+    (the clamp's reaction, docs/model.md sec. 10.5); slope_square = int phi'^2 (the span's
+    elongation is slope_square q^2 / (2 l)); mass =
     int phi^2 itself (not divided). By
     Gauss-Legendre on 4 x the basis' own nodes; pinned sines give -pi^2, -pi^4 / 4, 5 pi^6 /
     4, -pi^8 / 8, 4 / pi and pi."""
@@ -315,6 +341,7 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     d = [shape_values(row, s, k)[0] for k in range(5)]
     mass = d[0] ** 2 @ w
     fine = np.linspace(0.0, 1.0, 4097)
+    bend_0, _, bend_mid, shear_0, _, slope_0, _ = observed_rows(row)[:, 0]
     return {
         "mass": float(mass),
         "beta": float(row[0, 0]),
@@ -325,7 +352,11 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
         "quintic": float(d[2] ** 3 * d[1] ** 2 * d[0] @ w / mass),
         "gamma": float(d[0] @ w / mass),
         "slope": float(np.abs(shape_values(row, fine, 1)).max()),
-        "clamp_curvature": float(abs(shape_values(row, np.array([0.0]), 2)[0, 0])),
+        "clamp_curvature": float(abs(bend_0)),
+        "midspan_curvature": float(abs(bend_mid)),
+        "clamp_shear": float(abs(shear_0)),
+        "clamp_slope": float(abs(slope_0)),
+        "slope_square": float(d[1] ** 2 @ w),
     }
 
 

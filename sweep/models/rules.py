@@ -422,7 +422,8 @@ ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
 def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
     or model.membrane, not both); a rotational stiffness with elastic clamps only, and always
-    with them; a diameter (the strain at the clamp) only with clamps that hold rotation; ends
+    with them; a diameter (the bending strains) not where a pinned span under model.membrane
+    reports none (sweep.models.loads.wanted); ends
     other than pins need the consistent coefficients (Eq.32 is the pinned span's) and have no
     Floquet chart yet (it takes the pinned modes)."""
     if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
@@ -443,10 +444,11 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "add rotational_stiffness = 0.5 (N m/rad, each clamp) to [clamps], or an axis "
               "clamp_rotational_stiffness")
     if rotation == "pinned":
-        if _present("cable.diameter", given, axes):
-            _fail(_where("cable.diameter", axes), "is used for the bending strain at clamps that "
-                  "hold the span's rotation; pinned clamps bend it nowhere there",
-                  "add [clamps] rotation = 'clamped' or 'elastic', or remove the diameter")
+        if _present("cable.diameter", given, axes) and given.get("model.membrane") is not None:
+            _fail(_where("cable.diameter", axes), "is used for the bending strains, which a "
+                  "pinned span under the paper's local membrane term (model.membrane) does not "
+                  "report", "remove model.membrane (the uniform stretching tension), or the "
+                  "diameter")
         return
     if given.get("model.coefficients") == "paper":
         _fail("scene key 'clamps.rotation'", f"model.coefficients = 'paper' is the pinned span's "

@@ -26,7 +26,7 @@ from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, fla
 from ..runner import RunOptions, check_memory, placer, point_order, solve_chunked
 from ..scene import Scene
 from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
-from . import excitation, modal
+from . import excitation, loads, modal
 from .basis import Basis, BasisFamily, end_stiffness, span_basis
 
 KIND = "transverse"
@@ -745,9 +745,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                 attrs={"units": "m", "long_name": "largest deflection anywhere on the span: "
                        "max |w(x, t)| over 0 <= x <= l and the tail window (amplitude is the "
                        "midspan's)"})
-    if (not inputs.swept and "outputs.amplitude" in inputs.wanted
-            and (inputs.params.get("clamps_rotation") or "pinned") != "pinned"):
-        data.update(clamp_outputs(inputs, result, coords))
+    if not inputs.swept and "outputs.amplitude" in inputs.wanted and loads.wanted(inputs.params):
+        data.update(loads.load_outputs(inputs.params, result.reals, result.modal is not None,
+                                       dims, shape, coords))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                derived(coeffs["base_accel"], coords))
@@ -775,37 +775,6 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                          f"{system}, {method}, {CONTROLLERS[inputs.controller]}")
     attrs.update(span_attrs(inputs.params))
     return xr.Dataset(data, coords=all_coords, attrs=attrs)
-
-
-def clamp_outputs(inputs: Inputs, result: KernelResult, coords: dict[str, xr.DataArray]
-                  ) -> dict[str, xr.DataArray]:
-    """The bending at the clamps, where a stranded wire breaks (docs/model.md sec. 10): the
-    largest curvature there over the tail window, kappa = max |w_xx(0 or l, t)| (1/m), as the
-    outer fibre's strain (d / 2) kappa (`clamp_bending_strain`, d the cable's diameter) and
-    the clamp's moment EI kappa (`clamp_moment`, N m). Several modes: from the kernel's clamp
-    observer (kernels/modal_driver.py); one mode: |phi''(0)| q / l^2 at the tail's largest q
-    (the curvature is the mode's times q)."""
-    dims, shape, p = inputs.dims, inputs.shape, inputs.params
-    length = derived(p["length"], coords)
-    if result.modal is not None:
-        bend = xr.DataArray(result.reals[:, tk.CLAMP_BEND].reshape(shape), dims=dims)
-    else:
-        ends = modal.span_ends_of(p)
-        bend = (xr.DataArray(result.reals[:, tk.AMPLITUDE].reshape(shape), dims=dims)
-                * derived(ends["clamp_curvature"], coords))
-    kappa = (bend / length ** 2).transpose(*dims)
-    area = derived(p["area"], coords)
-    diameter = (derived(p["diameter"], coords) if p.get("diameter") is not None
-                else np.sqrt(4.0 * area / np.pi))
-    bending = derived(p["youngs_modulus"] * p["inertia"], coords)
-    strain = (0.5 * diameter * kappa).transpose(*dims)
-    strain.attrs = {"units": "1", "long_name": "bending strain of the outer fibre at the clamp: "
-                    "(d / 2) max |w_xx| at either clamp over the tail window (d the cable's "
-                    "diameter; the stretching's N / EA not included)"}
-    moment = (bending * kappa).transpose(*dims)
-    moment.attrs = {"units": "N m", "long_name": "bending moment at the clamp: EI max |w_xx| at "
-                    "either clamp over the tail window"}
-    return {"clamp_bending_strain": strain, "clamp_moment": moment}
 
 
 def span_attrs(params: dict[str, Any]) -> dict[str, str]:

@@ -1,0 +1,157 @@
+"""What the span does to its clamps and its wires (docs/model.md sec. 10.5): the bending strain
+at the clamps and at midspan, the clamp's moment and transverse reaction, the stretching's
+tension and strain, and the largest strain of them all, each its peak over the tail window.
+
+Several modes: from the multi-mode kernels' load observers (kernels/modal_driver.py: the
+curvature sum phi_n''(s) q_n at s = 0, 1, 1/2, the stretch E = q^T C q and the clamp shear
+F_e = sum phi_n'''(e) q_n - kappa E sum phi_n'(e) q_n, each's largest over the tail window).
+One mode: every one of them grows with |q| (the curvatures as |q|, the stretch as q^2, the
+shear as |q| (|phi'''(0)| + kappa E |phi'(0)|), both terms of one sign), so each peaks where q
+does and is the mode's integral times the tail amplitude (sweep.models.basis.one_mode_integrals).
+
+In SI, l the length, EI the bending and EA the axial stiffness, d the cable's outer diameter:
+curvature kappa = c / l^2 (c the observed curvature sum), strain (d / 2) kappa, moment EI kappa;
+tension N = k_s pi^2 E / (2 l) (k_s: sweep.models.modal.stretching), its strain N / EA;
+reaction EI F / l^3. `OUTPUTS` is the table: a new output is one row of it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, NamedTuple
+
+import numpy as np
+import xarray as xr
+
+from sweep.kernels import layout as tk
+
+from ..dataset import derived
+from . import modal
+from .basis import end_stiffness, span_ends
+
+
+class Peaks(NamedTuple):
+    """The observed peaks over the tail window, as DataArrays over the grid: curvature sums at
+    the clamps and at midspan (m: times 1 / l^2 the curvature), the stretch E (m^2) and the
+    clamp shear F (m: times EI / l^3 the reaction)."""
+    clamp: xr.DataArray
+    midspan: xr.DataArray
+    stretch: xr.DataArray
+    shear: xr.DataArray
+
+
+class Span(NamedTuple):
+    """A grid's span quantities the outputs need (SI; numbers or DataArrays): l, EI, EA, d and
+    k_s (None: the paper's local membrane term, no uniform tension)."""
+    length: Any
+    bending: Any
+    axial: Any
+    diameter: Any
+    k_s: Any
+
+
+def _strain(name: str) -> Callable[[Peaks, Span], Any]:
+    return lambda p, s: 0.5 * s.diameter * getattr(p, name) / s.length ** 2
+
+
+def _tension(p: Peaks, s: Span) -> Any:
+    return s.k_s * math.pi ** 2 * p.stretch / (2.0 * s.length)
+
+
+def _largest_strain(p: Peaks, s: Span) -> Any:
+    bending = np.maximum(_strain("clamp")(p, s), _strain("midspan")(p, s))
+    return bending + _tension(p, s) / s.axial
+
+
+class Output(NamedTuple):
+    """One row of `OUTPUTS`: name, units, long name, value(peaks, span), and when it is made:
+    `clamped` (only where the clamps hold rotation: a pin's is 0) and `tension` (only with
+    the uniform stretching tension)."""
+    name: str
+    units: str
+    long_name: str
+    value: Callable[[Peaks, Span], Any]
+    clamped: bool = False
+    tension: bool = False
+
+
+OUTPUTS = (
+    Output("clamp_bending_strain", "1", "bending strain of the outer fibre at the clamp: (d / 2) "
+           "max |w_xx| at either clamp over the tail window (d the cable's diameter; the "
+           "stretching's N / EA not included)", _strain("clamp"), clamped=True),
+    Output("clamp_moment", "N m", "bending moment at the clamp: EI max |w_xx| at either clamp "
+           "over the tail window", lambda p, s: s.bending * p.clamp / s.length ** 2,
+           clamped=True),
+    Output("midspan_bending_strain", "1", "bending strain of the outer fibre at midspan: "
+           "(d / 2) max |w_xx(l/2)| over the tail window", _strain("midspan")),
+    Output("clamp_force", "N", "transverse reaction at the clamp: max |V| at either clamp over "
+           "the tail window, V = -EI w_xxx + N w_x (the shear plus the stretching tension's "
+           "transverse part; without model.membrane's local term)",
+           lambda p, s: s.bending * p.shear / s.length ** 3),
+    Output("axial_tension", "N", "stretching tension of the span: its largest N = k_s e over "
+           "the tail window (e = (1/2) int w_x^2 dx the elongation, k_s the span and its clamps "
+           "in series)", _tension, tension=True),
+    Output("axial_strain", "1", "stretching strain of the span: axial_tension / EA",
+           lambda p, s: _tension(p, s) / s.axial, tension=True),
+    Output("max_strain", "1", "largest outer-fibre strain reported: max(clamp_bending_strain, "
+           "midspan_bending_strain) + axial_strain (their peaks added: an upper bound where "
+           "they do not coincide)", _largest_strain, tension=True),
+)
+NAMES = tuple(o.name for o in OUTPUTS)
+
+
+def wanted(params: dict[str, Any]) -> bool:
+    """Whether a scene gets these outputs: clamps that hold rotation, or the uniform tension
+    (pinned clamps under the paper's local membrane term report none: the paper's scenes)."""
+    rotation = params.get("clamps_rotation") or "pinned"
+    return rotation != "pinned" or params.get("membrane") is None
+
+
+def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
+                    coords: dict[str, xr.DataArray]) -> Peaks:
+    """The peaks of one mode from its tail amplitude (module docstring)."""
+    p = params
+    stiffness = end_stiffness(p.get("clamps_rotation") or "pinned",
+                              p.get("clamp_rotational_stiffness"), p["length"],
+                              p["youngs_modulus"] * p["inertia"])
+    ends = span_ends(stiffness)
+    ends = {k: derived(v, coords) for k, v in ends.items()}
+    q = amplitude
+    stretch = ends["slope_square"] / math.pi ** 2 * q * q
+    _, k_s = modal.stretching(p)
+    kappa = 0.0 if k_s is None else derived(
+        k_s * math.pi ** 2 * p["length"] / (2.0 * p["youngs_modulus"] * p["inertia"]), coords)
+    shear = q * (ends["clamp_shear"] + kappa * stretch * ends["clamp_slope"])
+    return Peaks(q * ends["clamp_curvature"], q * ends["midspan_curvature"], stretch, shear)
+
+
+def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
+                 dims: tuple[str, ...], shape: tuple[int, ...],
+                 coords: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
+    """The rows of `OUTPUTS` a scene gets (`wanted`), from a transverse run's `reals` (n,
+    kernels.layout.N_REALS): the load observers' columns with several modes, the tail
+    amplitude with one."""
+    def column(c: int) -> xr.DataArray:
+        return xr.DataArray(reals[:, c].reshape(shape), dims=dims)
+    if multi_mode:
+        peaks = Peaks(column(tk.CLAMP_BEND), column(tk.MID_BEND), column(tk.STRETCH),
+                      column(tk.CLAMP_SHEAR))
+    else:
+        peaks = _one_mode_peaks(params, column(tk.AMPLITUDE), coords)
+    p = params
+    area = derived(p["area"], coords)
+    diameter = (derived(p["diameter"], coords) if p.get("diameter") is not None
+                else np.sqrt(4.0 * area / np.pi))
+    _, k_s = modal.stretching(p)
+    span = Span(derived(p["length"], coords), derived(p["youngs_modulus"] * p["inertia"], coords),
+                derived(p["youngs_modulus"] * p["area"], coords), diameter,
+                None if k_s is None else derived(k_s, coords))
+    clamped = (p.get("clamps_rotation") or "pinned") != "pinned"
+    out = {}
+    for o in OUTPUTS:
+        if (o.clamped and not clamped) or (o.tension and span.k_s is None):
+            continue
+        value = xr.DataArray(o.value(peaks, span)).transpose(*dims)
+        value.attrs = {"units": o.units, "long_name": o.long_name}
+        out[o.name] = value
+    return out
