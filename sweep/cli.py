@@ -4,7 +4,7 @@
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
     sweep design RESULT.nc [--min-frequency HZ] [--max-amplitude M] [--quantity NAME]
-                 [--refine [--tolerance M]] [-o OUT.nc]
+                 [--max-deflection M] [--max-strain S] [--refine [--tolerance M]] [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -106,6 +106,12 @@ def _parser() -> argparse.ArgumentParser:
                              "else amplitude, or --quantity")
     design.add_argument("--quantity", default=None, metavar="NAME",
                         help="the variable (in m) --max-amplitude limits")
+    design.add_argument("--max-deflection", type=float, default=None, metavar="M",
+                        help="largest deflection anywhere on the span at most this (m): "
+                             "max_deflection (one mode: its midspan amplitude)")
+    design.add_argument("--max-strain", type=float, default=None, metavar="S",
+                        help="largest outer-fibre strain at most this (1, e.g. 0.001): "
+                             "max_strain, bending at the clamp or midspan plus stretching")
     design.add_argument("--refine", action="store_true",
                         help="refine each bracketed span by bisecting on length with runs of "
                              "the result's scene (the frequency criterion needs none)")
@@ -251,9 +257,10 @@ def _design(args: argparse.Namespace) -> int:
     from .design import max_span, refine_span, table
     from .io import check_output_path, write_netcdf
     from .plot import load_result
-    if args.min_frequency is None and args.max_amplitude is None:
-        raise UserError("design: no criterion given (give --min-frequency HZ and/or "
-                        "--max-amplitude M)")
+    if (args.min_frequency is None and args.max_amplitude is None
+            and args.max_deflection is None and args.max_strain is None):
+        raise UserError("design: no criterion given (give --min-frequency HZ, "
+                        "--max-amplitude M, --max-deflection M or --max-strain S)")
     if args.tolerance is not None and not args.refine:
         raise UserError(f"design: --tolerance {args.tolerance:g} is the bracket --refine "
                         "bisects to; give --refine too")
@@ -261,7 +268,8 @@ def _design(args: argparse.Namespace) -> int:
         check_output_path(args.output, args.overwrite)   # before any work, in one line
     ds = load_result(args.result)
     criteria = dict(min_frequency=args.min_frequency, max_amplitude=args.max_amplitude,
-                    quantity=args.quantity)
+                    quantity=args.quantity, max_deflection=args.max_deflection,
+                    max_strain=args.max_strain)
     if args.refine:
         result = refine_span(ds, **criteria,
                              tolerance=1e-3 if args.tolerance is None else args.tolerance)

@@ -10,6 +10,11 @@ margin of the criterion that binds. A length fails when
 * ``max_amplitude``: its response (`peak_amplitude` of a swept result, one with
   `peak_frequency`; else `amplitude`; or the variable named by ``quantity``, m) is above the
   limit, or is missing (NaN);
+* ``max_deflection``: its largest deflection anywhere on the span (`max_deflection`, m; a
+  one-mode result's midspan amplitude, where its mode peaks) is above the limit;
+* ``max_strain``: its largest outer-fibre strain (`max_strain`: the bending strain at the
+  clamp or at midspan, whichever is larger, plus the stretching's, sweep.models.loads) is
+  above the limit;
 * ``state``: its `state` is a failure (invalid_input, diverged, step_size_too_small,
   max_steps_reached);
 * ``stability``: where the result has `stability`, the straight span is unstable there
@@ -54,7 +59,8 @@ DIRECTION = "direction"
 STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVERGED,
                                                       km.STEP_TOO_SMALL, km.MAX_STEPS))
 """`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
-CRITERIA = ("min_frequency", "max_amplitude", "state", "stability")
+CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "state",
+            "stability")
 """The criteria in the order they are named when the shortest span fails several."""
 LIMITED_BY = CRITERIA + ("grid",)
 
@@ -87,16 +93,53 @@ def _length_quantities(ds: xr.Dataset, axes: tuple[str, ...]) -> list[str]:
                   and set(v.dims) <= set(axes))
 
 
+Limits = dict[str, tuple[str, float]]
+"""The upper-limit criteria of a design: criterion -> (the variable it reads, its limit)."""
+
+
+def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
+            max_strain: float | None) -> Limits:
+    """The deflection and strain criteria's variables (`max_deflection`, m: the largest
+    deflection anywhere on the span, which a one-mode result's midspan amplitude is;
+    `max_strain`, 1: bending plus stretching at the clamp or midspan), refused in one line
+    where the result lacks them."""
+    limits: Limits = {}
+    if max_deflection is not None:
+        if "max_deflection" in ds:
+            limits["max_deflection"] = ("max_deflection", max_deflection)
+        elif "mode" not in ds.dims:                  # one mode: its largest is at midspan
+            limits["max_deflection"] = (_default_quantity(ds), max_deflection)
+        else:
+            raise UserError("design: --max-deflection needs the variable 'max_deflection' "
+                            "(m, the largest deflection over the span), which this result "
+                            "lacks (a sine sweep has none; use --max-amplitude)")
+    if max_strain is not None:
+        if "max_strain" not in ds:
+            raise UserError("design: --max-strain needs the variable 'max_strain' (bending "
+                            "plus stretching strain), which this result lacks: it comes with "
+                            "the uniform stretching tension (no model.membrane) and is not "
+                            "made by a sine sweep")
+        limits["max_strain"] = ("max_strain", max_strain)
+    for _, (name, _) in limits.items():
+        extra = [d for d in ds[name].dims if d not in axes]
+        if extra:
+            raise UserError(f"design: '{name}' lies over {', '.join(map(str, extra))}, not "
+                            "a swept axis")
+    return limits
+
+
 def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
-           quantity: str | None) -> tuple[tuple[str, ...], str | None]:
+           quantity: str | None, max_deflection: float | None = None,
+           max_strain: float | None = None) -> tuple[tuple[str, ...], Limits]:
     """Refuse (one-line UserError) what max_span cannot answer; the swept axes and the
-    quantity the amplitude criterion reads (None without one)."""
+    upper-limit criteria with the variables they read (`Limits`)."""
     if not isinstance(ds, xr.Dataset):
         raise UserError(f"max_span: needs a result (an xarray Dataset), got "
                         f"{type(ds).__name__}")
-    if min_frequency is None and max_amplitude is None:
-        raise UserError("design: no criterion given (give --min-frequency HZ and/or "
-                        "--max-amplitude M)")
+    if min_frequency is None and max_amplitude is None and max_deflection is None \
+            and max_strain is None:
+        raise UserError("design: no criterion given (give --min-frequency HZ, "
+                        "--max-amplitude M, --max-deflection M or --max-strain S)")
     template = "state" if "state" in ds else "stability" if "stability" in ds else None
     if template is None:
         raise UserError("design: the result has neither 'state' nor 'stability' (give a "
@@ -116,8 +159,9 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
     if quantity is not None and max_amplitude is None:
         raise UserError(f"design: --quantity {quantity}: is the response --max-amplitude "
                         "limits; give --max-amplitude M too")
+    limits = _limits(ds, axes, max_deflection, max_strain)
     if max_amplitude is None:
-        return axes, None
+        return axes, limits
     name = _default_quantity(ds) if quantity is None else str(quantity)
     choices = ", ".join(_length_quantities(ds, axes)) or "none"
     if name not in ds.data_vars:
@@ -133,7 +177,7 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
         raise UserError(f"design: quantity '{name}' lies over {', '.join(map(str, extra))}, "
                         f"not a swept axis (give --quantity NAME of one over the axes only: "
                         f"{choices})")
-    return axes, name
+    return axes, {"max_amplitude": (name, max_amplitude), **limits}
 
 
 def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
@@ -142,7 +186,9 @@ def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
 
 
 def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
-             max_amplitude: float | None = None, quantity: str | None = None) -> xr.Dataset:
+             max_amplitude: float | None = None, quantity: str | None = None,
+             max_deflection: float | None = None, max_strain: float | None = None
+             ) -> xr.Dataset:
     """The largest span between clamps (m) that meets the criteria, per combination of the
     result's other swept axes.
 
@@ -155,6 +201,10 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
         (largest) value over `direction` counts.
     quantity : the variable `max_amplitude` limits (needs max_amplitude).
+    max_deflection : m; a length passes when `max_deflection`, the largest deflection anywhere
+        on the span, is at most this (one mode: the midspan's, where its largest lies).
+    max_strain : 1; a length passes when `max_strain` (the outer fibre's bending strain at
+        the clamp or midspan, whichever is larger, plus the stretching's) is at most this.
 
     Every length must also have a `state` that is not a failure (invalid_input, diverged,
     step_size_too_small, max_steps_reached on either direction) and, where the result has
@@ -176,7 +226,10 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     """
     fmin = None if min_frequency is None else _number(min_frequency, "--min-frequency", "100")
     amax = None if max_amplitude is None else _number(max_amplitude, "--max-amplitude", "0.002")
-    axes, qname = _check(ds, fmin, amax, quantity)
+    dmax = None if max_deflection is None else _number(max_deflection, "--max-deflection",
+                                                       "0.002")
+    smax = None if max_strain is None else _number(max_strain, "--max-strain", "0.001")
+    axes, limits = _check(ds, fmin, amax, quantity, dmax, smax)
     ds = ds.sortby(LENGTH)
     others = tuple(a for a in axes if a not in (LENGTH, DIRECTION))
     template_name = "state" if "state" in ds else "stability"
@@ -186,7 +239,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     shape = like.shape
     lengths = np.asarray(ds[LENGTH].values, float)
 
-    margins = _margins(ds, fmin, amax, qname, like)
+    margins = _margins(ds, fmin, limits, like)
     flat = {k: (m.reshape(-1, shape[-1]), v.reshape(-1, shape[-1]), how)
             for k, (m, v, how) in margins.items()}
     n = int(np.prod(shape[:-1], dtype=int))
@@ -221,7 +274,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     title = str(ds.attrs.get("title", ""))
     criteria = "; ".join(
         ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
-        + ([f"{qname} <= {amax:g} m"] if qname is not None else [])
+        + [f"{name} <= {limit:g} {ds[name].attrs.get('units', '')}".rstrip()
+           for name, limit in limits.values()]
         + (["state not in (" + ", ".join(STATE_FAILURES) + ")"] if "state" in ds else [])
         + (["growth_rate <= 0 (stable)"] if "stability" in ds else []))
     from .version import package_version
@@ -259,7 +313,7 @@ def _worst(var: xr.DataArray, how: str) -> xr.DataArray:
     return var
 
 
-def _margins(ds: xr.Dataset, fmin: float | None, amax: float | None, qname: str | None,
+def _margins(ds: xr.Dataset, fmin: float | None, limits: Limits,
              like: xr.DataArray) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
     """The pass/fail logic max_span and refine_span share: per criterion, its margin (>= 0
     passes, NaN fails), the value interpolated on, and how (`_interpolate`), each an array
@@ -269,9 +323,9 @@ def _margins(ds: xr.Dataset, fmin: float | None, amax: float | None, qname: str 
     if fmin is not None:
         f = _broadcast(_worst(ds["natural_frequency"], "min"), like)
         margins["min_frequency"] = (f - fmin, f, "log")
-    if qname is not None:
-        q = _broadcast(_worst(ds[qname], "max"), like)
-        margins["max_amplitude"] = (amax - q, q - amax, "linear")
+    for criterion, (name, limit) in limits.items():
+        q = _broadcast(_worst(ds[name], "max"), like)
+        margins[criterion] = (limit - q, q - limit, "linear")
     if "state" in ds:
         meanings = _flags(ds["state"])
         bad = [v for v, m in meanings.items() if m in STATE_FAILURES]
@@ -369,6 +423,7 @@ MAX_BISECTIONS = 64
 
 def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                 max_amplitude: float | None = None, quantity: str | None = None,
+                max_deflection: float | None = None, max_strain: float | None = None,
                 tolerance: float = 1e-3) -> xr.Dataset:
     """`max_span` refined beyond the grid by bisecting on length with the engine itself.
 
@@ -399,10 +454,11 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
 
     tol = _number(tolerance, "--tolerance", "0.001")
     grid = max_span(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
-                    quantity=quantity)
+                    quantity=quantity, max_deflection=max_deflection, max_strain=max_strain)
     fmin = None if min_frequency is None else float(min_frequency)
-    amax = None if max_amplitude is None else float(max_amplitude)
-    axes, qname = _check(ds, fmin, amax, quantity)
+    axes, limits = _check(ds, fmin, None if max_amplitude is None else float(max_amplitude),
+                          quantity, None if max_deflection is None else float(max_deflection),
+                          None if max_strain is None else float(max_strain))
     text = ds.attrs.get("scene")
     if not isinstance(text, str) or not text.strip():
         raise UserError("design --refine: the result has no 'scene' attribute to run again "
@@ -465,7 +521,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         like = one[name].isel({DIRECTION: 0}, drop=True) if DIRECTION in one[name].dims \
             else one[name]
         like = like.transpose(*[a for a in others if a in like.dims], LENGTH)
-        margins = _margins(one, None, amax, qname, like)
+        margins = _margins(one, None, limits, like)
         return [k for k in nonfrequency if k in margins
                 and not np.all(margins[k][0] >= 0.0)]
 
@@ -492,7 +548,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
             if DIRECTION in sub[like_name].dims else sub[like_name]
         like = like.transpose(*others, LENGTH)
         margins = {k: (m.reshape(-1), v.reshape(-1), how)
-                   for k, (m, v, how) in _margins(sub, fmin, amax, qname, like).items()}
+                   for k, (m, v, how) in _margins(sub, fmin, limits, like).items()}
         passes = np.logical_and.reduce([m >= 0.0 for m, _, _ in margins.values()])
         b = int(np.argmin(passes))
         a = b - 1

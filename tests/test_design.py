@@ -65,12 +65,15 @@ def linear_amplitude(length: float) -> float:
                                                    + (2 * ZETA * w1 * w) ** 2)
 
 
-def _run(tmp: Path, name: str, *, membrane: float = 0.0, cable: str = "",
+def _run(tmp: Path, name: str, *, membrane: float | None = 0.0, cable: str = "",
          base: str = f"acceleration_g = {LEVEL_G}\nfrequency = {BASE_FREQUENCY}",
          axes: str, solver: str = "t_end = 5.0", output: bool = True) -> tuple[xr.Dataset, Path]:
     path = tmp / f"{name}.toml"
-    path.write_text(SCENE.format(table1=TABLE1_CABLE, name=name, membrane=membrane,
-                                 cable=cable, base=base, axes=axes, solver=solver))
+    text = SCENE.format(table1=TABLE1_CABLE, name=name, membrane=membrane, cable=cable,
+                        base=base, axes=axes, solver=solver)
+    if membrane is None:                         # the uniform stretching tension
+        text = text.replace("membrane = None\n", "")
+    path.write_text(text)
     out = tmp / f"{name}.nc"
     ds = sweep.run(sweep.load_scene(str(path)), output=out if output else None, progress=False)
     return ds, out
@@ -81,8 +84,10 @@ def results(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("design")
     coarse = _run(tmp, "coarse", axes="length = {start = 0.1, stop = 0.6, num = 11}",
                   solver="t_end = 0.5")
-    # lengths from 0.1 m up to the 30 Hz resonance (0.357 m), every 5 mm
-    linear = _run(tmp, "linear", axes="length = {start = 0.1, stop = 0.34, num = 49}")
+    # lengths from 0.1 m up to the 30 Hz resonance (0.357 m), every 5 mm; the uniform
+    # stretching tension, negligible at this level (2e-6 of the stiffness at 1e-6 m)
+    linear = _run(tmp, "linear", membrane=None,
+                  axes="length = {start = 0.1, stop = 0.34, num = 49}")
     swept = _run(tmp, "swept", membrane=0.375,
                  base='acceleration_g = 0.5\n'
                       'sweep = {start = 20.0, stop = 60.0, rate = 16.0, direction = "both"}',
@@ -142,6 +147,32 @@ def test_both_criteria_the_smaller_span_binds(results):
     out = max_span(ds, min_frequency=100.0, max_amplitude=2e-8)
     assert float(out["max_span"]) == pytest.approx(a_small, rel=2e-3)
     assert str(out["limited_by"].values) == "max_amplitude"
+
+
+def _strain_reference(limit: float) -> float:
+    """The span where the linear midspan bending strain (d / 2) pi^2 q / l^2 (d of the solid
+    section, q `linear_amplitude`) reaches `limit` (the stretching's strain is ~ q^2: nil)."""
+    d = math.sqrt(4.0 * AREA / math.pi)
+    l_res = math.sqrt(math.pi * math.sqrt(E * INERTIA / (RHO * AREA))
+                      / (2 * BASE_FREQUENCY))
+    return brentq(lambda length: d / 2 * math.pi ** 2 * linear_amplitude(length) / length ** 2
+                  - limit, 0.1, l_res, xtol=1e-12)
+
+
+@pytest.mark.parametrize("limit", [1e-8, 1e-7])
+def test_strain_and_deflection_criteria_on_a_linear_span_are_the_closed_forms(results, limit):
+    """--max-strain on the pinned linear span: the midspan bending strain of the closed-form
+    amplitude reaches the limit there; --max-deflection: one mode's largest deflection is
+    its midspan amplitude (the amplitude criterion's span)."""
+    ds, _ = results["linear"]
+    out = max_span(ds, max_strain=limit)
+    assert float(out["max_span"]) == pytest.approx(_strain_reference(limit), rel=2e-3)
+    assert str(out["limited_by"].values) == "max_strain"
+    assert f"max_strain <= {limit:g} 1" in out.attrs["criteria"]
+    deflection = max_span(ds, max_deflection=limit * 10)
+    assert float(deflection["max_span"]) == pytest.approx(_amplitude_reference(limit * 10),
+                                                          rel=2e-3)
+    assert str(deflection["limited_by"].values) == "max_deflection"
 
 
 def test_a_swept_result_uses_peak_amplitude_over_its_worst_direction(results):
@@ -242,6 +273,8 @@ def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, caps
     ("no_length", ["--min-frequency", "100"], "length"),
     ("coarse", ["--max-amplitude", "1e-3", "--quantity", "nonesuch"], "nonesuch"),
     ("coarse", ["--min-frequency", "abc"], "invalid float"),
+    ("coarse", ["--max-strain", "1e-3"], "max_strain"),
+    ("swept", ["--max-strain", "-1"], "positive"),
 ])
 def test_cli_design_bad_input_is_one_line_exit_2(results, which, flags, fragment, capsys):
     _, path = results[which]
