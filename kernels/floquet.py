@@ -222,3 +222,122 @@ def floquet_block(c, k, kc, W, lo, hi, multiplier, growth, kind):
         multiplier[i] = m
         growth[i] = g
         kind[i] = kd
+
+
+# --- several coupled modes: the N-mode linear system (docs/model.md secs. 8, 10) -------------
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_steps_for(damping, stiffness, load, W, h_omega=H_OMEGA):
+    """`steps_for` of q'' + D q' + (S + L cos W t) q = 0 (damping (N,): D's diagonal, 1/s;
+    stiffness (N,): S's, 1/s^2; load (N, N): L, 1/s^2; W in rad/s): Omega = max(sqrt(rho), W,
+    max |D_n|) with rho = max_n (|S_n| + sum_m |L_nm|) (1/s^2), the row-sum bound on the
+    spectral radius of S + |P| L over the load cycle (the largest eigenvalue's size itself
+    where the system is diagonal: one mode gives `steps_for`'s sqrt(|k| + |kc|)). Returns -1
+    for W <= 0, non-finite input or more than MAX_STEPS."""
+    if not (W > 0.0) or not math.isfinite(W) or not (h_omega > 0.0):
+        return -1
+    n = damping.shape[0]
+    rho = 0.0
+    fast = 0.0
+    for i in range(n):
+        row = abs(stiffness[i])
+        for j in range(n):
+            row += abs(load[i, j])
+        if not (math.isfinite(row) and math.isfinite(damping[i])):
+            return -1
+        rho = max(rho, row)
+        fast = max(fast, abs(damping[i]))
+    omega = max(math.sqrt(rho), W, fast)
+    x = math.ceil(2.0 * math.pi * omega / (W * h_omega))
+    if not (x <= MAX_STEPS):
+        return -1
+    return max(MIN_STEPS, int(x))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _coupled_rhs(damping, stiffness, load, cos_wt, y, out):
+    """out = f(y) for the columns of y (2N, 2N): rows 0..N-1 the modal deflections q, N..2N-1
+    their rates q'; q'' = -D q' - S q - cos(W t) L q (`coupled_monodromy`)."""
+    n = damping.shape[0]
+    cols = y.shape[1]
+    for c in range(cols):
+        for i in range(n):
+            acc = -damping[i] * y[n + i, c] - stiffness[i] * y[i, c]
+            coupled = 0.0
+            for j in range(n):
+                coupled += load[i, j] * y[j, c]
+            out[i, c] = y[n + i, c]
+            out[n + i, c] = acc - cos_wt * coupled
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_monodromy(damping, stiffness, load, W, steps, phi):
+    """Phi(T), T = 2 pi / W (s), of the N coupled modes q'' + D q' + (S + L cos W t) q = 0
+    (D = diag(damping), 1/s; S = diag(stiffness), 1/s^2; L = load (N, N), 1/s^2, any matrix;
+    W in rad/s), written into phi (2N, 2N): column j is the state (q_1..q_N, q_1'..q_N') at T
+    from the j-th unit state at t = 0 (q in m, q' in m/s). The same fixed-step eighth-order
+    DOP853 weights and stage phases as `monodromy`, all 2N columns side by side; one mode with
+    load = [[kc]] gives `monodromy`'s matrix. NaN for steps < 1 or W <= 0; never raises."""
+    n2 = phi.shape[0]
+    if not (steps >= 1) or not (W > 0.0):
+        for i in range(n2):
+            for j in range(n2):
+                phi[i, j] = np.nan
+        return
+    m = int(steps)
+    dphi = 2.0 * math.pi / m                      # load phase advance a step (rad)
+    h = dphi / W                                  # step (s)
+    cs = np.empty(N_STAGES)
+    sn = np.empty(N_STAGES)
+    for s in range(N_STAGES):
+        cs[s] = math.cos(C[s] * dphi)
+        sn[s] = math.sin(C[s] * dphi)
+    K = np.empty((N_STAGES, n2, n2))
+    y = np.empty((n2, n2))
+    for i in range(n2):
+        for j in range(n2):
+            phi[i, j] = 1.0 if i == j else 0.0
+    for i in range(m):
+        th = i * dphi
+        ci = math.cos(th)
+        si = math.sin(th)
+        _coupled_rhs(damping, stiffness, load, ci, phi, K[0])
+        for s in range(1, N_STAGES):
+            for r in range(n2):
+                for c in range(n2):
+                    a = 0.0
+                    for j in range(s):
+                        a += A[s, j] * K[j, r, c]
+                    y[r, c] = phi[r, c] + h * a
+            _coupled_rhs(damping, stiffness, load, ci * cs[s] - si * sn[s], y, K[s])
+        for r in range(n2):
+            for c in range(n2):
+                b = 0.0
+                for j in range(N_STAGES):
+                    b += B[j] * K[j, r, c]
+                phi[r, c] += h * b
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_block(damping, stiffness, load, W, index, rate_ratio, load_shape, lo, hi, phi):
+    """Phi(T) (`coupled_monodromy`) of rows lo..hi-1 into phi (rows, 2N, 2N): row i's system
+    from its mode-1 coefficients and its basis b = index[i]: D_n = damping[i] rate_ratio[b, n]
+    (1/s), S_n = stiffness[i] rate_ratio[b, n]^2 (1/s^2), L = load[i] load_shape[b] (1/s^2),
+    W[i] (rad/s); damping, stiffness, load, W float64 (rows,), index int64 (rows,), rate_ratio
+    (bases, N): w_n / w_1, load_shape (bases, N, N): the axial-load matrix over its (1, 1)
+    entry. Steps by `coupled_steps_for`; a row it refuses (W <= 0, non-finite input, too many
+    steps) gets NaN. Releases the GIL; never raises."""
+    n = rate_ratio.shape[1]
+    d = np.empty(n)
+    s = np.empty(n)
+    ld = np.empty((n, n))
+    for i in range(lo, hi):
+        b = index[i]
+        for p in range(n):
+            r = rate_ratio[b, p]
+            d[p] = damping[i] * r
+            s[p] = stiffness[i] * r * r
+            for q in range(n):
+                ld[p, q] = load[i] * load_shape[b, p, q]
+        steps = coupled_steps_for(d, s, ld, W[i], H_OMEGA)
+        coupled_monodromy(d, s, ld, W[i], steps if steps >= 1 else 0, phi[i])
