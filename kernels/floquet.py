@@ -41,11 +41,22 @@ moves max |lambda| by about d / (2 sqrt(tr^2 - 4 det)) where the multipliers are
 all where they are a complex pair: |lambda| = sqrt(det) exactly), so 1e-7 holds everywhere but
 within tr^2 - 4 det < ~1e-9 of a zone boundary, where no double-precision trace does better.
 
-Several modes: linearised about q = 0 the modes of docs/model.md sec. 7 decouple (each its own
-c_n, k_n, kc_n), so a caller runs `floquet_block` once per mode and takes the largest
-multiplier and growth rate; nothing here couples modes.
+Several modes: linearised about q = 0 the pinned span's modes (docs/model.md sec. 7) decouple
+(each its own c_n, k_n, kc_n), so a caller runs `floquet_block` once per mode and takes the
+largest multiplier and growth rate. Clamped and elastic ends (docs/model.md sec. 10) couple
+them through the axial-load matrix (A_13 of a clamped span): the N modes obey
 
-No I/O; `floquet_block` releases the GIL and never raises.
+    q'' + D q' + (S + L cos W t) q = 0,    D = diag(2 zeta w_n), S = diag(w_n^2), L (N, N),
+
+(D in 1/s, S and L in 1/s^2, q in m) and `coupled_monodromy` integrates all 2N columns of its
+Phi(T) side by side with the same tableau, stage phases and step rule (`coupled_steps_for`:
+Omega from the row-sum bound max_n (|S_n| + sum_m |L_nm|) on the system's largest eigenvalue,
+which is `steps_for`'s |k| + |kc| for one mode). Its multipliers are Phi's eigenvalues, taken
+by the caller (sweep/models/stability.py: numpy, outside the kernel, which stays free of
+LAPACK); `coupled_block` fills the matrices of a block of points.
+
+No I/O; `floquet_block` and `coupled_block` release the GIL and never raise; the coupled
+functions compile only when a scene with coupled modes first calls them.
 """
 
 import math
@@ -65,7 +76,7 @@ KIND_BAD = -1           # W <= 0, non-finite input, or more than MAX_STEPS steps
 KIND_STABLE = 0         # max |lambda| <= 1
 KIND_POSITIVE = 1       # unstable, positive real multiplier > 1: period-T response (even zones)
 KIND_NEGATIVE = 2       # unstable, negative real multiplier < -1: period-2T response (odd zones)
-KIND_COMPLEX = 3        # unstable, complex pair outside the unit circle: only with c < 0
+KIND_COMPLEX = 3        # unstable complex pair: c < 0, or coupled modes near W = w_i + w_j
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -257,17 +268,21 @@ def coupled_steps_for(damping, stiffness, load, W, h_omega=H_OMEGA):
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _coupled_rhs(damping, stiffness, load, cos_wt, y, out):
     """out = f(y) for the columns of y (2N, 2N): rows 0..N-1 the modal deflections q, N..2N-1
-    their rates q'; q'' = -D q' - S q - cos(W t) L q (`coupled_monodromy`)."""
+    their rates q'; q'' = -D q' - S q - cos(W t) L q (`coupled_monodromy`). Inner loops run
+    along the rows (contiguous)."""
     n = damping.shape[0]
     cols = y.shape[1]
-    for c in range(cols):
-        for i in range(n):
-            acc = -damping[i] * y[n + i, c] - stiffness[i] * y[i, c]
-            coupled = 0.0
-            for j in range(n):
-                coupled += load[i, j] * y[j, c]
+    for i in range(n):
+        d = -damping[i]
+        s = -stiffness[i]
+        for c in range(cols):
             out[i, c] = y[n + i, c]
-            out[n + i, c] = acc - cos_wt * coupled
+            out[n + i, c] = d * y[n + i, c] + s * y[i, c]
+        for j in range(n):
+            w = -cos_wt * load[i, j]
+            if w != 0.0:
+                for c in range(cols):
+                    out[n + i, c] += w * y[j, c]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -303,19 +318,20 @@ def coupled_monodromy(damping, stiffness, load, W, steps, phi):
         si = math.sin(th)
         _coupled_rhs(damping, stiffness, load, ci, phi, K[0])
         for s in range(1, N_STAGES):
-            for r in range(n2):
-                for c in range(n2):
-                    a = 0.0
-                    for j in range(s):
-                        a += A[s, j] * K[j, r, c]
-                    y[r, c] = phi[r, c] + h * a
+            y[:, :] = phi
+            for j in range(s):
+                w = h * A[s, j]
+                if w != 0.0:                      # (the tableau has many zeros)
+                    for r in range(n2):
+                        for c in range(n2):
+                            y[r, c] += w * K[j, r, c]
             _coupled_rhs(damping, stiffness, load, ci * cs[s] - si * sn[s], y, K[s])
-        for r in range(n2):
-            for c in range(n2):
-                b = 0.0
-                for j in range(N_STAGES):
-                    b += B[j] * K[j, r, c]
-                phi[r, c] += h * b
+        for j in range(N_STAGES):
+            w = h * B[j]
+            if w != 0.0:
+                for r in range(n2):
+                    for c in range(n2):
+                        phi[r, c] += w * K[j, r, c]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -9,14 +9,30 @@ with, from the one-mode coefficients (sweep/models/modal.py, m the modal mass):
 c_1 = c / m, k_1 = k0 / m, kc_1 = k1 / m (either coefficient set, the paper's too), and for the
 consistent model's mode n (docs/model.md sec. 7, a harmonic load has no mean part)
 c_n = n^2 c_1, k_n = n^4 k_1, kc_n = n^2 kc_1. The base excitation and the nonlinear terms do
-not enter: this is the stability of the straight span itself. The modes decouple, so a point's
-multiplier is the largest of its modes'.
+not enter: this is the stability of the straight span itself. Pinned modes decouple, so a
+point's multiplier is the largest of its modes' (`_per_mode_points`; so is one mode of any
+span, from its own one-mode coefficients).
+
+Clamped and elastic ends with several modes: the axial load couples the span's own modes
+(docs/model.md sec. 10.2: A_ij = int phi_i' phi_j', modes 1 and 3 of a clamped span), and the
+N modes obey
+
+    q'' + D q' + (S + L cos W t) q = 0,    D_n = (w_n / w_1) c_1,  S_n = (w_n / w_1)^2 k_1,
+    L = kc_1 L' / L'_11,    L'_nm = int phi_m'' phi_n / int phi_n^2  (s = x / l)
+
+(the time-domain N-mode model's modal damping 2 zeta w_n and load projection, kernels/modes.py;
+L' by the basis' own quadrature, `coupled_matrices`; the basis of each point's clamps K =
+k_t l / EI, modal.oscillator's end_stiffness). `_coupled_points` integrates the 2N-state
+monodromy (kernels.floquet.coupled_block) and takes its eigenvalues here (`dominant`).
 
 Outputs: `floquet_multiplier` (max |lambda|, 1), `growth_rate` (ln max |lambda| / T, 1/s: > 0
 unstable, -zeta w1 in a stable region of a damped span), `stability` (CF flags: stable,
 unstable_period_1 with a multiplier > 1, the response repeating every load period,
-unstable_period_2 with one < -1, every two: the principal zone near W = 2 w1 is of this kind),
-and with several modes `floquet_mode`, the mode that has the largest multiplier.
+unstable_period_2 with one < -1, every two: the principal zone near W = 2 w1 is of this kind;
+unstable_complex, a complex pair outside the unit circle: coupled modes' combination resonance
+near W = w1 + w3), and with several modes `floquet_mode`: the mode that has the largest
+multiplier (pinned), or the one with the largest |q_n| in the largest multiplier's eigenvector
+(coupled).
 """
 
 from __future__ import annotations
@@ -96,11 +112,10 @@ def dominant(phi: np.ndarray, period: np.ndarray) -> tuple[np.ndarray, ...]:
     """(max |lambda| (1), growth rate ln(max |lambda|) / T (1/s), kind (kernels.floquet's
     kinds), mode) of monodromy matrices phi (rows, 2N, 2N) over periods T (s, (rows,)): the
     multipliers are Phi's eigenvalues (numpy); unstable where max |lambda| > 1 + MARGIN; the
-    kind is that of the largest (a real one, if
-    its imaginary part is at most REAL times its size, by its sign; a complex pair outside the
-    unit circle: a combination resonance of two coupled modes or negative damping); mode is
-    the mode n (1..N) with the largest |q_n| in its eigenvector (1 with one mode). Rows with
-    a non-finite Phi: NaN, KIND_BAD (-1) and mode 0."""
+    kind is that of the largest (a real one, if its imaginary part is at most REAL times its
+    size, by its sign; a complex pair outside the unit circle: a combination resonance of two
+    coupled modes, or negative damping); mode is the mode n (1..N) with the largest |q_n| in
+    its eigenvector (1 with one mode). Rows with a non-finite Phi: NaN, KIND_BAD (-1), mode 0."""
     from sweep.kernels import floquet
 
     rows, n = phi.shape[0], phi.shape[1] // 2
