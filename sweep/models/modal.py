@@ -121,9 +121,8 @@ def span_ends_of(p: Mapping[str, Any]) -> dict[str, Any] | None:
     rotation = p.get("clamps_rotation") or "pinned"
     if rotation == "pinned":
         return None
-    from .basis import end_stiffness, span_ends
-    return span_ends(end_stiffness(rotation, p.get("clamp_rotational_stiffness"), p["length"],
-                                   p["youngs_modulus"] * p["inertia"]))
+    from .basis import span_ends
+    return span_ends(_end_stiffness(p))
 
 
 def _end_stiffness(p: Mapping[str, Any]) -> Any:
