@@ -41,11 +41,22 @@ moves max |lambda| by about d / (2 sqrt(tr^2 - 4 det)) where the multipliers are
 all where they are a complex pair: |lambda| = sqrt(det) exactly), so 1e-7 holds everywhere but
 within tr^2 - 4 det < ~1e-9 of a zone boundary, where no double-precision trace does better.
 
-Several modes: linearised about q = 0 the modes of docs/model.md sec. 7 decouple (each its own
-c_n, k_n, kc_n), so a caller runs `floquet_block` once per mode and takes the largest
-multiplier and growth rate; nothing here couples modes.
+Several modes: linearised about q = 0 the pinned span's modes (docs/model.md sec. 7) decouple
+(each its own c_n, k_n, kc_n), so a caller runs `floquet_block` once per mode and takes the
+largest multiplier and growth rate. Clamped and elastic ends (docs/model.md sec. 10) couple
+them through the axial-load matrix (A_13 of a clamped span): the N modes obey
 
-No I/O; `floquet_block` releases the GIL and never raises.
+    q'' + D q' + (S + L cos W t) q = 0,    D = diag(2 zeta w_n), S = diag(w_n^2), L (N, N),
+
+(D in 1/s, S and L in 1/s^2, q in m) and `coupled_monodromy` integrates all 2N columns of its
+Phi(T) side by side with the same tableau, stage phases and step rule (`coupled_steps_for`:
+Omega from the row-sum bound max_n (|S_n| + sum_m |L_nm|) on the system's largest eigenvalue,
+which is `steps_for`'s |k| + |kc| for one mode). Its multipliers are Phi's eigenvalues, taken
+by the caller (sweep/models/stability.py: numpy, outside the kernel, which stays free of
+LAPACK); `coupled_block` fills the matrices of a block of points.
+
+No I/O; `floquet_block` and `coupled_block` release the GIL and never raise; the coupled
+functions compile only when a scene with coupled modes first calls them.
 """
 
 import math
@@ -65,7 +76,7 @@ KIND_BAD = -1           # W <= 0, non-finite input, or more than MAX_STEPS steps
 KIND_STABLE = 0         # max |lambda| <= 1
 KIND_POSITIVE = 1       # unstable, positive real multiplier > 1: period-T response (even zones)
 KIND_NEGATIVE = 2       # unstable, negative real multiplier < -1: period-2T response (odd zones)
-KIND_COMPLEX = 3        # unstable, complex pair outside the unit circle: only with c < 0
+KIND_COMPLEX = 3        # unstable complex pair: c < 0, or coupled modes near W = w_i + w_j
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -222,3 +233,127 @@ def floquet_block(c, k, kc, W, lo, hi, multiplier, growth, kind):
         multiplier[i] = m
         growth[i] = g
         kind[i] = kd
+
+
+# --- several coupled modes: the N-mode linear system (docs/model.md secs. 8, 10) -------------
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_steps_for(damping, stiffness, load, W, h_omega=H_OMEGA):
+    """`steps_for` of q'' + D q' + (S + L cos W t) q = 0 (damping (N,): D's diagonal, 1/s;
+    stiffness (N,): S's, 1/s^2; load (N, N): L, 1/s^2; W in rad/s): Omega = max(sqrt(rho), W,
+    max |D_n|) with rho = max_n (|S_n| + sum_m |L_nm|) (1/s^2), the row-sum bound on the
+    spectral radius of S + |P| L over the load cycle (the largest eigenvalue's size itself
+    where the system is diagonal: one mode gives `steps_for`'s sqrt(|k| + |kc|)). Returns -1
+    for W <= 0, non-finite input or more than MAX_STEPS."""
+    if not (W > 0.0) or not math.isfinite(W) or not (h_omega > 0.0):
+        return -1
+    n = damping.shape[0]
+    rho = 0.0
+    fast = 0.0
+    for i in range(n):
+        row = abs(stiffness[i])
+        for j in range(n):
+            row += abs(load[i, j])
+        if not (math.isfinite(row) and math.isfinite(damping[i])):
+            return -1
+        rho = max(rho, row)
+        fast = max(fast, abs(damping[i]))
+    omega = max(math.sqrt(rho), W, fast)
+    x = math.ceil(2.0 * math.pi * omega / (W * h_omega))
+    if not (x <= MAX_STEPS):
+        return -1
+    return max(MIN_STEPS, int(x))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _coupled_rhs(damping, stiffness, load, cos_wt, y, out):
+    """out = f(y) for the columns of y (2N, 2N): rows 0..N-1 the modal deflections q, N..2N-1
+    their rates q'; q'' = -D q' - S q - cos(W t) L q (`coupled_monodromy`). Inner loops run
+    along the rows (contiguous)."""
+    n = damping.shape[0]
+    cols = y.shape[1]
+    for i in range(n):
+        d = -damping[i]
+        s = -stiffness[i]
+        for c in range(cols):
+            out[i, c] = y[n + i, c]
+            out[n + i, c] = d * y[n + i, c] + s * y[i, c]
+        for j in range(n):
+            w = -cos_wt * load[i, j]
+            if w != 0.0:
+                for c in range(cols):
+                    out[n + i, c] += w * y[j, c]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_monodromy(damping, stiffness, load, W, steps, phi):
+    """Phi(T), T = 2 pi / W (s), of the N coupled modes q'' + D q' + (S + L cos W t) q = 0
+    (D = diag(damping), 1/s; S = diag(stiffness), 1/s^2; L = load (N, N), 1/s^2, any matrix;
+    W in rad/s), written into phi (2N, 2N): column j is the state (q_1..q_N, q_1'..q_N') at T
+    from the j-th unit state at t = 0 (q in m, q' in m/s). The same fixed-step eighth-order
+    DOP853 weights and stage phases as `monodromy`, all 2N columns side by side; one mode with
+    load = [[kc]] gives `monodromy`'s matrix. NaN for steps < 1 or W <= 0; never raises."""
+    n2 = phi.shape[0]
+    if not (steps >= 1) or not (W > 0.0):
+        for i in range(n2):
+            for j in range(n2):
+                phi[i, j] = np.nan
+        return
+    m = int(steps)
+    dphi = 2.0 * math.pi / m                      # load phase advance a step (rad)
+    h = dphi / W                                  # step (s)
+    cs = np.empty(N_STAGES)
+    sn = np.empty(N_STAGES)
+    for s in range(N_STAGES):
+        cs[s] = math.cos(C[s] * dphi)
+        sn[s] = math.sin(C[s] * dphi)
+    K = np.empty((N_STAGES, n2, n2))
+    y = np.empty((n2, n2))
+    for i in range(n2):
+        for j in range(n2):
+            phi[i, j] = 1.0 if i == j else 0.0
+    for i in range(m):
+        th = i * dphi
+        ci = math.cos(th)
+        si = math.sin(th)
+        _coupled_rhs(damping, stiffness, load, ci, phi, K[0])
+        for s in range(1, N_STAGES):
+            y[:, :] = phi
+            for j in range(s):
+                w = h * A[s, j]
+                if w != 0.0:                      # (the tableau has many zeros)
+                    for r in range(n2):
+                        for c in range(n2):
+                            y[r, c] += w * K[j, r, c]
+            _coupled_rhs(damping, stiffness, load, ci * cs[s] - si * sn[s], y, K[s])
+        for j in range(N_STAGES):
+            w = h * B[j]
+            if w != 0.0:
+                for r in range(n2):
+                    for c in range(n2):
+                        phi[r, c] += w * K[j, r, c]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_block(damping, stiffness, load, W, index, rate_ratio, load_shape, lo, hi, phi):
+    """Phi(T) (`coupled_monodromy`) of rows lo..hi-1 into phi (rows, 2N, 2N): row i's system
+    from its mode-1 coefficients and its basis b = index[i]: D_n = damping[i] rate_ratio[b, n]
+    (1/s), S_n = stiffness[i] rate_ratio[b, n]^2 (1/s^2), L = load[i] load_shape[b] (1/s^2),
+    W[i] (rad/s); damping, stiffness, load, W float64 (rows,), index int64 (rows,), rate_ratio
+    (bases, N): w_n / w_1, load_shape (bases, N, N): the axial-load matrix over its (1, 1)
+    entry. Steps by `coupled_steps_for`; a row it refuses (W <= 0, non-finite input, too many
+    steps) gets NaN. Releases the GIL; never raises."""
+    n = rate_ratio.shape[1]
+    d = np.empty(n)
+    s = np.empty(n)
+    ld = np.empty((n, n))
+    for i in range(lo, hi):
+        b = index[i]
+        for p in range(n):
+            r = rate_ratio[b, p]
+            d[p] = damping[i] * r
+            s[p] = stiffness[i] * r * r
+            for q in range(n):
+                ld[p, q] = load[i] * load_shape[b, p, q]
+        steps = coupled_steps_for(d, s, ld, W[i], H_OMEGA)
+        coupled_monodromy(d, s, ld, W[i], steps if steps >= 1 else 0, phi[i])

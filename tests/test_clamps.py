@@ -137,11 +137,11 @@ def test_bad_clamps_are_one_clear_line(overrides, words):
 @pytest.mark.parametrize("name, overrides, words", [
     ("paper-fig5", {"clamps.rotation": "clamped"}, ["clamps.rotation", "paper"]),
     ("paper-fig7", {"clamps.rotation": "clamped"}, ["clamps.rotation", "transverse"]),
-    ("harness-stability", {"clamps.rotation": "clamped"}, ["outputs.stability", "Floquet"]),
 ])
 def test_clamps_a_scene_cannot_honour_are_refused(name, overrides, words):
-    """The paper's Eq.32 is the pinned span's, a longitudinal scene has no bending modes, and
-    the Floquet chart takes the pinned modes: each refuses other clamps in one line."""
+    """The paper's Eq.32 is the pinned span's and a longitudinal scene has no bending modes:
+    each refuses other clamps in one line (the Floquet chart takes any clamps:
+    tests/test_floquet_coupled.py)."""
     with pytest.raises(SceneError) as info:
         sweep.load_scene(name, overrides=overrides)
     message = str(info.value)

@@ -121,9 +121,15 @@ def span_ends_of(p: Mapping[str, Any]) -> dict[str, Any] | None:
     rotation = p.get("clamps_rotation") or "pinned"
     if rotation == "pinned":
         return None
-    from .basis import end_stiffness, span_ends
-    return span_ends(end_stiffness(rotation, p.get("clamp_rotational_stiffness"), p["length"],
-                                   p["youngs_modulus"] * p["inertia"]))
+    from .basis import span_ends
+    return span_ends(_end_stiffness(p))
+
+
+def _end_stiffness(p: Mapping[str, Any]) -> Any:
+    """K = k_t l / EI (1) of p's clamps (sweep.models.basis.end_stiffness: inf clamped)."""
+    from .basis import end_stiffness
+    return end_stiffness(p.get("clamps_rotation") or "pinned", p.get("clamp_rotational_stiffness"),
+                         p["length"], p["youngs_modulus"] * p["inertia"])
 
 
 def _consistent_ends(p: Mapping[str, Any], ends: Mapping[str, Any]) -> dict[str, Any]:
@@ -240,6 +246,8 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     """
     ends = span_ends_of(p) if p["coefficients"] == "consistent" else None
     c = consistent(p, ends) if p["coefficients"] == "consistent" else paper(p)
+    # the clamps' K = k_t l / EI where they are not pins (sweep/models/stability.py's modes)
+    stiffness = {} if ends is None else {"end_stiffness": _end_stiffness(p)}
     out = {
         "mass": c["mass"],
         "damping": 2.0 * p["damping_ratio"] * c["mass"] * c["omega_1"],
@@ -251,6 +259,7 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
         "natural_frequency": c["omega_1"] / (2.0 * np.pi),
         "buckling_load": c["buckling_load"],
         "load_ratio": p["load_amplitude"] / c["buckling_load"],
+        **stiffness,
     }
     if p["load_type"] == "harmonic":
         if p.get("frequency") is not None:

@@ -423,9 +423,8 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
     or model.membrane, not both); a rotational stiffness with elastic clamps only, and always
     with them; a diameter (the bending strains) not where a pinned span under model.membrane
-    reports none (sweep.models.loads.wanted); ends
-    other than pins need the consistent coefficients (Eq.32 is the pinned span's) and have no
-    Floquet chart yet (it takes the pinned modes)."""
+    reports none (sweep.models.loads.wanted); ends other than pins need the consistent
+    coefficients (Eq.32 is the pinned span's)."""
     if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
                                                                     axes):
         _fail(f"{_where('clamps.axial_stiffness', axes)} and "
@@ -454,10 +453,6 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
         _fail("scene key 'clamps.rotation'", f"model.coefficients = 'paper' is the pinned span's "
               f"Eq.32; '{rotation}' clamps need the consistent coefficients",
               "use model.coefficients = 'consistent', or clamps.rotation = 'pinned'")
-    if given.get("outputs.stability"):
-        _fail("scene key 'outputs.stability'", f"the Floquet chart takes the pinned span's "
-              f"modes; '{rotation}' clamps couple them (not yet charted)",
-              "remove outputs.stability, or use clamps.rotation = 'pinned'")
 
 
 def _check_load_frequency_axis(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
