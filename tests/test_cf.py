@@ -28,6 +28,8 @@ REDUCED = {
     "harness-stepped-sine": {"axes.length": [0.5], "axes.base_frequency_ratio": [1.0, 1.2, 1.4],
                              "solver.t_end": 1.0},
     "launch-sine-qualification": {"axes.length": [0.2, 0.4], "base.sweep.rate": 64.0},
+    "harness-clamps": {"axes.length": [0.2, 0.4], "axes.clamp_rotational_stiffness": [0.1, 10.0],
+                       "solver.t_end": 0.3},
 }
 # The checker's priorities: high are its "errors", medium its "warnings", low its
 # "suggestions". A file fails on either of the first two.
