@@ -232,3 +232,21 @@ def test_elastic_ends_are_the_rotational_spring_table(stiffness, beta, end, mid,
     # between pinned (n pi) and clamped, mode by mode
     assert np.all(b.shapes[:, 0] > np.arange(1, 4) * math.pi)
     assert np.all(b.shapes[:, 0] < [4.7301, 7.8533, 10.9957])
+
+
+@pytest.mark.parametrize("stiffness", [0.0, 0.3, 3.0, 30.0, 300.0, math.inf])
+def test_the_observed_rows_are_the_shapes_derivatives_and_mode_1_pushes_one_way(stiffness):
+    """Basis.clamps holds phi'' at s = 0, 1, 1/2, phi''' and phi' at s = 0, 1 (pinned: the
+    closed forms), equal to finite differences of the shapes themselves; and the first mode's
+    reaction terms have one sign, -phi'''(0) > 0 and phi'(0) >= 0, whatever the ends (the
+    one-mode clamp_force is |q| (|phi'''(0)| + kappa E |phi'(0)|) only because of that)."""
+    from sweep.models.basis import span_basis
+    basis = span_basis(stiffness, 3)
+    h = 1e-4
+    for row, (k, s) in enumerate(((2, 0.0), (2, 1.0), (2, 0.5), (3, 0.0), (3, 1.0), (1, 0.0),
+                                  (1, 1.0))):
+        lower = shape_values(basis.shapes, np.array([s - h, s + h]), k - 1)
+        numeric = (lower[:, 1] - lower[:, 0]) / (2 * h)
+        scale = basis.shapes[:, 0] ** k
+        assert np.allclose(basis.clamps[row], numeric, atol=1e-6 * scale.max()), row
+    assert -basis.clamps[3, 0] > 0.0 and basis.clamps[5, 0] >= -1e-12

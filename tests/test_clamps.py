@@ -155,22 +155,29 @@ def test_clamps_a_scene_cannot_honour_are_refused(name, overrides, words):
 EI = 1.1e11 * 2.865e-12        # N m^2 of the scene's cable
 
 
+def _symmetric_parts(b: float, u: np.ndarray) -> tuple[np.ndarray, ...]:
+    """phi = cos(b u) + c cosh(b u), c = -cos(b/2) / cosh(b/2), and its first three
+    derivatives in u (= s - 1/2)."""
+    c = -math.cos(b / 2) / math.cosh(b / 2)
+    return (np.cos(b * u) + c * np.cosh(b * u),
+            b * (-np.sin(b * u) + c * np.sinh(b * u)),
+            b * b * (-np.cos(b * u) + c * np.cosh(b * u)),
+            b ** 3 * (np.sin(b * u) + c * np.sinh(b * u)))
+
+
 def _symmetric_modes(stiffness: float, count: int) -> list[tuple[float, Callable]]:
     """The symmetric modes of the span with springs K at both ends, written about midspan
     (u = s - 1/2): phi = cos(b u) + c cosh(b u), c = -cos(b/2) / cosh(b/2) (phi = 0 at the
     ends), b the roots of phi''(end) + K phi'(end) = 0 at u = 1/2 (brentq on a scan): another
     formulation than sweep.models.basis's (its 4 x 4 determinant over the whole span).
-    Returns (b, phi(s)) for the first `count`."""
+    Returns (b, phi(s)) for the first `count`; `_symmetric_parts(b, u)` gives phi and its
+    first three derivatives in s."""
     from scipy.optimize import brentq
 
-    def parts(b: float, u: np.ndarray):
-        c = -math.cos(b / 2) / math.cosh(b / 2)
-        return (np.cos(b * u) + c * np.cosh(b * u),
-                b * (-np.sin(b * u) + c * np.sinh(b * u)),
-                b * b * (-np.cos(b * u) + c * np.cosh(b * u)))
+    parts = _symmetric_parts
 
     def residual(b: float) -> float:
-        _, d1, d2 = parts(b, np.array(0.5))
+        _, d1, d2, _ = parts(b, np.array(0.5))
         return float(d2 + stiffness * d1) / (b * b + stiffness * b)
 
     grid = np.linspace(0.5, 40.0, 40000)
@@ -219,6 +226,23 @@ def test_the_linear_elastic_span_is_the_closed_form_response(modes, ratio):
     omega = ratio * omega_n[0]
     q = gamma * 1e-5 * 9.80665 / (omega_n ** 2 - omega ** 2 + 2j * ZETA * omega_n * omega)
     assert _one(ds, "amplitude") == pytest.approx(abs(np.sum(q * mid)), rel=1e-4)
+    # the loads of the steady complex shape W(s) = sum q_n phi_n(s) (derivatives in s): the
+    # curvatures |W''| / l^2, the reaction EI |W'''(0)| / l^3 (N W' is of order q^3: nil) and
+    # the tension's peak k_s (int |W'|^2 + |int W'^2|) / (4 l) over a cycle, k_s = EA / l
+    def shape(u, k):
+        return sum(qn * _symmetric_parts(b, np.asarray(u) - 0.5)[k]
+                   for qn, (b, _) in zip(q, symmetric))
+    d = math.sqrt(4 * 6e-6 / math.pi)
+    assert _one(ds, "midspan_bending_strain") == pytest.approx(
+        d / 2 * abs(shape(0.5, 2)) / LENGTH ** 2, rel=1e-4)
+    assert _one(ds, "clamp_bending_strain") == pytest.approx(
+        d / 2 * abs(shape(0.0, 2)) / LENGTH ** 2, rel=1e-4)
+    assert _one(ds, "clamp_force") == pytest.approx(EI * abs(shape(0.0, 3)) / LENGTH ** 3,
+                                                    rel=1e-4)
+    slope = shape(s, 1)
+    peak_e = ((np.abs(slope) ** 2 @ w) + abs(slope ** 2 @ w)) / (4 * LENGTH)
+    assert _one(ds, "axial_tension") == pytest.approx(1.1e11 * 6e-6 / LENGTH * peak_e,
+                                                      rel=1e-3)
 
 
 def test_an_elastic_grid_is_its_points_run_alone():
