@@ -82,6 +82,7 @@ from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span cou
 from .. import schema
 from ..errors import CableSweepWarning
 from ..scene.messages import _fail, _show
+from . import cable
 from .modal import oscillator
 from .wave import wave_parameters
 
@@ -789,6 +790,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     columns = Swept.of(axes).corners()
     params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
                               for name, key in schema.BY_AXIS.items()}
+    params = cable.resolve(params, values)
     if params["inertia"] is None:
         params["inertia"] = default_inertia(params["area"])
     params.update(coefficients=values["model.coefficients"], load_type=values["load.type"],
@@ -931,6 +933,7 @@ def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
     cable.inertia (m^4) from a scalar area."""
     if not any(d in mentioned for d in FREQUENCY_KEYS):
         values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    cable.defaults(values, mentioned)
     if "cable.inertia" not in mentioned and values["cable.area"] is not None:
         values["cable.inertia"] = default_inertia(values["cable.area"])
 
