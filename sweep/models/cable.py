@@ -238,7 +238,15 @@ def bending_note(values: Mapping[str, Any]) -> str | None:
     bundle = f"{values.get('cable.wires') or 1} x {wire}" if wire else None
     if values.get("cable.f1_measured") is not None:
         rotation = values.get("clamps.rotation") or "pinned"
-        return (f"measured: EI from f1 = {values['cable.f1_measured']:g} Hz on a "
+        mass = (wires.bundle(wire, values.get("cable.wires") or 1).linear_mass if wire
+                else values.get("cable.linear_mass"))
+        stiffness = values.get("clamps.rotational_stiffness")
+        ei = ""
+        if mass is not None and not (rotation == "elastic" and stiffness is None):
+            value = bending_from_f1(values["cable.f1_measured"], values["cable.f1_span"], mass,
+                                    rotation, stiffness)
+            ei = f" = {value:.6g} N m2"
+        return (f"measured: EI{ei} from f1 = {values['cable.f1_measured']:g} Hz on a "
                 f"{values['cable.f1_span']:g} m span with {rotation} ends (MODEL.md sec. 10)"
                 + (f"; mass and EA of the bundle {bundle} (sweep/wires.py)" if bundle else ""))
     if bundle:
