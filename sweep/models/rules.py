@@ -423,7 +423,8 @@ ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
 def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
     or model.membrane, not both); a rotational stiffness with elastic clamps only, and always
-    with them; a diameter (the strain at the clamp) only with clamps that hold rotation; ends
+    with them; a diameter (the strain at the clamp) only with clamps that hold rotation (or as
+    part of a data-sheet cable, sweep.models.cable); ends
     other than pins need the consistent coefficients (Eq.32 is the pinned span's) and have no
     Floquet chart yet (it takes the pinned modes)."""
     if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
@@ -444,7 +445,8 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "add rotational_stiffness = 0.5 (N m/rad, each clamp) to [clamps], or an axis "
               "clamp_rotational_stiffness")
     if rotation == "pinned":
-        if _present("cable.diameter", given, axes):
+        # a data sheet's outer diameter describes the cable (pinned clamps do not use it)
+        if _present("cable.diameter", given, axes) and not cable.is_sheet(given, axes):
             _fail(_where("cable.diameter", axes), "is used for the bending strain at clamps that "
                   "hold the span's rotation; pinned clamps bend it nowhere there",
                   "add [clamps] rotation = 'clamped' or 'elastic', or remove the diameter")

@@ -64,8 +64,8 @@ def _build(text: str, source: str, default_name: str,
     kind = models.rules_for(rules.model_kind(given))
     _check_continued(given, points)
     rules.check_pairs(given, swept)     # two spellings of one quantity first: the rules
-    cable.check(given, swept)           # one description of the cable (material or sheet)
     kind.check(given, swept)            # below read one of them
+    cable.check(given, swept)           # one description of the cable (material or sheet)
     _check_run(given)
     values = _resolve(given, swept, kind)
     kind.check_resolved(values, swept, given)
