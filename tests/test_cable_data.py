@@ -201,3 +201,13 @@ def test_f1_round_trip_through_a_run():
     ei = 0.0534 * (2 * math.pi * 40.0 * 0.4 ** 2 / 4.730040745 ** 2) ** 2
     assert source.startswith("measured") and f"{ei:.6g}" in source and "40 Hz" in source
     assert 'f1_measured = 40.0' in ds.attrs["scene"]
+
+
+def test_sweep_keys_shows_the_unit_and_what_it_accepts():
+    from sweep import keys
+    from sweep.scene import parse_override
+    text = keys.text("cable.linear_mass")
+    assert "[kg m-1]" in text and "'33.3 g/m'" in text and "mass per length" in text
+    assert "standard gravity" in keys.text("base.acceleration")
+    assert keys.accepted_units(schema.BY_DOTTED["cable.damping_ratio"]) == ""
+    assert parse_override("cable.diameter=1.27 mm") == ("cable.diameter", "1.27 mm")

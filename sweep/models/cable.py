@@ -34,6 +34,10 @@ SHEET_KEYS: tuple[str, ...] = ("cable.linear_mass", "cable.bending_rigidity",
                                "cable.axial_rigidity", "cable.f1_measured", "cable.wire")
 """Keys any one of which makes the scene's cable a data-sheet one."""
 WIRE_KEYS: tuple[str, ...] = ("cable.wires", "cable.bending")
+_SHEET_TWIN = {"cable.youngs_modulus": "bending_rigidity = E I and axial_rigidity = E A",
+               "cable.inertia": "bending_rigidity = E I", "cable.density": "linear_mass = rho A",
+               "cable.area": "linear_mass = rho A and axial_rigidity = E A"}
+"""What a material key is in the data-sheet set (for the message refusing both)."""
 REFERENCE_AREA = 1.0
 """A (m^2) of the equivalent material of a data-sheet cable without a diameter: any area gives
 the same products; this one is never shown."""
@@ -77,8 +81,8 @@ def check(given: dict[str, Any], swept: Mapping[str, Any]) -> None:
               "two descriptions of one cable: material (youngs_modulus, density, area, "
               "inertia) and data sheet (linear_mass, bending_rigidity, axial_rigidity, "
               "f1_measured, wire); give one set, not both",
-              f"remove {material[0]} (EI, m = rho A and EA come from the data sheet), or the "
-              "data-sheet keys")
+              f"remove {material[0]}, or give it as the data sheet's "
+              f"{_SHEET_TWIN[material[0]]}; or remove the data-sheet keys")
     if given.get("model.kind", "transverse") == "longitudinal":
         _fail(_where(sheet[0], swept), "the longitudinal wave model and its time-step checks "
               "take the material keys (wave speed sqrt(E / rho), E A)",

@@ -792,6 +792,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     columns = Swept.of(axes).corners()
     params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
                               for name, key in schema.BY_AXIS.items()}
+    as_given = params                   # what the messages name (not a data sheet's equivalents)
     params = cable.resolve(params, values)
     if params["inertia"] is None:
         params["inertia"] = default_inertia(params["area"])
@@ -823,7 +824,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0
     inputs = []
     for axis, key in schema.BY_AXIS.items():
-        value = params[axis]
+        value = as_given[axis]
         if value is None or key.section not in ("cable", "model", "load", "base"):
             continue
         value = float(np.atleast_1d(value)[corner % np.size(value)])
