@@ -15,6 +15,11 @@ Shared rules:
   inertia follows the area point by point (`sweep.grid.parameters`).
 - The derived coefficients (`sweep.models.oscillator`, `sweep.models.wave.wave_parameters`)
   must be finite at every corner of the grid.
+- The cable is given by material (youngs_modulus, density, area, inertia) or by its data
+  sheet (linear_mass, bending_rigidity or f1_measured, axial_rigidity, diameter; or a wire of
+  sweep/wires.py), never both: sweep/models/cable.py holds those rules (`cable.check`, called
+  by the scene pipeline after the kind's) and turns a data sheet into the material the
+  formulas here and in the models take (`cable.resolve`).
 
 Transverse scenes (``model.kind = "transverse"``, the default):
 - ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
