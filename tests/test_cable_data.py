@@ -164,6 +164,14 @@ def test_a_wire_scene_gives_the_bundle_to_the_model():
         f1 = math.pi / (2 * 0.3 ** 2) * math.sqrt(b.bending(bound) / b.linear_mass)
         assert float(oscillator(p)["natural_frequency"]) == pytest.approx(f1, rel=1e-12)
         assert p["diameter"] == pytest.approx(3 * 0.050 * INCH)
+        assert cable.bending_note(scene.values).startswith(f"bound: the {bound} bound")
+    # the bracket as an axis: the wire's mass and EA, EI swept between the two bounds
+    scene = load('[cable]\nwire = "spec55-22"\nwires = 7\n[axes]\n'
+                 f'bending_rigidity = [{b.bending_lower!r}, {b.bending_upper!r}]\n')
+    f1 = oscillator(parameters(scene, coordinates(scene)))["natural_frequency"]
+    np.testing.assert_allclose(f1.values, [math.pi / 2 * math.sqrt(b.bending(x) / b.linear_mass)
+                                           for x in ("lower", "upper")], rtol=1e-12)
+    assert cable.bending_note(scene.values).startswith("given")
 
 
 # ---------------------------------------------------------------- EI from a measured f1

@@ -253,7 +253,10 @@ def bending_note(values: Mapping[str, Any]) -> str | None:
         return (f"measured: EI{ei} from f1 = {values['cable.f1_measured']:g} Hz on a "
                 f"{values['cable.f1_span']:g} m span with {rotation} ends (MODEL.md sec. 10)"
                 + (f"; mass and EA of the bundle {bundle} (sweep/wires.py)" if bundle else ""))
-    if bundle:
+    if bundle and values.get("cable.bending") is not None:
         return (f"bound: the {values['cable.bending']} bound of the EI of the bundle {bundle} "
                 "(sweep/wires.py; a measured f1 beats both bounds)")
+    if bundle:
+        return (f"given: cable.bending_rigidity, with the mass and EA of the bundle {bundle} "
+                "(sweep/wires.py)")
     return None
