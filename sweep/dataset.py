@@ -55,19 +55,23 @@ def derived(values: Any, coords: dict[str, xr.DataArray]) -> xr.DataArray:
 class Provenance:
     """What a result says about where it came from, resolved once from its scene
     (`provenance`): its name, description and source, the resolved scene text, the model kind
-    and coefficient set."""
+    and coefficient set; `bending_source`: where a data-sheet cable's EI came from (a measured
+    f1, a bundle's bound; sweep.models.cable.bending_note), None otherwise."""
     title: str
     description: str
     source: str
     scene_text: str
     kind: str
     coefficients: str
+    bending_source: str | None = None
 
 
 def provenance(scene: Scene) -> Provenance:
     """The Provenance of a result of `scene`."""
+    from .models.cable import bending_note
     return Provenance(scene.name, scene.description, scene.source, scene.to_toml(),
-                      scene.get("model.kind"), scene.get("model.coefficients"))
+                      scene.get("model.kind"), scene.get("model.coefficients"),
+                      bending_note(scene.values))
 
 
 def global_attrs(origin: Provenance, shape: tuple[int, ...], elapsed: float,
@@ -87,6 +91,7 @@ def global_attrs(origin: Provenance, shape: tuple[int, ...], elapsed: float,
         "coefficients": origin.coefficients,
         "run_seconds": float(elapsed),
         "n_points": counter(np.prod(shape, dtype=np.int64))[()],
+        **({"bending_rigidity_source": origin.bending_source} if origin.bending_source else {}),
     }
 
 

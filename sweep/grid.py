@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .models.cable import resolve
 from .models.rules import default_inertia
 from .scene import Scene
 from .scene.points import POINT_DIM
@@ -48,6 +49,7 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params: dict[str, Any] = {}
     for name, key in BY_AXIS.items():
         params[name] = coords[name] if name in coords else scene.get(key.dotted)
+    params = resolve(params, scene.values)      # a data-sheet cable: its equivalent material
     if params["inertia"] is None:                 # not given, area swept: follows the area
         params["inertia"] = default_inertia(params["area"])
     params["coefficients"] = scene.get("model.coefficients")

@@ -79,6 +79,12 @@ def units(key: schema.Key) -> str:
     return _UNITS_TEXT.get(key.units, key.units)
 
 
+def accepted_units(key: schema.Key) -> str:
+    """The values with units a key accepts ('' for keys without units): sweep.scene.units."""
+    from .scene.units import accepted
+    return accepted(key)
+
+
 def help_text(key: schema.Key) -> str:
     """What the key means: the schema's help text if it has one, else its long name."""
     return getattr(key, "help", "") or key.long_name
@@ -119,6 +125,9 @@ def text(which: str | None = None) -> str:
         lines.append(head)
         if allowed(key):
             lines.append(f"    allowed: {allowed(key)}")
+        if accepted_units(key):
+            lines += textwrap.wrap(f"units: {accepted_units(key)}", 96, initial_indent="    ",
+                                   subsequent_indent="        ")
         lines += textwrap.wrap(help_text(key), 96, initial_indent="    ",
                                subsequent_indent="    ") + [""]
     if which is None:
@@ -161,7 +170,10 @@ def markdown() -> str:
            "reference in a terminal: `sweep keys`, or `sweep keys SECTION` (or one dotted key).", "",
            "A scene is a TOML file in SI units. *Default* is the value used when the key is absent",
            "(empty: none; the description says what happens then). *Axis*: a float key that may",
-           "instead be swept under `[axes]`, by that name. Units `1`: dimensionless.", "",
+           "instead be swept under `[axes]`, by that name. Units `1`: dimensionless. *Accepts*:",
+           "a key with units also takes a string with a unit, converted to SI when the scene",
+           "loads (\"1.27 mm\", \"33.3 g/m\", \"0.5 g\"; on acceleration keys g is standard",
+           "gravity, elsewhere the gram).", "",
            "## Top level", "", "| key | type | description |", "|---|---|---|"]
     out += [f"| `{name}` | str | {_cell(meaning)} |" for name, meaning in schema.TOP_LEVEL.items()]
     for section in schema.SECTIONS:
@@ -169,13 +181,14 @@ def markdown() -> str:
         if not keys:
             continue
         out += ["", f"## [{section}]", "",
-                "| key | type | default | units | allowed | axis | description |",
-                "|---|---|---|---|---|---|---|"]
+                "| key | type | default | units | allowed | axis | description | accepts |",
+                "|---|---|---|---|---|---|---|---|"]
         for k in keys:
             default = toml_value(k.default)
             out.append(f"| `{k.dotted}` | {k.kind} | {f'`{default}`' if default else ''} | "
                        f"{_cell(k.units)} | {_cell(allowed(k))} | "
-                       f"{f'`{k.axis}`' if k.axis else ''} | {_cell(help_text(k))} |")
+                       f"{f'`{k.axis}`' if k.axis else ''} | {_cell(help_text(k))} | "
+                       f"{_cell(accepted_units(k))} |")
     spacings = ", ".join(f"`{s}`" for s in schema.AXIS_SPACINGS)
     out += ["", "## [axes]", "",
             "Each entry sweeps one float key: `NAME = [v1, v2, ...]`, or",

@@ -19,6 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from .wires import WIRE_NAMES
+
 STANDARD_GRAVITY = 9.80665
 """g (m s-2), the standard acceleration of gravity: what a level in g (``base.acceleration_g``,
 the ``absolute_acceleration_g`` output) is a multiple of. The one place this number is written."""
@@ -109,6 +111,29 @@ KEYS: tuple[Key, ...] = (
         long_name="outer diameter d: the outer fibre lies d/2 from the neutral axis (the bending "
                   "strain at the clamp); default that of the solid round section, "
                   "sqrt(4 A / pi)", axis="diameter"),
+    # data-sheet alternatives to the material keys above (sweep/models/cable.py; either set)
+    Key("cable", "linear_mass", "float", None, units="kg m-1", minimum=0.0, exclusive_min=True,
+        long_name="mass per unit length m = rho A of the cable or bundle, as its data sheet "
+                  "gives it (instead of density and area)", axis="linear_mass"),
+    Key("cable", "bending_rigidity", "float", None, units="N m2", minimum=0.0,
+        exclusive_min=True, long_name="bending stiffness EI (instead of youngs_modulus and "
+                                      "inertia)", axis="bending_rigidity"),
+    Key("cable", "axial_rigidity", "float", None, units="N", minimum=0.0, exclusive_min=True,
+        long_name="axial stiffness EA of the cable's section, for its stretching (not the "
+                  "clamps' axial_stiffness, N/m)", axis="axial_rigidity"),
+    Key("cable", "f1_measured", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
+        long_name="first natural frequency measured on a span of f1_span between the scene's "
+                  "clamps: gives EI (MODEL.md sec. 10) instead of bending_rigidity"),
+    Key("cable", "f1_span", "float", None, units="m", minimum=0.0, exclusive_min=True,
+        long_name="length of the span whose f1_measured was measured"),
+    Key("cable", "wire", "str", None, choices=WIRE_NAMES,
+        long_name="a wire of the table in sweep/wires.py: its mass, diameter, EA and EI "
+                  "bounds, for a bundle of cable.wires of them"),
+    Key("cable", "wires", "int", None, units="1", minimum=1, maximum=1000,
+        long_name="number of identical cable.wire wires in the bundle (default 1)"),
+    Key("cable", "bending", "str", None, choices=("lower", "upper"),
+        long_name="which bound of a cable.wire bundle's EI: lower (strands slipping, n EI of "
+                  "the wires' strands) or upper (the solid section); a measured f1 beats both"),
     Key("cable", "damping_ratio", "float", 0.0, units="1", minimum=0.0,
         long_name="modal viscous damping ratio", axis="damping_ratio"),
     Key("cable", "length", "float", 1.0, units="m", minimum=0.0, exclusive_min=True,

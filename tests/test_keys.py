@@ -39,7 +39,7 @@ def _table_rows(page: str) -> dict[str, list[str]]:
 def test_page_lists_every_key_with_a_default_that_reads_back():
     rows = _table_rows(keys.markdown())
     assert sorted(rows) == sorted(schema.BY_DOTTED)
-    for dotted, (_, kind, default, units, _allowed, axis, meaning) in rows.items():
+    for dotted, (_, kind, default, units, _allowed, axis, meaning, _accepts) in rows.items():
         key = schema.BY_DOTTED[dotted]
         assert kind == key.kind and units == key.units and meaning
         assert axis.strip("`") == (key.axis or "")

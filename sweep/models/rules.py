@@ -15,6 +15,11 @@ Shared rules:
   inertia follows the area point by point (`sweep.grid.parameters`).
 - The derived coefficients (`sweep.models.oscillator`, `sweep.models.wave.wave_parameters`)
   must be finite at every corner of the grid.
+- The cable is given by material (youngs_modulus, density, area, inertia) or by its data
+  sheet (linear_mass, bending_rigidity or f1_measured, axial_rigidity, diameter; or a wire of
+  sweep/wires.py), never both: sweep/models/cable.py holds those rules (`cable.check`, called
+  by the scene pipeline after the kind's) and turns a data sheet into the material the
+  formulas here and in the models take (`cable.resolve`).
 
 Transverse scenes (``model.kind = "transverse"``, the default):
 - ``solver.t_end`` defaults to 5.0 s; ``solver.transits`` is refused.
@@ -82,6 +87,7 @@ from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span cou
 from .. import schema
 from ..errors import CableSweepWarning
 from ..scene.messages import _fail, _show
+from . import cable
 from .modal import oscillator
 from .wave import wave_parameters
 
@@ -423,8 +429,9 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
     or model.membrane, not both); a rotational stiffness with elastic clamps only, and always
     with them; a diameter (the bending strains) not where a pinned span under model.membrane
-    reports none (sweep.models.loads.wanted); ends other than pins need the consistent
-    coefficients (Eq.32 is the pinned span's)."""
+    reports none (sweep.models.loads.wanted), unless it is part of a data-sheet cable
+    (sweep.models.cable); ends other than pins need the consistent coefficients (Eq.32 is the
+    pinned span's)."""
     if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
                                                                     axes):
         _fail(f"{_where('clamps.axial_stiffness', axes)} and "
@@ -443,7 +450,9 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "add rotational_stiffness = 0.5 (N m/rad, each clamp) to [clamps], or an axis "
               "clamp_rotational_stiffness")
     if rotation == "pinned":
-        if _present("cable.diameter", given, axes) and given.get("model.membrane") is not None:
+        # a data sheet's outer diameter describes the cable, used or not
+        if (_present("cable.diameter", given, axes) and given.get("model.membrane") is not None
+                and not cable.is_sheet(given, axes)):
             _fail(_where("cable.diameter", axes), "is used for the bending strains, which a "
                   "pinned span under the paper's local membrane term (model.membrane) does not "
                   "report", "remove model.membrane (the uniform stretching tension), or the "
@@ -786,6 +795,8 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     columns = Swept.of(axes).corners()
     params: dict[str, Any] = {name: columns.get(name, _float64(values[key.dotted]))
                               for name, key in schema.BY_AXIS.items()}
+    as_given = params                   # what the messages name (not a data sheet's equivalents)
+    params = cable.resolve(params, values)
     if params["inertia"] is None:
         params["inertia"] = default_inertia(params["area"])
     params.update(coefficients=values["model.coefficients"], load_type=values["load.type"],
@@ -816,7 +827,7 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0
     inputs = []
     for axis, key in schema.BY_AXIS.items():
-        value = params[axis]
+        value = as_given[axis]
         if value is None or key.section not in ("cable", "model", "load", "base"):
             continue
         value = float(np.atleast_1d(value)[corner % np.size(value)])
@@ -928,6 +939,7 @@ def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
     cable.inertia (m^4) from a scalar area."""
     if not any(d in mentioned for d in FREQUENCY_KEYS):
         values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    cable.defaults(values, mentioned)
     if "cable.inertia" not in mentioned and values["cable.area"] is not None:
         values["cable.inertia"] = default_inertia(values["cable.area"])
 

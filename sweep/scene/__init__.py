@@ -24,6 +24,7 @@ The package, one job a module (each re-exported name below keeps working from he
     build      the pipeline: load_scene, load_scene_text (read, override, check, resolve)
     reading    finding and reading a built-in scene or a file; size, encoding, TOML syntax
     overrides  --set KEY=VALUE: parsed, applied, either-or partners dropped
+    units      values with units ("33.3 g/m", "0.5 g") converted to SI first (pint, lazily)
     values     the document's keys and each value against the schema (kind, bounds, choices)
     axes       [axes]: lists and {start, stop, num, spacing} ranges, exact
     document   the Scene and its TOML writer

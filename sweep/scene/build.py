@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import models, schema
-from ..models import rules
+from ..models import cable, rules
 from ..models.swept import Swept
 from .axes import _check_axes, _flatten_axes
 from .document import Scene
@@ -20,6 +20,7 @@ from .messages import _fail
 from .overrides import _apply_overrides, _parse_overrides
 from .points import _check_points
 from .reading import _parse_toml, _read_scene
+from .units import convert_document
 from .values import _check_description, _check_name, _check_sections, _check_top_level
 
 
@@ -52,6 +53,7 @@ def _build(text: str, source: str, default_name: str,
     _apply_overrides(doc, applied)
     _flatten_tables(doc)
     _check_top_level(doc)
+    convert_document(doc)               # unit strings -> SI numbers, once
     name = _check_name(doc.get("name", default_name))
     description = _check_description(doc.get("description", ""))
     given = _check_sections(doc)
@@ -63,6 +65,7 @@ def _build(text: str, source: str, default_name: str,
     _check_continued(given, points)
     rules.check_pairs(given, swept)     # two spellings of one quantity first: the rules
     kind.check(given, swept)            # below read one of them
+    cable.check(given, swept)           # one description of the cable (material or sheet)
     _check_run(given)
     values = _resolve(given, swept, kind)
     kind.check_resolved(values, swept, given)

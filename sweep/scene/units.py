@@ -1,0 +1,193 @@
+"""Values with units: a scene may write any dimensional number as a string, "33.3 g/m",
+"1.27 mm", "0.5 g", "3.2 lb/kft", "100 Hz", and it is converted here, once, to the key's SI
+unit (the schema's ``units``), before any other check sees it. Plain numbers stay SI.
+
+Where: every float key, the items of "floats" and "pairs" keys (a pair's first item is a
+frequency, Hz), the values of [axes] lists and ranges (start, stop) and of [points] lists.
+A string on a dimensionless key, a unit of the wrong dimension or an unknown unit is one
+SceneError line. pint parses the strings, and is imported only when a scene holds one.
+
+"g" means grams to pint. On an acceleration key (base.acceleration in m/s^2, the keys in g:
+base.acceleration_g, base.levels_g) a "g" written alone is read as standard gravity
+(schema.STANDARD_GRAVITY, 9.80665 m/s^2), so "0.5 g" is half of it there; everywhere else g
+is the gram ("33.3 g/m").
+"""
+
+from __future__ import annotations
+
+import re
+from functools import lru_cache
+from typing import Any
+
+from .. import schema
+from .messages import _fail, _show
+
+ACCELERATION_UNITS = ("m s-2", schema.G_UNITS)
+"""Schema units of the keys on which "g" means standard gravity."""
+_LONE_G = re.compile(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])")
+_UDUNITS_TERM = re.compile(r"([A-Za-z]+)(-?\d+)?")
+
+_DIMENSION_NAMES: dict[str, str] = {
+    "[length]": "a length", "[mass]": "a mass", "[time]": "a time",
+    "[mass] / [length]": "a mass per length", "[mass] / [length] ** 3": "a density",
+    "[length] ** 2": "an area", "[length] ** 4": "a second moment of area",
+    "1 / [time]": "a frequency", "[length] / [time]": "a speed",
+    "[length] / [time] ** 2": "an acceleration", "[mass] * [length] / [time] ** 2": "a force",
+    "[mass] / [length] / [time] ** 2": "a pressure",
+    "[mass] * [length] ** 3 / [time] ** 2": "a bending stiffness (force x area)",
+    "[mass] * [length] ** 2 / [time] ** 2": "a moment (force x length)",
+    "[mass] / [time] ** 2": "a stiffness (force per length)",
+    "[length] ** 2 / [time] ** 3": "an acceleration spectral density",
+    "1 / [time] ** 2": "an acceleration per length ('g' is standard gravity on this key)",
+    "dimensionless": "a pure number",
+}
+_EXAMPLES: dict[str, str] = {
+    "m": "'1.27 mm'", "kg m-1": "'33.3 g/m' or '3.2 lb/kft'", "Hz": "'100 Hz'",
+    "N m2": "'2e-3 N m^2'", "N": "'1.6 MN'", "m s-2": "'0.5 g' or '4.9 m/s^2'",
+    schema.G_UNITS: "'0.5 g'", "kg m-3": "'8.9 g/cm^3'", "Pa": "'110 GPa'", "m2": "'6 mm^2'",
+    "m4": "'2.9e-12 m^4'", "s": "'20 ms'", "N m rad-1": "'0.5 N m/rad'", "N m-1": "'1 MN/m'",
+    "m s-1": "'0.1 m/s'", "min-1": "'2 /min'",
+}
+
+
+_QUANTITIES: dict[str, str] = {
+    "m": "length", "kg m-1": "mass per length", "Hz": "frequency", "N m2": "bending stiffness",
+    "N": "force", "m s-2": "acceleration", schema.G_UNITS: "acceleration", "kg m-3": "density",
+    "Pa": "pressure", "m2": "area", "m4": "second moment of area", "s": "time",
+    "N m rad-1": "rotational stiffness", "N m-1": "stiffness", "m s-1": "speed",
+    "min-1": "rate",
+}
+
+
+def accepted(key: schema.Key) -> str:
+    """What a key accepts besides a plain SI number, in words ('' for a key without units):
+    e.g. "or a string with any length unit, e.g. '1.27 mm'". No pint needed."""
+    if key.units in ("", "1") or key.kind not in ("float", "floats", "pairs"):
+        return ""
+    quantity = _QUANTITIES.get(key.units, key.units)
+    gravity = " ('g': standard gravity)" if key.units in ACCELERATION_UNITS else ""
+    return (f"a number in {'g' if key.units == schema.G_UNITS else key.units}, or a string with "
+            f"any {quantity} unit, e.g. {_EXAMPLES.get(key.units, key.units)}{gravity}")
+
+
+def convert_document(doc: dict[str, Any]) -> None:
+    """Replace every unit string on a numeric key of `doc` by its SI value, in place (the
+    sections' keys, [axes] and [points]; flattened, overrides applied)."""
+    from .axes import _axis_or_none
+    for section, table in doc.items():
+        if not isinstance(table, dict):
+            continue
+        for name, raw in table.items():
+            if section in schema.SWEPT_SECTIONS:
+                axis = _axis_or_none(name)
+                if axis is None:
+                    continue
+                key = schema.BY_AXIS[axis]
+                where = f"{'axis' if section == 'axes' else '[points] entry'} '{name}'"
+                table[name] = _swept(where, key, raw)
+                continue
+            key = schema.BY_DOTTED.get(f"{section}.{name}")
+            if key is not None and key.kind in ("float", "floats", "pairs"):
+                table[name] = _value(f"scene key '{key.dotted}'", key, raw)
+
+
+def _swept(where: str, key: schema.Key, raw: Any) -> Any:
+    if isinstance(raw, list):
+        return [to_si(where, key, v) if _has_unit(v) else v for v in raw]
+    if isinstance(raw, dict):
+        return {k: to_si(where, key, v) if k in ("start", "stop") and _has_unit(v) else v
+                for k, v in raw.items()}
+    return to_si(where, key, raw) if _has_unit(raw) else raw
+
+
+def _value(where: str, key: schema.Key, raw: Any) -> Any:
+    if key.kind == "float":
+        return to_si(where, key, raw) if _has_unit(raw) else raw
+    if not isinstance(raw, list):
+        return raw
+    if key.kind == "floats":
+        return [to_si(where, key, v) if _has_unit(v) else v for v in raw]
+    hertz = schema.BY_DOTTED["base.frequency"]            # a pair's first item: Hz
+    return [[to_si(where, hertz, item[0]) if _has_unit(item[0]) else item[0],
+             to_si(where, key, item[1]) if _has_unit(item[1]) else item[1]]
+            if isinstance(item, list) and len(item) == 2 else item for item in raw]
+
+
+def _has_unit(value: Any) -> bool:
+    """Whether `value` is a string that is not a plain number (a quoted plain number is left
+    for the value checks, which say it must be a number)."""
+    if not isinstance(value, str):
+        return False
+    try:
+        float(value)
+    except ValueError:
+        return True
+    return False
+
+
+def to_si(where: str, key: schema.Key, text: str) -> float:
+    """The number a unit string means, in the key's SI unit (schema units); refused in one
+    line for a dimensionless key, an unknown unit, or a quantity of another dimension."""
+    if key.units in ("", "1"):
+        _fail(where, f"{_show(text)} is a string; the key is a pure number and takes no unit",
+              f"write {key.name} = a plain number, without quotes")
+    import pint
+    registry = _registry()
+    acceleration = key.units in ACCELERATION_UNITS
+    parsed_text = _LONE_G.sub("g_0", text) if acceleration else text
+    target = _pint_units(key.units)
+    example = _EXAMPLES.get(key.units, f"a number with a unit of {key.units}")
+    gravity = " ('g' is standard gravity on this key)" if acceleration else ""
+    try:
+        quantity = registry.Quantity(parsed_text.strip())
+    except (pint.errors.UndefinedUnitError, AttributeError) as exc:
+        unknown = getattr(exc, "unit_names", None) or ()
+        named = f"unknown unit '{unknown[0] if isinstance(unknown, (list, tuple)) else unknown}'" \
+            if unknown else "not a number with a unit"
+        _fail(where, f"{_show(text)}: {named}",
+              f"give a number and a unit of {key.units}, e.g. {example}{gravity}")
+    except Exception:                            # pint's parser raises many kinds
+        _fail(where, f"{_show(text)} is not a number with a unit",
+              f"give a number and a unit of {key.units}, e.g. {example}{gravity}")
+    if not isinstance(quantity, registry.Quantity):    # a bare number parses as a float
+        quantity = registry.Quantity(quantity)
+    try:
+        value = float(quantity.to(target).magnitude)
+    except pint.errors.DimensionalityError:
+        got = _dimension_name(quantity.dimensionality)
+        want = _dimension_name(registry.Quantity(1.0, target).dimensionality)
+        _fail(where, f"{_show(text)} is {got}, the key takes {want} ({key.units})",
+              f"give e.g. {example}{gravity}")
+    except Exception as exc:                     # offset units (degC) and the like
+        _fail(where, f"{_show(text)} cannot be converted to {key.units} ({exc})",
+              f"give e.g. {example}")
+    # 15 significant digits: '33.3 g/m' is 0.0333, not 33.3 x 0.001 = 0.033299999999999996
+    return float(f"{value:.15g}")
+
+
+def _dimension_name(dimensionality: Any) -> str:
+    text = str(dimensionality)
+    return _DIMENSION_NAMES.get(text, f"of dimension {text}")
+
+
+def _pint_units(units: str) -> str:
+    """A schema (UDUNITS) unit string in pint's syntax: "kg m-3" -> "kg * m ** -3"; the keys
+    in g -> "g_0" (standard gravity)."""
+    if units == schema.G_UNITS:
+        return "g_0"
+    terms = []
+    for term in units.split():
+        match = _UDUNITS_TERM.fullmatch(term)
+        if match is None:
+            terms.append(term)
+        else:
+            name, power = match.groups()
+            terms.append(f"{name} ** {power}" if power else name)
+    return " * ".join(terms)
+
+
+@lru_cache(maxsize=1)
+def _registry() -> Any:
+    """pint's unit registry (built once: about 0.5 s)."""
+    import pint
+    return pint.UnitRegistry()

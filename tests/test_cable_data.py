@@ -1,0 +1,221 @@
+"""Cable data as a harness engineer has it (issue 37): values with units, the data-sheet keys
+(linear_mass, bending_rigidity, axial_rigidity), EI from a measured f1, and the wire table's
+bundles. The bad-input lines (wrong dimension, unknown unit, a unit on a dimensionless key, both
+sets of cable keys, a missing key) are in tests/data/bad (unit_*, cable_*), run by
+tests/test_bad_input.py.
+
+Every expected number here is a hand conversion or a textbook formula, not the code's output.
+Only one test runs the engine (the f1 round trip, on the clamped one-mode scene that
+tests/test_clamps.py compiles already).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import sweep
+from sweep import schema, wires
+from sweep.grid import coordinates, parameters
+from sweep.models import cable
+from sweep.models.modal import oscillator
+from sweep.scene.units import to_si
+
+G0 = 9.80665
+LB, FT, INCH = 0.45359237, 0.3048, 0.0254
+
+# For every schema unit: a string in other units and its value in the SI unit, by hand.
+BY_HAND: dict[str, tuple[str, float]] = {
+    "m": ("2.5 mm", 2.5e-3),
+    "kg m-1": ("3.2 lb/kft", 3.2 * LB / (1000 * FT)),
+    "N m2": ("2000 N mm^2", 2000e-6),
+    "N": ("1.5 kN", 1500.0),
+    "Hz": ("0.1 kHz", 100.0),
+    "Pa": ("110 GPa", 1.1e11),
+    "kg m-3": ("8.9 g/cm^3", 8900.0),
+    "m2": ("6 mm^2", 6e-6),
+    "m4": ("2 mm^4", 2e-12),
+    "s": ("250 ms", 0.25),
+    "m s-1": ("3 cm/s", 0.03),
+    "m s-2": ("0.5 g", 0.5 * G0),
+    schema.G_UNITS: ("4.903325 m/s^2", 0.5),
+    "N m rad-1": ("500 N mm/rad", 0.5),
+    "N m-1": ("1 kN/mm", 1e6),
+    "min-1": ("3 /h", 0.05),
+}
+DIMENSIONAL = [k for k in schema.KEYS
+               if k.kind in ("float", "floats", "pairs") and k.units not in ("", "1")]
+
+
+def load(text: str, **overrides) -> sweep.Scene:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")          # the zero-solution warning of bare scenes
+        return sweep.load_scene_text(text, overrides=overrides or None)
+
+
+@pytest.mark.parametrize("key", DIMENSIONAL, ids=lambda k: k.dotted)
+def test_every_dimensional_key_converts_a_unit_string_by_hand(key):
+    text, expected = BY_HAND[key.units]     # a KeyError: a new unit needs its hand conversion
+    assert to_si(f"scene key '{key.dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("33.3 g/m", 0.0333), ("4.76 g/m", 4.76e-3), ("3.2 lb/kft", 3.2 * LB / 304.8),
+    ("0.0333 kg/m", 0.0333), ("33.3 mg/mm", 0.0333)])
+def test_linear_mass_strings_in_a_scene(text, expected):
+    scene = load(f'[cable]\nlinear_mass = "{text}"\nbending_rigidity = 2e-3\n'
+                 'axial_rigidity = 1.6e6\n')
+    assert scene.get("cable.linear_mass") == pytest.approx(expected, rel=1e-14)
+
+
+def test_g_is_standard_gravity_on_acceleration_keys_and_the_gram_elsewhere():
+    scene = load('[base]\nacceleration = "0.5 g"\nfrequency = "20 Hz"\n'
+                 '[cable]\nlinear_mass = "33.3 g/m"\nbending_rigidity = 2e-3\n'
+                 'axial_rigidity = 1.6e6\n')
+    assert scene.get("base.acceleration") == pytest.approx(0.5 * G0, rel=1e-15)
+    assert scene.get("cable.linear_mass") == pytest.approx(0.0333, rel=1e-15)
+    table = load('[base]\nlevels_g = [["5 Hz", "0.5 g"], ["0.1 kHz", "9.80665 m/s^2"]]\n'
+                 'frequency = 20.0\n')
+    assert table.get("base.levels_g") == ((5.0, 0.5), (100.0, pytest.approx(1.0, rel=1e-15)))
+
+
+def test_units_in_axes_points_and_overrides_and_the_resolved_scene_is_si():
+    scene = load('[clamps]\nrotation = "clamped"\n[cable]\nbending_rigidity = "2e-3 N m^2"\n'
+                 'axial_rigidity = "1.6 MN"\n[axes]\nlength = {start = "300 mm", stop = "0.5 m", '
+                 'num = 3}\n[points]\nlinear_mass = ["33.3 g/m", "3.2 lb/kft"]\n'
+                 'diameter = ["3.81 mm", "0.05 in"]\n',
+                 **{"base.acceleration_g": "0.25 g", "base.frequency": "50 Hz"})
+    assert list(scene.axes["length"]) == [0.3, 0.4, 0.5]
+    assert list(scene.points["linear_mass"]) == [0.0333, pytest.approx(3.2 * LB / 304.8)]
+    assert list(scene.points["diameter"]) == [0.00381, pytest.approx(0.05 * INCH)]
+    assert scene.get("base.acceleration_g") == 0.25
+    text = scene.to_toml()
+    assert all(isinstance(v, float) for k, v in scene.values.items()
+               if schema.BY_DOTTED[k].kind == "float" and v is not None)
+    assert "youngs_modulus" not in text and "density" not in text
+    assert load(text) == scene
+
+
+MATERIAL = ('[model]\nmembrane = 0.375\n[cable]\nyoungs_modulus = 1.1e11\ndensity = 8900.0\n'
+            'area = 6e-6\ninertia = 2.865e-12\n[initial]\ndisplacement = 1e-4\n'
+            '[axes]\nlength = [0.3, 0.55, 1.0]\nload_amplitude = [0.0, 2.0]\n')
+SHEET = ('[model]\nmembrane = 0.375\n[cable]\nlinear_mass = "53.4 g/m"\n'
+         'bending_rigidity = "0.31515 N m^2"\naxial_rigidity = "660 kN"\n'
+         '[initial]\ndisplacement = 1e-4\n[axes]\nlength = [0.3, 0.55, 1.0]\n'
+         'load_amplitude = [0.0, 2.0]\n')
+
+
+@pytest.mark.parametrize("extra", ["", "[clamps]\naxial_stiffness = 1e5\n"])
+def test_the_data_sheet_gives_the_material_scene_coefficients(extra):
+    """rho A = 8900 x 6e-6 = 0.0534 kg/m, EI = 1.1e11 x 2.865e-12, EA = 1.1e11 x 6e-6: every
+    coefficient of the model (stretching, load, Pcr, f1) the same to round-off."""
+    text_m = MATERIAL.replace("membrane = 0.375\n", "") + extra if extra else MATERIAL
+    text_s = SHEET.replace("membrane = 0.375\n", "") + extra if extra else SHEET
+    a, b = (oscillator(parameters(s, coordinates(s))) for s in (load(text_m), load(text_s)))
+    for name in ("k0", "k1", "g0", "g1", "h", "natural_frequency", "buckling_load"):
+        np.testing.assert_allclose(np.asarray(b[name], float), np.asarray(a[name], float),
+                                   rtol=1e-13, err_msg=name)
+
+
+def test_diameter_reaches_the_clamp_strain_and_rho_a_is_the_linear_mass():
+    scene = load('[clamps]\nrotation = "clamped"\n[cable]\nlinear_mass = "33.3 g/m"\n'
+                 'bending_rigidity = "2e-3 N m^2"\naxial_rigidity = "1.6 MN"\n'
+                 'diameter = "3.81 mm"\nlength = 0.4\n')
+    p = parameters(scene, coordinates(scene))
+    assert p["diameter"] == 0.00381
+    assert p["density"] * p["area"] == pytest.approx(0.0333, rel=1e-15)
+    assert p["youngs_modulus"] * p["inertia"] == pytest.approx(2e-3, rel=1e-15)
+    assert p["youngs_modulus"] * p["area"] == pytest.approx(1.6e6, rel=1e-15)
+    f1 = 4.730040745 ** 2 / (2 * math.pi * 0.4 ** 2) * math.sqrt(2e-3 / 0.0333)
+    assert float(oscillator(p)["natural_frequency"]) == pytest.approx(f1, rel=1e-9)
+
+
+# ---------------------------------------------------------------- the wire table and bundles
+
+@pytest.mark.parametrize("count, ring_sum, rings", [(1, 0.0, 0), (3, 2.0, 1), (7, 6.0, 1),
+                                                     (19, 6 * 1 + 6 * 3 + 6 * 4, 2)])
+def test_bundle_against_the_formulas(count, ring_sum, rings):
+    """Mass n m; diameter (2k + 1) d; EI lower n s E pi d_s^4 / 64; upper E (n A_c^2 / (4 pi)
+    + A_c sum r_i^2 / 2), r_i of a hexagonal bundle: ring 1 at d, ring 2 at 2 d and sqrt(3) d."""
+    w = wires.WIRES["spec55-22"]
+    d, ds, e, s = 0.050 * INCH, 0.0063 * INCH, 1.1e11, 19
+    area = s * math.pi * ds ** 2 / 4
+    b = wires.bundle("spec55-22", count)
+    assert w.linear_mass == pytest.approx(3.2 * LB / (1000 * FT), rel=1e-15)
+    assert b.linear_mass == pytest.approx(count * 3.2 * LB / (1000 * FT), rel=1e-15)
+    assert b.diameter == pytest.approx((2 * rings + 1) * d, rel=1e-15)
+    assert b.axial_rigidity == pytest.approx(count * e * area, rel=1e-15)
+    assert b.bending_lower == pytest.approx(count * s * e * math.pi * ds ** 4 / 64, rel=1e-14)
+    upper = e * (count * area ** 2 / (4 * math.pi) + area * ring_sum * d ** 2 / 2)
+    assert b.bending_upper == pytest.approx(upper, rel=1e-14)
+    assert b.bending_lower < b.bending_upper
+
+
+def test_a_wire_scene_gives_the_bundle_to_the_model():
+    """7 x spec55-22, lower bound: f1 = (pi / l)^2 / (2 pi) sqrt(EI_lower / (7 m))."""
+    b = wires.bundle("spec55-22", 7)
+    for bound in ("lower", "upper"):
+        scene = load(f'[cable]\nwire = "spec55-22"\nwires = 7\nbending = "{bound}"\n'
+                     'length = "300 mm"\n')
+        p = parameters(scene, coordinates(scene))
+        f1 = math.pi / (2 * 0.3 ** 2) * math.sqrt(b.bending(bound) / b.linear_mass)
+        assert float(oscillator(p)["natural_frequency"]) == pytest.approx(f1, rel=1e-12)
+        assert p["diameter"] == pytest.approx(3 * 0.050 * INCH)
+        assert cable.bending_note(scene.values).startswith(f"bound: the {bound} bound")
+    # the bracket as an axis: the wire's mass and EA, EI swept between the two bounds
+    scene = load('[cable]\nwire = "spec55-22"\nwires = 7\n[axes]\n'
+                 f'bending_rigidity = [{b.bending_lower!r}, {b.bending_upper!r}]\n')
+    f1 = oscillator(parameters(scene, coordinates(scene)))["natural_frequency"]
+    np.testing.assert_allclose(f1.values, [math.pi / 2 * math.sqrt(b.bending(x) / b.linear_mass)
+                                           for x in ("lower", "upper")], rtol=1e-12)
+    assert cable.bending_note(scene.values).startswith("given")
+
+
+# ---------------------------------------------------------------- EI from a measured f1
+
+@pytest.mark.parametrize("rotation, beta", [("pinned", math.pi), ("clamped", 4.730040745)])
+def test_bending_from_f1_inverts_the_textbook_frequency(rotation, beta):
+    ei = cable.bending_from_f1(12.0, 0.5, 0.0333, rotation)
+    assert ei == pytest.approx(0.0333 * (2 * math.pi * 12.0 * 0.5 ** 2 / beta ** 2) ** 2,
+                               rel=1e-9)
+
+
+@pytest.mark.parametrize("stiffness_ratio, beta", [(1.0, 3.3988), (10.0, 4.1557),
+                                                   (100.0, 4.6413)])
+def test_bending_from_f1_of_elastic_ends_matches_model_md_table(stiffness_ratio, beta):
+    """MODEL.md 10.3: K = k_t l / EI -> b_1 l. Pick EI0 and k_t = K EI0 / l, make f1 from the
+    table's b_1 l, and solve back: EI0 to the table's 5 digits."""
+    ei0, span, mass = 2e-3, 0.4, 0.0333
+    f1 = beta ** 2 / (2 * math.pi * span ** 2) * math.sqrt(ei0 / mass)
+    ei = cable.bending_from_f1(f1, span, mass, "elastic", stiffness_ratio * ei0 / span)
+    assert ei == pytest.approx(ei0, rel=2e-4)
+
+
+def test_f1_round_trip_through_a_run():
+    """EI from f1 = 40 Hz measured on a 0.4 m clamped span: the run of that span gives
+    natural_frequency = 40 Hz back, and the dataset says where EI came from."""
+    text = ('name = "f1-round-trip"\n[model]\nmodes = 1\n[clamps]\nrotation = "clamped"\n'
+            '[cable]\nlinear_mass = "53.4 g/m"\naxial_rigidity = "660 kN"\n'
+            'diameter = "2.76 mm"\nf1_measured = "40 Hz"\nf1_span = "400 mm"\n'
+            'damping_ratio = 0.02\n[base]\nacceleration_g = 1e-5\nfrequency_ratio = 1.0\n'
+            '[solver]\nt_end = 0.2\nrtol = 1e-10\n[metrics]\ntail = 0.25\n'
+            '[axes]\nlength = [0.4]\n')
+    ds = sweep.run(load(text), progress=False)
+    assert float(ds["natural_frequency"].squeeze()) == pytest.approx(40.0, rel=1e-9)
+    source = ds.attrs["bending_rigidity_source"]
+    ei = 0.0534 * (2 * math.pi * 40.0 * 0.4 ** 2 / 4.730040745 ** 2) ** 2
+    assert source.startswith("measured") and f"{ei:.6g}" in source and "40 Hz" in source
+    assert 'f1_measured = 40.0' in ds.attrs["scene"]
+
+
+def test_sweep_keys_shows_the_unit_and_what_it_accepts():
+    from sweep import keys
+    from sweep.scene import parse_override
+    text = keys.text("cable.linear_mass")
+    assert "[kg m-1]" in text and "'33.3 g/m'" in text and "mass per length" in text
+    assert "standard gravity" in keys.text("base.acceleration")
+    assert keys.accepted_units(schema.BY_DOTTED["cable.damping_ratio"]) == ""
+    assert parse_override("cable.diameter=1.27 mm") == ("cable.diameter", "1.27 mm")
