@@ -14,6 +14,12 @@ touches three private names of xarray (``xarray.namedarray.pycompat._cached_duck
 writers call it) and leaves any that is not there alone, and does nothing where dask is
 already imported. Called by the entry points that are about to build xarray objects
 (`sweep.run`, the plot and design commands); measured in benchmarks/startup.py.
+
+pint the same way: xarray, where pint is installed (a dependency of ours, for unit strings in
+scenes), imports pint at its first `.values` (0.6 s: pint imports dask where dask is
+installed) only to ask whether an array is a pint Quantity, which none can be before pint is
+imported. Its cached "pint" duck-array module answers from ``sys.modules`` too (the real
+Quantity once pint is imported, by anyone).
 """
 
 from __future__ import annotations
@@ -50,12 +56,49 @@ class _DaskOnceImported:
         return Version(module.__version__) if module is not None else Version("0.0.0")
 
 
+class _PintOnceImported:
+    """xarray's DuckArrayModule for "pint", answering from what is imported."""
+
+    @property
+    def type(self) -> tuple[type, ...]:
+        kind = getattr(sys.modules.get("pint"), "Quantity", None)
+        return (kind,) if isinstance(kind, type) else ()
+
+    @property
+    def available(self) -> bool:
+        return "pint" in sys.modules or importlib.util.find_spec("pint") is not None
+
+    @property
+    def module(self) -> Any:
+        return importlib.import_module("pint") if self.available else None
+
+    @property
+    def version(self) -> Any:
+        from packaging.version import Version
+        module = self.module
+        return Version(module.__version__) if module is not None else Version("0.0.0")
+
+
+def _defer_pint() -> None:
+    """xarray's "pint" duck-array module answers from sys.modules (module docstring)."""
+    if "pint" in sys.modules:
+        return
+    try:
+        from xarray.namedarray import pycompat
+    except ImportError:
+        return
+    cache = getattr(pycompat, "_cached_duck_array_modules", None)
+    if isinstance(cache, dict) and "pint" not in cache:
+        cache["pint"] = _PintOnceImported()
+
+
 def defer() -> None:
-    """Install the two deferrals (once per process; see the module docstring)."""
+    """Install the deferrals (once per process; see the module docstring)."""
     global _DONE
     if _DONE:
         return
     _DONE = True
+    _defer_pint()
     if "dask" in sys.modules:
         return
     try:

@@ -71,6 +71,7 @@ def test_a_threads_run_and_a_plot_import_no_dask(tmp_path):
             f"from sweep.plot import load_result, plot\nplot(load_result({str(out)!r}))\n")
     loaded = _loaded_after(code)["loaded"]
     assert "dask" not in loaded and "distributed" not in loaded
+    assert "pint" not in loaded               # xarray would import it at the first .values
     assert {"numpy", "xarray", "numba"} <= set(loaded)
 
 
