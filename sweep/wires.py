@@ -4,9 +4,9 @@ Data only, plus the bundle rules: a scene names a row (``cable.wire = "spec55-22
 (``cable.wires = 7``) and a bound of the bundle's bending stiffness (``cable.bending =
 "lower" | "upper"``); sweep/models/cable.py turns them into the model's m, EI and EA.
 
-Every number of a row cites its source in the row. A row holds only what a source gives: a
-gauge whose outer diameter and mass per length could not be sourced is left out (no ESCC 3901
-row yet: the detail specifications were not at hand; add rows with their source).
+Every row cites its source (SPEC55_SOURCE: the Spec-55 gauges 26 to 12 of one Raychem
+specification control drawing, as printed). A row holds only what a source gives: no ESCC 3901
+row yet (its detail specifications were not at hand; add rows with their source).
 
 Bundle rules (SI units throughout):
 - mass per length: n m_wire (kg/m);
@@ -77,19 +77,44 @@ class Wire:
         return self.strands * self.modulus * math.pi * self.strand_diameter ** 4 / 64.0
 
 
-WIRES: dict[str, Wire] = {w.name: w for w in (
-    Wire("spec55-22", "AWG 22 Spec-55 (SAE AS22759/32-22, Raychem 55A0111-22): ETFE over "
-         "19-strand tin-plated copper",
-         diameter=0.050 * INCH,                     # 1.27 mm
-         linear_mass=3.2 * POUND / (1000.0 * FOOT),  # 3.2 lb/kft = 4.762 g/m
-         strands=19, strand_diameter=0.0063 * INCH,  # 19/34: 0.0063 in strands
-         modulus=COPPER_MODULUS,
-         source="outer diameter 0.050 in and 3.2 lb/1000 ft: the data-sheet values quoted in "
-                "issue 37 (1.27 mm, 4.76 g/m), not checked here against SAE AS22759/32 itself; "
-                "stranding 19/34, strands 0.0063 in: a stranded-wire chart (Stranded Wire Data "
-                "Chart, 22 AWG 19/34), AWG 34 = 0.0063 in by ASTM B258; copper E: "
-                "COPPER_MODULUS"),
-)}
+def awg_diameter(gauge: int) -> float:
+    """The diameter (m) of a solid round wire of AWG `gauge`, by the gauge's definition (ASTM
+    B258): 0.005 in x 92^((36 - n) / 39)."""
+    return 0.005 * INCH * 92.0 ** ((36 - gauge) / 39.0)
+
+
+SPEC55_SOURCE = ("TE Connectivity (Raychem) Specification Control Drawing 55A0813, revision S "
+                 "(2017-01-12), Table I: wire, radiation-crosslinked modified ETFE, normal "
+                 "weight, nickel-coated copper, 600 V (Spec 55A): stranding, finished wire "
+                 "diameter (nominal, in) and maximum weight (lb/1000 ft); strand diameter: the "
+                 "AWG definition (ASTM B258, `awg_diameter`); copper E: COPPER_MODULUS")
+"""Where every Spec-55 row comes from."""
+
+SPEC55_TABLE = (            # (AWG, strands, strand AWG, finished diameter in, lb/1000 ft)
+    (26, 19, 38, 0.040, 1.70),
+    (24, 19, 36, 0.045, 2.30),
+    (22, 19, 34, 0.050, 3.20),
+    (20, 19, 32, 0.058, 4.70),
+    (18, 19, 30, 0.070, 7.20),
+    (16, 19, 29, 0.077, 9.00),
+    (14, 19, 27, 0.094, 13.8),
+    (12, 37, 28, 0.111, 20.5),
+)
+"""SCD 55A0813's Table I, as printed (SPEC55_SOURCE). The weight is the sheet's maximum, so a
+span's mass (and its f1 by a few per cent) errs on the heavy side. No ESCC 3901 rows: its
+detail specifications were not at hand; add rows with their source."""
+
+
+def _spec55(gauge: int, strands: int, strand_gauge: int, diameter_in: float,
+            weight_lb_kft: float) -> Wire:
+    return Wire(f"spec55-{gauge}", f"AWG {gauge} Spec-55 (Raychem 55A0813-{gauge}): modified "
+                f"ETFE over {strands}/{strand_gauge} nickel-coated copper",
+                diameter=diameter_in * INCH, linear_mass=weight_lb_kft * POUND / (1000.0 * FOOT),
+                strands=strands, strand_diameter=awg_diameter(strand_gauge),
+                modulus=COPPER_MODULUS, source=SPEC55_SOURCE)
+
+
+WIRES: dict[str, Wire] = {w.name: w for w in (_spec55(*row) for row in SPEC55_TABLE)}
 
 WIRE_NAMES: tuple[str, ...] = tuple(WIRES)
 

@@ -141,7 +141,7 @@ def test_bundle_against_the_formulas(count, ring_sum, rings):
     """Mass n m; diameter (2k + 1) d; EI lower n s E pi d_s^4 / 64; upper E (n A_c^2 / (4 pi)
     + A_c sum r_i^2 / 2), r_i of a hexagonal bundle: ring 1 at d, ring 2 at 2 d and sqrt(3) d."""
     w = wires.WIRES["spec55-22"]
-    d, ds, e, s = 0.050 * INCH, 0.0063 * INCH, 1.1e11, 19
+    d, ds, e, s = 0.050 * INCH, 0.005 * 92 ** (2 / 39) * INCH, 1.1e11, 19   # AWG 34 strands
     area = s * math.pi * ds ** 2 / 4
     b = wires.bundle("spec55-22", count)
     assert w.linear_mass == pytest.approx(3.2 * LB / (1000 * FT), rel=1e-15)
