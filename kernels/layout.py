@@ -30,7 +30,9 @@ STOP_STEADY = 19    # 1.0: a point whose response is steady (or has decayed) end
                     # (metrics.steady_period); 0.0, the default: every point runs to t_end
 STEADY_PERIODS = 20  # M: the periods the steadiness test spans and the moved tail window holds
 STEADY_TOL = 21     # eps: the test's tolerance on the extrema, relative to the amplitude
-N_SETTINGS = 22
+LOADS = 22          # 1.0: the multi-mode drivers observe the span's loads (the curvatures, the
+                    # stretch and the clamp shear: sweep.models.loads); 0.0: they skip them
+N_SETTINGS = 23
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)

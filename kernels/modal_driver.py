@@ -30,7 +30,7 @@ from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
 from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, FAILURE_TIME, FIRST_STEP, MAX_STEP,
-                     METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
+                     LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
                      SPAN_MAX, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
@@ -188,9 +188,11 @@ def modal_size(n_modes):
     largest |sum phi_n''(s) q_n| at each clamp s = 0, 1 and at midspan s = 1/2 in the tail
     window (clamp_slot(N) + 0, 1, 2, m: the curvature there times l^2; `_observe_bends`),
     the largest stretch E and clamp shears |F_0|, |F_1| there (load_slot(N) + 0, 1, 2;
-    kernels.modes.span_loads; `_observe_loads`), and the shear factor kappa of the point's
-    prepared row (factor_slot(N), 1/m^2, kernels.modes.shear_factor, set by `start`)."""
-    return 3 * n_modes + 8
+    kernels.modes.span_loads; `_observe_loads`), the shear factor kappa of the point's
+    prepared row (factor_slot(N), 1/m^2, kernels.modes.shear_factor) and whether the loads
+    are observed at all (factor_slot(N) + 1: settings[LOADS], 1.0 or 0.0), both set by
+    `start`."""
+    return 3 * n_modes + 9
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -333,6 +335,8 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         if t + x * h >= t_tail:
             modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
             _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
+    if modal[factor_slot(n) + 1] == 0.0:           # the scene wants no loads
+        return
     located = _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
                              Qp, located)
     _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, located,
@@ -564,6 +568,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[clamp_slot(n) + e] = abs(c0) if t_tail <= 0.0 else 0.0
     kappa = md.shear_factor(pp, n)
     modal[factor_slot(n)] = kappa
+    modal[factor_slot(n) + 1] = settings[LOADS]
     loads = np.empty(6)
     md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, loads)
     for k in range(3):

@@ -52,7 +52,7 @@ from . import modal_driver as drv
 from . import modes as md
 from . import trajectory as tj
 from .lanes import _step_factor
-from .layout import (CONTROLLER, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
+from .layout import (CONTROLLER, LOADS, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
                      N_REALS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING)
 from .oscillator import BOUND, N_PARAMS
 from .transverse import classify_metrics
@@ -249,17 +249,19 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP, LD):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, an extremum of q_n or a
     divergence (|q_n| > bound, or q_n' not finite), or, ending in the tail window, a crest of
     the deflection at the place x* of the span's largest (its mode shapes in MOD, as
     modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV:
     the basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a
     maximum of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis'
-    coupling; MOD's shear factor): the scalar path's turn; else 0."""
+    coupling; MOD's shear factor; LD (2, 6): scratch), where the scene observes the loads
+    (settings[LOADS], in MOD): the scalar path's turn; else 0."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
+    observe = MOD[drv.factor_slot(n) + 1, 0] != 0.0     # settings[LOADS], every lane's
     for i in range(n):
         for l in range(n_run):
             v0 = Y[n + i, l]
@@ -276,6 +278,8 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP):
         crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
         tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
         EV[l] = 1.0 if crest & tail else EV[l]
+    if not observe:
+        return
     for e in range(md.N_BENDS):
         for l in range(n_run):
             r0 = 0.0
@@ -286,8 +290,8 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP):
             crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             EV[l] = 1.0 if crest & tail else EV[l]
-    a = np.empty(6)
-    b = np.empty(6)
+    a = LD[0]
+    b = LD[1]
     kappa_at = drv.factor_slot(n)
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
@@ -347,13 +351,13 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
     same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
     their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
-    theirs (modal_driver.load_slot)."""
+    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch)."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
@@ -362,6 +366,8 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP):
             q = abs(YN[i, l])
             MOD[i, l] = max(MOD[i, l], q) if take else MOD[i, l]
             MOD[n + i, l] = max(MOD[n + i, l], q) if ordinary else MOD[n + i, l]
+    if MOD[drv.factor_slot(n) + 1, 0] == 0.0:          # settings[LOADS]: none observed
+        return
     slot = drv.clamp_slot(n)
     for e in range(md.N_BENDS):
         for l in range(n_run):
@@ -371,7 +377,7 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP):
             take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
                     & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
             MOD[slot + e, l] = max(MOD[slot + e, l], abs(c)) if take else MOD[slot + e, l]
-    b = np.empty(6)
+    b = LD[0]
     loads = drv.load_slot(n)
     kappa_at = drv.factor_slot(n)
     for l in range(n_run):
@@ -539,6 +545,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     KM = np.zeros((n_stages + 1, 2, L))
     QV = np.zeros((2, L))
     MOD = np.zeros((drv.modal_size(n), L))
+    for l in range(L):
+        MOD[drv.factor_slot(n) + 1, l] = settings[LOADS]     # as modal_driver.start sets it
     PP = np.zeros((md.prepared_size(n), L))
     P1 = np.zeros(N_PARAMS * L)
     FLD = np.zeros((4, nodes, L))
@@ -556,6 +564,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     fl = np.empty(dim)
     ml = np.empty(drv.modal_size(n))
     qx = np.empty(drv.observer_scratch(n))
+    LD = np.empty((2, 6))
     Kl = np.empty((n_stages + 1, dim))
     Km = np.empty((n_stages + 1, 2))
     terms = dopri5.DENSE_TERMS if eighth else dopri5.QUARTIC_TERMS   # RK45: its quartic
@@ -611,10 +620,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
         _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS],
-                     basis[md.COUPLING])
+                     basis[md.COUPLING], LD)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING])
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING],
+                    LD)
         if base is not None:
             tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
         if n_flagged > 0:

@@ -103,8 +103,21 @@ NAMES = tuple(o.name for o in OUTPUTS)
 def wanted(params: dict[str, Any]) -> bool:
     """Whether a scene gets these outputs: clamps that hold rotation, or the uniform tension
     (pinned clamps under the paper's local membrane term report none: the paper's scenes)."""
-    rotation = params.get("clamps_rotation") or "pinned"
-    return rotation != "pinned" or params.get("membrane") is None
+    return _wanted(params.get("clamps_rotation"), params.get("membrane") is not None)
+
+
+def _wanted(rotation: str | None, membrane: bool) -> bool:
+    return (rotation or "pinned") != "pinned" or not membrane
+
+
+def observed(scene: Any, swept: bool) -> bool:
+    """Whether the multi-mode kernels observe the loads for `scene` (kernels/layout.py's
+    LOADS): where it gets these outputs (`wanted`), with its amplitude and not swept (a sine
+    sweep reports none); else they skip that work."""
+    membrane = (scene.get("model.membrane") is not None or "membrane" in scene.axes
+                or "membrane" in (scene.points or {}))
+    return (not swept and bool(scene.get("outputs.amplitude"))
+            and _wanted(scene.get("clamps.rotation"), membrane))
 
 
 def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
