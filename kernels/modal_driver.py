@@ -292,12 +292,20 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
     order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every mode's
     interpolant, scratch; qx (N), Qp (2, terms): scratch; basis: the span's (kernels.modes).
     And where the deflection at the place x* of the largest so far turns inside the step (a
-    crest there that no mode's extremum marks), the span there too."""
+    crest there that no mode's extremum marks), the span there too. The loads (`_observe_bends`,
+    `_observe_loads`) over the tail window, or over the whole run where `start` marked it so
+    (a sine sweep: their peak over the whole sweep)."""
     n = n_modes
     for i in range(n):
         modal[n + i] = max(modal[n + i], abs(y_new[i]))
         if t_new >= t_tail:
             modal[i] = max(modal[i], abs(y_new[i]))
+    located = False
+    if modal[factor_slot(n) + 1] == WHOLE_RUN:
+        located = _observe_bends(t, t_new, 0.0, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
+                                 Qp, located)
+        located = _observe_loads(t, t_new, 0.0, y, y_new, K, h, n, eighth, modal, Km, QA,
+                                 basis, located, qx)
     if t_new < t_tail:
         return
     r0 = 0.0
@@ -306,7 +314,6 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         r0 += modal[2 * n + 1 + c] * y[n + c]
         r1 += modal[2 * n + 1 + c] * y_new[n + c]
     crest = _turns(r0, r1)                           # at x*, as it stands at the step's start
-    located = False
     if crest:                                        # first: x* may move below
         for c in range(n):
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
@@ -335,12 +342,18 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         if t + x * h >= t_tail:
             modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
             _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
-    if modal[factor_slot(n) + 1] == 0.0:           # the scene wants no loads
+    if modal[factor_slot(n) + 1] != TAIL_WINDOW:    # none, or over the whole run (above)
         return
     located = _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
                              Qp, located)
     _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, located,
                    qx)
+
+
+TAIL_WINDOW = 1.0
+"""settings[LOADS] (and the accumulator's flag): the loads' peaks over the tail window."""
+WHOLE_RUN = 2.0
+"""settings[LOADS]: over the whole run (a sine sweep's peak over the sweep)."""
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -416,7 +429,8 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
     the step's end, at the tail's start inside the step and, where |L_k| rises at the step's
     start and falls at its end, at its maximum inside the step (bisection on its rate, on
     every mode's interpolant: the loads are not linear in q, so no root of one polynomial
-    gives it). qx: scratch (`observer_scratch`)."""
+    gives it). qx: scratch (`observer_scratch`). Returns whether the interpolants are now
+    computed."""
     slot = load_slot(n)
     kappa = modal[factor_slot(n)]
     rows = basis[md.CLAMPS]
@@ -432,10 +446,11 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
         modal[slot + k] = max(modal[slot + k], abs(b[2 * k]))
         need = need or (_load_rises(a, k) > 0.0 and _load_rises(b, k) <= 0.0)
     if not need:
-        return
+        return located
     if not located:
         for c in range(n):
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
+        located = True
     if inside:
         _loads_at(y, h, QA, (t_tail - t) / h, n, basis, kappa, qv, m)
         for k in range(3):
@@ -455,6 +470,7 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
         if t + lo * h >= t_tail:
             _loads_at(y, h, QA, lo, n, basis, kappa, qv, m)
             modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
+    return located
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -501,10 +517,7 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
         return state
     final = md.span_maximum(y, n, basis)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
-    reals[CLAMP_BEND] = max(modal[clamp_slot(n)], modal[clamp_slot(n) + 1])
-    reals[MID_BEND] = modal[clamp_slot(n) + 2]
-    reals[STRETCH] = modal[load_slot(n)]
-    reals[CLAMP_SHEAR] = max(modal[load_slot(n) + 1], modal[load_slot(n) + 2])
+    load_columns(modal, n, reals)
     if state != mt.DECAYED and state != mt.STEADY:
         return state
     peak = 0.0
@@ -516,6 +529,16 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
         if state == mt.STEADY and _hidden(basis, i) and modal[i] > HIDDEN_FLOOR * peak:
             return mt.HIDDEN_MODE
     return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def load_columns(modal, n, reals):
+    """reals' CLAMP_BEND, MID_BEND, STRETCH and CLAMP_SHEAR from the modes' accumulator
+    (`modal_size`): the loads' peaks, the larger of the two clamps'."""
+    reals[CLAMP_BEND] = max(modal[clamp_slot(n)], modal[clamp_slot(n) + 1])
+    reals[MID_BEND] = modal[clamp_slot(n) + 2]
+    reals[STRETCH] = modal[load_slot(n)]
+    reals[CLAMP_SHEAR] = max(modal[load_slot(n) + 1], modal[load_slot(n) + 2])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -561,18 +584,19 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[n + i] = abs(y[i])
     modal[2 * n] = md.span_maximum(y, n, basis) if t_tail <= 0.0 else 0.0
     curvature = basis[md.CLAMPS]
+    t_loads = 0.0 if settings[LOADS] == WHOLE_RUN else t_tail
     for e in range(md.N_BENDS):
         c0 = 0.0
         for i in range(n):
             c0 += curvature[e, i] * y[i]
-        modal[clamp_slot(n) + e] = abs(c0) if t_tail <= 0.0 else 0.0
+        modal[clamp_slot(n) + e] = abs(c0) if t_loads <= 0.0 else 0.0
     kappa = md.shear_factor(pp, n)
     modal[factor_slot(n)] = kappa
     modal[factor_slot(n) + 1] = settings[LOADS]
     loads = np.empty(6)
     md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, loads)
     for k in range(3):
-        modal[load_slot(n) + k] = abs(loads[2 * k]) if t_tail <= 0.0 else 0.0
+        modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     midspan = basis[md.MIDSPAN]
     for i in range(n):
         modal[2 * n + 1 + i] = midspan[i]
@@ -725,6 +749,8 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(row, md.EXCITATION, 1, settings, acc, buf, state, reals, envelope)
+        if not (state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS):
+            load_columns(ext, n_modes, reals)
     else:
         state = span_state(state, ext, y, n_modes, settings, reals, basis)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS

@@ -110,19 +110,27 @@ def _wanted(rotation: str | None, membrane: bool) -> bool:
     return (rotation or "pinned") != "pinned" or not membrane
 
 
-def observed(scene: Any, swept: bool) -> bool:
-    """Whether the multi-mode kernels observe the loads for `scene` (kernels/layout.py's
-    LOADS): where it gets these outputs (`wanted`), with its amplitude and not swept (a sine
-    sweep reports none); else they skip that work."""
+TAIL_WINDOW = 1.0
+"""kernels/layout.py's LOADS setting: the loads' peaks over the tail window
+(kernels.modal_driver.TAIL_WINDOW)."""
+WHOLE_RUN = 2.0
+"""LOADS: over the whole run, a sine sweep's (kernels.modal_driver.WHOLE_RUN)."""
+
+
+def observation(scene: Any, swept: bool) -> float:
+    """kernels/layout.py's LOADS setting for `scene`: where it gets these outputs (`wanted`)
+    and its amplitude, their peaks over the tail window (TAIL_WINDOW) or, swept, over the
+    whole sweep (WHOLE_RUN); else 0.0, and the kernels skip that work."""
     membrane = (scene.get("model.membrane") is not None or "membrane" in scene.axes
                 or "membrane" in (scene.points or {}))
-    return (not swept and bool(scene.get("outputs.amplitude"))
-            and _wanted(scene.get("clamps.rotation"), membrane))
+    if not (scene.get("outputs.amplitude") and _wanted(scene.get("clamps.rotation"), membrane)):
+        return 0.0
+    return WHOLE_RUN if swept else TAIL_WINDOW
 
 
 def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
                     coords: dict[str, xr.DataArray]) -> Peaks:
-    """The peaks of one mode from its tail amplitude (module docstring)."""
+    """The peaks of one mode from its largest |q| (module docstring)."""
     p = params
     stiffness = end_stiffness(p.get("clamps_rotation") or "pinned",
                               p.get("clamp_rotational_stiffness"), p["length"],
@@ -140,17 +148,19 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
 
 def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
                  dims: tuple[str, ...], shape: tuple[int, ...],
-                 coords: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
+                 coords: dict[str, xr.DataArray], swept: bool = False
+                 ) -> dict[str, xr.DataArray]:
     """The rows of `OUTPUTS` a scene gets (`wanted`), from a transverse run's `reals` (n,
     kernels.layout.N_REALS): the load observers' columns with several modes, the tail
-    amplitude with one."""
+    amplitude with one; `swept`: a sine sweep's, each peak over the whole sweep (one mode:
+    from its peak over the run)."""
     def column(c: int) -> xr.DataArray:
         return xr.DataArray(reals[:, c].reshape(shape), dims=dims)
     if multi_mode:
         peaks = Peaks(column(tk.CLAMP_BEND), column(tk.MID_BEND), column(tk.STRETCH),
                       column(tk.CLAMP_SHEAR))
     else:
-        peaks = _one_mode_peaks(params, column(tk.AMPLITUDE), coords)
+        peaks = _one_mode_peaks(params, column(tk.PEAK if swept else tk.AMPLITUDE), coords)
     p = params
     area = derived(p["area"], coords)
     diameter = (derived(p["diameter"], coords) if p.get("diameter") is not None
@@ -165,6 +175,8 @@ def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
         if (o.clamped and not clamped) or (o.tension and span.k_s is None):
             continue
         value = xr.DataArray(o.value(peaks, span)).transpose(*dims)
-        value.attrs = {"units": o.units, "long_name": o.long_name}
+        long_name = o.long_name.replace("over the tail window", "over the whole sweep") \
+            if swept else o.long_name
+        value.attrs = {"units": o.units, "long_name": long_name}
         out[o.name] = value
     return out

@@ -140,8 +140,7 @@ def settings_vector(scene: Scene) -> np.ndarray:
     s[tk.METHOD] = 1.0 if scene.get("solver.method") == "dop853" else 0.0
     if scene.has_base:                  # else 0.0: no forcing term compiled
         s[tk.BASE] = 1.0
-    if loads.observed(scene, excitation.is_swept(scene.values, scene.swept)):
-        s[tk.LOADS] = 1.0
+    s[tk.LOADS] = loads.observation(scene, excitation.is_swept(scene.values, scene.swept))
     if scene.get("solver.stop_when_steady"):
         s[tk.STOP_STEADY] = 1.0
         s[tk.STEADY_PERIODS] = scene.get("solver.steady_periods")
@@ -747,10 +746,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                 attrs={"units": "m", "long_name": "largest deflection anywhere on the span: "
                        "max |w(x, t)| over 0 <= x <= l and the tail window (amplitude is the "
                        "midspan's)"})
-    if (not inputs.swept and "outputs.amplitude" in inputs.wanted and loads.wanted(inputs.params)
-            and inputs.settings[tk.LOADS] != 0.0):
+    if inputs.settings[tk.LOADS] != 0.0:
         data.update(loads.load_outputs(inputs.params, result.reals, result.modal is not None,
-                                       dims, shape, coords))
+                                       dims, shape, coords, inputs.swept))
     if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                derived(coeffs["base_accel"], coords))
