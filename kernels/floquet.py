@@ -80,6 +80,17 @@ KIND_COMPLEX = 3        # unstable complex pair: c < 0, or coupled modes near W 
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def _stage_phases(dphi):
+    """cos and sin of each stage's load phase offset C_s dphi (rad), once per case."""
+    cs = np.empty(N_STAGES)
+    sn = np.empty(N_STAGES)
+    for s in range(N_STAGES):
+        cs[s] = math.cos(C[s] * dphi)
+        sn[s] = math.sin(C[s] * dphi)
+    return cs, sn
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def monodromy(c, k, kc, W, steps):
     """The monodromy matrix Phi(T), T = 2 pi / W (s), of q'' + c q' + (k + kc cos W t) q = 0
     (c in 1/s, k, kc in 1/s^2, W in rad/s) by `steps` equal steps of the DOP853 eighth-order
@@ -91,12 +102,7 @@ def monodromy(c, k, kc, W, steps):
     n = int(steps)
     dphi = 2.0 * math.pi / n                      # load phase advance a step (rad)
     h = dphi / W                                  # step (s)
-    # cos/sin of each stage's phase offset C_s dphi, once per case
-    cs = np.empty(N_STAGES)
-    sn = np.empty(N_STAGES)
-    for s in range(N_STAGES):
-        cs[s] = math.cos(C[s] * dphi)
-        sn[s] = math.sin(C[s] * dphi)
+    cs, sn = _stage_phases(dphi)
     K = np.empty((N_STAGES, 4))
     q1 = 1.0
     v1 = 0.0
@@ -302,11 +308,7 @@ def coupled_monodromy(damping, stiffness, load, W, steps, phi):
     m = int(steps)
     dphi = 2.0 * math.pi / m                      # load phase advance a step (rad)
     h = dphi / W                                  # step (s)
-    cs = np.empty(N_STAGES)
-    sn = np.empty(N_STAGES)
-    for s in range(N_STAGES):
-        cs[s] = math.cos(C[s] * dphi)
-        sn[s] = math.sin(C[s] * dphi)
+    cs, sn = _stage_phases(dphi)
     K = np.empty((N_STAGES, n2, n2))
     y = np.empty((n2, n2))
     for i in range(n2):

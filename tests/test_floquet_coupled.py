@@ -167,6 +167,19 @@ def one(ds, name: str, **at) -> float:
     return float(ds[name].sel(**at).item())
 
 
+def _check_chart(ds, M: np.ndarray, B: np.ndarray, A: np.ndarray, w: np.ndarray,
+                 ratios: list[float], loads: list[float]) -> None:
+    """The chart's multiplier (1e-8), growth rate (1e-6) and stability flag at every (ratio,
+    load) against SciPy's monodromy of the same system (`reference`), damping ratio 0.01."""
+    for r in ratios:
+        for p in loads:
+            size, rate = top(*reference(M, B, A, w, 0.01, p, r * w[0]))
+            at = {"frequency_ratio": r, "load_amplitude": p}
+            assert one(ds, "floquet_multiplier", **at) == pytest.approx(size, rel=1e-8)
+            assert one(ds, "growth_rate", **at) == pytest.approx(rate, rel=1e-6, abs=1e-7)
+            assert (one(ds, "stability", **at) != 0) == (size > 1.0)
+
+
 # --- one clamped mode ----------------------------------------------------------------------
 
 def test_one_clamped_mode_against_scipy():
@@ -176,13 +189,7 @@ def test_one_clamped_mode_against_scipy():
     ds = chart("clamped", 1, ratios, loads, zeta=0.01)
     M, B, A = matrices(g.clamped_shapes(1, LENGTH))
     w = frequencies(CLAMPED_BL[:1])
-    for r in ratios:
-        for p in loads:
-            size, rate = top(*reference(M, B, A, w, 0.01, p, r * w[0]))
-            at = {"frequency_ratio": r, "load_amplitude": p}
-            assert one(ds, "floquet_multiplier", **at) == pytest.approx(size, rel=1e-8)
-            assert one(ds, "growth_rate", **at) == pytest.approx(rate, rel=1e-6, abs=1e-7)
-            assert (one(ds, "stability", **at) != 0) == (size > 1.0)
+    _check_chart(ds, M, B, A, w, ratios, loads)
 
 
 def test_one_clamped_mode_zone_is_mathieus():
@@ -289,10 +296,4 @@ def test_elastic_ends_against_scipy():
     ratios, loads = [2.0, round(1.0 + w[2] / w[0], 3)], [6.0, 12.0]
     ds = chart("elastic", 3, ratios, loads, zeta=0.01,
                extra=f"rotational_stiffness = {stiffness * EI / LENGTH!r}")
-    for r in ratios:
-        for p in loads:
-            size, rate = top(*reference(M, B, A, w, 0.01, p, r * w[0]))
-            at = {"frequency_ratio": r, "load_amplitude": p}
-            assert one(ds, "floquet_multiplier", **at) == pytest.approx(size, rel=1e-8)
-            assert one(ds, "growth_rate", **at) == pytest.approx(rate, rel=1e-6, abs=1e-7)
-            assert (one(ds, "stability", **at) != 0) == (size > 1.0)
+    _check_chart(ds, M, B, A, w, ratios, loads)
