@@ -32,22 +32,27 @@ from typing import Any
 _DONE = False
 
 
-class _DaskOnceImported:
-    """xarray's DuckArrayModule for "dask", answering from what is imported."""
+class _OnceImported:
+    """xarray's DuckArrayModule for package `name`, answering from what is imported: its
+    array type (`_kind`) only once the package is, and the package itself on demand."""
+
+    name = ""
+
+    def _kind(self) -> Any:
+        raise NotImplementedError
 
     @property
     def type(self) -> tuple[type, ...]:
-        array = sys.modules.get("dask.array")
-        kind = getattr(array, "Array", None)
+        kind = self._kind()
         return (kind,) if isinstance(kind, type) else ()
 
     @property
     def available(self) -> bool:
-        return "dask" in sys.modules or importlib.util.find_spec("dask") is not None
+        return self.name in sys.modules or importlib.util.find_spec(self.name) is not None
 
     @property
     def module(self) -> Any:
-        return importlib.import_module("dask") if self.available else None
+        return importlib.import_module(self.name) if self.available else None
 
     @property
     def version(self) -> Any:
@@ -56,27 +61,22 @@ class _DaskOnceImported:
         return Version(module.__version__) if module is not None else Version("0.0.0")
 
 
-class _PintOnceImported:
-    """xarray's DuckArrayModule for "pint", answering from what is imported."""
+class _DaskOnceImported(_OnceImported):
+    """xarray's DuckArrayModule for "dask": dask.array.Array once dask.array is imported."""
 
-    @property
-    def type(self) -> tuple[type, ...]:
-        kind = getattr(sys.modules.get("pint"), "Quantity", None)
-        return (kind,) if isinstance(kind, type) else ()
+    name = "dask"
 
-    @property
-    def available(self) -> bool:
-        return "pint" in sys.modules or importlib.util.find_spec("pint") is not None
+    def _kind(self) -> Any:
+        return getattr(sys.modules.get("dask.array"), "Array", None)
 
-    @property
-    def module(self) -> Any:
-        return importlib.import_module("pint") if self.available else None
 
-    @property
-    def version(self) -> Any:
-        from packaging.version import Version
-        module = self.module
-        return Version(module.__version__) if module is not None else Version("0.0.0")
+class _PintOnceImported(_OnceImported):
+    """xarray's DuckArrayModule for "pint": pint.Quantity once pint is imported."""
+
+    name = "pint"
+
+    def _kind(self) -> Any:
+        return getattr(sys.modules.get("pint"), "Quantity", None)
 
 
 def _defer_pint() -> None:
