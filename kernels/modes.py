@@ -9,8 +9,8 @@ sin(n pi x / l) are the first), projected on every phi_m and divided by rho A in
     q_m'' = -2 zeta w_m q_m' - w_m^2 q_m - N_m(q, t) - Gamma_m a_b(t)
 
 N_m the projection of the axial-load and nonlinear terms: the bending terms either from the
-span's energy (a row's BENDING 1, below) or Eq.17's as the paper prints them (0). In the dimensionless fields of
-xi = pi x / l in [0, pi] (k = pi / l)
+span's energy (a row's BENDING 1, below) or Eq.17's as the paper prints them (0). In the
+dimensionless fields of xi = pi x / l in [0, pi] (k = pi / l)
 
     a = sum q_n dphi_n/dxi,  b = sum q_n d2phi_n/dxi2,  c = ... d3,  d = ... d4
 
