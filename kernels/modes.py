@@ -8,8 +8,9 @@ sin(n pi x / l) are the first), projected on every phi_m and divided by rho A in
 
     q_m'' = -2 zeta w_m q_m' - w_m^2 q_m - N_m(q, t) - Gamma_m a_b(t)
 
-N_m the projection of Eq.17's axial-load and nonlinear terms. In the dimensionless fields of
-xi = pi x / l in [0, pi] (k = pi / l)
+N_m the projection of the axial-load and nonlinear terms: the bending terms either from the
+span's energy (a row's BENDING 1, below) or Eq.17's as the paper prints them (0). In the
+dimensionless fields of xi = pi x / l in [0, pi] (k = pi / l)
 
     a = sum q_n dphi_n/dxi,  b = sum q_n d2phi_n/dxi2,  c = ... d3,  d = ... d4
 
@@ -29,6 +30,19 @@ A_ij = int phi_i' phi_j' for other shapes with no code of its own. The cost grow
 (fields and projection), where precomputed coupling tensors would grow as N^6 (the quintic's).
 With N = 1 it reproduces the one-mode coefficients K3 and K5 of docs/model.md sec. 2
 (tests/test_modes.py).
+
+Eq.17's bending terms are not the gradient of an energy with several modes (their Jacobian
+is not symmetric: an undamped span's energy wanders). The span's bending energy (EI / 2) int
+kappa^2 dx, kappa = w_xx / (1 + w_x^2)^(3/2), is (EI / 2) int w_xx^2 (1 - 3 w_x^2 + 6 w_x^4)
+dx to quintic order; its generalised force on mode m in the weak form (no integration by
+parts, so right for every end condition, rotational springs included) has the nonlinear part,
+per unit rho A, in the fields above,
+
+    int [a^2 b (-3 beta_b + 6 beta_q a^2) phi_m'' + a b^2 (-3 beta_b + 12 beta_q a^2) phi_m'],
+
+(phi_m', phi_m'' in xi), summed with the basis' weights on the shapes' slopes and curvatures
+(T rows 5 and 6); the stretching and the axial load stay as above, without Eq.17's bending
+terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as before.
 
 `basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives: (T, the
 shapes' derivatives at the nodes and the projection weights; stations, the shapes at stations
@@ -63,7 +77,8 @@ V_SCALE = 9         # its velocity scale                                        
 PARTICIPATION = 10  # 4 / pi (0 without base excitation); mode n: times its basis ratio
 LOAD_PHASE = 11     # phi_W: P(t) = P0 cos(W t + phi_W)                                    (rad)
 TENSION = 12        # k_s k^4 l / (2 rho A): the uniform stretching tension's factor  (1/(s^2 m^2))
-EXCITATION = 13     # the base excitation block (kernels.excitation): a_b(t), fixed or swept
+BENDING = 13        # the bending terms: 1 from the span's energy (weak form), 0 Eq.17's    (1)
+EXCITATION = 14     # the base excitation block (kernels.excitation): a_b(t), fixed or swept
 BASE_ACCEL = EXCITATION + ex.ACCEL   # A, base acceleration amplitude                     (m/s^2)
 BASE_OMEGA = EXCITATION + ex.OMEGA   # w_b, base angular frequency (a sweep's start)      (rad/s)
 BASE_PHASE = EXCITATION + ex.PHASE   # phi_b (a stepped sweep's carried phase)            (rad)
@@ -71,11 +86,11 @@ N_FIXED = EXCITATION + ex.SIZE       # then q_n(0) (m) for n = 1..N, then q_n'(0
 
 FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", "omega",
                "bound", "q_scale", "v_scale", "participation", "load_phase",
-               "tension") + ex.NAMES
+               "tension", "bending") + ex.NAMES
 
 
 # The items of the `basis` tuple every modal kernel takes (module docstring).
-TABLES = 0          # (5, N, nodes): the shapes' derivatives at the nodes, projection weights
+TABLES = 0          # (7, N, nodes): the shapes' derivatives at the nodes, projection weights
 STATIONS = 1        # (M + 1, N): the shapes at stations along the span
 MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
@@ -170,7 +185,8 @@ S_LOAD_PHASE = 5
 S_LOAD_MEAN = 6     # the axial load's linear term P(t) k^2 / rho A: constant part    (1/s^2)
 S_LOAD_COS = 7      # and the part times cos(W t + phi_W)                             (1/s^2)
 S_TENSION = 8       # the uniform tension's factor (TENSION)                          (1/(s^2 m^2))
-S_EXCITATION = 9    # the excitation block, copied from the raw row
+S_ENERGY = 9        # 1: the bending terms from the span's energy, 0: Eq.17's (BENDING)     (1)
+S_EXCITATION = 10   # the excitation block, copied from the raw row
 S_BASE_ACCEL = S_EXCITATION + ex.ACCEL
 S_BASE_OMEGA = S_EXCITATION + ex.OMEGA
 S_BASE_PHASE = S_EXCITATION + ex.PHASE
@@ -300,6 +316,7 @@ def prepare(row, n_modes, pp, ratios):
     pp[s + S_LOAD_MEAN] = row[LOAD_MEAN]
     pp[s + S_LOAD_COS] = row[LOAD_COS]
     pp[s + S_TENSION] = row[TENSION]
+    pp[s + S_ENERGY] = 1.0 if row[BENDING] != 0.0 else 0.0
     for c in range(ex.SIZE):
         pp[s + S_EXCITATION + c] = row[EXCITATION + c]
 
@@ -316,6 +333,34 @@ _CONTRACT = {"contract"}
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
+    """The nonlinear forces at the nodes (per unit rho A, in the fields' units) of lanes
+    whose bending terms may come from the span's energy (S_ENERGY 1) or Eq.17 (0), from the
+    fields FLD[0..3] = (a, b, c, d) at each node: FLD[0] = what is projected on phi_m (the
+    stretching, the axial load and, for Eq.17's lanes, Eq.17's bending terms), FLD[1] and
+    FLD[2] = the energy's bending force's parts projected on dphi_m/dxi and d2phi_m/dxi2
+    (module docstring: a b^2 (-3 beta_b + 12 beta_q a^2) and a^2 b (-3 beta_b + 6 beta_q
+    a^2); 0 for Eq.17's lanes). SC[0], SC[1]: the linear and membrane factors of b."""
+    for j in range(nodes):
+        for l in range(n_run):
+            a = FLD[0, j, l]
+            b = FLD[1, j, l]
+            c = FLD[2, j, l]
+            d = FLD[3, j, l]
+            a2 = a * a
+            b2 = b * b
+            e = PP[sc + S_ENERGY, l]
+            beta_b = PP[sc + S_BETA_B, l]
+            beta_q = PP[sc + S_BETA_Q, l]
+            FLD[0, j, l] = ((1.0 - e) * (beta_b * (-3.0 * b2 * b - 11.0 * a * b * c
+                                                    - 3.0 * a2 * d)
+                                         + 10.5 * beta_q * a2 * b2 * b)
+                            + (SC[0, l] - SC[1, l] * a2) * b)
+            FLD[1, j, l] = e * a * b2 * (12.0 * beta_q * a2 - 3.0 * beta_b)
+            FLD[2, j, l] = e * a2 * b * (6.0 * beta_q * a2 - 3.0 * beta_b)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
@@ -325,7 +370,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     sin) or True (vecmath's vectorisable ones); base: None (no base excitation term) or True;
     CP: the basis' coupling A_ij / pi^2 (basis[COUPLING]), for the uniform stretching tension
     N = k_s e, e = (k^2 l / 2) sum CP_ij q_i q_j, which adds -N k^2 b / rho A to F (a lane whose
-    TENSION is 0 has none; when no lane has one it is not computed).
+    TENSION is 0 has none; when no lane has one it is not computed). A lane whose S_ENERGY is
+    1 takes its bending terms from the span's energy (module docstring), projected on the
+    shapes' slopes and curvatures too (`_energy_forces`).
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode
     there: the nonlinear terms and the axial load's linear term P(t) w_xx (for pinned sines a
@@ -391,19 +438,25 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                 FLD[1, j, l] += t1 * q
                 FLD[2, j, l] += t2 * q
                 FLD[3, j, l] += t3 * q
-    for j in range(nodes):
-        for l in range(n_run):
-            a = FLD[0, j, l]
-            b = FLD[1, j, l]
-            c = FLD[2, j, l]
-            d = FLD[3, j, l]
-            a2 = a * a
-            b2 = b * b
-            # the membrane and the axial load's linear term share their factor b
-            FLD[0, j, l] = (PP[sc + S_BETA_B, l] * (-3.0 * b2 * b - 11.0 * a * b * c
-                                                     - 3.0 * a2 * d)
-                            + (SC[0, l] - SC[1, l] * a2) * b
-                            + 10.5 * PP[sc + S_BETA_Q, l] * a2 * b2 * b)
+    energy = False
+    for l in range(n_run):
+        energy = energy or PP[sc + S_ENERGY, l] != 0.0
+    if energy:
+        _energy_forces(PP, sc, FLD, SC, nodes, n_run)
+    else:
+        for j in range(nodes):
+            for l in range(n_run):
+                a = FLD[0, j, l]
+                b = FLD[1, j, l]
+                c = FLD[2, j, l]
+                d = FLD[3, j, l]
+                a2 = a * a
+                b2 = b * b
+                # the membrane and the axial load's linear term share their factor b
+                FLD[0, j, l] = (PP[sc + S_BETA_B, l] * (-3.0 * b2 * b - 11.0 * a * b * c
+                                                         - 3.0 * a2 * d)
+                                + (SC[0, l] - SC[1, l] * a2) * b
+                                + 10.5 * PP[sc + S_BETA_Q, l] * a2 * b2 * b)
     for i in range(n):
         w = T[4, i, 0]
         for l in range(n_run):
@@ -412,6 +465,12 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             w = T[4, i, j]
             for l in range(n_run):
                 SC[3, l] += w * FLD[0, j, l]
+        if energy:                      # the weak form's parts, on phi_m' and phi_m''
+            for j in range(nodes):
+                w1 = T[5, i, j]
+                w2 = T[6, i, j]
+                for l in range(n_run):
+                    SC[3, l] += w1 * FLD[1, j, l] + w2 * FLD[2, j, l]
         for l in range(n_run):
             acc = (PP[P_STIFF * n + i, l] * X[i, l] + PP[P_DAMPING * n + i, l] * X[n + i, l]
                    - SC[3, l])

@@ -290,16 +290,29 @@ def sine_shapes(n_modes: int, length: float) -> list[Callable[[np.ndarray, int],
     return [make(n) for n in range(1, n_modes + 1)]
 
 
+def bending_energy(ei: float, w1: np.ndarray, w2: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """U_b = (EI / 2) int w_xx^2 (1 - 3 w_x^2 + 6 w_x^4) dx (J) from the slope w1 and curvature
+    w2 (1/m) at quadrature nodes with `weights` (m), the last axis: the bending energy of the
+    exact curvature kappa = w_xx / (1 + w_x^2)^(3/2), kappa^2 = w_xx^2 (1 + w_x^2)^-3, to the
+    quintic order of its forces (the series' next term, -10 w_x^6, is left out)."""
+    return 0.5 * ei * (w2 ** 2 * (1.0 - 3.0 * w1 ** 2 + 6.0 * w1 ** 4)) @ weights
+
+
 def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration: float = 0.0,
                base_frequency: float = 0.0, nodes: int = 96,
                tension_stiffness: float | None = None) -> Callable:
     """SciPy right-hand side of the Galerkin equations on the span's own linear modes `shapes`
     (clamped_shapes' or sine_shapes' callables; omegas: their natural angular frequencies,
-    rad/s): Eq.17's residual R (module docstring, no end load) at Gauss-Legendre nodes,
-    projected on each mode and divided by rho A int phi_n^2; modal damping 2 zeta w_n; base
-    participation int phi_n / int phi_n^2; a_b = A sin(2 pi f t). tension_stiffness k_s (N/m):
-    the stretching is the uniform tension N = k_s e, e = (1/2) int w_x^2 dx (R gains - N w_xx)
-    instead of the local membrane term (cable.membrane is then not used)."""
+    rad/s), projected on each mode by Gauss-Legendre and divided by rho A int phi_n^2; modal
+    damping 2 zeta w_n; base participation int phi_n / int phi_n^2; a_b = A sin(2 pi f t).
+
+    tension_stiffness None: Eq.17's residual R (module docstring, no end load), the paper's
+    local membrane term and bending terms, projected on phi_m. tension_stiffness k_s (N/m): the
+    stretching is the uniform tension N = k_s e, e = (1/2) int w_x^2 dx (R gains - N w_xx, on
+    phi_m), and the bending nonlinearity is the weak form of `bending_energy`'s U_b, the
+    engine's rule for a span without model.membrane: Q_m = EI int [w_xx (-3 w_x^2 + 6 w_x^4)
+    phi_m'' + w_xx^2 (-3 w_x + 12 w_x^3) phi_m'] dx (its linear part EI w_xxxx stays on
+    phi_m: for the span's own modes that is the stiffness, springs at the ends included)."""
     n_modes = len(shapes)
     l = cable.length
     g, weights = np.polynomial.legendre.leggauss(nodes)
@@ -307,7 +320,7 @@ def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration
     d = [np.array([phi(x, k) for phi in shapes]) for k in range(5)]     # (N, M) each
     mass = (d[0] ** 2) @ weights
     gamma = (d[0] @ weights) / mass
-    project = (d[0] * weights).T / (cable.density * cable.area * mass)   # (M, N)
+    project = [(d[k] * weights).T / (cable.density * cable.area * mass) for k in range(3)]
     ei, ea = cable.youngs_modulus * cable.inertia, cable.youngs_modulus * cable.area
     damping = 2.0 * cable.damping_ratio * np.asarray(omegas)
     omega_b = 2.0 * math.pi * base_frequency
@@ -316,11 +329,14 @@ def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration
         q, v = y[:n_modes], y[n_modes:]
         w1, w2, w3, w4 = (q @ d[k] for k in range(1, 5))
         if tension_stiffness is None:
-            stretch = -4.0 * cable.membrane * ea * w2 * w1 ** 2
+            r = (ei * w4 - 3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1
+                 - 4.0 * cable.membrane * ea * w2 * w1 ** 2
+                 - 3.0 * ei * w4 * w1 ** 2 + 10.5 * ei * w2 ** 3 * w1 ** 2)
+            force = r @ project[0]
         else:
-            stretch = -tension_stiffness * 0.5 * (w1 ** 2 @ weights) * w2
-        r = (ei * w4 - 3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1 + stretch
-             - 3.0 * ei * w4 * w1 ** 2 + 10.5 * ei * w2 ** 3 * w1 ** 2)
-        a = -damping * v - r @ project - gamma * base_acceleration * math.sin(omega_b * t)
+            r = ei * w4 - tension_stiffness * 0.5 * (w1 ** 2 @ weights) * w2
+            force = (r @ project[0] + ei * w2 ** 2 * (-3.0 * w1 + 12.0 * w1 ** 3) @ project[1]
+                     + ei * w2 * (-3.0 * w1 ** 2 + 6.0 * w1 ** 4) @ project[2])
+        a = -damping * v - force - gamma * base_acceleration * math.sin(omega_b * t)
         return np.concatenate((v, a))
     return f

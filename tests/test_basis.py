@@ -32,7 +32,9 @@ def test_pinned_sines_are_the_closed_forms():
     xi = np.arange(1, m) * math.pi / m
     k = np.arange(1, n + 1)[:, None]
     expected = [k * np.cos(k * xi), -k ** 2 * np.sin(k * xi), -k ** 3 * np.cos(k * xi),
-                k ** 4 * np.sin(k * xi), 2.0 / m * np.sin(k * xi)]
+                k ** 4 * np.sin(k * xi), 2.0 / m * np.sin(k * xi),
+                2.0 / m * k * np.cos(k * xi), -2.0 / m * k ** 2 * np.sin(k * xi)]
+    assert b.tables.shape[0] == len(expected)
     for got, want in zip(b.tables, expected):
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
     np.testing.assert_array_equal(b.midspan, [1.0, 0.0, -1.0, 0.0])      # exact zeros

@@ -201,3 +201,42 @@ t_end = 2.0
     assert inside not in (km.DIVERGED, km.STEP_TOO_SMALL, km.MAX_STEPS)
     assert float(ds["peak_amplitude"][0]) == pytest.approx(0.98 * qb, rel=1e-6)
     assert outside == km.DIVERGED and 0 < float(ds["failure_time"][1]) < 2.0
+
+
+@pytest.mark.parametrize("rotation", ["pinned", "clamped", 10.0])
+def test_one_mode_bending_terms_are_the_gradient_of_the_bending_energy(rotation):
+    """One mode, no model.membrane (the bending terms from the span's energy, issue 35), the
+    clamps sliding (no stretching): the cubic and quintic coefficients g, h of q'' + w1^2 q +
+    g q^3 + h q^5 are those of the bending energy U_b(q) = (EI/2) int w''^2 (1 - 3 w'^2 +
+    6 w'^4) dx of w = q phi, phi the span's first mode scaled to max |phi| = 1 (SciPy's own
+    quadrature on sweep.models.basis' shape: U_b is a polynomial a2 q^2 + a4 q^4 + a6 q^6, its
+    a4 and a6 solved from three amplitudes; then g = 4 a4 / m, h = 6 a6 / m, m = rho A
+    int phi^2 dx). Pinned ends: -(3/2) and +(9/4) (EI/rho A) k^6, k^8, not Eq.17's -5/4 and
+    -21/16."""
+    from sweep.models import basis
+    E, rho, A, I, l = 1.1e11, 8900.0, 6e-6, 2.865e-12, 0.6
+    k_t = None if isinstance(rotation, str) else rotation * E * I / l
+    p = dict(youngs_modulus=E, density=rho, area=A, inertia=I, length=l, load_amplitude=0.0,
+             clamps_rotation=rotation if k_t is None else "elastic",
+             clamp_rotational_stiffness=k_t, clamp_axial_stiffness=0.0)
+    c = models.consistent(p)
+    shape = basis.span_basis(basis.end_stiffness(p["clamps_rotation"], k_t, l, E * I), 1).shapes
+
+    def d(x, n):
+        return basis.shape_values(shape, np.array([x / l]), n)[0, 0] / l ** n
+
+    def energy(q):
+        return quad(lambda x: 0.5 * E * I * (q * d(x, 2)) ** 2 * (
+            1.0 - 3.0 * (q * d(x, 1)) ** 2 + 6.0 * (q * d(x, 1)) ** 4), 0, l,
+            epsabs=0, epsrel=1e-13, limit=200)[0]
+
+    q = np.array([0.01, 0.02, 0.03])
+    a2, a4, a6 = np.linalg.solve(np.stack([q ** 2, q ** 4, q ** 6], axis=1),
+                                 [energy(x) for x in q])
+    m = rho * A * quad(lambda x: d(x, 0) ** 2, 0, l, epsabs=0, epsrel=1e-13)[0]
+    assert c["g"] == pytest.approx(4.0 * a4 / m, rel=1e-7)
+    assert c["h"] == pytest.approx(6.0 * a6 / m, rel=1e-6)
+    if rotation == "pinned":
+        k = np.pi / l
+        assert c["g"] == pytest.approx(-1.5 * E * I / (rho * A) * k ** 6, rel=1e-12)
+        assert c["h"] == pytest.approx(2.25 * E * I / (rho * A) * k ** 8, rel=1e-12)

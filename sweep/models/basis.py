@@ -46,10 +46,12 @@ class Basis:
 
     shapes: (N, 5) rows (beta, A, B, C, D) of the beam-function form; frequency_ratio (N,):
     w_n / w_p; participation_ratio (N,): Gamma_n / (4 / pi) (Gamma_n = int phi_n /
-    int phi_n^2, uniform base motion); tables (5, N, J): at the J quadrature nodes s_j, phi_n' / pi,
+    int phi_n^2, uniform base motion); tables (7, N, J): at the J quadrature nodes s_j, phi_n' / pi,
     phi_n'' / pi^2, phi_n''' / pi^3, phi_n'''' / pi^4 (derivatives in s, so these are the
-    derivatives in xi = pi s, the kernel's fields' units) and the projection weights
-    w_j phi_n(s_j) / int phi_n^2; midspan (N,): phi_n(1/2); stations ((M + 1), N): phi_n at
+    derivatives in xi = pi s, the kernel's fields' units), the projection weights
+    w_j phi_n(s_j) / int phi_n^2, and the weak form's on the shapes' slopes and curvatures,
+    w_j (phi_n'(s_j) / pi) / int phi_n^2 and w_j (phi_n''(s_j) / pi^2) / int phi_n^2 (the
+    bending force from the span's energy, kernels/modes.py); midspan (N,): phi_n(1/2); stations ((M + 1), N): phi_n at
     s_k = k / M, M = SPAN_STATIONS_PER_MODE N; coupling (N, N): A_ij / pi^2, A_ij = int phi_i'
     phi_j' ds (the span's elongation is (l k^2 / 2) q^T coupling q, k = pi / l: the uniform
     stretching tension's); clamps (7, N): what the load observers watch per unit q_n
@@ -94,12 +96,14 @@ def pinned_sines(n_modes: int) -> Basis:
     forms throughout. w_n = n^2 w_p; Gamma_n / (4 / pi) = 1 / n for odd n and 0 for even n;
     the quadrature is the trapezoidal rule on M = 3N + 1 equal intervals (interior nodes
     only: the integrands vanish at the ends), exact for the trigonometric polynomials of
-    degree <= 6N the cubic and quintic terms make; phi_n(1/2) = 1, 0, -1, 0, ... exactly."""
+    degree <= 6N the cubic and quintic terms make (the energy's bending terms' projections on
+    phi_n' and phi_n'' too: cosine polynomials of degree <= 6N that vanish at the ends);
+    phi_n(1/2) = 1, 0, -1, 0, ... exactly."""
     if n_modes < 1:
         raise ValueError(f"n_modes = {n_modes}: at least one mode")
     n = n_modes
     m = 3 * n + 1
-    tables = np.empty((5, n, m - 1))
+    tables = np.empty((7, n, m - 1))
     for i in range(n):
         k = i + 1.0
         for j in range(m - 1):
@@ -111,6 +115,8 @@ def pinned_sines(n_modes: int) -> Basis:
             tables[2, i, j] = -k * k * k * cn
             tables[3, i, j] = k * k * k * k * sn
             tables[4, i, j] = 2.0 / m * sn
+            tables[5, i, j] = 2.0 / m * k * cn
+            tables[6, i, j] = -2.0 / m * k * k * sn
     orders = np.arange(1, n + 1)
     midspan = np.zeros(n)
     midspan[0::2] = [1.0 if (i // 2) % 2 == 0 else -1.0 for i in range(0, n, 2)]
@@ -183,10 +189,11 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     phi = shape_values(shapes, s)
     mass = phi ** 2 @ w                                   # int phi_n^2 ds
     gamma = (phi @ w) / mass                              # int phi_n / int phi_n^2
-    tables = np.empty((5, n, nodes))
+    tables = np.empty((7, n, nodes))
     for order in range(1, 5):
         tables[order - 1] = shape_values(shapes, s, order) / math.pi ** order
     tables[4] = w[None, :] * phi / mass[:, None]
+    tables[5:7] = w[None, None, :] * tables[0:2] / mass[None, :, None]
     stations_m = SPAN_STATIONS_PER_MODE * n
     stations = shape_values(shapes, np.arange(stations_m + 1) / stations_m).T
     midspan = shape_values(shapes, np.array([0.5]))[:, 0]
@@ -329,7 +336,10 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     one-mode equation of the span (docs/model.md secs. 2 and 10): beta = b_1 l; load =
     int phi'' phi; stretch = int phi'' phi'^2 phi (the membrane and the load's cubic term);
     curvature = int (3 phi''^3 + 11 phi'' phi''' phi' + 3 phi'''' phi'^2) phi (the cubic
-    curvature terms); quintic = int phi''^3 phi'^2 phi; gamma = int phi / int phi^2 (base
+    curvature terms); quintic = int phi''^3 phi'^2 phi (Eq.17's); bend_cubic = 6 int phi'^2
+    phi''^2 and bend_quintic = 18 int phi'^4 phi''^2 (the same terms from the span's bending
+    energy (EI / 2) int w''^2 (1 - 3 w'^2 + 6 w'^4): its force on one mode is EI (-bend_cubic
+    q^3 + bend_quintic q^5) int phi^2 / l^6, ^8); gamma = int phi / int phi^2 (base
     participation); slope = max |phi'| (the mode's largest slope per unit amplitude);
     clamp_curvature = |phi''(0)| (the curvature at the clamps per unit amplitude);
     midspan_curvature = |phi''(1/2)|; clamp_shear = |phi'''(0)| and clamp_slope = |phi'(0)|
@@ -337,7 +347,7 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     elongation is slope_square q^2 / (2 l)); mass =
     int phi^2 itself (not divided). By
     Gauss-Legendre on 4 x the basis' own nodes; pinned sines give -pi^2, -pi^4 / 4, 5 pi^6 /
-    4, -pi^8 / 8, 4 / pi and pi."""
+    4, -pi^8 / 8, 3 pi^6 / 2, 9 pi^8 / 4, 4 / pi and pi."""
     row = basis.shapes[:1]
     x, w = np.polynomial.legendre.leggauss(4 * quadrature_nodes(basis.n_modes))
     s, w = (x + 1.0) / 2.0, w / 2.0
@@ -353,6 +363,8 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
         "curvature": float((3.0 * d[2] ** 3 + 11.0 * d[2] * d[3] * d[1]
                             + 3.0 * d[4] * d[1] ** 2) * d[0] @ w / mass),
         "quintic": float(d[2] ** 3 * d[1] ** 2 * d[0] @ w / mass),
+        "bend_cubic": float(6.0 * d[1] ** 2 * d[2] ** 2 @ w / mass),
+        "bend_quintic": float(18.0 * d[1] ** 4 * d[2] ** 2 @ w / mass),
         "gamma": float(d[0] @ w / mass),
         "slope": float(np.abs(shape_values(row, fine, 1)).max()),
         "clamp_curvature": float(abs(bend_0)),

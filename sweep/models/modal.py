@@ -11,8 +11,10 @@ Every function here works element-wise on floats, NumPy arrays or xarray DataArr
 derived quantities keep exactly the dimensions of the axes they depend on.
 
 Two coefficient sets (docs/model.md sec. 2):
-- "consistent": the Galerkin projection of the paper's Eq.17 on sin(pi x / l), re-derived;
-  divided by rho A l / 2, so m = 1 and q is the midspan deflection in metres.
+- "consistent": the Galerkin projection on sin(pi x / l) (the span's own first mode where the
+  clamps are not pins), divided by rho A l / 2, so m = 1 and q is the midspan deflection in
+  metres; the bending terms from the span's energy, or the paper's Eq.17 re-derived where
+  the scene gives the paper's local membrane term (`energy_bending`).
 - "paper": Eq.32 exactly as printed (Table 1 cable baked in), including its errors: the
   parametric (cos) terms 10x too small, the frequency 1.86 n pi rad/s with the 1/l^4 of w0
   dropped, and a quintic of the wrong sign. `paper_parametric = "corrected"` multiplies the two
@@ -85,17 +87,29 @@ def consistent(p: Mapping[str, Any], ends: Mapping[str, Any] | None = None) -> d
     alpha, k_s = stretching(p)
     membrane = (alpha * p["youngs_modulus"] / p["density"] * power(k, 4) if k_s is None
                 else k_s * np.pi ** 4 / (4.0 * rho_a * power(p["length"], 3)))
+    # the bending terms: the span's energy's 3/2 and 9/4, or Eq.17's 5/4 and -21/16
+    cubic, quintic = (1.5, 2.25) if energy_bending(p) else (1.25, -21.0 / 16.0)
     return {
         "mass": 1.0,
         "k": w1_sq,
-        "g": membrane - 1.25 * ei / rho_a * power(k, 6),
-        "h": -21.0 / 16.0 * ei / rho_a * power(k, 8),
+        "g": membrane - cubic * ei / rho_a * power(k, 6),
+        "h": quintic * ei / rho_a * power(k, 8),
         "k_load": -load * k ** 2 / rho_a,
         "g_load": load * power(k, 4) / (2.0 * rho_a),
         "omega_1": w1,
         "buckling_load": ei * k ** 2,
         "omega_ref": w1,
     }
+
+
+def energy_bending(p: Mapping[str, Any]) -> bool:
+    """Whether p's bending nonlinearity comes from the span's energy (docs/model.md sec. 7):
+    the weak form of (EI / 2) int w_xx^2 (1 - 3 w_x^2 + 6 w_x^4) dx, the exact curvature's
+    energy to quintic order, whose forces are its gradient (an undamped, unforced span keeps
+    its energy). Where the scene reproduces the paper (coefficients = "paper", or its local
+    membrane term model.membrane: Eq.17 projected as printed) the bending terms are Eq.17's
+    instead, which with several modes are not the gradient of any energy."""
+    return p.get("coefficients", "consistent") != "paper" and p.get("membrane") is None
 
 
 def stretching(p: Mapping[str, Any]) -> tuple[Any, Any]:
@@ -137,7 +151,8 @@ def _consistent_ends(p: Mapping[str, Any], ends: Mapping[str, Any]) -> dict[str,
     projection of Eq.17 on the span's own first mode phi(x / l), from its integrals `ends`
     (sweep.models.basis.one_mode_integrals, each a number or an array over the points, plus
     "buckling": Pcr l^2 / EI, basis.buckling_factor); q is the deflection at the mode's
-    largest, its midspan. Pinned sines' integrals give `consistent`'s closed forms."""
+    largest, its midspan; the bending terms from the span's energy or Eq.17's
+    (`energy_bending`). Pinned sines' integrals give `consistent`'s closed forms."""
     l = p["length"]
     ei = p["youngs_modulus"] * p["inertia"]
     rho_a = p["density"] * p["area"]
@@ -147,11 +162,13 @@ def _consistent_ends(p: Mapping[str, Any], ends: Mapping[str, Any]) -> dict[str,
     alpha, k_s = stretching(p)
     membrane = (-4.0 * alpha * p["youngs_modulus"] / p["density"] * stretch if k_s is None
                 else k_s * ends["load"] ** 2 * ends["mass"] / (2.0 * rho_a * power(l, 3)))
+    cubic, quintic = ((ends["bend_cubic"], ends["bend_quintic"]) if energy_bending(p)
+                      else (ends["curvature"], 10.5 * ends["quintic"]))
     return {
         "mass": 1.0,
         "k": w1_sq,
-        "g": membrane - ei / rho_a * ends["curvature"] / power(l, 6),
-        "h": 10.5 * ei / rho_a * ends["quintic"] / power(l, 8),
+        "g": membrane - ei / rho_a * cubic / power(l, 6),
+        "h": ei / rho_a * quintic / power(l, 8),
         "k_load": load * ends["load"] / (rho_a * l * l),
         "g_load": -2.0 * load / rho_a * stretch,
         "omega_1": np.sqrt(w1_sq),
@@ -400,6 +417,7 @@ def modes_columns(p: Mapping[str, Any], one_mode: Mapping[str, Any], n_modes: in
         "load_cos": load if harmonic else 0.0,
         "membrane": 4.0 * alpha * p["youngs_modulus"] / p["density"] * power(k, 4),
         "tension": 0.0 if k_s is None else k_s * power(k, 4) * p["length"] / (2.0 * rho_a),
+        "bending": 1.0 if energy_bending(p) else 0.0,
         "k_sq": k ** 2,
         "omega": one_mode["omega"],
         "bound": one_mode["bound"],

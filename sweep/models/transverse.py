@@ -779,8 +779,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
 
 
 def span_attrs(params: dict[str, Any]) -> dict[str, str]:
-    """What the clamps hold and how the span stretches, in words (global attributes `clamps`
-    and `stretching`; docs/model.md sec. 10), from the parameters by axis name."""
+    """What the clamps hold, how the span stretches and whose bending terms it takes, in
+    words (global attributes `clamps`, `stretching` and `bending`; docs/model.md secs. 7 and
+    10), from the parameters by axis name."""
     def value(name: str, units: str) -> str:
         v = params.get(name)
         return f"over the axis {name}" if hasattr(v, "dims") else f"{float(v):g} {units}"
@@ -791,9 +792,13 @@ def span_attrs(params: dict[str, Any]) -> dict[str, str]:
     if clamps is None:
         clamps = ("elastic: rotational springs at the clamps, k_t "
                   f"{value('clamp_rotational_stiffness', 'N m/rad')} each (K = k_t l / EI)")
+    bending = ("from the span's bending energy (EI/2) int w_xx^2 (1 - 3 w_x^2 + 6 w_x^4) dx, "
+               "its weak form" if modal.energy_bending(params) else
+               "the paper's Eq.17 terms as printed (not the gradient of an energy with several "
+               "modes)")
     if params.get("coefficients") == "paper":
         return {"clamps": clamps, "stretching": "the paper's Eq.32 as printed (its numbers hold "
-                "the local membrane term with alpha = 3/8)"}
+                "the local membrane term with alpha = 3/8)", "bending": bending}
     alpha, k_s = modal.stretching(params)
     if k_s is None:
         stretching = (f"the paper's local membrane term 4 alpha EA w_xx w_x^2, alpha "
@@ -805,4 +810,4 @@ def span_attrs(params: dict[str, Any]) -> dict[str, str]:
         stretching = ("the uniform tension N = k_s e of the span's elongation e = (1/2) int "
                       "w_x^2 dx, 1 / k_s = l / EA + 2 / k_a, clamps of axial stiffness k_a "
                       f"{value('clamp_axial_stiffness', 'N/m')} each (0: no stretching)")
-    return {"clamps": clamps, "stretching": stretching}
+    return {"clamps": clamps, "stretching": stretching, "bending": bending}
