@@ -219,3 +219,11 @@ def test_sweep_keys_shows_the_unit_and_what_it_accepts():
     assert "standard gravity" in keys.text("base.acceleration")
     assert keys.accepted_units(schema.BY_DOTTED["cable.damping_ratio"]) == ""
     assert parse_override("cable.diameter=1.27 mm") == ("cable.diameter", "1.27 mm")
+
+
+def test_a_data_sheet_beyond_double_range_is_one_line():
+    """axial_rigidity = 1e308 over a 2.76 mm section makes E overflow (inf) and I = EI / E
+    vanish: one line naming the data-sheet keys, not a traceback (found by the scene fuzzer)."""
+    with pytest.raises(sweep.SceneError) as info:
+        sweep.load_scene("harness-clamps", overrides={"cable.axial_rigidity": 1e308})
+    assert "cable.axial_rigidity" in str(info.value) and "\n" not in str(info.value)

@@ -188,9 +188,17 @@ def resolve(p: dict[str, Any], values: Mapping[str, Any]) -> dict[str, Any]:
                                   values.get("clamps.rotation") or "pinned",
                                   p.get("clamp_rotational_stiffness"))
     area = REFERENCE_AREA if diameter is None else np.pi * diameter * diameter / 4.0
-    modulus = axial / area
-    out.update(youngs_modulus=modulus, density=mass / area, area=area,
-               inertia=bending / modulus, diameter=diameter)
+    with np.errstate(all="ignore"):
+        modulus = axial / area
+        material = dict(youngs_modulus=modulus, density=mass / area, inertia=bending / modulus)
+    for name, value in material.items():
+        v = np.asarray(value, float)
+        if not (np.all(np.isfinite(v)) and np.all(v > 0.0)):
+            _fail("scene key 'cable.axial_rigidity', 'cable.bending_rigidity' or "
+                  "'cable.linear_mass'", f"the cable they describe has no finite positive "
+                  f"{name.replace('_', ' ')} (a value out of double precision's range)",
+                  "give the data sheet's values in SI, e.g. axial_rigidity = \"660 kN\"")
+    out.update(material, area=area, diameter=diameter)
     return out
 
 
