@@ -16,6 +16,16 @@ runs. After END (s; the sweep's end) the clamps stop: a_b = 0. A sweep's level r
 over its first RAMP seconds, as a shaker's does, by the factor (1 - cos(pi t / RAMP)) / 2
 (RAMP = 0: full level from t = 0).
 
+A random base acceleration is the excitation kind `record` (docs/model.md sec. 11): a_b(t)
+sampled at fs on a grid, records[r, 0, k] = a_b(k / fs) and records[r, 1, k] its time
+derivative (m/s^3, exact from the spectrum), interpolated between samples by the cubic
+Hermite polynomial through both (so the forcing is continuous with its rate, as the adaptive
+step wants), periodic with the record's period N / fs. The records are shared by every grid
+point (common random numbers): the kernels take them as the `base` switch itself, an array
+where the sine kinds take True (`signal`), and a row's block names its record: RECORD (its
+realisation r), RECORD_RATE (fs, Hz) and RECORD_SCALE (the level factor, 1: the spectrum as
+given; in the ACCEL column).
+
 The columns form one block, read as p[o + column * s] from its first column (the accessor of
 kernels.oscillator: o the block's first slot, s the stride), so each System places the block
 where it likes in its rows and calls `acceleration` on it. Units: t in s.
@@ -24,6 +34,9 @@ where it likes in its rows and calls `acceleration` on it. Units: t in s.
 import math
 
 import numba as nb
+import numpy as np
+from numba.core import types
+from numba.extending import overload
 
 # Columns of the excitation block, relative to its first column.
 ACCEL = 0           # A, the constant level (m/s^2 peak; read when SEGMENTS = 0)
@@ -39,6 +52,11 @@ LOG_LEVEL = EDGE + MAX_SEGMENTS     # ln A there (A in m/s^2)
 SLOPE = LOG_LEVEL + MAX_SEGMENTS    # d ln A / d ln w on the segment (1)
 RAMP = SLOPE + MAX_SEGMENTS         # with SEGMENTS > 0: the level's rise time from 0 (s)
 SIZE = RAMP + 1
+# The record kind's columns (the sine kinds' ACCEL, OMEGA and PHASE: a row is one kind or the
+# other, as its scene's `base` switch is an array of records or True).
+RECORD_SCALE = ACCEL   # the level factor on the record (1), 10^(dB / 20) of a level in dB
+RECORD_RATE = OMEGA    # fs, the records' sample rate (Hz)
+RECORD = PHASE         # r, which record (realisation) the row follows (an index, as a float)
 
 NAMES = (("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments",
           "sweep_end", "log_base_omega")
@@ -88,3 +106,55 @@ def acceleration(t, p, o, s):
 def frequency(t, p, o, s):
     """The excitation frequency f(t) (Hz) of the block at p[o + column * s] at time t (s)."""
     return p[o + OMEGA * s] / (2.0 * math.pi) * math.exp(p[o + RATE * s] * t)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def record_acceleration(t, p, o, s, records):
+    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
+    at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
+    fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
+    p[o + RECORD_SCALE * s]."""
+    n = records.shape[2]
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    x = t * fs
+    kf = math.floor(x)
+    u = x - kf
+    k = int(kf) % n
+    k1 = k + 1 if k + 1 < n else 0
+    dt = 1.0 / fs
+    u2 = u * u
+    u3 = u2 * u
+    value = ((2.0 * u3 - 3.0 * u2 + 1.0) * records[r, 0, k]
+             + (u3 - 2.0 * u2 + u) * dt * records[r, 1, k]
+             + (3.0 * u2 - 2.0 * u3) * records[r, 0, k1]
+             + (u3 - u2) * dt * records[r, 1, k1])
+    return p[o + RECORD_SCALE * s] * value
+
+
+def signal(t, p, o, s, base):
+    """a_b(t) (m/s^2) of the excitation block at p[o + column * s] for the scene's `base`
+    switch: True (or any non-array): the sine kinds (`acceleration`); an array of records:
+    the record kind (`record_acceleration`). Compiled, the choice is made from base's type."""
+    if isinstance(base, np.ndarray):
+        return record_acceleration(t, p, o, s, base)
+    return acceleration(t, p, o, s)
+
+
+@overload(signal, inline="always")
+def _signal(t, p, o, s, base):
+    if isinstance(base, types.Array):
+        return lambda t, p, o, s, base: record_acceleration(t, p, o, s, base)
+    return lambda t, p, o, s, base: acceleration(t, p, o, s)
+
+
+def is_record(base):
+    """Whether the scene's `base` switch is an array of records (the record kind)."""
+    return isinstance(base, np.ndarray)
+
+
+@overload(is_record, inline="always")
+def _is_record(base):
+    if isinstance(base, types.Array):
+        return lambda base: True
+    return lambda base: False

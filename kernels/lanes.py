@@ -208,7 +208,7 @@ def _attempt(W, rtol, n_run, parametric, base):
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
         if base is not None:      # the last stage's own a_b (the same arithmetic)
-            W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True)
+            W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -267,7 +267,7 @@ def _attempt8(W, rtol, n_run, parametric, base):
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
         if base is not None:
-            W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True)
+            W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)

@@ -32,7 +32,11 @@ STEADY_PERIODS = 20  # M: the periods the steadiness test spans and the moved ta
 STEADY_TOL = 21     # eps: the test's tolerance on the extrema, relative to the amplitude
 LOADS = 22          # 1.0: the multi-mode drivers observe the span's loads (the curvatures, the
                     # stretch and the clamp shear: sweep.models.loads); 0.0: they skip them
-N_SETTINGS = 23
+N_LEVELS = 23       # a random base acceleration (the record kind): how many levels of
+                    # |q| (outputs.clearance) have their up-crossings counted, <= MAX_LEVELS
+LEVEL_0 = 24        # ... level k (m) at LEVEL_0 + k
+MAX_LEVELS = 4
+N_SETTINGS = LEVEL_0 + MAX_LEVELS
 
 # Columns of the `reals` output.
 AMPLITUDE = 0       # max |q| over the tail window (m)
@@ -59,7 +63,15 @@ STRETCH = 13        # multi-mode: max q^T C q over the tail window (m^2; C = A /
 CLAMP_SHEAR = 14    # multi-mode: max |F_e| over both clamps e and the tail window (m; the
                     # transverse reaction is EI / l^3 times it: kernels.modes.span_loads); NaN
                     # for one mode
-N_REALS = 15
+# A random base acceleration (the record kind, kernels.excitation): over the statistics window
+# (the tail window; kernels.trajectory.observe_random), NaN otherwise
+RMS_DEFLECTION = 15  # RMS of q (m)
+RMS_VELOCITY = 16   # RMS of q' (m/s)
+RMS_ACCELERATION = 17  # RMS of the absolute acceleration q'' + a_b (m/s^2)
+ZERO_RATE = 18      # up-crossings of q = 0 per second (1/s)
+LEVEL_RATE = 19     # level k's up-crossings by |q| per second (1/s) at LEVEL_RATE + k
+WINDOW = LEVEL_RATE + MAX_LEVELS  # the statistics window's length (s)
+N_REALS = WINDOW + 1
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

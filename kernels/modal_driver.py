@@ -576,7 +576,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
                              S, n, T, base)
         evals += 1.0
     fv = _project(f, weights, n, n)
-    a0 = fv + (md.base_acceleration(0.0, pp, n) if base is not None else 0.0)
+    a0 = fv + (md.base_acceleration(0.0, pp, n, base) if base is not None else 0.0)
     tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
              fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
     for i in range(n):
@@ -638,7 +638,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     y = np.empty(dim)
     y_new = np.empty(dim)
     stage = np.empty(dim)
-    acc = np.empty(tj.N_SLOTS)
+    acc = np.zeros(tj.SCALAR_SLOTS)
     buf = tj.new_buffer()
 
     start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, weights, basis, base)

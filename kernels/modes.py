@@ -322,9 +322,10 @@ def prepare(row, n_modes, pp, ratios):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def base_acceleration(t, pp, n_modes):
-    """a_b(t) (m/s^2) of a prepared row (kernels.excitation)."""
-    return ex.acceleration(t, pp, 3 * n_modes + S_EXCITATION, 1)
+def base_acceleration(t, pp, n_modes, base):
+    """a_b(t) (m/s^2) of a prepared row (kernels.excitation.signal: `base` True for the sine
+    kinds, the records for the record kind)."""
+    return ex.signal(t, pp, 3 * n_modes + S_EXCITATION, 1, base)
 
 
 # The right-hand side may fuse a * b + c into one fused multiply-add (no reordering): the lanes
@@ -410,7 +411,8 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             flat = PP.reshape(PP.size)
             lanes = PP.shape[1]
             for l in range(n_run):
-                SC[2, l] = ex.acceleration(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes)
+                SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes,
+                                         base)
         else:                           # the lanes: fixed frequency and level, vectorised
             for l in range(n_run):
                 x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]

@@ -102,20 +102,21 @@ def prepare(row, p, o, s):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _excitation_signal(t, p, o, s):
-    """kernels.excitation's a_b(t) of the row's block (fixed or swept): a call of its own, so
+def _excitation_signal(t, p, o, s, base):
+    """kernels.excitation's a_b(t) of the row's block (a sine kind, fixed or swept, or, where
+    `base` is an array of records, the record kind: `excitation.signal`): a call of its own, so
     that inlining `base_acceleration` into a vector loop copies no more than its sine."""
-    return ex.acceleration(t, p, o + EXCITATION * s, s)
+    return ex.signal(t, p, o + EXCITATION * s, s, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4))
-def base_acceleration(t, p, o, s, fast):
+def base_acceleration(t, p, o, s, fast, base):
     """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation
-    block's own (kernels.excitation: fixed or swept frequency, constant or tabled level);
-    fast True (the lanes, which take fixed-frequency, fixed-level rows only):
-    A sin(w_b t + phi_b) with vecmath's fast_sin."""
+    block's own (kernels.excitation: fixed or swept frequency, constant or tabled level, or a
+    random record where `base` is the records); fast True (the lanes, which take
+    fixed-frequency, fixed-level rows only): A sin(w_b t + phi_b) with vecmath's fast_sin."""
     if fast is None:
-        return _excitation_signal(t, p, o, s)
+        return _excitation_signal(t, p, o, s, base)
     x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
     return p[o + BASE_ACCEL * s] * fast_sin(x)
 
@@ -141,7 +142,7 @@ def acceleration(t, q, v, p, o, s, fast, parametric, base):
         a = p[o + K0 * s] * q + p[o + G0 * s] * q * q2 + p[o + H * s] * q * q2 * q2
     a = a + p[o + DAMPING * s] * v
     if base is not None:
-        a = a - p[o + PARTICIPATION * s] * base_acceleration(t, p, o, s, fast)
+        a = a - p[o + PARTICIPATION * s] * base_acceleration(t, p, o, s, fast, base)
     return a
 
 

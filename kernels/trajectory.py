@@ -21,6 +21,7 @@ import math
 import numba as nb
 import numpy as np
 
+from . import excitation as ex
 from . import metrics as mt
 from . import dop853
 from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
@@ -28,8 +29,8 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
                      dense_root, dense_value, initial_step, pi_log2_err, pi_step_factor,
                      step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
-                     MIN_STEP, RTOL, SAMPLE_DT, STEADY_PERIODS, STEADY_TOL, TAIL,
-                     T_END)
+                     LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
+                     STEADY_PERIODS, STEADY_TOL, TAIL, T_END)
 from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
 from .stages import InlineWhereTrue
 from .vecmath import log2_fast
@@ -80,6 +81,19 @@ T_TAIL = INTERP + 12   # this trajectory's tail window start (s): t_end (1 - tai
                         # found steady (settings STOP_STEADY), the maximum where it was found so
 T_FINAL = T_TAIL + 1    # this trajectory's end time (s): t_end, or the moved tail window's end
 N_SLOTS = T_FINAL + 1
+# The record kind's statistics (a random base acceleration, kernels.excitation), after the
+# slots every driver keeps: only the scalar drivers run records, and they allocate
+# SCALAR_SLOTS, zeroed. The window starts at the first step end at or after the tail window's
+# start and ends with the run; over it (`observe_random`):
+IN_WINDOW = N_SLOTS      # 1.0 once the window has started
+W_START = IN_WINDOW + 1  # when it started (s)
+W_END = W_START + 1      # the last step end in it (s)
+SUM_Q2 = W_END + 1       # integral of q^2 dt (m^2 s), on the step's quintic Hermite
+SUM_V2 = SUM_Q2 + 1      # integral of q'^2 dt (m^2/s), on the same quintic's slope
+SUM_A2 = SUM_V2 + 1      # integral of (q'' + a_b)^2 dt (m^2/s^3), trapezoidal on step ends
+UP_ZERO = SUM_A2 + 1     # up-crossings of q = 0
+UP_LEVEL = UP_ZERO + 1   # level k's crossings of |q| upwards through settings[LEVEL_0 + k]
+SCALAR_SLOTS = UP_LEVEL + MAX_LEVELS
 
 # The PI controller's memory before the first accepted step: pi_log2_err(PI_MIN_ERR_PREV),
 # computed once here (the same arithmetic in Python) rather than compiled into `start`.
@@ -142,7 +156,7 @@ def start(p, o, s, settings, acc, series, parametric, base):
         evals += 1.0
     a0 = fv
     if base is not None:
-        a0 += base_acceleration(0.0, p, o, s, None)
+        a0 += base_acceleration(0.0, p, o, s, None, base)
     begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, p[o + BOUND * s])
 
 
@@ -456,7 +470,7 @@ def samples_interpolant(acc, a, sa):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def absolute_acceleration_at(acc, a, sa, p, o, s, t):
+def absolute_acceleration_at(acc, a, sa, p, o, s, t, base):
     """q'' + a_b (m/s^2) at time t (s) on the samples' interpolant (`samples_interpolant`'s
     INTERP slots), a_b(t) exact (oscillator.base_acceleration of the row at
     p[o + column * s])."""
@@ -471,7 +485,7 @@ def absolute_acceleration_at(acc, a, sa, p, o, s, t):
         d2 = d2 * d + 2.0 * d1
         d1 = d1 * d + value
         value = value * d + acc[a + (INTERP + j) * sa]
-    return d2 / (span * span) + base_acceleration(t, p, o, s, None)
+    return d2 / (span * span) + base_acceleration(t, p, o, s, None, base)
 
 
 PEAK_ITERATIONS = 6     # successive parabolas at most, refining an acceleration extremum
@@ -480,7 +494,7 @@ PEAK_VALUE_TOL = 1e-12  # ... until one changes the extremum's value by less tha
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def refine_acceleration_peak(acc, a, sa, p, o, s):
+def refine_acceleration_peak(acc, a, sa, p, o, s, base):
     """Where `observe_acceleration` set ACC_TURN: the extremum of q'' + a_b between the oldest
     and newest of the last three step-end samples (two consecutive steps), found by successive
     parabolic interpolation on `absolute_acceleration_at` (the samples' degree-8 interpolant,
@@ -508,7 +522,7 @@ def refine_acceleration_peak(acc, a, sa, p, o, s):
         tv = 0.5 * (xa + xb) - 0.5 * d1 / curvature
         if not (xa < tv < xc) or tv == xb:
             break
-        yv = absolute_acceleration_at(acc, a, sa, p, o, s, tv)
+        yv = absolute_acceleration_at(acc, a, sa, p, o, s, tv, base)
         if tv >= t_tail:
             best = max(best, abs(yv))
         gain = sign * (yv - yb)
@@ -534,11 +548,11 @@ def refine_marked_lanes(W, L, p, p_first, n_run):
     accumulator at W[j + slot * L], its row at p[p_first + j + column * L]."""
     for j in range(n_run):
         if W[j + ACC_TURN * L] != 0.0:
-            refine_acceleration_peak(W, j, L, p, p_first + j, L)
+            refine_acceleration_peak(W, j, L, p, p_first + j, L, True)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv):
+def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv, base):
     """The absolute acceleration |q'' + a_b| (m/s^2) where the tail window starts, at t_tail
     (s) inside the step just sampled, from t (s) where the state was (q m, q' = v m/s,
     q'' = fv m/s^2): the step-end samples and their refinement see only what lies after it.
@@ -552,10 +566,10 @@ def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv):
         acc[middle + S_Q] = q
         acc[middle + S_V] = v
         acc[middle + S_F] = fv
-        acc[middle + S_A] = fv + base_acceleration(t, p, o, s, None)
+        acc[middle + S_A] = fv + base_acceleration(t, p, o, s, None, base)
         acc[middle + SAMPLE_SIZE + S_A] = math.nan
     samples_interpolant(acc, 0, 1)
-    at_start = absolute_acceleration_at(acc, 0, 1, p, o, s, t_tail)
+    at_start = absolute_acceleration_at(acc, 0, 1, p, o, s, t_tail, base)
     acc[ACC_AMP] = max(acc[ACC_AMP], abs(at_start))
 
 
@@ -610,7 +624,7 @@ def _observe_base(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_tail
     lanes._observe_acceleration) its branch is dead, and Numba does not copy it in before it
     prunes the branch."""
     observe_acceleration(acc, a, sa, t_new, q_new, v_new, fv_new,
-                         fv_new + base_acceleration(t + h, p, o, s, fast), t_tail, take)
+                         fv_new + base_acceleration(t + h, p, o, s, fast, base), t_tail, take)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -698,9 +712,17 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
                                   thr_rel, True, None, base)
     if base is not None:
         if acc[ACC_TURN] != 0.0:
-            refine_acceleration_peak(acc, 0, 1, p, o, s)
+            refine_acceleration_peak(acc, 0, 1, p, o, s, base)
         if t < t_tail <= t_new:
-            observe_tail_start(acc, p, o, s, t_tail, t, q_old, v_old, fv_old)
+            observe_tail_start(acc, p, o, s, t_tail, t, q_old, v_old, fv_old, base)
+        if ex.is_record(base):
+            newest = ACC_SAMPLES + S_A
+            a_new = acc[newest]
+            a_old = acc[ACC_SAMPLES + SAMPLE_SIZE + S_A]     # at t: the step before's end
+            if math.isnan(a_old):
+                a_old = fv_old + base_acceleration(t, p, o, s, None, base)
+            observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new,
+                           K[fsal_row(K), 1], a_old, a_new, has_ext, qe)
 
     if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
@@ -728,6 +750,89 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     last = fsal_row(K)
     acc[FQ] = K[last, 0]
     acc[FV] = K[last, 1]
+
+
+def _quintic_gram() -> tuple[np.ndarray, np.ndarray]:
+    """(M, D): the Gram matrices over [0, 1] of the quintic Hermite basis H_i (the
+    polynomials of degree 5 with H_i's value, slope and second derivative at 0 and 1 the unit
+    vector e_i, in the order value, slope, second derivative at 0, then at 1) and of their
+    derivatives: M_ij = int H_i H_j, D_ij = int H_i' H_j'. From the monomials' exact
+    integrals; computed once, at import."""
+    conditions = np.zeros((6, 6))
+    for k in range(6):                     # value, slope, second derivative of s^k at 0 and 1
+        conditions[0, k] = 1.0 if k == 0 else 0.0
+        conditions[1, k] = 1.0 if k == 1 else 0.0
+        conditions[2, k] = 2.0 if k == 2 else 0.0
+        conditions[3, k] = 1.0
+        conditions[4, k] = float(k)
+        conditions[5, k] = float(k * (k - 1))
+    basis = np.linalg.inv(conditions)      # column i: H_i's monomial coefficients
+    powers = np.arange(6)
+    plain = 1.0 / (powers[:, None] + powers[None, :] + 1.0)
+    slope = np.zeros((6, 6))
+    for a in range(1, 6):
+        for b in range(1, 6):
+            slope[a, b] = a * b / (a + b - 1.0)
+    return basis.T @ plain @ basis, basis.T @ slope @ basis
+
+
+_GRAM, _SLOPE_GRAM = _quintic_gram()
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _quintic_squares(h, q0, v0, a0, q1, v1, a1):
+    """The integrals over a step of length h (s) of q^2 and q'^2 on the quintic Hermite
+    through q, q' = v and q'' = a at both ends: (h c^T M c, c^T D c / h), c = (q0, h v0,
+    h^2 a0, q1, h v1, h^2 a1), M and D `_quintic_gram`'s."""
+    c = (1.0 * q0, h * v0, h * h * a0, 1.0 * q1, h * v1, h * h * a1)
+    square = 0.0
+    slope = 0.0
+    for i in range(6):
+        for j in range(6):
+            square += c[i] * _GRAM[i, j] * c[j]
+            slope += c[i] * _SLOPE_GRAM[i, j] * c[j]
+    return h * square, slope / h
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _count_crossings(settings, acc, a, b):
+    """Crossings on a monotone piece of q from a to b (m): of zero upwards, and of each of
+    settings' levels u by |q| upwards (q up through u, or down through -u)."""
+    if a < 0.0 <= b:
+        acc[UP_ZERO] += 1.0
+    for k in range(int(settings[N_LEVELS])):
+        u = settings[LEVEL_0 + k]
+        if (a < u <= b) or (a > -u >= b):
+            acc[UP_LEVEL + k] += 1.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
+                   a_old, a_new, has_ext, qe):
+    """The record kind's statistics of the accepted step [t, t_new] (s) of the watched
+    deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
+    m/s^2; qe its extremum inside the step where has_ext), once the step starts at or after
+    the tail window's start: the integrals of q^2 and q'^2 on the quintic Hermite through q,
+    q', q'' at both ends (`_quintic_squares`), of (q'' + a_b)^2 by the trapezoidal rule
+    (SCALAR_SLOTS), and
+    the crossings of zero and of settings' levels on the step's monotone pieces, q_old to qe
+    to q_new (a level grazed inside a step counts)."""
+    if t < acc[T_TAIL]:
+        return
+    if acc[IN_WINDOW] == 0.0:
+        acc[IN_WINDOW] = 1.0
+        acc[W_START] = t
+    h = t_new - t
+    acc[W_END] = t_new
+    square, slope = _quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+    acc[SUM_Q2] += square
+    acc[SUM_V2] += slope
+    acc[SUM_A2] += 0.5 * h * (a_old * a_old + a_new * a_new)
+    if has_ext:
+        _count_crossings(settings, acc, q_old, qe)
+        _count_crossings(settings, acc, qe, q_new)
+    else:
+        _count_crossings(settings, acc, q_old, q_new)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -21,6 +21,7 @@ import math
 import numba as nb
 import numpy as np
 
+from . import excitation as ex
 from . import metrics as mt
 from . import trajectory as tj
 from . import dop853
@@ -29,7 +30,8 @@ from .layout import *  # noqa: F401,F403  (settings and output layouts, re-expor
 from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FIRST_BAND,
                      N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
                      REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, STOP_TIME, T_END,
-                     TOL, WANT_SETTLING)
+                     TOL, WANT_SETTLING, LEVEL_RATE, N_LEVELS, RMS_ACCELERATION,
+                     RMS_DEFLECTION, RMS_VELOCITY, WINDOW, ZERO_RATE)
 from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepare,
                          stiffness)
 
@@ -46,7 +48,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
     """
     rtol = max(settings[RTOL], MIN_RTOL)
-    acc = np.empty(tj.N_SLOTS)
+    acc = np.zeros(tj.SCALAR_SLOTS)
     buf = tj.new_buffer()
     K = np.empty((dop853.N_STAGES_EXTENDED if eighth else 7, 2))   # DOP853: room for the
     Qc = np.empty((2, DENSE_TERMS if eighth else QUARTIC_TERMS))     # dense output's stages
@@ -139,6 +141,8 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
     reals[PEAK] = peak
     if base is not None:
         reals[ACCELERATION] = acc[tj.ACC_AMP]
+    if ex.is_record(base):
+        return random_outputs(settings, acc, reals)
     n_max, n_min, period = mt.tail_counts(buf, n_ext, t_tail)
     reals[PERIOD] = period
     band = tol * tail_amp
@@ -240,6 +244,25 @@ def solve_point(row, settings, reals, counts, series, envelope, parametric, base
     if settings[SWEPT] != 0.0:
         state = swept_outputs(p, EXCITATION, 1, settings, acc, buf, state, reals, envelope)
     return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def random_outputs(settings, acc, reals):
+    """A random base acceleration's statistics over the window of a trajectory that ran to
+    its end (kernels.trajectory.observe_random): the RMS of q, q' and q'' + a_b, the
+    up-crossing rates of zero and of settings' levels of |q|, the window's length. A random
+    response has no settling to judge: the state is COMPLETED."""
+    span = acc[tj.W_END] - acc[tj.W_START]
+    if acc[tj.IN_WINDOW] == 0.0 or not span > 0.0:
+        return mt.COMPLETED
+    reals[RMS_DEFLECTION] = math.sqrt(acc[tj.SUM_Q2] / span)
+    reals[RMS_VELOCITY] = math.sqrt(acc[tj.SUM_V2] / span)
+    reals[RMS_ACCELERATION] = math.sqrt(acc[tj.SUM_A2] / span)
+    reals[ZERO_RATE] = acc[tj.UP_ZERO] / span
+    for k in range(int(settings[N_LEVELS])):
+        reals[LEVEL_RATE + k] = acc[tj.UP_LEVEL + k] / span
+    reals[WINDOW] = span
+    return mt.COMPLETED
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -94,13 +94,15 @@ def longitudinal_outputs(n: int, n_hist: int, n_snap: int,
 
 
 def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, driver: str,
-                     n_bands: int = -1, per_point_end: bool = False, threads: int = 0,
+                     n_bands: int = -1, per_point_end: bool = False,
+                     records: np.ndarray | None = None, threads: int = 0,
                      on_block: Callable[[int, int, dict], None] | None = None,
                      stop: threading.Event | None = None) -> dict[str, np.ndarray]:
     """Transverse kernel over `params` rows; outputs by name (states, reals, counts, series;
     `transverse_outputs`). A swept base frequency (settings[SWEPT] = 1): n_bands the envelope's
     bands, and per_point_end: each point ends with its own sweep (the rows' sweep_end column,
-    kernels.excitation.END) rather than at settings' T_END.
+    kernels.excitation.END) rather than at settings' T_END. records: a random base
+    acceleration's records (sweep/models/random_outputs.py), shared by every row.
 
     on_block(lo, hi, outputs) hears of each block of rows as soon as it is final; with `stop`
     set the call returns early, with only the rows on_block reported solved."""
@@ -112,7 +114,8 @@ def transverse_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, d
     solve_transverse(params, settings, out["states"], out["reals"], out["counts"], out["series"],
                      driver=driver, threads=threads, on_block=report, stop=stop,
                      envelope=out.get("envelope"),
-                     durations=_ends(params, osc.EXCITATION) if per_point_end else None)
+                     durations=_ends(params, osc.EXCITATION) if per_point_end else None,
+                     records=records)
     return out
 
 
@@ -141,7 +144,7 @@ def modes_of(basis: tuple[np.ndarray, ...] | list) -> int:
 def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
                 basis: tuple[np.ndarray, ...],
                 driver: str = "lanes", n_bands: int = -1, per_point_end: bool = False,
-                threads: int = 0,
+                records: np.ndarray | None = None, threads: int = 0,
                 on_block: Callable[[int, int, dict], None] | None = None,
                 stop: threading.Event | None = None) -> dict[str, np.ndarray]:
     """The multi-mode kernel (kernels.modal_driver) over `params` rows (kernels.modes columns
@@ -153,7 +156,7 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     from sweep.kernels import modes as md
     if isinstance(basis, list):
         return _family_chunk(params, settings, n_samples, basis, driver, n_bands,
-                             per_point_end, threads, on_block, stop)
+                             per_point_end, records, threads, on_block, stop)
 
     from .threads import solve_modes
     out = modes_outputs(params.shape[0], n_samples, modes_of(basis), n_bands)
@@ -161,12 +164,14 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     solve_modes(params, basis, settings, out["states"], out["reals"], out["counts"],
                 out["series"], out["modal"], out["final"], driver=driver, threads=threads,
                 on_block=report, stop=stop, envelope=out.get("envelope"),
-                durations=_ends(params, md.EXCITATION) if per_point_end else None)
+                durations=_ends(params, md.EXCITATION) if per_point_end else None,
+                records=records)
     return out
 
 
 def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, family: list,
-                  driver: str, n_bands: int, per_point_end: bool, threads: int,
+                  driver: str, n_bands: int, per_point_end: bool,
+                  records: np.ndarray | None, threads: int,
                   on_block: Callable[[int, int, dict], None] | None,
                   stop: threading.Event | None) -> dict[str, np.ndarray]:
     """`modes_chunk` of rows whose basis varies (the last column: an index into `family`):
@@ -189,8 +194,8 @@ def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, fami
                     on_block(a, z, out)
 
         part = modes_chunk(rows[at], settings, n_samples, family[b], driver, n_bands,
-                           per_point_end, threads, report if on_block is not None else None,
-                           stop)
+                           per_point_end, records, threads,
+                           report if on_block is not None else None, stop)
         for name, values in part.items():
             out[name][at] = values
     return out

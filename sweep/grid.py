@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .models import random_scene
 from .models.cable import resolve
 from .models.rules import default_inertia
 from .scene import Scene
@@ -35,6 +36,12 @@ def coordinates(scene: Scene) -> dict[str, xr.DataArray]:
         key = BY_AXIS[name]
         coords[name] = xr.DataArray(np.asarray(values, dtype=float), dims=name,
                                     attrs={"units": key.units, "long_name": key.long_name})
+    if random_scene.is_random(scene.values):        # last: the records every point sees
+        coords[random_scene.REALISATION_DIM] = xr.DataArray(
+            np.arange(scene.get("base.realisations"), dtype=np.int32),
+            dims=random_scene.REALISATION_DIM,
+            attrs={"units": "1", "long_name": "realisation: which record of the random base "
+                                              "acceleration (the same records at every point)"})
     return coords
 
 
@@ -59,9 +66,24 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params["divergence_bound"] = scene.get("metrics.divergence_bound")
     params["base_levels_g"] = scene.get("base.levels_g")
     params["base_sweep_ramp_cycles"] = scene.get("base.sweep.ramp_cycles")
+    params.update(random_parameters(scene.values, coords))
     if params["load_type"] == "constant":      # no frequency axis: refused by load_scene
         params["frequency"] = None
     return params
+
+
+def random_parameters(values: dict[str, Any], coords: dict[str, xr.DataArray]
+                      ) -> dict[str, Any]:
+    """A random scene's parameters (None where the scene is not random): base_asd, its
+    spectrum as (f in Hz, W in (m/s^2)^2/Hz) breakpoints; base_sample_rate (Hz); realisation,
+    the record each point follows (on the realisation dimension)."""
+    key = random_scene.spectrum_key(values)
+    if key is None:
+        return {"base_asd": None, "base_sample_rate": None, "realisation": None}
+    from .models.random import spectrum
+    return {"base_asd": spectrum(values[key], key=key, per_g2=key == "base.asd_g2"),
+            "base_sample_rate": random_scene.sample_rate(values),
+            "realisation": coords[random_scene.REALISATION_DIM].astype(float)}
 
 
 def flatten(values: dict[str, Any], names: tuple[str, ...], dims: tuple[str, ...],

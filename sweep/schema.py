@@ -27,6 +27,8 @@ the ``absolute_acceleration_g`` output) is a multiple of. The one place this num
 G_UNITS = f"{STANDARD_GRAVITY:g} m s-2"
 """UDUNITS units of a value given in g: "9.80665 m s-2" (a scaled unit that converts to m s-2
 in any UDUNITS tool; "g" would mean grams, "1" dimensionless)."""
+G2_UNITS = f"{STANDARD_GRAVITY ** 2:.10g} m2 s-4 Hz-1"
+"""UDUNITS units of a spectral density given in g^2/Hz (base.asd_g2)."""
 
 
 @dataclass(frozen=True)
@@ -179,6 +181,35 @@ KEYS: tuple[Key, ...] = (
     Key("base", "levels_g", "pairs", None, units=G_UNITS,
         long_name="base level table instead of a constant level: (frequency in Hz, peak level "
                   "in g) breakpoints, interpolated log-log"),
+    # a random base acceleration instead of a sine: [base] asd_g2 = [[Hz, g^2/Hz], ...]
+    # (docs/model.md sec. 11; sweep/models/random.py)
+    Key("base", "asd_g2", "pairs", None, units=G2_UNITS,
+        long_name="random base acceleration: one-sided acceleration spectral density as "
+                  "(frequency in Hz, level in g^2/Hz) breakpoints, interpolated log-log, zero "
+                  "outside them"),
+    Key("base", "asd", "pairs", None, units="m2 s-4 Hz-1",
+        long_name="random base acceleration: one-sided acceleration spectral density as "
+                  "(frequency in Hz, level in (m/s^2)^2/Hz) breakpoints, interpolated log-log"),
+    Key("base", "asd_scale", "float", None, units="1", minimum=-60.0, maximum=60.0,
+        long_name="random base acceleration: level relative to the spectrum given, in dB on "
+                  "the ASD (10 log10 of its factor; -3: acceptance from qualification; "
+                  "default 0)",
+        axis="base_asd_scale"),
+    Key("base", "duration", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="random base acceleration: length of each record (the run's end time)"),
+    Key("base", "realisations", "int", None, units="1", minimum=1, maximum=100_000,
+        long_name="random base acceleration: independent records, the same for every grid "
+                  "point (a realisation dimension; default 1)"),
+    Key("base", "seed", "int", None, units="1", minimum=0,
+        long_name="random base acceleration: seed of the records (the same seed, the same "
+                  "records, bit for bit; default 0)"),
+    Key("base", "sample_rate", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
+        long_name="random base acceleration: the records' sample rate (default 10 x the "
+                  "spectrum's top frequency)"),
+    Key("base", "test_duration", "float", None, units="s", minimum=0.0, exclusive_min=True,
+        long_name="random base acceleration: the test's duration for the expected number of "
+                  "exceedances of outputs.clearance (default base.duration; GEVS: 120 s an "
+                  "axis)"),
     # [initial]
     Key("initial", "displacement", "float", 0.0, units="m",
         long_name="initial midspan deflection q(0)", axis="initial_displacement"),
@@ -264,6 +295,10 @@ KEYS: tuple[Key, ...] = (
         long_name="transverse, harmonic load: Floquet multiplier, growth rate and stability of "
                   "the straight span, from one load period (with the time-domain outputs off, "
                   "nothing else is integrated)"),
+    Key("outputs", "clearance", "floats", None, units="m", minimum=0.0,
+        long_name="random base acceleration: levels of |midspan deflection| (at most 4) whose "
+                  "up-crossing rates, expected exceedances in base.test_duration and "
+                  "probability of at least one are stored"),
     Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
     Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="time-series sample interval (default t_end/1000)"),

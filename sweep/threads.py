@@ -94,11 +94,14 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                      on_block: Callable[[int, int], None] | None = None,
                      stop: threading.Event | None = None,
                      envelope: np.ndarray | None = None,
-                     durations: np.ndarray | None = None) -> None:
+                     durations: np.ndarray | None = None,
+                     records: np.ndarray | None = None) -> None:
     """Solve every row of `params` (n, N_PARAMS) into the preallocated outputs (first axis n):
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
     A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
     for its response envelope and durations (n,), each point's end time (s; `swept_settings`).
+    records: a random base acceleration's (R, 2, N) records, which the kernels take as their
+    `base` switch (kernels.excitation's record kind; the scalar driver only).
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
@@ -119,6 +122,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
     parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
+    base = _random_base(records, driver, base)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept:
@@ -163,7 +167,8 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
                 final: np.ndarray, *, driver: str = "lanes", threads: int = 0,
                 on_block: Callable[[int, int], None] | None = None,
                 stop: threading.Event | None = None, envelope: np.ndarray | None = None,
-                durations: np.ndarray | None = None) -> None:
+                durations: np.ndarray | None = None,
+                records: np.ndarray | None = None) -> None:
     """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for the N
     modes of `basis` in (the mode shapes as the kernels take them:
     sweep.models.basis.Basis.kernel_arrays()), the same outputs plus modal (n, N), each mode's
@@ -180,7 +185,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         from sweep.kernels import modal_lanes as kernel
     else:
         kernel = modal_driver
-    base = True if settings[tk.BASE] != 0.0 else None
+    base = _random_base(records, driver, True if settings[tk.BASE] != 0.0 else None)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept and driver != "scalar":
@@ -212,6 +217,16 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
     watch = Watch(states, on_block, stop)
     run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
                tick=watch.ticker())
+
+
+def _random_base(records: np.ndarray | None, driver: str, base: bool | None) -> Any:
+    """The kernels' `base` switch: the records of a random base acceleration (the scalar
+    driver only), else `base` as it is (None or True: a sine kind)."""
+    if records is None:
+        return base
+    if driver != "scalar":
+        raise ValueError("a random base acceleration takes driver 'scalar'")
+    return np.ascontiguousarray(records, dtype=np.float64)
 
 
 def method_switch(settings: np.ndarray) -> bool | None:

@@ -45,6 +45,8 @@ BY_HAND: dict[str, tuple[str, float]] = {
     "N m rad-1": ("500 N mm/rad", 0.5),
     "N m-1": ("1 kN/mm", 1e6),
     "min-1": ("3 /h", 0.05),
+    "m2 s-4 Hz-1": ("0.16 g^2/Hz", 0.16 * G0 ** 2),
+    schema.G2_UNITS: ("961.7038422250001 m^2/s^4/Hz", 10.0),
 }
 DIMENSIONAL = [k for k in schema.KEYS
                if k.kind in ("float", "floats", "pairs") and k.units not in ("", "1")]

@@ -298,7 +298,12 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
     out["load_phase"] = 0.0              # (continuation.py)
     swept = p.get("base_sweep_start") is not None
     level, omega_b = base["base_accel"], base["base_omega"]
-    if np.any(base["participation"] != 0.0) and not swept:
+    random = p.get("base_asd") is not None
+    if random:                  # the scales of three times the record's RMS, quasi-static
+        f, w = p["base_asd"]
+        from .random import mean_square
+        level, omega_b = 3.0 * base["base_accel"] * np.sqrt(mean_square(f, w)), c["omega_1"]
+    elif np.any(base["participation"] != 0.0) and not swept:
         out.update(base_response(level, omega_b, c["omega_1"], p["damping_ratio"],
                                  base["participation"]))
     if swept:                     # the scales of the sweep's largest level, lowest frequency
@@ -326,6 +331,10 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
     ends after its duration (`excitation.sweep_duration`). Every column 0 when p has no base
     level (no [base] table)."""
     levels = p.get("base_levels_g")
+    if p.get("base_asd") is not None:     # the record kind: level factor, sample rate, record
+        block = excitation.block(random_level(p), p["base_sample_rate"])
+        block["base_phase"] = p["realisation"]
+        return {"participation": PARTICIPATION, **block}
     if p.get("base_acceleration") is None and p.get("base_acceleration_g") is None \
             and levels is None:
         return {"participation": 0.0, **excitation.block(0.0, 0.0)}
@@ -348,6 +357,12 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
     accel = (excitation.table_level(levels, omega / (2.0 * np.pi)) if levels is not None
              else _level(p))
     return {"participation": PARTICIPATION, **excitation.block(accel, omega)}
+
+
+def random_level(p: Mapping[str, Any]) -> Any:
+    """The level factor (1) on a random scene's records: 10^(dB / 20) of base_asd_scale (dB
+    on the ASD, so its square root on the acceleration)."""
+    return 10.0 ** (p["base_asd_scale"] / 20.0)
 
 
 def _level(p: Mapping[str, Any]) -> Any:

@@ -87,7 +87,7 @@ from sweep.kernels.wave_layout import LEVEL_LIMIT  # most time levels a span cou
 from .. import schema
 from ..errors import CableSweepWarning
 from ..scene.messages import _fail, _show
-from . import cable
+from . import cable, random_scene
 from .modal import oscillator
 from .wave import wave_parameters
 
@@ -159,7 +159,7 @@ MAX_SAMPLES = 10_000_000
 def has_base(values: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
     """Whether a resolved scene (its values and axes) has base excitation: a base level is
     given, as a [base] key or an axis (a validated scene then has a base frequency too)."""
-    return values.get(BASE_TABLE_KEY) is not None or any(
+    return values.get(BASE_TABLE_KEY) is not None or random_scene.is_random(values) or any(
         values.get(d) is not None or schema.BY_DOTTED[d].axis in axes for d in BASE_LEVEL_KEYS)
 
 
@@ -210,6 +210,9 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
               else f"scene key '{d}'")
              for d in BASE_KEYS if _present(d, given, axes)]
     _check_envelope(given, axes)
+    random_scene.check(given, axes)
+    if random_scene.is_random(given):
+        return                          # a spectrum instead of a level and a frequency
     if not named and not has_table:
         return
     where = named[0] if named else "scene section '[base]'"
@@ -708,8 +711,8 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
     oscillator has no forcing term (the end load enters the stiffness only), so such a sweep
     stays at q = 0 everywhere: it would look like a result and say nothing. Base excitation
     with a level above zero somewhere drives the span from rest: no warning then."""
-    if values.get(BASE_TABLE_KEY) is not None:      # a table's levels are > 0
-        return
+    if values.get(BASE_TABLE_KEY) is not None or random_scene.is_random(values):
+        return                                      # a table's levels, a spectrum are > 0
     if values.get("outputs.stability"):             # its multipliers say what a seed would do
         return
     if has_base(values, axes) and any(
@@ -948,8 +951,10 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
                          mentioned: set[str]) -> None:
     """solver.t_end 5 s, and the paper preset's initial.velocity without an initial condition."""
     _shared_defaults(values, mentioned)
+    if random_scene.is_random(values):
+        random_scene.defaults(values, mentioned)
     swept = any(d in mentioned for d in SWEEP_KEYS)
-    if "solver.t_end" not in mentioned and not swept:
+    if "solver.t_end" not in mentioned and not swept and not random_scene.is_random(values):
         values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps
     if swept:            # no settling; the scalar driver; the peaks over the whole sweep
         # and no variable that means nothing for a sweep: no response period (the frequency

@@ -26,8 +26,9 @@ from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, fla
 from ..runner import RunOptions, check_memory, placer, point_order, solve_chunked
 from ..scene import Scene
 from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
-from . import excitation, loads, modal
+from . import excitation, loads, modal, random_outputs
 from .basis import Basis, BasisFamily, end_stiffness, span_basis
+from .random_outputs import RandomInputs
 
 KIND = "transverse"
 MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
@@ -237,6 +238,7 @@ class Inputs:
     bands: tuple[int, int, int] | None = None
     per_point_end: bool = False
     sweep_direction: str | None = None
+    random: RandomInputs | None = None
 
 
 def end_stiffness_of(params: dict[str, Any]) -> Any:
@@ -289,7 +291,8 @@ def resolve(scene: Scene) -> Inputs:
                   bands=(envelope_bands(scene) + (scene.get("outputs.bands_per_octave"),)
                          if swept and scene.get("outputs.envelope") else None),
                   per_point_end=swept and scene.get("solver.t_end") is None,
-                  sweep_direction=scene.get("base.sweep.direction"))
+                  sweep_direction=scene.get("base.sweep.direction"),
+                  random=RandomInputs.of(scene.values))
 
 
 TIME_DOMAIN_OUTPUTS = ("outputs.amplitude", "outputs.peak_amplitude", "outputs.settling_time",
@@ -386,7 +389,12 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
     settings = inputs.settings.copy()
     n_points = int(np.prod(shape, dtype=np.int64))
     set_constant_stiffness(settings, coeffs)
-    system = _system(inputs, settings)
+    records = None
+    if inputs.random is not None:          # its statistics window, levels and records
+        random_outputs.set_settings(settings, inputs.random, coeffs, inputs.params,
+                                    settings[tk.TOL])
+        records = inputs.random.records()
+    system = _system(inputs, settings, records)
     started = time.perf_counter()
     if inputs.continuation is not None:
         return _run_stepped(inputs, options, coeffs, system, settings, started)
@@ -394,7 +402,8 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
         return _run_directed(inputs, options, coeffs, settings, started)
     out = solve_chunked(options, system.chunk_fn, system.rows_at, system.args,
                         system.outputs(n_points))
-    return assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
+    return assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started,
+                    records, settings)
 
 
 def _run_directed(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any],
@@ -472,9 +481,9 @@ def modal_rows(inputs: Inputs, points: np.ndarray) -> np.ndarray:
     return rows
 
 
-def _system(inputs: Inputs, settings: np.ndarray) -> _System:
+def _system(inputs: Inputs, settings: np.ndarray, records: np.ndarray | None = None) -> _System:
     """How the runner drives the System of `inputs`: the one-mode oscillator (model.modes = 1)
-    or the N-mode model (`modal_rows`)."""
+    or the N-mode model (`modal_rows`); records: a random scene's (the kernels' `base`)."""
     from sweep.kernels import oscillator as osc
 
     from ..execute import modes_chunk, modes_outputs, transverse_chunk, transverse_outputs
@@ -485,6 +494,8 @@ def _system(inputs: Inputs, settings: np.ndarray) -> _System:
     swept = (() if not inputs.swept else
              ((inputs.bands[1] if inputs.bands else 0), inputs.per_point_end))
     n_bands = swept[0] if swept else -1
+    if records is not None:            # after the sweep's arguments, which it has not
+        swept = (-1, False, records)
     if n == 1:
         def rows_at(points: np.ndarray) -> np.ndarray:
             at = grid.point_values(params, dims, shape, points)
@@ -718,15 +729,17 @@ def state_attrs(swept: bool = False) -> dict[str, Any]:
 
 
 def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
-             elapsed: float) -> xr.Dataset:
+             elapsed: float, records: np.ndarray | None = None,
+             settings: np.ndarray | None = None) -> xr.Dataset:
     """Build the result Dataset of the contract from the flat kernel result: the variables the
     scene asked for (inputs.wanted), with units and long names; the derived closed forms
-    (`coeffs`, sweep/models/modal.py) on their own axes; elapsed: the solve's wall time (s)."""
+    (`coeffs`, sweep/models/modal.py) on their own axes; elapsed: the solve's wall time (s).
+    A random scene: its records and the settings it ran with (its statistics window)."""
     coords, dims, shape = inputs.coords, inputs.dims, inputs.shape
     short, method = METHODS[inputs.method]
     data: dict[str, xr.DataArray] = {}
     data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims,
-                                 attrs=state_attrs(inputs.swept))
+                                 attrs=state_attrs(inputs.swept or inputs.random is not None))
     for name, (col, units, long_name, switch) in _REALS.items():
         if switch is None or switch in inputs.wanted:
             data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
@@ -749,7 +762,16 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     if inputs.settings[tk.LOADS] != 0.0:
         data.update(loads.load_outputs(inputs.params, result.reals, result.modal is not None,
                                        dims, shape, coords, inputs.swept))
-    if inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
+    if inputs.random is not None:
+        settings = inputs.settings if settings is None else settings
+        t_tail = settings[tk.T_END] * (1.0 - settings[tk.TAIL])
+        variables, extra = random_outputs.outputs(
+            result.reals, result.states, result.reals[:, tk.AMPLITUDE], dims, shape, coords,
+            inputs.random, coeffs, inputs.params, records, t_tail, inputs.basis,
+            inputs.n_modes)
+        data.update(variables)
+        coords = {**coords, **extra}
+    elif inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                derived(coeffs["base_accel"], coords))
         if inputs.swept and inputs.params.get("base_levels_g") is not None:

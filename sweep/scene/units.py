@@ -22,7 +22,7 @@ from typing import Any
 from .. import schema
 from .messages import _fail, _show
 
-ACCELERATION_UNITS = ("m s-2", schema.G_UNITS)
+ACCELERATION_UNITS = ("m s-2", schema.G_UNITS, "m2 s-4 Hz-1", schema.G2_UNITS)
 """Schema units of the keys on which "g" means standard gravity."""
 _LONE_G = re.compile(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])")
 _UDUNITS_TERM = re.compile(r"([A-Za-z]+)(-?\d+)?")
@@ -46,7 +46,8 @@ _EXAMPLES: dict[str, str] = {
     "N m2": "'2e-3 N m^2'", "N": "'1.6 MN'", "m s-2": "'0.5 g' or '4.9 m/s^2'",
     schema.G_UNITS: "'0.5 g'", "kg m-3": "'8.9 g/cm^3'", "Pa": "'110 GPa'", "m2": "'6 mm^2'",
     "m4": "'2.9e-12 m^4'", "s": "'20 ms'", "N m rad-1": "'0.5 N m/rad'", "N m-1": "'1 MN/m'",
-    "m s-1": "'0.1 m/s'", "min-1": "'2 /min'",
+    "m s-1": "'0.1 m/s'", "min-1": "'2 /min'", "m2 s-4 Hz-1": "'0.16 g^2/Hz'",
+    schema.G2_UNITS: "'0.16 g^2/Hz'",
 }
 
 
@@ -55,7 +56,8 @@ _QUANTITIES: dict[str, str] = {
     "N": "force", "m s-2": "acceleration", schema.G_UNITS: "acceleration", "kg m-3": "density",
     "Pa": "pressure", "m2": "area", "m4": "second moment of area", "s": "time",
     "N m rad-1": "rotational stiffness", "N m-1": "stiffness", "m s-1": "speed",
-    "min-1": "rate",
+    "min-1": "rate", "m2 s-4 Hz-1": "acceleration spectral density",
+    schema.G2_UNITS: "acceleration spectral density",
 }
 
 
@@ -66,7 +68,8 @@ def accepted(key: schema.Key) -> str:
         return ""
     quantity = _QUANTITIES.get(key.units, key.units)
     gravity = " ('g': standard gravity)" if key.units in ACCELERATION_UNITS else ""
-    return (f"a number in {'g' if key.units == schema.G_UNITS else key.units}, or a string with "
+    shown = {schema.G_UNITS: "g", schema.G2_UNITS: "g^2/Hz"}.get(key.units, key.units)
+    return (f"a number in {shown}, or a string with "
             f"any {quantity} unit, e.g. {_EXAMPLES.get(key.units, key.units)}{gravity}")
 
 
@@ -175,6 +178,8 @@ def _pint_units(units: str) -> str:
     in g -> "g_0" (standard gravity)."""
     if units == schema.G_UNITS:
         return "g_0"
+    if units == schema.G2_UNITS:
+        return "g_0 ** 2 / Hz"
     terms = []
     for term in units.split():
         match = _UDUNITS_TERM.fullmatch(term)

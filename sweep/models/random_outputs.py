@@ -1,0 +1,247 @@
+"""What a random scene computes and stores (docs/model.md sec. 11): its inputs resolved once
+(`RandomInputs`), the kernel settings of its statistics (`set_settings`), its records, and its
+outputs as one table (`OUTPUTS`: each row a name, the kernel column it reads, units and long
+name) plus what is made from them over the realisations.
+
+Per grid point and realisation, over the statistics window (the record after the start-up
+transient, sweep/models/random_scene.py): the RMS midspan deflection, velocity and absolute
+acceleration, the up-crossing rate of zero, the peak |deflection| (`peak_deflection`), the peak
+factor, and with outputs.clearance each level's up-crossing rate by |q|, the expected number of
+exceedances in the test and the probability of at least one (Poisson: 1 - exp(-nu T)). Over
+the realisations: the mean of each statistic with a 95 % confidence half-width (Student's t),
+the escape probability (the fraction of realisations that diverged: a softening span has no
+stationary RMS), and beside them the exact linear RMS of the same span (stretching and end
+load off) and the realised and specified grms of the input.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from sweep.kernels import layout as tk
+from sweep.kernels import states as km
+
+from ..dataset import derived
+from ..schema import G_UNITS, STANDARD_GRAVITY
+from . import random_scene
+from .random_scene import REALISATION_DIM
+
+CLEARANCE_DIM = "clearance"
+CONFIDENCE = 0.95
+"""The confidence of the intervals on the means over realisations."""
+
+OUTPUTS: tuple[tuple[str, int, str, str], ...] = (
+    ("rms_deflection", tk.RMS_DEFLECTION, "m",
+     "RMS midspan deflection over the statistics window"),
+    ("rms_velocity", tk.RMS_VELOCITY, "m s-1",
+     "RMS midspan velocity over the statistics window"),
+    ("rms_acceleration", tk.RMS_ACCELERATION, "m s-2",
+     "RMS absolute midspan acceleration q'' + a_b over the statistics window"),
+    ("zero_upcrossing_rate", tk.ZERO_RATE, "s-1",
+     "up-crossings of zero by the midspan deflection per second"),
+    ("statistics_window", tk.WINDOW, "s",
+     "length of the statistics window: the record after the start-up transient"),
+)
+"""Per point and realisation: (variable, kernels.layout reals column, units, long name)."""
+MEANS: tuple[str, ...] = ("rms_deflection", "rms_acceleration_g", "peak_deflection",
+                          "peak_factor")
+"""The statistics whose mean over the realisations is stored, with its confidence interval."""
+
+
+@dataclass(frozen=True)
+class RandomInputs:
+    """A random scene's base acceleration, resolved once: spectrum (f Hz, W (m/s^2)^2/Hz) at
+    0 dB; duration (s, each record); t_end (s, the run); sample_rate (Hz); realisations;
+    seed; test_duration (s, for the expected exceedances); clearance (m, levels of |q|)."""
+    spectrum: tuple[np.ndarray, np.ndarray]
+    duration: float
+    t_end: float
+    sample_rate: float
+    realisations: int
+    seed: int
+    test_duration: float
+    clearance: tuple[float, ...]
+
+    @classmethod
+    def of(cls, values: dict[str, Any]) -> RandomInputs | None:
+        """From a scene's resolved values; None where the scene is not random."""
+        key = random_scene.spectrum_key(values)
+        if key is None:
+            return None
+        from .random import spectrum
+        duration = float(values["base.duration"])
+        test = values.get("base.test_duration")
+        return cls(spectrum=spectrum(values[key], key=key, per_g2=key == "base.asd_g2"),
+                   duration=duration, t_end=float(values["solver.t_end"]),
+                   sample_rate=random_scene.sample_rate(values),
+                   realisations=int(values["base.realisations"]),
+                   seed=int(values["base.seed"]),
+                   test_duration=float(test) if test is not None else duration,
+                   clearance=tuple(float(u) for u in values.get("outputs.clearance") or ()))
+
+    def records(self) -> np.ndarray:
+        """The records the kernels take as their `base` switch: (R, 2, N) samples of a_b at
+        0 dB and their derivatives (sweep/models/random.py)."""
+        from .random import synthesise
+        f, w = self.spectrum
+        return synthesise(f, w, self.duration, self.sample_rate, self.realisations,
+                          self.seed).values
+
+
+def set_settings(settings: np.ndarray, random: RandomInputs, coeffs: dict[str, Any],
+                 params: dict[str, Any], tolerance: float) -> None:
+    """A random scene's kernel settings: the statistics window (TAIL, after the start-up
+    transient of the least-damped point, `random_scene.window_fraction`), no settling time,
+    and the clearance levels whose crossings the kernels count."""
+    startup = random_scene.startup_time(coeffs["natural_frequency"], params["damping_ratio"],
+                                        tolerance)
+    settings[tk.TAIL] = random_scene.window_fraction(random.t_end, startup, settings[tk.TAIL])
+    settings[tk.WANT_SETTLING] = 0.0
+    settings[tk.N_LEVELS] = len(random.clearance)
+    for k, level in enumerate(random.clearance):
+        settings[tk.LEVEL_0 + k] = level
+
+
+def _t_factor(n: int) -> float:
+    """Student's t quantile for a two-sided CONFIDENCE interval with n - 1 degrees of
+    freedom (n >= 2), from a table (no SciPy at run time); the normal 1.96 beyond 30."""
+    table = {2: 12.706, 3: 4.303, 4: 3.182, 5: 2.776, 6: 2.571, 7: 2.447, 8: 2.365, 9: 2.306,
+             10: 2.262, 11: 2.228, 12: 2.201, 13: 2.179, 14: 2.160, 15: 2.145, 16: 2.131,
+             17: 2.120, 18: 2.110, 19: 2.101, 20: 2.093, 21: 2.086, 22: 2.080, 23: 2.074,
+             24: 2.069, 25: 2.064, 26: 2.060, 27: 2.056, 28: 2.052, 29: 2.048, 30: 2.045}
+    return table.get(n, 1.96)
+
+
+def mean_and_interval(values: xr.DataArray) -> tuple[xr.DataArray, xr.DataArray]:
+    """The mean over the realisations of the finite values (a diverged realisation has none)
+    and the half-width of its CONFIDENCE interval, t s / sqrt(n) (NaN with fewer than two)."""
+    finite = values.where(np.isfinite(values))
+    n = finite.count(REALISATION_DIM)
+    mean = finite.mean(REALISATION_DIM)
+    spread = finite.std(REALISATION_DIM, ddof=1) if values.sizes[REALISATION_DIM] > 1 \
+        else xr.full_like(mean, np.nan)
+    factor = xr.apply_ufunc(np.vectorize(lambda k: _t_factor(int(k)) if k >= 2 else np.nan,
+                                         otypes=[float]), n)
+    return mean, (factor * spread / np.sqrt(n.where(n > 0))).where(n >= 2)
+
+
+def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
+               basis: Any, n_modes: int, coords: dict[str, xr.DataArray]) -> xr.DataArray:
+    """The exact RMS midspan deflection (m) of the same span made linear (no stretching, no
+    end load) under the same spectrum at each level: the root of the integral of
+    |H(f)|^2 W(f) over the spectrum, H the midspan's receptance summed over the modes, mode n
+    at f1 times its basis frequency ratio with damping ratio zeta, weighted by its midspan
+    value and participation (sweep/models/random.py `linear_mean_square`); on the axes it
+    depends on. NaN where the basis varies over the grid (elastic ends swept)."""
+    from .basis import BasisFamily
+    from .random import linear_mean_square
+    f, w = random.spectrum
+    f1 = derived(coeffs["natural_frequency"], coords)
+    zeta = derived(params["damping_ratio"], coords)
+    level = derived(coeffs["base_accel"], coords)
+    if n_modes == 1:
+        ratio, weight = np.ones(1), np.ones(1)
+        gamma = derived(coeffs["participation"], coords)
+    else:
+        ratio = basis.frequency_ratio / basis.frequency_ratio[0] if not isinstance(
+            basis, BasisFamily) else np.full(n_modes, np.nan)
+        weight = basis.midspan * basis.participation_ratio if not isinstance(
+            basis, BasisFamily) else np.full(n_modes, np.nan)
+        gamma = derived(4.0 / np.pi, coords)
+    f1, zeta, gamma, level = xr.broadcast(f1, zeta, gamma, level)
+    omega = 2.0 * np.pi * f1.values[..., None] * ratio
+    with np.errstate(invalid="ignore"):
+        ms = linear_mean_square(f, w, omega, 2.0 * zeta.values[..., None] * omega,
+                                gamma.values[..., None] * weight)
+    out = f1.copy(data=np.sqrt(ms) * level.values)
+    out.attrs = {"units": "m", "long_name": "exact RMS midspan deflection of the same span "
+                 "made linear (no stretching, no end load) under the same spectrum: beside "
+                 "rms_deflection, the nonlinearity's effect"}
+    return out
+
+
+def realised_grms(records: np.ndarray, random: RandomInputs, t_tail: float) -> np.ndarray:
+    """Each record's RMS (g, at 0 dB) over the statistics window [t_tail, t_end] (s), from
+    its samples there."""
+    fs = random.sample_rate
+    first, last = int(math.ceil(t_tail * fs)), int(math.floor(random.t_end * fs))
+    window = records[:, 0, first:last + 1]
+    return np.sqrt(np.mean(window * window, axis=1)) / STANDARD_GRAVITY
+
+
+def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
+            dims: tuple[str, ...], shape: tuple[int, ...], coords: dict[str, xr.DataArray],
+            random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
+            records: np.ndarray, t_tail: float, basis: Any, n_modes: int) -> tuple[dict[str, xr.DataArray], dict[str, xr.DataArray]]:
+    """The random outputs of a run (variables, extra coordinates): OUTPUTS, the acceleration
+    in g, the peak factor, each MEANS statistic's mean and interval over the realisations,
+    the escape probability, the clearance levels' rates and exceedances, the linear RMS and
+    the input's grms. reals, states: the kernel's (grid order); amplitude: the peak |q| over
+    the window (m) per point."""
+    from .random import grms
+    data: dict[str, xr.DataArray] = {}
+    for name, column, units, long_name in OUTPUTS:
+        data[name] = xr.DataArray(reals[:, column].reshape(shape), dims=dims,
+                                  attrs={"units": units, "long_name": long_name})
+    data["rms_acceleration_g"] = data["rms_acceleration"] / STANDARD_GRAVITY
+    data["rms_acceleration_g"].attrs = {
+        "units": G_UNITS, "long_name": "RMS absolute midspan acceleration in g "
+                                       f"({STANDARD_GRAVITY:g} m s-2), grms"}
+    peak = xr.DataArray(amplitude.reshape(shape), dims=dims, attrs={
+        "units": "m", "long_name": "largest |midspan deflection| over the statistics window"})
+    data["peak_deflection"] = peak
+    with np.errstate(divide="ignore", invalid="ignore"):
+        data["peak_factor"] = peak / data["rms_deflection"]
+    data["peak_factor"].attrs = {"units": "1", "long_name": "peak factor: the largest "
+                                 "|midspan deflection| over the window over its RMS"}
+    for name in MEANS:
+        source = data[name]
+        mean, half = mean_and_interval(source)
+        what = source.attrs["long_name"]
+        data[f"{name}_mean"] = mean.assign_attrs(
+            units=source.attrs["units"], long_name=f"mean over the realisations of: {what}",
+            cell_methods=f"{REALISATION_DIM}: mean")
+        data[f"{name}_ci"] = half.assign_attrs(
+            units=source.attrs["units"], long_name=f"half-width of the {CONFIDENCE:.0%} "
+            f"confidence interval (Student's t) of {name}_mean")
+    escaped = xr.DataArray((states == km.DIVERGED).reshape(shape), dims=dims)
+    data["escape_probability"] = escaped.mean(REALISATION_DIM).assign_attrs(
+        units="1", long_name="fraction of the realisations in which the span escaped "
+        "(diverged) within the run: a softening span's measure, where an RMS means nothing",
+        cell_methods=f"{REALISATION_DIM}: mean")
+    extra: dict[str, xr.DataArray] = {}
+    if random.clearance:
+        levels = xr.DataArray(np.array(random.clearance), dims=CLEARANCE_DIM,
+                              attrs={"units": "m", "long_name": "clearance level of |midspan "
+                                     "deflection| (outputs.clearance)"})
+        extra[CLEARANCE_DIM] = levels
+        n = len(random.clearance)
+        rate = xr.DataArray(reals[:, tk.LEVEL_RATE:tk.LEVEL_RATE + n].reshape(shape + (n,)),
+                            dims=dims + (CLEARANCE_DIM,))
+        data["clearance_upcrossing_rate"] = rate.assign_attrs(
+            units="s-1", long_name="up-crossings of the clearance level by |midspan "
+            "deflection| per second over the statistics window")
+        expected = rate * random.test_duration
+        data["expected_exceedances"] = expected.assign_attrs(
+            units="1", long_name=f"expected number of exceedances of the clearance level in "
+            f"the test ({random.test_duration:g} s): the measured rate times its duration")
+        data["exceedance_probability"] = (1.0 - np.exp(-expected)).assign_attrs(
+            units="1", long_name="probability that |midspan deflection| exceeds the "
+            "clearance level at least once in the test, 1 - exp(-expected_exceedances) "
+            "(Poisson crossings, Rice)")
+    data["linear_rms"] = linear_rms(random, coeffs, params, basis, n_modes, coords)
+    f, w = random.spectrum
+    level = derived(coeffs["base_accel"], coords)
+    data["base_grms_spectrum"] = (level * grms(f, w)).assign_attrs(
+        units=G_UNITS, long_name="RMS base acceleration of the spectrum at its level (grms: "
+                                 "the root of its integral)")
+    realised = xr.DataArray(realised_grms(records, random, t_tail), dims=REALISATION_DIM)
+    data["base_grms"] = (level * realised).assign_attrs(
+        units=G_UNITS, long_name="RMS base acceleration of the record over the statistics "
+                                 "window (grms as realised)")
+    return data, extra

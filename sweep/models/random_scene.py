@@ -1,0 +1,171 @@
+"""The scene rules of a random base acceleration (docs/model.md sec. 11): which keys it takes
+and refuses, its defaults, and the kernel settings it sets (the statistics window, the
+clearance levels). The spectrum and its records are sweep/models/random.py's; the outputs
+sweep/models/random_outputs.py's.
+
+A scene is random when it gives ``base.asd_g2`` (g^2/Hz) or ``base.asd`` ((m/s^2)^2/Hz): the
+records replace the sine ([base] acceleration, frequency, sweep and levels_g are refused with
+them), every grid point sees the same ``base.realisations`` records (a ``realisation``
+dimension), the run ends with the record (``base.duration``; ``solver.t_end`` may be shorter,
+never longer: the record is periodic), and the statistics are taken after the start-up
+transient has decayed (`startup_time`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+
+from .. import schema
+from ..scene.messages import _fail, _show
+
+RANDOM_KEYS: tuple[str, str] = ("base.asd_g2", "base.asd")
+"""The two spellings of the spectrum (g^2/Hz and (m/s^2)^2/Hz)."""
+RANDOM_ONLY: tuple[str, ...] = ("base.asd_scale", "base.duration", "base.realisations",
+                                "base.seed", "base.sample_rate", "base.test_duration",
+                                "outputs.clearance")
+"""Keys that mean something only with a spectrum."""
+SINE_KEYS: tuple[str, ...] = ("base.acceleration", "base.acceleration_g", "base.levels_g",
+                              "base.frequency", "base.frequency_ratio", "base.sweep.start",
+                              "base.sweep.stop", "base.sweep.rate", "base.sweep.ramp_cycles",
+                              "base.sweep.direction")
+MAX_LEVELS = 4
+"""Most clearance levels (kernels.layout.MAX_LEVELS)."""
+REALISATION_DIM = "realisation"
+DEFAULT_RTOL = 1e-6
+"""solver.rtol of a random scene that gives none: its RMS is a statistic whose error over a
+record is about 1 % (docs/model.md sec. 11.3); 1e-6 integrates a record to far better."""
+
+
+def spectrum_key(values: Mapping[str, Any]) -> str | None:
+    """Which spelling of the spectrum a scene gives (values or given keys), or None."""
+    return next((k for k in RANDOM_KEYS if values.get(k) is not None), None)
+
+
+def is_random(values: Mapping[str, Any]) -> bool:
+    """Whether a scene's base excitation is a random record (a spectrum is given)."""
+    return spectrum_key(values) is not None
+
+
+def _present(dotted: str, given: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
+    axis = schema.BY_DOTTED[dotted].axis
+    return dotted in given or (axis is not None and axis in axes)
+
+
+def check(given: dict[str, Any], axes: Mapping[str, Any]) -> None:
+    """Refuse what a random scene cannot take, and random keys without a spectrum (given:
+    dotted key -> value, before defaults; axes: axis name -> values)."""
+    if not is_random(given):
+        for dotted in RANDOM_ONLY:
+            if _present(dotted, given, axes):
+                _fail(f"scene key '{dotted}'", "only for a random base acceleration",
+                      "give its spectrum, [base] asd_g2 = [[20.0, 0.026], [50.0, 0.16], "
+                      "[800.0, 0.16], [2000.0, 0.026]] (Hz, g^2/Hz), or remove the key")
+        return
+    if all(k in given for k in RANDOM_KEYS):
+        _fail("scene keys 'base.asd_g2' and 'base.asd'", "give one, not both",
+              "remove one of them: asd_g2 is in g^2/Hz, asd in (m/s^2)^2/Hz")
+    key = spectrum_key(given)
+    for dotted in SINE_KEYS:
+        if _present(dotted, given, axes):
+            _fail(f"scene key '{dotted}'", f"a random base acceleration ({key}) replaces the "
+                  "sine excitation", f"remove {dotted}, or remove {key} for a sine")
+    if given.get("model.kind") == "longitudinal":
+        _fail(f"scene key '{key}'", "model.kind = 'longitudinal' has no base excitation",
+              "remove the spectrum, or use model.kind = 'transverse'")
+    if given.get("model.coefficients") == "paper":
+        _fail(f"scene key '{key}'", "model.coefficients = 'paper' has no base excitation "
+              "(Eq.32 as printed has no forcing term)", "use model.coefficients = 'consistent'")
+    if given.get("base.duration") is None:
+        _fail("scene section '[base]'", f"a random base acceleration ({key}) needs "
+              "base.duration, each record's length in seconds",
+              "add duration = 20.0 (s) to [base]; 1 % on the RMS of a 100 Hz span with "
+              "2 % damping takes about 200 s of records (base.realisations x duration)")
+    refused = (("continuation.axis", "a stepped sweep steps a sine's frequency",
+                "remove [continuation]"),
+               ("solver.stop_when_steady", "a random response is never steady",
+                "remove it"),
+               ("outputs.settling_time", "a random response has no settling time",
+                "remove it: a random scene stores RMS, peaks and crossing rates"),
+               ("outputs.stability", "the Floquet chart is the unforced span's",
+                "run it in a scene without the spectrum"),
+               ("outputs.envelope", "the envelope is a sine sweep's", "remove it"))
+    for dotted, why, fix in refused:
+        if given.get(dotted) not in (None, False):
+            _fail(f"scene key '{dotted}'", f"{why} ({key} is a random base acceleration)", fix)
+    if given.get("solver.driver") == "lanes":
+        _fail("scene key 'solver.driver'", "a random base acceleration is solved by the "
+              "'scalar' driver only (the lanes' vector loops take a fixed sine)",
+              "remove solver.driver (a random scene takes 'scalar')")
+    duration = given["base.duration"]
+    t_end = given.get("solver.t_end")
+    if t_end is not None and t_end > duration:
+        _fail("scene key 'solver.t_end'", f"{_show(t_end)} s is longer than the record, "
+              f"base.duration = {_show(duration)} s (the record repeats with that period)",
+              "remove solver.t_end (the run ends with the record), or give a longer "
+              "base.duration")
+    levels = given.get("outputs.clearance")
+    if levels is not None:
+        if not 1 <= len(levels) <= MAX_LEVELS or not all(u > 0.0 for u in levels):
+            _fail("scene key 'outputs.clearance'", f"{_show(levels)}: give 1 to "
+                  f"{MAX_LEVELS} levels of |deflection|, each > 0 (m)",
+                  "e.g. clearance = [0.001, 0.002]")
+    _check_sampling(given, key)
+
+
+def _check_sampling(given: Mapping[str, Any], key: str) -> None:
+    """The records' sample rate must carry the spectrum (above twice its top frequency)."""
+    top = float(given[key][-1][0])
+    rate = given.get("base.sample_rate")
+    if rate is not None and not rate > 2.0 * top:
+        _fail("scene key 'base.sample_rate'", f"{_show(rate)} Hz cannot carry the spectrum "
+              f"up to {top:g} Hz (it must be above twice its top frequency)",
+              f"give at least {2.5 * top:g} Hz, or remove it (the default is 10 x, "
+              f"{10.0 * top:g} Hz)")
+
+
+def defaults(values: dict[str, Any], mentioned: set[str]) -> None:
+    """A random scene's defaults: its level 0 dB, one record, seed 0, the scalar driver,
+    DOP853 at rtol DEFAULT_RTOL, t_end the
+    record's length, and no settling time or response period (they mean nothing for a
+    random response)."""
+    for dotted, value in (("base.asd_scale", 0.0), ("base.realisations", 1), ("base.seed", 0),
+                          ("solver.driver", "scalar"), ("solver.method", "dop853"),
+                          ("solver.rtol", DEFAULT_RTOL),
+                          ("solver.t_end", values["base.duration"]), ("metrics.tail", 1.0),
+                          ("outputs.settling_time", False),
+                          ("outputs.response_period", False)):
+        if dotted not in mentioned:
+            values[dotted] = value
+
+
+def sample_rate(values: Mapping[str, Any]) -> float:
+    """The records' sample rate (Hz): base.sample_rate, or 10 x the spectrum's top
+    frequency (the usual rule, docs/model.md sec. 11.1)."""
+    given = values.get("base.sample_rate")
+    return float(given) if given is not None else 10.0 * float(values[spectrum_key(values)][-1][0])
+
+
+def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float) -> float:
+    """How long (s) the start-up transient of the slowest point takes to decay to
+    `tolerance` of its size: ln(1/tolerance) / (zeta w1), the largest over the grid (mode 1
+    decays slowest: every mode's zeta w_n is w_n / w1 times mode 1's). Infinite undamped."""
+    with np.errstate(divide="ignore"):
+        rate = np.asarray(damping_ratio * 2.0 * math.pi * natural_frequency, float)
+    slowest = float(np.min(rate))
+    return math.log(1.0 / tolerance) / slowest if slowest > 0.0 else math.inf
+
+
+def window_fraction(t_end: float, startup: float, tail: float) -> float:
+    """The kernels' TAIL setting of a random scene: its statistics window is the last `tail`
+    of the run (metrics.tail, 1 by default) but never the start-up transient (`startup_time`,
+    s): it starts at the later of the two. One-line error where less than a tenth of the run
+    is left after the transient."""
+    if not startup < 0.9 * t_end:
+        _fail("scene key 'base.duration'", f"the run ({t_end:g} s) leaves less than a tenth "
+              f"of it after the start-up transient has decayed ({startup:.3g} s = "
+              "ln(1/metrics.tolerance) / (zeta w1) at the least-damped point)",
+              f"give base.duration of at least {10.0 * startup:.3g} s, or more damping")
+    return min(tail, (t_end - startup) / t_end)
