@@ -30,6 +30,8 @@ REDUCED = {
     "launch-sine-qualification": {"axes.length": [0.2, 0.4], "base.sweep.rate": 64.0},
     "harness-clamps": {"axes.length": [0.2, 0.4], "axes.clamp_rotational_stiffness": [0.1, 10.0],
                        "solver.t_end": 0.3},
+    "launch-random-gevs": {"axes.length": [0.1, 0.15], "base.realisations": 2,
+                           "base.duration": 2.0},
 }
 # The checker's priorities: high are its "errors", medium its "warnings", low its
 # "suggestions". A file fails on either of the first two.

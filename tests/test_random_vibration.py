@@ -275,3 +275,27 @@ def test_a_record_shorter_than_the_start_up_is_refused():
     with pytest.raises(SceneError) as caught:
         sweep.run(sc)
     assert "start-up transient" in str(caught.value)
+
+
+def test_a_softening_oscillator_escapes_and_has_no_rms():
+    """q'' + 2 zeta w q' + w^2 q - k q^3 = -a_b with the barrier at q_b = w / sqrt(k) equal to
+    1.5 linear RMS: every realisation leaves through it within 8 s (the divergence bound put
+    just beyond it), reported diverged with its failure time inside the run and NaN
+    statistics (an escape has no stationary RMS); at a barrier of 8 RMS none escapes."""
+    f, w = rnd.spectrum(FLAT)
+    omega, zeta = 2 * math.pi * 60.0, 0.05
+    sigma = math.sqrt(float(rnd.linear_mean_square(
+        f, w, np.array([omega]), np.array([2 * zeta * omega]), np.ones(1))))
+    records = rnd.synthesise(f, w, 8.0, 5000.0, 4, 2)
+    for barrier, escapes in ((1.5 * sigma, True), (8.0 * sigma, False)):
+        rows = _rows(omega, zeta, -omega ** 2 / barrier ** 2, 4, 5000.0)
+        rows[:, osc.BOUND] = 1.2 * barrier
+        out = _run(rows, records, 8.0, 1.0)
+        if escapes:
+            assert np.all(out["states"] == 5)                       # diverged
+            times = out["reals"][:, tk.FAILURE_TIME]
+            assert np.all((times > 0.0) & (times < 8.0))
+            assert np.all(np.isnan(out["reals"][:, tk.RMS_DEFLECTION]))
+        else:
+            assert np.all(out["states"] == 8)
+            assert np.all(np.isfinite(out["reals"][:, tk.RMS_DEFLECTION]))

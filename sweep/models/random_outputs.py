@@ -204,16 +204,14 @@ def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
         mean, half = mean_and_interval(source)
         what = source.attrs["long_name"]
         data[f"{name}_mean"] = mean.assign_attrs(
-            units=source.attrs["units"], long_name=f"mean over the realisations of: {what}",
-            cell_methods=f"{REALISATION_DIM}: mean")
+            units=source.attrs["units"], long_name=f"mean over the realisations of: {what}")
         data[f"{name}_ci"] = half.assign_attrs(
             units=source.attrs["units"], long_name=f"half-width of the {CONFIDENCE:.0%} "
             f"confidence interval (Student's t) of {name}_mean")
     escaped = xr.DataArray((states == km.DIVERGED).reshape(shape), dims=dims)
     data["escape_probability"] = escaped.mean(REALISATION_DIM).assign_attrs(
         units="1", long_name="fraction of the realisations in which the span escaped "
-        "(diverged) within the run: a softening span's measure, where an RMS means nothing",
-        cell_methods=f"{REALISATION_DIM}: mean")
+        "(diverged) within the run: a softening span's measure, where an RMS means nothing")
     extra: dict[str, xr.DataArray] = {}
     if random.clearance:
         levels = xr.DataArray(np.array(random.clearance), dims=CLEARANCE_DIM,

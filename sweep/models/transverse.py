@@ -712,9 +712,15 @@ def band_coordinates(first: int, count: int, bands_per_octave: int) -> dict[str,
     return {BAND_DIM: centre, bounds_name: edges}
 
 
-def state_attrs(swept: bool = False) -> dict[str, Any]:
+def state_attrs(swept: bool = False, random: bool = False) -> dict[str, Any]:
     """CF flag attributes of the transverse `state` variable (`swept`: of a swept base
-    frequency, whose points complete their sweeps or fail)."""
+    frequency, whose points complete their sweeps or fail; `random`: of a random base
+    acceleration, whose records run to their ends or escape)."""
+    if random:
+        return {**flag_attrs(km.SWEPT_STATES), "long_name": "response state of the point",
+                "comment": "completed: the record ran to its end (a random response has no "
+                           "settling to judge); diverged: the span escaped (failure_time says "
+                           "when); the failure states have NaN outputs"}
     if swept:
         return {**flag_attrs(km.SWEPT_STATES), "long_name": "response state of the point",
                 "comment": "completed: the point ran its whole sweep (a sweep has no settling "
@@ -739,7 +745,7 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     short, method = METHODS[inputs.method]
     data: dict[str, xr.DataArray] = {}
     data["state"] = xr.DataArray(result.states.reshape(shape), dims=dims,
-                                 attrs=state_attrs(inputs.swept or inputs.random is not None))
+                                 attrs=state_attrs(inputs.swept, inputs.random is not None))
     for name, (col, units, long_name, switch) in _REALS.items():
         if switch is None or switch in inputs.wanted:
             data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
