@@ -161,11 +161,22 @@ def _as_floats(where: str, key: schema.Key, raw: Any) -> tuple[float, ...]:
     return tuple(values)
 
 
+MAX_SPECTRUM_BREAKPOINTS = 200
+"""Most breakpoints of a random spectrum (base.asd_g2, base.asd)."""
+
+
 def _as_pairs(where: str, key: schema.Key, raw: Any) -> tuple[tuple[float, float], ...]:
     """A table of breakpoints: 2 to MAX_BREAKPOINTS [x, y] pairs of finite numbers > 0, x
-    strictly increasing (``base.levels_g``: x in Hz, y in g)."""
+    strictly increasing (``base.levels_g``: x in Hz, y in g; a spectrum, ``base.asd_g2`` or
+    ``base.asd``: up to MAX_SPECTRUM_BREAKPOINTS, y in g^2/Hz or (m/s^2)^2/Hz)."""
     from ..models.excitation import MAX_BREAKPOINTS
-    fix = f"write e.g. {key.name} = [[5.0, 0.5], [100.0, 0.6]] (Hz, g)"
+    if key.name.startswith("asd"):
+        MAX_BREAKPOINTS = MAX_SPECTRUM_BREAKPOINTS      # read by the models, not a kernel table
+        unit = "g^2/Hz" if key.name == "asd_g2" else "(m/s^2)^2/Hz"
+        fix = (f"write e.g. {key.name} = [[20.0, 0.026], [50.0, 0.16], [800.0, 0.16], "
+               f"[2000.0, 0.026]] (Hz, {unit})")
+    else:
+        fix = f"write e.g. {key.name} = [[5.0, 0.5], [100.0, 0.6]] (Hz, g)"
     if not isinstance(raw, list) or not 2 <= len(raw) <= MAX_BREAKPOINTS:
         _fail(where, f"must be a list of 2 to {MAX_BREAKPOINTS} [frequency, level] pairs, got "
               f"{_show(raw)}", fix)
