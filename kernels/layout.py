@@ -71,7 +71,9 @@ RMS_ACCELERATION = 17  # RMS of the absolute acceleration q'' + a_b (m/s^2)
 ZERO_RATE = 18      # up-crossings of q = 0 per second (1/s)
 LEVEL_RATE = 19     # level k's up-crossings by |q| per second (1/s) at LEVEL_RATE + k
 WINDOW = LEVEL_RATE + MAX_LEVELS  # the statistics window's length (s)
-N_REALS = WINDOW + 1
+RMS_RELATIVE = WINDOW + 1  # RMS of q'' (m/s^2): with RMS_DEFLECTION and RMS_VELOCITY, q's
+                    # spectral moments m0, m2, m4 are their squares
+N_REALS = RMS_RELATIVE + 1
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -91,7 +91,8 @@ W_END = W_START + 1      # the last step end in it (s)
 SUM_Q2 = W_END + 1       # integral of q^2 dt (m^2 s), on the step's quintic Hermite
 SUM_V2 = SUM_Q2 + 1      # integral of q'^2 dt (m^2/s), on the same quintic's slope
 SUM_A2 = SUM_V2 + 1      # integral of (q'' + a_b)^2 dt (m^2/s^3), trapezoidal on step ends
-UP_ZERO = SUM_A2 + 1     # up-crossings of q = 0
+SUM_F2 = SUM_A2 + 1      # integral of q''^2 dt (m^2/s^3), on the quintic's second derivative
+UP_ZERO = SUM_F2 + 1     # up-crossings of q = 0
 UP_LEVEL = UP_ZERO + 1   # level k's crossings of |q| upwards through settings[LEVEL_0 + k]
 SCALAR_SLOTS = UP_LEVEL + MAX_LEVELS
 
@@ -753,11 +754,11 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
 
 
 def _quintic_gram() -> tuple[np.ndarray, np.ndarray]:
-    """(M, D): the Gram matrices over [0, 1] of the quintic Hermite basis H_i (the
+    """(M, D, E): the Gram matrices over [0, 1] of the quintic Hermite basis H_i (the
     polynomials of degree 5 with H_i's value, slope and second derivative at 0 and 1 the unit
     vector e_i, in the order value, slope, second derivative at 0, then at 1) and of their
-    derivatives: M_ij = int H_i H_j, D_ij = int H_i' H_j'. From the monomials' exact
-    integrals; computed once, at import."""
+    first and second derivatives: M_ij = int H_i H_j, D_ij = int H_i' H_j', E_ij = int H_i''
+    H_j''. From the monomials' exact integrals; computed once, at import."""
     conditions = np.zeros((6, 6))
     for k in range(6):                     # value, slope, second derivative of s^k at 0 and 1
         conditions[0, k] = 1.0 if k == 0 else 0.0
@@ -770,28 +771,33 @@ def _quintic_gram() -> tuple[np.ndarray, np.ndarray]:
     powers = np.arange(6)
     plain = 1.0 / (powers[:, None] + powers[None, :] + 1.0)
     slope = np.zeros((6, 6))
+    curve = np.zeros((6, 6))
     for a in range(1, 6):
         for b in range(1, 6):
             slope[a, b] = a * b / (a + b - 1.0)
-    return basis.T @ plain @ basis, basis.T @ slope @ basis
+            if a >= 2 and b >= 2:
+                curve[a, b] = a * (a - 1) * b * (b - 1) / (a + b - 3.0)
+    return (basis.T @ plain @ basis, basis.T @ slope @ basis, basis.T @ curve @ basis)
 
 
-_GRAM, _SLOPE_GRAM = _quintic_gram()
+_GRAM, _SLOPE_GRAM, _CURVE_GRAM = _quintic_gram()
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _quintic_squares(h, q0, v0, a0, q1, v1, a1):
-    """The integrals over a step of length h (s) of q^2 and q'^2 on the quintic Hermite
-    through q, q' = v and q'' = a at both ends: (h c^T M c, c^T D c / h), c = (q0, h v0,
-    h^2 a0, q1, h v1, h^2 a1), M and D `_quintic_gram`'s."""
+    """The integrals over a step of length h (s) of q^2, q'^2 and q''^2 on the quintic
+    Hermite through q, q' = v and q'' = a at both ends: (h c^T M c, c^T D c / h,
+    c^T E c / h^3), c = (q0, h v0, h^2 a0, q1, h v1, h^2 a1), M, D, E `_quintic_gram`'s."""
     c = (1.0 * q0, h * v0, h * h * a0, 1.0 * q1, h * v1, h * h * a1)
     square = 0.0
     slope = 0.0
+    curve = 0.0
     for i in range(6):
         for j in range(6):
             square += c[i] * _GRAM[i, j] * c[j]
             slope += c[i] * _SLOPE_GRAM[i, j] * c[j]
-    return h * square, slope / h
+            curve += c[i] * _CURVE_GRAM[i, j] * c[j]
+    return h * square, slope / h, curve / (h * h * h)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -812,8 +818,8 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
     """The record kind's statistics of the accepted step [t, t_new] (s) of the watched
     deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
     m/s^2; qe its extremum inside the step where has_ext), once the step starts at or after
-    the tail window's start: the integrals of q^2 and q'^2 on the quintic Hermite through q,
-    q', q'' at both ends (`_quintic_squares`), of (q'' + a_b)^2 by the trapezoidal rule
+    the tail window's start: the integrals of q^2, q'^2 and q''^2 on the quintic Hermite
+    through q, q', q'' at both ends (`_quintic_squares`), of (q'' + a_b)^2 by the trapezoidal rule
     (SCALAR_SLOTS), and
     the crossings of zero and of settings' levels on the step's monotone pieces, q_old to qe
     to q_new (a level grazed inside a step counts)."""
@@ -824,9 +830,10 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
         acc[W_START] = t
     h = t_new - t
     acc[W_END] = t_new
-    square, slope = _quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+    square, slope, curve = _quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
     acc[SUM_Q2] += square
     acc[SUM_V2] += slope
+    acc[SUM_F2] += curve
     acc[SUM_A2] += 0.5 * h * (a_old * a_old + a_new * a_new)
     if has_ext:
         _count_crossings(settings, acc, q_old, qe)

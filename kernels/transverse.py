@@ -31,7 +31,7 @@ from .layout import (ACCELERATION, AMPLITUDE, BANDS_PER_OCTAVE, FAILURE_TIME, FI
                      N_COUNTS, N_REALS, PEAK, PEAK_FREQUENCY, PERIOD, Q_END, SWEPT, V_END,
                      REJECTED, RHS_EVALS, RTOL, SETTLING, STEPS, STOP_TIME, T_END,
                      TOL, WANT_SETTLING, LEVEL_RATE, N_LEVELS, RMS_ACCELERATION,
-                     RMS_DEFLECTION, RMS_VELOCITY, WINDOW, ZERO_RATE)
+                     RMS_DEFLECTION, RMS_RELATIVE, RMS_VELOCITY, WINDOW, ZERO_RATE)
 from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepare,
                          stiffness)
 
@@ -249,7 +249,7 @@ def solve_point(row, settings, reals, counts, series, envelope, parametric, base
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def random_outputs(settings, acc, reals):
     """A random base acceleration's statistics over the window of a trajectory that ran to
-    its end (kernels.trajectory.observe_random): the RMS of q, q' and q'' + a_b, the
+    its end (kernels.trajectory.observe_random): the RMS of q, q', q'' and q'' + a_b, the
     up-crossing rates of zero and of settings' levels of |q|, the window's length. A random
     response has no settling to judge: the state is COMPLETED."""
     span = acc[tj.W_END] - acc[tj.W_START]
@@ -258,6 +258,7 @@ def random_outputs(settings, acc, reals):
     reals[RMS_DEFLECTION] = math.sqrt(acc[tj.SUM_Q2] / span)
     reals[RMS_VELOCITY] = math.sqrt(acc[tj.SUM_V2] / span)
     reals[RMS_ACCELERATION] = math.sqrt(acc[tj.SUM_A2] / span)
+    reals[RMS_RELATIVE] = math.sqrt(acc[tj.SUM_F2] / span)
     reals[ZERO_RATE] = acc[tj.UP_ZERO] / span
     for k in range(int(settings[N_LEVELS])):
         reals[LEVEL_RATE + k] = acc[tj.UP_LEVEL + k] / span

@@ -229,3 +229,20 @@ def test_a_data_sheet_beyond_double_range_is_one_line():
     with pytest.raises(sweep.SceneError) as info:
         sweep.load_scene("harness-clamps", overrides={"cable.axial_rigidity": 1e308})
     assert "cable.axial_rigidity" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_data_sheet_without_a_diameter_reports_no_bending_strain():
+    """A data sheet gives no area to take an outer diameter from: a pinned span under the
+    uniform tension reports its tension and axial strain but no bending strain (it once took
+    the 1 m^2 reference area's 1.13 m and said 50 % strain); with cable.diameter the midspan's
+    is (d / 2) (pi / l)^2 times the one mode's amplitude."""
+    text = ('[cable]\nlinear_mass = "53.4 g/m"\nbending_rigidity = "0.31515 N m^2"\n'
+            'axial_rigidity = "660 kN"\n[base]\nacceleration_g = 0.5\nfrequency = 20.0\n'
+            '[axes]\nlength = [0.3, 0.5]\n[solver]\nt_end = 1.0\n')
+    bare = sweep.run(load(text))
+    assert "axial_strain" in bare and "midspan_bending_strain" not in bare
+    assert "max_strain" not in bare
+    given = sweep.run(load(text.replace('axial_rigidity = "660 kN"\n',
+                                        'axial_rigidity = "660 kN"\ndiameter = "2 mm"\n')))
+    expected = 0.5 * 2e-3 * (np.pi / given.length) ** 2 * given.amplitude
+    np.testing.assert_allclose(given.midspan_bending_strain, expected, rtol=1e-12)

@@ -65,25 +65,27 @@ def _largest_strain(p: Peaks, s: Span) -> Any:
 
 class Output(NamedTuple):
     """One row of `OUTPUTS`: name, units, long name, value(peaks, span), and when it is made:
-    `clamped` (only where the clamps hold rotation: a pin's is 0) and `tension` (only with
-    the uniform stretching tension)."""
+    `clamped` (only where the clamps hold rotation: a pin's is 0), `tension` (only with the
+    uniform stretching tension) and `diameter` (only where the cable's outer diameter is
+    known: a data sheet without cable.diameter gives none)."""
     name: str
     units: str
     long_name: str
     value: Callable[[Peaks, Span], Any]
     clamped: bool = False
     tension: bool = False
+    diameter: bool = False
 
 
 OUTPUTS = (
     Output("clamp_bending_strain", "1", "bending strain of the outer fibre at the clamp: (d / 2) "
            "max |w_xx| at either clamp over the tail window (d the cable's diameter; the "
-           "stretching's N / EA not included)", _strain("clamp"), clamped=True),
+           "stretching's N / EA not included)", _strain("clamp"), clamped=True, diameter=True),
     Output("clamp_moment", "N m", "bending moment at the clamp: EI max |w_xx| at either clamp "
            "over the tail window", lambda p, s: s.bending * p.clamp / s.length ** 2,
            clamped=True),
     Output("midspan_bending_strain", "1", "bending strain of the outer fibre at midspan: "
-           "(d / 2) max |w_xx(l/2)| over the tail window", _strain("midspan")),
+           "(d / 2) max |w_xx(l/2)| over the tail window", _strain("midspan"), diameter=True),
     Output("clamp_force", "N", "transverse reaction at the clamp: max |V| at either clamp over "
            "the tail window, V = -EI w_xxx + N w_x (the shear plus the stretching tension's "
            "transverse part; without model.membrane's local term)",
@@ -95,7 +97,7 @@ OUTPUTS = (
            lambda p, s: _tension(p, s) / s.axial, tension=True),
     Output("max_strain", "1", "largest outer-fibre strain reported: max(clamp_bending_strain, "
            "midspan_bending_strain) + axial_strain (their peaks added: an upper bound where "
-           "they do not coincide)", _largest_strain, tension=True),
+           "they do not coincide)", _largest_strain, tension=True, diameter=True),
 )
 NAMES = tuple(o.name for o in OUTPUTS)
 
@@ -170,9 +172,11 @@ def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
                 derived(p["youngs_modulus"] * p["area"], coords), diameter,
                 None if k_s is None else derived(k_s, coords))
     clamped = (p.get("clamps_rotation") or "pinned") != "pinned"
+    sheet_without_diameter = p.get("diameter") is None and p.get("linear_mass") is not None
     out = {}
     for o in OUTPUTS:
-        if (o.clamped and not clamped) or (o.tension and span.k_s is None):
+        if ((o.clamped and not clamped) or (o.tension and span.k_s is None)
+                or (o.diameter and sheet_without_diameter)):
             continue
         value = xr.DataArray(o.value(peaks, span)).transpose(*dims)
         long_name = o.long_name.replace("over the tail window", "over the whole sweep") \

@@ -42,6 +42,9 @@ OUTPUTS: tuple[tuple[str, int, str, str], ...] = (
      "RMS midspan velocity over the statistics window"),
     ("rms_acceleration", tk.RMS_ACCELERATION, "m s-2",
      "RMS absolute midspan acceleration q'' + a_b over the statistics window"),
+    ("rms_relative_acceleration", tk.RMS_RELATIVE, "m s-2",
+     "RMS of the midspan deflection's second derivative q'' (relative to the clamps) over the "
+     "statistics window"),
     ("zero_upcrossing_rate", tk.ZERO_RATE, "s-1",
      "up-crossings of zero by the midspan deflection per second"),
     ("statistics_window", tk.WINDOW, "s",
@@ -165,6 +168,46 @@ def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, A
     return out
 
 
+def spectral_moments(data: dict[str, xr.DataArray], n_modes: int,
+                     loads: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
+    """The midspan deflection's spectral moments m0 = E[q^2], m2 = E[q'^2], m4 = E[q''^2]
+    (the squares of its RMS, its rate's and its second derivative's) and the irregularity
+    factor m2 / sqrt(m0 m4) (1: narrow band); with one mode, whose bending strains are
+    proportional to q, the RMS bending strain at each place the loads report and its moments
+    (the deflection's times the strain per metre squared; `loads`: the loads' variables,
+    sweep/models/loads.py), for fatigue."""
+    m0 = data["rms_deflection"] ** 2
+    m2 = data["rms_velocity"] ** 2
+    m4 = data["rms_relative_acceleration"] ** 2
+    out = {}
+    for order, value, units in ((0, m0, "m2"), (2, m2, "m2 s-2"), (4, m4, "m2 s-4")):
+        out[f"deflection_m{order}"] = value.assign_attrs(
+            units=units, long_name=f"spectral moment m{order} of the midspan deflection: the "
+            f"mean square of its {['', '', 'rate', '', 'second derivative'][order] or 'value'}"
+            " over the statistics window")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out["irregularity_factor"] = (m2 / np.sqrt(m0 * m4)).assign_attrs(
+            units="1", long_name="irregularity factor m2 / sqrt(m0 m4) of the midspan "
+            "deflection (1: narrow band, every zero crossing a peak)")
+    if n_modes != 1:
+        return out
+    for place in ("clamp", "midspan"):
+        peak = loads.get(f"{place}_bending_strain")
+        if peak is None:
+            continue
+        with np.errstate(divide="ignore", invalid="ignore"):
+            per_metre = peak / data["peak_deflection"]     # one mode: strain = c q
+        out[f"rms_{place}_bending_strain"] = (per_metre * data["rms_deflection"]).assign_attrs(
+            units="1", long_name=f"RMS outer-fibre bending strain at the {place} over the "
+            "statistics window (one mode: proportional to the midspan deflection)")
+        for order, value, units in ((0, m0, "1"), (2, m2, "s-2"), (4, m4, "s-4")):
+            out[f"{place}_strain_m{order}"] = (per_metre ** 2 * value).assign_attrs(
+                units=units, long_name=f"spectral moment m{order} of the bending strain at "
+                f"the {place} (for fatigue: narrow-band damage from m0 and m2, Dirlik's "
+                "from m0 to m4 and m1)")
+    return out
+
+
 def realised_grms(records: np.ndarray, random: RandomInputs, t_tail: float) -> np.ndarray:
     """Each record's RMS (g, at 0 dB) over the statistics window [t_tail, t_end] (s), from
     its samples there."""
@@ -177,12 +220,13 @@ def realised_grms(records: np.ndarray, random: RandomInputs, t_tail: float) -> n
 def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
             dims: tuple[str, ...], shape: tuple[int, ...], coords: dict[str, xr.DataArray],
             random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
-            records: np.ndarray, t_tail: float, basis: Any, n_modes: int) -> tuple[dict[str, xr.DataArray], dict[str, xr.DataArray]]:
+            records: np.ndarray, t_tail: float, basis: Any, n_modes: int,
+            loads: dict[str, xr.DataArray] | None = None) -> tuple[dict[str, xr.DataArray], dict[str, xr.DataArray]]:
     """The random outputs of a run (variables, extra coordinates): OUTPUTS, the acceleration
     in g, the peak factor, each MEANS statistic's mean and interval over the realisations,
     the escape probability, the clearance levels' rates and exceedances, the linear RMS and
     the input's grms. reals, states: the kernel's (grid order); amplitude: the peak |q| over
-    the window (m) per point."""
+    the window (m) per point; loads: the span's load outputs (for the strains' moments)."""
     from .random import grms
     data: dict[str, xr.DataArray] = {}
     for name, column, units, long_name in OUTPUTS:
@@ -232,6 +276,7 @@ def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
             units="1", long_name="probability that |midspan deflection| exceeds the "
             "clearance level at least once in the test, 1 - exp(-expected_exceedances) "
             "(Poisson crossings, Rice)")
+    data.update(spectral_moments(data, n_modes, loads or {}))
     data["linear_rms"] = linear_rms(random, coeffs, params, basis, n_modes, coords)
     f, w = random.spectrum
     level = derived(coeffs["base_accel"], coords)

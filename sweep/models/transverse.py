@@ -774,7 +774,7 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
         variables, extra = random_outputs.outputs(
             result.reals, result.states, result.reals[:, tk.AMPLITUDE], dims, shape, coords,
             inputs.random, coeffs, inputs.params, records, t_tail, inputs.basis,
-            inputs.n_modes)
+            inputs.n_modes, data)
         data.update(variables)
         coords = {**coords, **extra}
     elif inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
