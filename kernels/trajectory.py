@@ -712,7 +712,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
                                   K[fsal_row(K), 1], t_tail, track, centre, thr_fixed,
                                   thr_rel, True, None, base)
     if base is not None:
-        if acc[ACC_TURN] != 0.0:
+        if acc[ACC_TURN] != 0.0 and not ex.is_record(base):
             refine_acceleration_peak(acc, 0, 1, p, o, s, base)
         if t < t_tail <= t_new:
             observe_tail_start(acc, p, o, s, t_tail, t, q_old, v_old, fv_old, base)
