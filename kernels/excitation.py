@@ -57,6 +57,8 @@ SIZE = RAMP + 1
 RECORD_SCALE = ACCEL   # the level factor on the record (1), 10^(dB / 20) of a level in dB
 RECORD_RATE = OMEGA    # fs, the records' sample rate (Hz)
 RECORD = PHASE         # r, which record (realisation) the row follows (an index, as a float)
+RECORD_START = END     # the row's statistics start no earlier than this (s): its start-up
+                       # transient's end (kernels.trajectory.delay_window)
 
 NAMES = (("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments",
           "sweep_end", "log_base_omega")

@@ -579,6 +579,9 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     a0 = fv + (md.base_acceleration(0.0, pp, n, base) if base is not None else 0.0)
     tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
              fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
+    if ex.is_record(base):
+        tj.delay_window(acc, row[md.EXCITATION + ex.RECORD_START])
+        t_tail = acc[tj.T_TAIL]
     for i in range(n):
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
         modal[n + i] = abs(y[i])

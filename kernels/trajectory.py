@@ -31,7 +31,8 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
                      STEADY_PERIODS, STEADY_TOL, TAIL, T_END)
-from .oscillator import BOUND, Q0, Q_SCALE, V0, V_SCALE, acceleration, base_acceleration
+from .oscillator import (BOUND, EXCITATION, Q0, Q_SCALE, V0, V_SCALE, acceleration,
+                         base_acceleration)
 from .stages import InlineWhereTrue
 from .vecmath import log2_fast
 
@@ -159,6 +160,22 @@ def start(p, o, s, settings, acc, series, parametric, base):
     if base is not None:
         a0 += base_acceleration(0.0, p, o, s, None, base)
     begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, p[o + BOUND * s])
+    if ex.is_record(base):
+        delay_window(acc, p[o + (EXCITATION + ex.RECORD_START) * s])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def delay_window(acc, start):
+    """A random record's own statistics window: the tail window starts no earlier than
+    `start` (s, the row's start-up transient's end), so that a point's statistics depend on
+    its own row only, not on the grid's slowest point. Called right after `begin`."""
+    if start <= acc[T_TAIL]:
+        return
+    acc[T_TAIL] = start
+    acc[TAIL_AMP] = 0.0
+    acc[TAIL_QMIN] = math.inf
+    acc[TAIL_QMAX] = -math.inf
+    acc[ACC_AMP] = 0.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

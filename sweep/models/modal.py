@@ -334,6 +334,9 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
     if p.get("base_asd") is not None:     # the record kind: level factor, sample rate, record
         block = excitation.block(random_level(p), p["base_sample_rate"])
         block["base_phase"] = p["realisation"]
+        with np.errstate(divide="ignore"):   # the row's statistics start after its transient
+            block["sweep_end"] = (np.log(1.0 / p["statistics_tolerance"])
+                                  / (p["damping_ratio"] * omega_1))
         return {"participation": PARTICIPATION, **block}
     if p.get("base_acceleration") is None and p.get("base_acceleration_g") is None \
             and levels is None:

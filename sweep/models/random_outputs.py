@@ -98,12 +98,13 @@ class RandomInputs:
 
 def set_settings(settings: np.ndarray, random: RandomInputs, coeffs: dict[str, Any],
                  params: dict[str, Any], tolerance: float) -> None:
-    """A random scene's kernel settings: the statistics window (TAIL, after the start-up
-    transient of the least-damped point, `random_scene.window_fraction`), no settling time,
-    and the clearance levels whose crossings the kernels count."""
-    startup = random_scene.startup_time(coeffs["natural_frequency"], params["damping_ratio"],
-                                        tolerance)
-    settings[tk.TAIL] = random_scene.window_fraction(random.t_end, startup, settings[tk.TAIL])
+    """A random scene's kernel settings: no settling time, and the clearance levels whose
+    crossings the kernels count. The statistics window is metrics.tail's (TAIL, the whole run
+    by default), each point's starting no earlier than its own start-up transient's end (its
+    row's RECORD_START, sweep/models/modal.py); a run too short for the least-damped point is
+    refused (`random_scene.check_duration`)."""
+    random_scene.check_duration(random.t_end, random_scene.startup_time(
+        coeffs["natural_frequency"], params["damping_ratio"], tolerance))
     settings[tk.WANT_SETTLING] = 0.0
     settings[tk.N_LEVELS] = len(random.clearance)
     for k, level in enumerate(random.clearance):
@@ -208,19 +209,17 @@ def spectral_moments(data: dict[str, xr.DataArray], n_modes: int,
     return out
 
 
-def realised_grms(records: np.ndarray, random: RandomInputs, t_tail: float) -> np.ndarray:
-    """Each record's RMS (g, at 0 dB) over the statistics window [t_tail, t_end] (s), from
-    its samples there."""
-    fs = random.sample_rate
-    first, last = int(math.ceil(t_tail * fs)), int(math.floor(random.t_end * fs))
-    window = records[:, 0, first:last + 1]
-    return np.sqrt(np.mean(window * window, axis=1)) / STANDARD_GRAVITY
+def realised_grms(records: np.ndarray, random: RandomInputs) -> np.ndarray:
+    """Each record's RMS (g, at 0 dB) over the run [0, t_end] (s), from its samples."""
+    last = int(math.floor(random.t_end * random.sample_rate))
+    run = records[:, 0, :last + 1]
+    return np.sqrt(np.mean(run * run, axis=1)) / STANDARD_GRAVITY
 
 
 def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
             dims: tuple[str, ...], shape: tuple[int, ...], coords: dict[str, xr.DataArray],
             random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
-            records: np.ndarray, t_tail: float, basis: Any, n_modes: int,
+            records: np.ndarray, basis: Any, n_modes: int,
             loads: dict[str, xr.DataArray] | None = None) -> tuple[dict[str, xr.DataArray], dict[str, xr.DataArray]]:
     """The random outputs of a run (variables, extra coordinates): OUTPUTS, the acceleration
     in g, the peak factor, each MEANS statistic's mean and interval over the realisations,
@@ -283,8 +282,8 @@ def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
     data["base_grms_spectrum"] = (level * grms(f, w)).assign_attrs(
         units=G_UNITS, long_name="RMS base acceleration of the spectrum at its level (grms: "
                                  "the root of its integral)")
-    realised = xr.DataArray(realised_grms(records, random, t_tail), dims=REALISATION_DIM)
+    realised = xr.DataArray(realised_grms(records, random), dims=REALISATION_DIM)
     data["base_grms"] = (level * realised).assign_attrs(
-        units=G_UNITS, long_name="RMS base acceleration of the record over the statistics "
-                                 "window (grms as realised)")
+        units=G_UNITS, long_name="RMS base acceleration of the record over the run (grms "
+                                 "as realised)")
     return data, extra

@@ -158,14 +158,12 @@ def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float) -
     return math.log(1.0 / tolerance) / slowest if slowest > 0.0 else math.inf
 
 
-def window_fraction(t_end: float, startup: float, tail: float) -> float:
-    """The kernels' TAIL setting of a random scene: its statistics window is the last `tail`
-    of the run (metrics.tail, 1 by default) but never the start-up transient (`startup_time`,
-    s): it starts at the later of the two. One-line error where less than a tenth of the run
-    is left after the transient."""
+def check_duration(t_end: float, startup: float) -> None:
+    """Refuse (one line) a run that leaves less than a tenth of itself after the start-up
+    transient of its least-damped point (`startup_time`, s): each point's statistics start
+    after its own transient (kernels.trajectory.delay_window)."""
     if not startup < 0.9 * t_end:
         _fail("scene key 'base.duration'", f"the run ({t_end:g} s) leaves less than a tenth "
               f"of it after the start-up transient has decayed ({startup:.3g} s = "
               "ln(1/metrics.tolerance) / (zeta w1) at the least-damped point)",
               f"give base.duration of at least {10.0 * startup:.3g} s, or more damping")
-    return min(tail, (t_end - startup) / t_end)

@@ -403,7 +403,7 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
     out = solve_chunked(options, system.chunk_fn, system.rows_at, system.args,
                         system.outputs(n_points))
     return assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started,
-                    records, settings)
+                    records)
 
 
 def _run_directed(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any],
@@ -735,12 +735,11 @@ def state_attrs(swept: bool = False, random: bool = False) -> dict[str, Any]:
 
 
 def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
-             elapsed: float, records: np.ndarray | None = None,
-             settings: np.ndarray | None = None) -> xr.Dataset:
+             elapsed: float, records: np.ndarray | None = None) -> xr.Dataset:
     """Build the result Dataset of the contract from the flat kernel result: the variables the
     scene asked for (inputs.wanted), with units and long names; the derived closed forms
     (`coeffs`, sweep/models/modal.py) on their own axes; elapsed: the solve's wall time (s).
-    A random scene: its records and the settings it ran with (its statistics window)."""
+    A random scene: its records (for the input's realised grms)."""
     coords, dims, shape = inputs.coords, inputs.dims, inputs.shape
     short, method = METHODS[inputs.method]
     data: dict[str, xr.DataArray] = {}
@@ -769,12 +768,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
         data.update(loads.load_outputs(inputs.params, result.reals, result.modal is not None,
                                        dims, shape, coords, inputs.swept))
     if inputs.random is not None:
-        settings = inputs.settings if settings is None else settings
-        t_tail = settings[tk.T_END] * (1.0 - settings[tk.TAIL])
         variables, extra = random_outputs.outputs(
             result.reals, result.states, result.reals[:, tk.AMPLITUDE], dims, shape, coords,
-            inputs.random, coeffs, inputs.params, records, t_tail, inputs.basis,
-            inputs.n_modes, data)
+            inputs.random, coeffs, inputs.params, records, inputs.basis, inputs.n_modes, data)
         data.update(variables)
         coords = {**coords, **extra}
     elif inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
