@@ -4,7 +4,8 @@
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
     sweep design RESULT.nc [--min-frequency HZ] [--max-amplitude M] [--quantity NAME]
-                 [--max-deflection M] [--max-strain S] [--refine [--tolerance M]] [-o OUT.nc]
+                 [--max-deflection M] [--max-strain S] [--max-rms M] [--max-peak M]
+                 [--clearance M [--max-probability P]] [--refine [--tolerance M]] [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -112,9 +113,24 @@ def _parser() -> argparse.ArgumentParser:
     design.add_argument("--max-strain", type=float, default=None, metavar="S",
                         help="largest outer-fibre strain at most this (1, e.g. 0.001): "
                              "max_strain, bending at the clamp or midspan plus stretching")
+    design.add_argument("--max-rms", type=float, default=None, metavar="M",
+                        help="random result: RMS midspan deflection, the mean over the "
+                             "realisations (rms_deflection_mean), at most this (m)")
+    design.add_argument("--max-peak", type=float, default=None, metavar="M",
+                        help="random result: largest |midspan deflection|, the mean over the "
+                             "realisations (peak_deflection_mean), at most this (m)")
+    design.add_argument("--clearance", type=float, default=None, metavar="M",
+                        help="random result: the probability that |midspan deflection| exceeds "
+                             "this clearance level (m, one of the result's outputs.clearance) "
+                             "at least once in the test, mean over the realisations, at most "
+                             "--max-probability")
+    design.add_argument("--max-probability", type=float, default=None, metavar="P",
+                        help="--clearance: the largest exceedance probability (default 0.01, "
+                             "i.e. 1 %%)")
     design.add_argument("--refine", action="store_true",
                         help="refine each bracketed span by bisecting on length with runs of "
-                             "the result's scene (the frequency criterion needs none)")
+                             "the result's scene (the frequency criterion needs none; not for "
+                             "a random result)")
     design.add_argument("--tolerance", type=float, default=None, metavar="M",
                         help="--refine: bisect until the bracket is below this (m, default "
                              "0.001)")
@@ -254,13 +270,13 @@ def _modes(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from .design import max_span, refine_span, table
+    from .design import NO_CRITERION, max_span, refine_span, table
     from .io import check_output_path, write_netcdf
     from .plot import load_result
-    if (args.min_frequency is None and args.max_amplitude is None
-            and args.max_deflection is None and args.max_strain is None):
-        raise UserError("design: no criterion given (give --min-frequency HZ, "
-                        "--max-amplitude M, --max-deflection M or --max-strain S)")
+    if all(v is None for v in (args.min_frequency, args.max_amplitude, args.max_deflection,
+                               args.max_strain, args.max_rms, args.max_peak, args.clearance,
+                               args.max_probability)):
+        raise UserError(NO_CRITERION)
     if args.tolerance is not None and not args.refine:
         raise UserError(f"design: --tolerance {args.tolerance:g} is the bracket --refine "
                         "bisects to; give --refine too")
@@ -269,7 +285,9 @@ def _design(args: argparse.Namespace) -> int:
     ds = load_result(args.result)
     criteria = dict(min_frequency=args.min_frequency, max_amplitude=args.max_amplitude,
                     quantity=args.quantity, max_deflection=args.max_deflection,
-                    max_strain=args.max_strain)
+                    max_strain=args.max_strain, max_rms=args.max_rms,
+                    max_peak=args.max_peak, clearance=args.clearance,
+                    max_probability=args.max_probability)
     if args.refine:
         result = refine_span(ds, **criteria,
                              tolerance=1e-3 if args.tolerance is None else args.tolerance)

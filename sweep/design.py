@@ -15,20 +15,31 @@ margin of the criterion that binds. A length fails when
 * ``max_strain``: its largest outer-fibre strain (`max_strain`: the bending strain at the
   clamp or at midspan, whichever is larger, plus the stretching's, sweep.models.loads) is
   above the limit;
+* ``max_rms`` (a random result, docs/model.md sec. 11): its mean over the realisations of the
+  RMS midspan deflection (`rms_deflection_mean`, m) is above the limit;
+* ``max_peak`` (a random result): its mean over the realisations of the largest |midspan
+  deflection| (`peak_deflection_mean`, m) is above the limit;
+* ``clearance`` (a random result with outputs.clearance): the probability that |midspan
+  deflection| exceeds the clearance level at least once in the test (`exceedance_probability`
+  at that `clearance` level, mean over the realisations, 1) is above ``max_probability``
+  (0.01 by default);
 * ``state``: its `state` is a failure (invalid_input, diverged, step_size_too_small,
   max_steps_reached);
 * ``stability``: where the result has `stability`, the straight span is unstable there
   (`growth_rate` > 0, or a flag other than stable).
 
-A stepped or swept result's `direction` (up, down) counts at its worst: the quantity's maximum
-over direction, and a length fails on a state or stability failure of either direction.
+A stepped or swept result's `direction` (up, down) and a random result's `realisation` (its
+Monte Carlo records) count at their worst: the quantity's maximum over them, and a length fails
+on a state or stability failure of any of them (a realisation that escaped, state diverged,
+fails its length). The design is over the result's axes less length, direction and
+realisation.
 
 Interpolation between the last passing grid length l_a and the first failing one l_b:
 frequency in log f against log l (f1 ~ l^-2 unloaded, so the frequency criterion alone is
-exact), amplitude linearly in l of (quantity - limit), stability linearly in l of growth_rate;
-a state failure (which has no margin) and a missing value give l_a. When several criteria fail
-at l_b the smallest of their spans binds. max_span runs no analysis: its span is only as good
-as the grid.
+exact), amplitude and every other upper limit linearly in l of (quantity - limit), stability
+linearly in l of growth_rate; a state failure (which has no margin) and a missing value give
+l_a. When several criteria fail at l_b the smallest of their spans binds. max_span runs no
+analysis: its span is only as good as the grid.
 
 `refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
 bracketed span it bisects on length with one-length engine runs of the result's stored scene,
@@ -51,18 +62,28 @@ import xarray as xr
 from sweep.kernels import states as km
 
 from .errors import UserError
+from .models.random_scene import REALISATION_DIM
 from .scene.points import POINT_DIM
 from .schema import BY_AXIS
 
 LENGTH = "length"
 DIRECTION = "direction"
+REALISATION = REALISATION_DIM
+CLEARANCE = "clearance"
+WORST_OVER = (DIRECTION, REALISATION)
+"""Dimensions a criterion counts at its worst over, never a design axis."""
+DEFAULT_MAX_PROBABILITY = 0.01
+"""The clearance criterion's largest exceedance probability by default (1 %)."""
 STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVERGED,
                                                       km.STEP_TOO_SMALL, km.MAX_STEPS))
 """`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
-CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "state",
-            "stability")
+CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
+            "max_peak", "clearance", "state", "stability")
 """The criteria in the order they are named when the shortest span fails several."""
 LIMITED_BY = CRITERIA + ("grid",)
+NO_CRITERION = ("design: no criterion given (give --min-frequency HZ, --max-amplitude M, "
+                "--max-deflection M, --max-strain S, --max-rms M, --max-peak M or "
+                "--clearance M)")
 
 
 def _number(value: Any, flag: str, example: str) -> float:
@@ -93,22 +114,37 @@ def _length_quantities(ds: xr.Dataset, axes: tuple[str, ...]) -> list[str]:
                   and set(v.dims) <= set(axes))
 
 
-Limits = dict[str, tuple[str, float]]
-"""The upper-limit criteria of a design: criterion -> (the variable it reads, its limit)."""
+Limits = dict[str, tuple[str, float, float | None]]
+"""The upper-limit criteria of a design: criterion -> (the variable it reads, its limit, the
+`clearance` level (m) it is read at, or None)."""
+
+RANDOM_HOW = ("it comes from a random scene ([base] asd_g2 or asd, e.g. the built-in "
+              "launch-random-gevs)")
+
+
+def _clearance_index(var: xr.DataArray, level: float) -> int | None:
+    """The index of `level` (m) among `var`'s `clearance` coordinate, None where absent."""
+    levels = np.asarray(var[CLEARANCE].values, float) if CLEARANCE in var.coords else \
+        np.empty(0)
+    hits = np.flatnonzero(np.isclose(levels, level, rtol=1e-9, atol=0.0))
+    return int(hits[0]) if hits.size else None
 
 
 def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
-            max_strain: float | None) -> Limits:
-    """The deflection and strain criteria's variables (`max_deflection`, m: the largest
-    deflection anywhere on the span, which a one-mode result's midspan amplitude is;
-    `max_strain`, 1: bending plus stretching at the clamp or midspan), refused in one line
-    where the result lacks them."""
+            max_strain: float | None, max_rms: float | None = None,
+            max_peak: float | None = None, clearance: float | None = None,
+            max_probability: float | None = None) -> Limits:
+    """The upper-limit criteria's variables (`max_deflection`, m: the largest deflection
+    anywhere on the span, which a one-mode result's midspan amplitude is; `max_strain`, 1:
+    bending plus stretching at the clamp or midspan; a random result's `rms_deflection_mean`
+    and `peak_deflection_mean`, m, and `exceedance_probability` at the `clearance` level, 1),
+    refused in one line where the result lacks them."""
     limits: Limits = {}
     if max_deflection is not None:
         if "max_deflection" in ds:
-            limits["max_deflection"] = ("max_deflection", max_deflection)
+            limits["max_deflection"] = ("max_deflection", max_deflection, None)
         elif "mode" not in ds.dims:                  # one mode: its largest is at midspan
-            limits["max_deflection"] = (_default_quantity(ds), max_deflection)
+            limits["max_deflection"] = (_default_quantity(ds), max_deflection, None)
         else:
             raise UserError("design: --max-deflection needs the variable 'max_deflection' "
                             "(m, the largest deflection over the span), which this result "
@@ -119,9 +155,37 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
                             "plus stretching strain), which this result lacks: it comes with "
                             "the uniform stretching tension (no model.membrane) and is not "
                             "made by a sine sweep")
-        limits["max_strain"] = ("max_strain", max_strain)
-    for _, (name, _) in limits.items():
-        extra = [d for d in ds[name].dims if d not in axes]
+        limits["max_strain"] = ("max_strain", max_strain, None)
+    for criterion, flag, name, limit, what in (
+            ("max_rms", "--max-rms", "rms_deflection_mean", max_rms,
+             "m, the mean over the realisations of the RMS midspan deflection"),
+            ("max_peak", "--max-peak", "peak_deflection_mean", max_peak,
+             "m, the mean over the realisations of the largest |midspan deflection|")):
+        if limit is None:
+            continue
+        if name not in ds:
+            raise UserError(f"design: {flag} needs the variable '{name}' ({what}), which this "
+                            f"result lacks: {RANDOM_HOW}")
+        limits[criterion] = (name, limit, None)
+    if clearance is not None:
+        name = "exceedance_probability"
+        if name not in ds:
+            raise UserError(f"design: --clearance needs the variable '{name}' (the probability "
+                            "that |midspan deflection| exceeds a clearance level in the test), "
+                            f"which this result lacks: {RANDOM_HOW}, with outputs.clearance = "
+                            f"[levels in m] including {clearance:g}")
+        if _clearance_index(ds[name], clearance) is None:
+            levels = np.asarray(ds[CLEARANCE].values, float) if CLEARANCE in ds.coords \
+                else np.empty(0)
+            have = ", ".join(f"{v:g}" for v in levels) or "none"
+            raise UserError(f"design: --clearance {clearance:g}: not one of the result's "
+                            f"clearance levels ({have} m); run the scene with "
+                            f"outputs.clearance = [...] including {clearance:g}")
+        p = DEFAULT_MAX_PROBABILITY if max_probability is None else max_probability
+        limits["clearance"] = (name, p, clearance)
+    for _, (name, _, level) in limits.items():
+        extra = [d for d in ds[name].dims if d not in axes
+                 and not (level is not None and d == CLEARANCE)]
         if extra:
             raise UserError(f"design: '{name}' lies over {', '.join(map(str, extra))}, not "
                             "a swept axis")
@@ -130,23 +194,24 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
 
 def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
            quantity: str | None, max_deflection: float | None = None,
-           max_strain: float | None = None) -> tuple[tuple[str, ...], Limits]:
+           max_strain: float | None = None, max_rms: float | None = None,
+           max_peak: float | None = None, clearance: float | None = None,
+           max_probability: float | None = None) -> tuple[tuple[str, ...], Limits]:
     """Refuse (one-line UserError) what max_span cannot answer; the swept axes and the
     upper-limit criteria with the variables they read (`Limits`)."""
     if not isinstance(ds, xr.Dataset):
         raise UserError(f"max_span: needs a result (an xarray Dataset), got "
                         f"{type(ds).__name__}")
-    if min_frequency is None and max_amplitude is None and max_deflection is None \
-            and max_strain is None:
-        raise UserError("design: no criterion given (give --min-frequency HZ, "
-                        "--max-amplitude M, --max-deflection M or --max-strain S)")
+    if all(c is None for c in (min_frequency, max_amplitude, max_deflection, max_strain,
+                               max_rms, max_peak, clearance)):
+        raise UserError(NO_CRITERION)
     template = "state" if "state" in ds else "stability" if "stability" in ds else None
     if template is None:
         raise UserError("design: the result has neither 'state' nor 'stability' (give a "
                         "result written by 'sweep run ... -o FILE.nc')")
     axes = tuple(str(d) for d in ds[template].dims)
     if LENGTH not in axes or LENGTH not in ds.coords:
-        have = ", ".join(a for a in axes if a != DIRECTION) or "none"
+        have = ", ".join(a for a in axes if a not in WORST_OVER) or "none"
         raise UserError(f"design: the result has no 'length' axis (its axes: {have}); run the "
                         "scene with one, e.g. --set 'axes.length={start=0.1, stop=0.6, num=11}'")
     lengths = np.asarray(ds[LENGTH].values, float)
@@ -159,7 +224,8 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
     if quantity is not None and max_amplitude is None:
         raise UserError(f"design: --quantity {quantity}: is the response --max-amplitude "
                         "limits; give --max-amplitude M too")
-    limits = _limits(ds, axes, max_deflection, max_strain)
+    limits = _limits(ds, axes, max_deflection, max_strain, max_rms, max_peak, clearance,
+                     max_probability)
     if max_amplitude is None:
         return axes, limits
     name = _default_quantity(ds) if quantity is None else str(quantity)
@@ -177,7 +243,41 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
         raise UserError(f"design: quantity '{name}' lies over {', '.join(map(str, extra))}, "
                         f"not a swept axis (give --quantity NAME of one over the axes only: "
                         f"{choices})")
-    return axes, {"max_amplitude": (name, max_amplitude), **limits}
+    return axes, {"max_amplitude": (name, max_amplitude, None), **limits}
+
+
+def _parse(min_frequency: Any, max_amplitude: Any, max_deflection: Any, max_strain: Any,
+           max_rms: Any, max_peak: Any, clearance: Any, max_probability: Any
+           ) -> dict[str, float | None]:
+    """The criteria's limits as positive finite floats (None where not given), refused in one
+    line otherwise; max_probability below 1 too."""
+    given = {"min_frequency": (min_frequency, "--min-frequency", "100"),
+             "max_amplitude": (max_amplitude, "--max-amplitude", "0.002"),
+             "max_deflection": (max_deflection, "--max-deflection", "0.002"),
+             "max_strain": (max_strain, "--max-strain", "0.001"),
+             "max_rms": (max_rms, "--max-rms", "0.001"),
+             "max_peak": (max_peak, "--max-peak", "0.004"),
+             "clearance": (clearance, "--clearance", "0.002"),
+             "max_probability": (max_probability, "--max-probability", "0.01")}
+    out = {k: None if v is None else _number(v, flag, example)
+           for k, (v, flag, example) in given.items()}
+    p = out["max_probability"]
+    if p is not None and clearance is None:
+        raise UserError(f"design: --max-probability {p:g} is the limit of the clearance "
+                        "criterion; give --clearance M too")
+    if p is not None and not p < 1.0:
+        raise UserError(f"--max-probability {p:g}: a probability must be below 1, e.g. "
+                        "--max-probability 0.01")
+    return out
+
+
+def _like(var: xr.DataArray) -> xr.DataArray:
+    """`var` without the dimensions criteria count at their worst over (direction,
+    realisation): the shape of the design's pass/fail arrays."""
+    for d in WORST_OVER:
+        if d in var.dims:
+            var = var.isel({d: 0}, drop=True)
+    return var
 
 
 def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
@@ -187,7 +287,9 @@ def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
 
 def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
              max_amplitude: float | None = None, quantity: str | None = None,
-             max_deflection: float | None = None, max_strain: float | None = None
+             max_deflection: float | None = None, max_strain: float | None = None,
+             max_rms: float | None = None, max_peak: float | None = None,
+             clearance: float | None = None, max_probability: float | None = None
              ) -> xr.Dataset:
     """The largest span between clamps (m) that meets the criteria, per combination of the
     result's other swept axes.
@@ -199,43 +301,52 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
         `quantity` (a variable in m over the swept axes), by default `peak_amplitude` for a
         swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
-        (largest) value over `direction` counts.
+        (largest) value over `direction` and `realisation` counts.
     quantity : the variable `max_amplitude` limits (needs max_amplitude).
     max_deflection : m; a length passes when `max_deflection`, the largest deflection anywhere
         on the span, is at most this (one mode: the midspan's, where its largest lies).
     max_strain : 1; a length passes when `max_strain` (the outer fibre's bending strain at
         the clamp or midspan, whichever is larger, plus the stretching's) is at most this.
+    max_rms : m; a random result's length passes when `rms_deflection_mean`, the mean over the
+        realisations of the RMS midspan deflection, is at most this.
+    max_peak : m; a random result's length passes when `peak_deflection_mean`, the mean over
+        the realisations of the largest |midspan deflection|, is at most this.
+    clearance : m, one of a random result's `clearance` levels (outputs.clearance); a length
+        passes when `exceedance_probability` there (that |midspan deflection| exceeds it at
+        least once in the test), mean over the realisations, is at most `max_probability`.
+    max_probability : 1, below 1; the clearance criterion's limit (needs clearance; default
+        0.01, i.e. 1 %).
 
     Every length must also have a `state` that is not a failure (invalid_input, diverged,
-    step_size_too_small, max_steps_reached on either direction) and, where the result has
-    `stability`, be stable (growth_rate <= 0).
+    step_size_too_small, max_steps_reached on either direction or in any realisation) and,
+    where the result has `stability`, be stable (growth_rate <= 0).
 
     Returns
     -------
-    A Dataset over the result's axes other than `length` and `direction` (their coordinates
-    kept) with `max_span` (m): the largest length before the first failing grid length,
-    interpolated between the last passing and the first failing one on the binding
+    A Dataset over the result's axes other than `length`, `direction` and `realisation` (their
+    coordinates kept) with `max_span` (m): the largest length before the first failing grid
+    length, interpolated between the last passing and the first failing one on the binding
     criterion's margin (module docstring); the longest grid length when none fails; NaN when
-    the shortest already fails. `limited_by` (strings): the binding criterion,
-    "min_frequency", "max_amplitude", "state" or "stability" ("grid" when no length fails;
-    with a NaN max_span the criterion the shortest span fails). Attributes: `criteria`, the
+    the shortest already fails. `limited_by` (strings): the binding criterion, one of
+    CRITERIA, or "grid" when no length fails (with a NaN max_span the criterion the shortest
+    span fails). Attributes: `criteria`, the
     source result's `title`.
 
     Raises UserError (one line) without a criterion, without a `length` axis, for an unknown
-    quantity or one whose units are not m, a non-positive limit.
+    quantity or one whose units are not m, a non-positive limit, a result without the
+    variable a criterion reads (a random one's for max_rms, max_peak, clearance), a clearance
+    level the result does not hold.
     """
-    fmin = None if min_frequency is None else _number(min_frequency, "--min-frequency", "100")
-    amax = None if max_amplitude is None else _number(max_amplitude, "--max-amplitude", "0.002")
-    dmax = None if max_deflection is None else _number(max_deflection, "--max-deflection",
-                                                       "0.002")
-    smax = None if max_strain is None else _number(max_strain, "--max-strain", "0.001")
-    axes, limits = _check(ds, fmin, amax, quantity, dmax, smax)
+    c = _parse(min_frequency, max_amplitude, max_deflection, max_strain, max_rms, max_peak,
+               clearance, max_probability)
+    fmin = c["min_frequency"]
+    axes, limits = _check(ds, fmin, c["max_amplitude"], quantity, c["max_deflection"],
+                          c["max_strain"], c["max_rms"], c["max_peak"], c["clearance"],
+                          c["max_probability"])
     ds = ds.sortby(LENGTH)
-    others = tuple(a for a in axes if a not in (LENGTH, DIRECTION))
+    others = tuple(a for a in axes if a not in (LENGTH, *WORST_OVER))
     template_name = "state" if "state" in ds else "stability"
-    like = ds[template_name].isel({DIRECTION: 0}, drop=True) if DIRECTION in axes \
-        else ds[template_name]
-    like = like.transpose(*others, LENGTH)
+    like = _like(ds[template_name]).transpose(*others, LENGTH)
     shape = like.shape
     lengths = np.asarray(ds[LENGTH].values, float)
 
@@ -275,7 +386,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     criteria = "; ".join(
         ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
         + [f"{name} <= {limit:g} {ds[name].attrs.get('units', '')}".rstrip()
-           for name, limit in limits.values()]
+           if level is None else f"{name} at clearance {level:g} m, mean over the "
+           f"realisations, <= {limit:g}" for name, limit, level in limits.values()]
         + (["state not in (" + ", ".join(STATE_FAILURES) + ")"] if "state" in ds else [])
         + (["growth_rate <= 0 (stable)"] if "stability" in ds else []))
     from .version import package_version
@@ -307,24 +419,44 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
 
 
 def _worst(var: xr.DataArray, how: str) -> xr.DataArray:
-    if DIRECTION in var.dims:
-        # skipna=False: a missing direction is not a pass
-        return getattr(var, how)(DIRECTION, skipna=False)
+    """`var` at its worst (`how`: "max" or "min") over direction and realisation."""
+    over = [d for d in WORST_OVER if d in var.dims]
+    if over:
+        # skipna=False: a missing direction or realisation is not a pass
+        return getattr(var, how)(over, skipna=False)
     return var
+
+
+def _limited(ds: xr.Dataset, name: str, level: float | None) -> xr.DataArray:
+    """The value an upper-limit criterion compares with its limit: `name` at its worst over
+    direction and realisation, or at the `clearance` level (m) the mean over the realisations
+    of the finite values (a realisation that escaped has none, and fails `state`)."""
+    var = ds[name]
+    if level is None:
+        return _worst(var, "max")
+    index = _clearance_index(var, level)
+    if index is None:                            # _limits refuses this first
+        raise UserError(f"design: --clearance {level:g}: not one of the clearance levels of "
+                        f"'{name}'")
+    var = var.isel({CLEARANCE: index}, drop=True)
+    if REALISATION in var.dims:
+        var = var.mean(REALISATION)
+    return _worst(var, "max")
 
 
 def _margins(ds: xr.Dataset, fmin: float | None, limits: Limits,
              like: xr.DataArray) -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
     """The pass/fail logic max_span and refine_span share: per criterion, its margin (>= 0
     passes, NaN fails), the value interpolated on, and how (`_interpolate`), each an array
-    shaped like `like` (the flags over the axes less direction, length last)."""
+    shaped like `like` (the flags over the axes less direction and realisation, length
+    last)."""
     shape = like.shape
     margins: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
     if fmin is not None:
         f = _broadcast(_worst(ds["natural_frequency"], "min"), like)
         margins["min_frequency"] = (f - fmin, f, "log")
-    for criterion, (name, limit) in limits.items():
-        q = _broadcast(_worst(ds[name], "max"), like)
+    for criterion, (name, limit, level) in limits.items():
+        q = _broadcast(_limited(ds, name, level), like)
         margins[criterion] = (limit - q, q - limit, "linear")
     if "state" in ds:
         meanings = _flags(ds["state"])
@@ -424,6 +556,8 @@ MAX_BISECTIONS = 64
 def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                 max_amplitude: float | None = None, quantity: str | None = None,
                 max_deflection: float | None = None, max_strain: float | None = None,
+                max_rms: float | None = None, max_peak: float | None = None,
+                clearance: float | None = None, max_probability: float | None = None,
                 tolerance: float = 1e-3) -> xr.Dataset:
     """`max_span` refined beyond the grid by bisecting on length with the engine itself.
 
@@ -447,18 +581,29 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     Returns max_span's Dataset with the refined spans; attributes `refine_runs` (engine runs
     made), `refine_tolerance` (m) and `refinement` (how). Raises UserError (one line) as
     max_span, for a result without its scene, a non-positive tolerance, an axis the stored
-    scene lacks, and a stepped result stepped along length (its branch depends on the path).
+    scene lacks, a stepped result stepped along length (its branch depends on the path), and a
+    random result (one with `realisation`: a one-length run's statistics window, which starts
+    after the slowest span's start-up transient, is not the grid's, so its statistics differ
+    from the grid's by more than a bisection resolves; refine the scene's length axis).
     """
     from .run import run
     from .scene import load_scene_text
 
     tol = _number(tolerance, "--tolerance", "0.001")
-    grid = max_span(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
-                    quantity=quantity, max_deflection=max_deflection, max_strain=max_strain)
-    fmin = None if min_frequency is None else float(min_frequency)
-    axes, limits = _check(ds, fmin, None if max_amplitude is None else float(max_amplitude),
-                          quantity, None if max_deflection is None else float(max_deflection),
-                          None if max_strain is None else float(max_strain))
+    if isinstance(ds, xr.Dataset) and REALISATION in ds.dims:
+        raise UserError("design: --refine re-runs points, and a random result's statistics "
+                        "depend on its grid (the statistics window starts after the longest "
+                        "span's transient); for a random result refine the length axis in "
+                        "the scene instead")
+    criteria = dict(min_frequency=min_frequency, max_amplitude=max_amplitude,
+                    max_deflection=max_deflection, max_strain=max_strain, max_rms=max_rms,
+                    max_peak=max_peak, clearance=clearance, max_probability=max_probability)
+    grid = max_span(ds, quantity=quantity, **criteria)
+    c = _parse(**criteria)
+    fmin = c["min_frequency"]
+    axes, limits = _check(ds, fmin, c["max_amplitude"], quantity, c["max_deflection"],
+                          c["max_strain"], c["max_rms"], c["max_peak"], c["clearance"],
+                          c["max_probability"])
     text = ds.attrs.get("scene")
     if not isinstance(text, str) or not text.strip():
         raise UserError("design --refine: the result has no 'scene' attribute to run again "
@@ -473,7 +618,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         raise UserError("design --refine: the result is stepped along length (its branch "
                         "depends on the path); refine on a finer length axis instead")
     ds = ds.sortby(LENGTH)
-    others = tuple(a for a in axes if a not in (LENGTH, DIRECTION))
+    others = tuple(a for a in axes if a not in (LENGTH, *WORST_OVER))
     missing = [a for a in others if a not in scene_axes or a not in ds.coords]
     if missing:
         raise UserError(f"design --refine: axis {', '.join(missing)} is not an axis of the "
@@ -518,8 +663,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         if stepped is not None:
             one = one.sel({stepped: [point[stepped]]})
         name = "state" if "state" in one else "stability"
-        like = one[name].isel({DIRECTION: 0}, drop=True) if DIRECTION in one[name].dims \
-            else one[name]
+        like = _like(one[name])
         like = like.transpose(*[a for a in others if a in like.dims], LENGTH)
         margins = _margins(one, None, limits, like)
         return [k for k in nonfrequency if k in margins
@@ -544,9 +688,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         sub = ds.sel({a: v for a, v in point.items()}) if point else ds
         sub = sub.expand_dims({a: [v] for a, v in point.items()}) if point else sub
         like_name = "state" if "state" in sub else "stability"
-        like = sub[like_name].isel({DIRECTION: 0}, drop=True) \
-            if DIRECTION in sub[like_name].dims else sub[like_name]
-        like = like.transpose(*others, LENGTH)
+        like = _like(sub[like_name]).transpose(*others, LENGTH)
         margins = {k: (m.reshape(-1), v.reshape(-1), how)
                    for k, (m, v, how) in _margins(sub, fmin, limits, like).items()}
         passes = np.logical_and.reduce([m >= 0.0 for m, _, _ in margins.values()])

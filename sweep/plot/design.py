@@ -21,6 +21,11 @@ from .style import _coord, _is_log_spaced, _legend, _new_axes, _plain_ticks, _un
 CRITERION_STYLES = {
     "min_frequency": ("C0", "o", "first natural frequency (min_frequency)"),
     "max_amplitude": ("C3", "s", "response amplitude (max_amplitude)"),
+    "max_deflection": ("C2", "v", "deflection over the span (max_deflection)"),
+    "max_strain": ("C5", "P", "outer-fibre strain (max_strain)"),
+    "max_rms": ("C6", "p", "mean RMS deflection (max_rms)"),
+    "max_peak": ("C8", "h", "mean peak deflection (max_peak)"),
+    "clearance": ("C9", "*", "clearance exceedance probability (clearance)"),
     "state": ("C1", "X", "run failed (state)"),
     "stability": ("C4", "D", "parametric instability (stability)"),
     "grid": ("0.5", "^", "none within the grid (grid: longest length)"),

@@ -141,7 +141,8 @@ def load_result(path: str | os.PathLike) -> xr.Dataset:
     return ds
 
 
-_DESIGN_LIMITS = ("min_frequency", "max_amplitude", "state", "stability", "grid")
+_DESIGN_LIMITS = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
+                  "max_peak", "clearance", "state", "stability", "grid")
 """sweep.design.LIMITED_BY (not imported: the figures do not depend on the design layer)."""
 
 

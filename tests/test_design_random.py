@@ -1,0 +1,220 @@
+"""The clamp-spacing question on a random-vibration result (sweep/design.py, docs/model.md
+sec. 9 and 11): the `realisation` dimension counts at its worst, never as a design axis, and
+the criteria --max-rms, --max-peak and --clearance. Synthetic Datasets built here (dims length
+x realisation x clearance) with closed-form crossings; one reduced real run of
+launch-random-gevs for the CLI end to end."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import sweep
+from sweep.cli import main
+from sweep.design import CRITERIA, LIMITED_BY, max_span, refine_span
+
+LENGTHS = np.array([0.10, 0.15, 0.20, 0.25, 0.30])        # m
+LEVELS = np.array([0.001, 0.002, 0.005])                   # m, clearance levels
+FLAGS = dict(flag_values=np.array([0, 8, 5, 6, 7], np.int8),
+             flag_meanings="invalid_input completed diverged step_size_too_small "
+                           "max_steps_reached")
+COMPLETED, DIVERGED = 8, 5
+
+
+def rms_of(length: np.ndarray) -> np.ndarray:
+    """The synthetic mean RMS midspan deflection (m), linear in length: 0.01 * length."""
+    return 0.01 * np.asarray(length, float)
+
+
+def synthetic(*, realisations: int = 3, scales: tuple[float, ...] | None = None,
+              diverged: tuple[int, int] | None = None) -> xr.Dataset:
+    """A random result over length (x base_asd_scale) x realisation (x clearance): state
+    completed (or diverged at (length index, realisation)), rms_deflection_mean = rms_of(l)
+    (x 2 per dB of scale), peak_deflection_mean = 4 rms, exceedance_probability growing
+    linearly in length and the same in every realisation but the last (which adds 0.02)."""
+    axes = {"length": LENGTHS}
+    if scales is not None:
+        axes["base_asd_scale"] = np.array(scales, float)
+    dims = tuple(axes)
+    shape = tuple(len(v) for v in axes.values())
+    gain = np.ones(shape)
+    if scales is not None:
+        gain = gain * (2.0 ** np.asarray(scales))[None, :]
+    rms = rms_of(LENGTHS).reshape((-1,) + (1,) * (len(shape) - 1)) * gain
+    state = np.full(shape + (realisations,), COMPLETED, np.int8)
+    per_real = np.repeat(rms[..., None], realisations, axis=-1)
+    per_real = per_real * (1.0 + 0.1 * np.arange(realisations))     # the last the largest
+    if diverged is not None:
+        state[(diverged[0],) + (0,) * (len(shape) - 1) + (diverged[1],)] = DIVERGED
+        per_real[(diverged[0],) + (0,) * (len(shape) - 1) + (diverged[1],)] = np.nan
+    # P(l, c) = (l - 0.1) / 0.2 * 0.02 / (c / 0.001): 0 at 0.1 m, 0.02 at 0.3 m for 1 mm
+    prob = ((LENGTHS - 0.10) / 0.20 * 0.02)[:, None] / (LEVELS / 0.001)[None, :]
+    prob = prob.reshape((len(LENGTHS),) + (1,) * (len(shape) - 1) + (1, len(LEVELS)))
+    prob = np.broadcast_to(prob, shape + (realisations, len(LEVELS))).copy()
+    prob[..., -1, :] += 0.02 * np.broadcast_to(
+        (LENGTHS - 0.10)[:, None] / 0.20, (len(LENGTHS), len(LEVELS))).reshape(
+        (len(LENGTHS),) + (1,) * (len(shape) - 1) + (len(LEVELS),))
+    rdims = dims + ("realisation",)
+    return xr.Dataset(
+        {"state": xr.DataArray(state, dims=rdims, attrs=dict(FLAGS, units="1")),
+         "rms_deflection": xr.DataArray(per_real, dims=rdims, attrs={"units": "m"}),
+         "amplitude": xr.DataArray(4.0 * per_real, dims=rdims, attrs={"units": "m"}),
+         "rms_deflection_mean": xr.DataArray(rms, dims=dims, attrs={"units": "m"}),
+         "peak_deflection_mean": xr.DataArray(4.0 * rms, dims=dims, attrs={"units": "m"}),
+         "exceedance_probability": xr.DataArray(prob, dims=rdims + ("clearance",),
+                                                attrs={"units": "1"}),
+         "natural_frequency": xr.DataArray(52.6 * (0.15 / LENGTHS) ** 2, dims=("length",),
+                                           attrs={"units": "Hz"})},
+        coords={**{k: (k, v, {"units": "m"} if k == "length" else {"units": "dB"})
+                   for k, v in axes.items()},
+                "realisation": np.arange(realisations, dtype=np.int32),
+                "clearance": ("clearance", LEVELS, {"units": "m"})},
+        attrs={"title": "synthetic-random"})
+
+
+def test_the_new_criteria_are_named():
+    assert {"max_rms", "max_peak", "clearance"} <= set(CRITERIA)
+    from sweep.plot.result import _DESIGN_LIMITS
+    assert set(_DESIGN_LIMITS) == set(LIMITED_BY)        # sweep plot reads every one
+
+
+@pytest.mark.parametrize("limit", [0.0012, 0.0017, 0.0024])
+def test_max_rms_is_the_linear_crossing(limit):
+    out = max_span(synthetic(), max_rms=limit)
+    # rms = 0.01 l crosses the limit at l = 100 limit, inside the grid
+    assert float(out["max_span"]) == pytest.approx(100.0 * limit, rel=1e-12)
+    assert str(out["limited_by"].values) == "max_rms"
+
+
+def test_max_peak_reads_the_mean_peak():
+    out = max_span(synthetic(), max_peak=0.008)          # 4 * 0.01 l = 0.008 at l = 0.2
+    assert float(out["max_span"]) == pytest.approx(0.2, rel=1e-12)
+    assert str(out["limited_by"].values) == "max_peak"
+
+
+def test_realisation_is_no_design_axis_and_counts_at_its_worst():
+    ds = synthetic(realisations=3, scales=(-3.0, 0.0))
+    out = max_span(ds, max_rms=0.0015)
+    assert out["max_span"].dims == ("base_asd_scale",)
+    assert "realisation" not in out.dims
+    # rms = 0.01 l 2^(dB): crossing at l = 0.15 * 2^3 (beyond the grid) and 0.15
+    assert str(out["limited_by"].values[0]) == "grid"
+    assert float(out["max_span"].values[0]) == pytest.approx(0.30)
+    assert float(out["max_span"].values[1]) == pytest.approx(0.15, rel=1e-12)
+    # a per-realisation quantity counts at its largest realisation (1.2 x the first)
+    amp = max_span(ds, max_amplitude=0.006)
+    assert float(amp["max_span"].values[1]) == pytest.approx(0.006 / (4 * 0.01 * 1.2),
+                                                            rel=1e-12)
+
+
+def test_a_diverged_realisation_fails_its_length():
+    # realisation 1 escapes at 0.25 m: the rms criterion alone would pass up to 0.30 m
+    out = max_span(synthetic(diverged=(3, 1)), max_rms=1.0)
+    assert float(out["max_span"]) == pytest.approx(0.20)
+    assert str(out["limited_by"].values) == "state"
+    shortest = max_span(synthetic(diverged=(0, 0)), max_rms=1.0)
+    assert np.isnan(float(shortest["max_span"]))
+    assert str(shortest["limited_by"].values) == "state"
+
+
+@pytest.mark.parametrize("level, p, expected", [
+    # mean over 3 realisations of P = k (l - 0.1) / 0.2 with k = 0.02 / (c / 1 mm) + 0.02 / 3
+    (0.001, 0.01, 0.10 + 0.2 * 0.01 / (0.02 + 0.02 / 3)),
+    (0.002, 0.01, 0.10 + 0.2 * 0.01 / (0.01 + 0.02 / 3)),
+    (0.001, 0.02, 0.10 + 0.2 * 0.02 / (0.02 + 0.02 / 3)),
+])
+def test_clearance_is_the_mean_exceedance_probability_crossing(level, p, expected):
+    out = max_span(synthetic(), clearance=level, max_probability=p)
+    assert float(out["max_span"]) == pytest.approx(expected, rel=1e-12)
+    assert str(out["limited_by"].values) == "clearance"
+    assert f"clearance {level:g} m" in out.attrs["criteria"]
+
+
+def test_clearance_default_probability_is_one_percent():
+    a = max_span(synthetic(), clearance=0.001)
+    b = max_span(synthetic(), clearance=0.001, max_probability=0.01)
+    assert float(a["max_span"]) == float(b["max_span"])
+
+
+def test_the_smallest_span_binds_among_the_random_criteria():
+    out = max_span(synthetic(), max_rms=0.0025, max_peak=0.008, clearance=0.001)
+    spans = {"max_rms": 0.25, "max_peak": 0.20, "clearance": 0.10 + 0.2 * 0.01 / (0.02 + 0.02 / 3)}
+    assert float(out["max_span"]) == pytest.approx(min(spans.values()), rel=1e-12)
+    assert str(out["limited_by"].values) == "clearance"
+
+
+def _sine_result() -> xr.Dataset:
+    ds = synthetic()
+    keep = ["state", "amplitude", "natural_frequency"]
+    return ds[keep].isel(realisation=0, drop=True)
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    (dict(max_rms=0.001), "'rms_deflection_mean'"),
+    (dict(max_peak=0.004), "'peak_deflection_mean'"),
+    (dict(clearance=0.002), "'exceedance_probability'"),
+])
+def test_a_non_random_result_is_refused_in_one_line(kwargs, fragment):
+    with pytest.raises(sweep.UserError, match=fragment) as info:
+        max_span(_sine_result(), **kwargs)
+    assert "asd_g2" in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    (dict(clearance=0.003), "not one of the result's clearance levels (0.001, 0.002, 0.005 m)"),
+    (dict(max_rms=0.001, max_probability=0.05), "give --clearance M too"),
+    (dict(clearance=0.001, max_probability=1.0), "below 1"),
+    (dict(max_rms=-1.0), "--max-rms -1"),
+    (dict(max_peak="x"), "--max-peak 'x'"),
+])
+def test_bad_random_criteria_are_one_line(kwargs, fragment):
+    with pytest.raises(sweep.UserError) as info:
+        max_span(synthetic(), **kwargs)
+    assert fragment in str(info.value) and "\n" not in str(info.value)
+
+
+def test_refine_refuses_a_random_result_in_one_line():
+    with pytest.raises(sweep.UserError, match="refine the length axis in the scene") as info:
+        refine_span(synthetic(), max_rms=0.0015)
+    assert "\n" not in str(info.value)
+
+
+@pytest.fixture(scope="module")
+def random_file(tmp_path_factory):
+    """A reduced launch-random-gevs (3 lengths, 2 records of 2 s, 0 dB, one clearance level),
+    written as 'sweep run -o' writes it."""
+    scene = sweep.load_scene("launch-random-gevs", {
+        "axes.length": [0.1, 0.14, 0.18], "base.realisations": 2, "base.duration": 2.0,
+        "axes.base_asd_scale": [0.0], "outputs.clearance": [0.001]})
+    path = tmp_path_factory.mktemp("random") / "gevs.nc"
+    ds = sweep.run(scene, output=path, progress=False)
+    return ds, path
+
+
+def test_cli_design_of_a_random_result_end_to_end(random_file, tmp_path, capsys):
+    ds, path = random_file
+    rms = ds["rms_deflection_mean"].isel(base_asd_scale=0).values
+    assert np.all(np.diff(rms) > 0)                      # grows with length
+    limit = float(0.5 * (rms[1] + rms[2]))               # crossing between 0.14 and 0.18 m
+    out = tmp_path / "span.nc"
+    assert main(["design", str(path), "--max-rms", f"{limit!r}", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "max_rms" in printed
+    got = xr.open_dataset(out)
+    assert got["max_span"].dims == ("base_asd_scale",)
+    expected = 0.14 + 0.04 * (limit - rms[1]) / (rms[2] - rms[1])
+    assert float(got["max_span"].values[0]) == pytest.approx(expected, rel=1e-9)
+    got.close()
+    # a clearance level the result lacks: exit 2, one line on stderr naming its levels
+    assert main(["design", str(path), "--clearance", "0.002"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "(0.001 m)" in err and "outputs.clearance" in err
+    assert main(["design", str(path), "--max-rms", "0.001", "--refine"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--refine" in err
+    with pytest.raises(SystemExit) as info:               # argparse: not a number
+        main(["design", str(path), "--max-peak", "big"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--max-peak" in err
