@@ -80,14 +80,6 @@ def _design(**criteria: float) -> Callable[[xr.Dataset], str]:
     return phrase
 
 
-def _random_design(ds: xr.Dataset) -> str:
-    """`sweep design --max-rms 0.001` of the random scene, one line per level (dB)."""
-    from sweep.design import max_span
-    out = max_span(ds, max_rms=0.001)
-    return " # ".join(f"{float(db):g} {float(span) * 1e3:.2f} {by}" for db, span, by in zip(
-        out["base_asd_scale"].values, out["max_span"].values, out["limited_by"].values))
-
-
 def _stepped(ds: xr.Dataset) -> str:
     def jumps(direction: str, flag: int) -> list[str]:
         out = []
@@ -122,8 +114,6 @@ FIGURES: tuple[Figure, ...] = (
            _design(min_frequency=100.0)),
     Figure("launch-sine-qualification", "sweep design --max-amplitude 0.002 --min-frequency 40",
            _design(max_amplitude=0.002, min_frequency=40.0)),
-    Figure("launch-random-gevs", "sweep design --max-rms 0.001 at -3 and 0 dB",
-           _random_design),
     Figure("harness-stepped-sine", "where the up and down sweeps jump", _stepped),
     Figure("harness-base-sine", "worst accelerations and deflections", _base_sine),
 )

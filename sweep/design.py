@@ -582,19 +582,19 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     made), `refine_tolerance` (m) and `refinement` (how). Raises UserError (one line) as
     max_span, for a result without its scene, a non-positive tolerance, an axis the stored
     scene lacks, a stepped result stepped along length (its branch depends on the path), and a
-    random result (one with `realisation`: a one-length run's statistics window, which starts
-    after the slowest span's start-up transient, is not the grid's, so its statistics differ
-    from the grid's by more than a bisection resolves; refine the scene's length axis).
+    random result (one with `realisation`: its criteria are Monte Carlo means of a few
+    records, whose scatter from one length to the next is more than a bisection resolves;
+    refine the scene's length axis, and add records).
     """
     from .run import run
     from .scene import load_scene_text
 
     tol = _number(tolerance, "--tolerance", "0.001")
     if isinstance(ds, xr.Dataset) and REALISATION in ds.dims:
-        raise UserError("design: --refine re-runs points, and a random result's statistics "
-                        "depend on its grid (the statistics window starts after the longest "
-                        "span's transient); for a random result refine the length axis in "
-                        "the scene instead")
+        raise UserError("design: --refine bisects between lengths, and a random result's "
+                        "criteria are Monte Carlo means whose scatter from one length to the "
+                        "next is more than a bisection resolves; for a random result refine "
+                        "the length axis in the scene instead (and add base.realisations)")
     criteria = dict(min_frequency=min_frequency, max_amplitude=max_amplitude,
                     max_deflection=max_deflection, max_strain=max_strain, max_rms=max_rms,
                     max_peak=max_peak, clearance=clearance, max_probability=max_probability)
