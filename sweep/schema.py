@@ -125,7 +125,7 @@ KEYS: tuple[Key, ...] = (
                   "clamps' axial_stiffness, N/m)", axis="axial_rigidity"),
     Key("cable", "f1_measured", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
         long_name="first natural frequency measured on a span of f1_span between the scene's "
-                  "clamps: gives EI (MODEL.md sec. 10) instead of bending_rigidity"),
+                  "clamps: gives EI (docs/model.md sec. 10) instead of bending_rigidity"),
     Key("cable", "f1_span", "float", None, units="m", minimum=0.0, exclusive_min=True,
         long_name="length of the span whose f1_measured was measured"),
     Key("cable", "wire", "str", None, choices=WIRE_NAMES,

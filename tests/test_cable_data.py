@@ -188,7 +188,7 @@ def test_bending_from_f1_inverts_the_textbook_frequency(rotation, beta):
 @pytest.mark.parametrize("stiffness_ratio, beta", [(1.0, 3.3988), (10.0, 4.1557),
                                                    (100.0, 4.6413)])
 def test_bending_from_f1_of_elastic_ends_matches_model_md_table(stiffness_ratio, beta):
-    """MODEL.md 10.3: K = k_t l / EI -> b_1 l. Pick EI0 and k_t = K EI0 / l, make f1 from the
+    """docs/model.md sec. 10 (the rotational-spring table): K = k_t l / EI -> b_1 l. Pick EI0 and k_t = K EI0 / l, make f1 from the
     table's b_1 l, and solve back: EI0 to the table's 5 digits."""
     ei0, span, mass = 2e-3, 0.4, 0.0333
     f1 = beta ** 2 / (2 * math.pi * span ** 2) * math.sqrt(ei0 / mass)

@@ -1,6 +1,6 @@
 """solver.stop_when_steady: a point ends once its response is steady (or has decayed), its
 tail window moved to the periods after. Checked against the closed-form linear base response
-(MODEL.md sec. 5), against the full run of the same points, and on responses that never
+(docs/model.md secs. 3 and 5), against the full run of the same points, and on responses that never
 settle (beating), which must never stop."""
 
 from __future__ import annotations

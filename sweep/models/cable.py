@@ -259,7 +259,7 @@ def bending_note(values: Mapping[str, Any]) -> str | None:
                                     rotation, stiffness)
             ei = f" = {value:.6g} N m2"
         return (f"measured: EI{ei} from f1 = {values['cable.f1_measured']:g} Hz on a "
-                f"{values['cable.f1_span']:g} m span with {rotation} ends (MODEL.md sec. 10)"
+                f"{values['cable.f1_span']:g} m span with {rotation} ends (docs/model.md sec. 10)"
                 + (f"; mass and EA of the bundle {bundle} (sweep/wires.py)" if bundle else ""))
     if bundle and values.get("cable.bending") is not None:
         return (f"bound: the {values['cable.bending']} bound of the EI of the bundle {bundle} "
