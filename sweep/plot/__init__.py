@@ -39,6 +39,16 @@ What `plot` draws, by the result's content:
   growth rate against it with its zero line (`plot_growth_rate`); with the time-domain map
   too, that map with the Floquet boundary over it ('stability_over_amplitude',
   `plot_stability_over_map`, "Floquet: unstable inside");
+- a random base excitation ([base] asd_g2 / asd, docs/model.md sec. 11): `realisation` (the
+  Monte Carlo records) is a statistical dimension, not a swept axis; against the swept axis
+  (span length when swept), one line per value of at most five of one other: the mean RMS
+  midspan deflection over the records with its 95 % interval shaded and the exact linear RMS
+  dashed ('rms', `plot_rms`), the mean peak deflection with the clearance levels ('peak',
+  `plot_peak`), the probability of exceeding each clearance in the test ('exceedance',
+  `plot_exceedance`), and the empirical distribution of peak / RMS over every record ('peaks',
+  `plot_peak_factors`); the per-point figures draw the means over the records (maps of the
+  mean RMS and peak deflection over two axes, the mean grms and escape probability), a point
+  marked where one of its records did not complete;
 - longitudinal: snapshots along the span (`plot_snapshots`, the paper's Fig 7) and the end
   histories (`plot_histories`); with swept axes also the peak end displacement and the
   dynamic amplification over them.
@@ -81,6 +91,7 @@ The package, split like xarray's plot/ by what is drawn:
     design.py    a 'sweep design' result: max_span against its axis, by criterion (plot_design)
     stability.py Floquet stability: the Ince-Strutt chart, the growth rate, the boundary over a map
     envelope.py  a continuous sine sweep: the response envelope over frequency (plot_envelope)
+    random.py    a random excitation: RMS, peak, exceedance and peak factors over the records
     figures.py   which figures a result gets, and writing them (plot, save)
 """
 
@@ -95,6 +106,7 @@ from .labels import footer, label
 from .line import plot_line
 from .maps import _HATCHES, FLOOR, plot_map, plot_state_map  # noqa: F401
 from .overlays import PAPER_FIG5_AMPLITUDES
+from .random import plot_exceedance, plot_peak, plot_peak_factors, plot_rms
 from .result import check_result, load_result, parse_select, select_points, swept_axes
 from .series import plot_histories, plot_snapshots, plot_time_series
 from .stability import plot_growth_rate, plot_stability_chart, plot_stability_over_map
@@ -103,8 +115,9 @@ from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
            "check_result", "load_result", "parse_select", "plot", "plot_branches",
            "plot_design",
-           "plot_envelope", "plot_growth_rate",
+           "plot_envelope", "plot_exceedance", "plot_growth_rate",
            "plot_histories",
-           "plot_line", "plot_map", "plot_snapshots", "plot_state_map", "plot_time_series",
+           "plot_line", "plot_map", "plot_peak", "plot_peak_factors", "plot_rms",
+           "plot_snapshots", "plot_state_map", "plot_time_series",
            "plot_stability_chart", "plot_stability_over_map",
            "save", "select_points", "state_styles", "swept_axes", "why_not_drawn"]

@@ -28,8 +28,10 @@ from .design import plot_design
 from .envelope import BAND_DIM, plot_envelope
 from .line import plot_line
 from .maps import plot_map, plot_state_map
-from .result import (DIRECTION_DIM, _scene, _time_dim, check_result, is_design_result,
-                     select_points,
+from .random import (peak_factors, plot_exceedance, plot_peak, plot_peak_factors, plot_rms,
+                     random_axes)
+from .result import (CLEARANCE_DIM, DIRECTION_DIM, _scene, _time_dim, check_result,
+                     is_design_result, is_random_result, over_points, select_points,
                      swept_axes)
 from .stability import (floquet_boundary_in_range, plot_growth_rate, plot_stability_chart,
                         plot_stability_over_map)
@@ -82,6 +84,11 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     'stability' (the Floquet Ince-Strutt chart over two axes, the growth rate against one) and,
     when the time-domain map exists too, 'stability_over_amplitude' (the amplitude map with the
     Floquet boundary over it); a stability-only result (no `state`) gets 'stability' alone.
+    A random result ([base] asd_g2 / asd): its `realisation` is not a swept axis; 'rms',
+    'peak', 'exceedance' (with outputs.clearance) and 'peaks' (`_random_figures`, random.py),
+    and in place of the per-realisation quantities and the state map the means over the
+    realisations: maps of 'rms_deflection_mean' and 'peak_deflection_mean' over two axes,
+    'rms_acceleration_g_mean' and 'escape_probability' over one or two.
     Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
     swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
@@ -100,7 +107,11 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     ds = select_points(ds, select)
     axes = swept_axes(ds)
     figures = Figures(select=select)
-    if ds.attrs.get("model_kind") == "longitudinal":
+    random = is_random_result(ds)
+    points = over_points(ds) if random else ds     # a random result: the means, per point
+    if random:
+        scalars = _RANDOM_SCALARS[:] if len(axes) == 2 else _RANDOM_SCALARS[2:]
+    elif ds.attrs.get("model_kind") == "longitudinal":
         scalars = ["peak_end_displacement", "dynamic_amplification"]
     else:
         scalars = ["amplitude", "settling_time"]
@@ -108,26 +119,28 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             scalars.insert(1, "absolute_acceleration_g")
         if _is_swept(ds):                          # a continuous sine sweep: its peak first
             scalars[:0] = ["peak_amplitude", "peak_frequency"]
-    if len(axes) == 2:
+    if len(axes) == 2 and not random:
         scalars.append("state")
     for var in scalars:
-        if var not in ds or len(axes) not in (1, 2):
+        if var not in points or len(axes) not in (1, 2):
             continue
         if var == "state":
             reason = (f"every point is "
                       f"{_state_meaning(ds.isel({a: 0 for a in ds['state'].dims}))}"
                       if np.unique(ds["state"].values).size == 1 else None)
         else:
-            reason = why_not_drawn(ds[var])
+            reason = why_not_drawn(points[var])
         if reason is not None:
             figures.skipped[var] = reason
             _log.info("%s: %s: no figure (%s)", ds.attrs.get("title", "result"), var, reason)
         elif len(axes) == 1 and var != "state":
-            figures[var] = plot_line(ds, var).figure
+            figures[var] = plot_line(points, var).figure
         else:
             for key, way in _ways(ds, var):
                 figures[key] = (plot_state_map(ds, direction=way) if var == "state"
-                                else plot_map(ds, var, direction=way)).figure
+                                else plot_map(points, var, direction=way)).figure
+    if random:
+        _random_figures(ds, figures)
     if "growth_rate" in ds:
         _stability_figures(ds, axes, figures)
     if "envelope" in ds:
@@ -143,6 +156,46 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
             _plain_ticks(ax)
         _add_footer(fig, ds)
     return figures
+
+
+_RANDOM_SCALARS = ["rms_deflection_mean", "peak_deflection_mean", "rms_acceleration_g_mean",
+                   "escape_probability"]
+"""A random result's per-point figures: means over the realisations (maps over two axes;
+over one axis the deflections are on 'rms' and 'peak', so only the last two get lines)."""
+
+
+def _random_figures(ds: xr.Dataset, figures: Figures) -> None:
+    """A random result's own figures (random.py): 'rms' and 'peak' (means with their
+    intervals against the swept axis, the linear RMS dashed, the clearance levels), 'exceedance'
+    (with clearance levels) and 'peaks' (the peak factor's distribution over every record).
+    Each is left out, with the reason, where its data are all NaN (every realisation escaped),
+    where no axis is swept, or where the other axis has more values than one figure shows."""
+    title = ds.attrs.get("title", "result")
+    try:
+        x, _level = random_axes(ds)
+        too_many = None
+    except UserError as exc:
+        x, too_many = None, str(exc)
+    drawn = {"rms": ("rms_deflection_mean", plot_rms),
+             "peak": ("peak_deflection_mean", plot_peak),
+             "exceedance": ("exceedance_probability", plot_exceedance),
+             "peaks": ("peak_deflection", plot_peak_factors)}
+    if CLEARANCE_DIM not in ds.dims:
+        del drawn["exceedance"]
+    for name, (var, draw) in drawn.items():
+        if var not in ds:
+            continue
+        why = too_many
+        if why is None and x is None and name != "peaks":     # 'peaks' pools every point
+            why = "no swept axis with more than one value"
+        if why is None and (not np.isfinite(np.asarray(ds[var].values, float)).any()
+                            or name == "peaks" and not peak_factors(ds).size):
+            why = "no point has a value (all NaN: every realisation escaped or failed)"
+        if why is not None:
+            figures.skipped[name] = why
+            _log.info("%s: %s: no figure (%s)", title, name, why)
+        else:
+            figures[name] = draw(ds)
 
 
 def _design_figures(ds: xr.Dataset, select: Mapping[str, Any] | None) -> Figures:

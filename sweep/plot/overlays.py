@@ -277,6 +277,9 @@ def _base_text(ds: xr.Dataset, get: Callable[[str, str], Any]) -> str | None:
     if not ("absolute_acceleration_g" in ds or "base" in doc or any(
             str(a).startswith("base_") for a in doc.get("axes", {}))):
         return None
+    base = doc.get("base") if isinstance(doc.get("base"), dict) else {}
+    if "asd_g2" in base or "asd" in base:
+        return _random_text(ds, base, get)
     level_g, level = get("base", "acceleration_g"), get("base", "acceleration")
     freq, ratio = get("base", "frequency"), get("base", "frequency_ratio")
     sweep = doc.get("base", {}).get("sweep") if isinstance(doc.get("base"), dict) else None
@@ -292,6 +295,26 @@ def _base_text(ds: xr.Dataset, get: Callable[[str, str], Any]) -> str | None:
         text += f" at {float(freq):.4g} Hz"
     elif ratio is not None:
         text += f" at f/f1 = {float(ratio):.4g}"
+    return text
+
+
+def _random_text(ds: xr.Dataset, base: dict, get: Callable[[str, str], Any]) -> str:
+    """'base random 20-2000 Hz, 14.1 grms, +0 dB, 8 records of 8 s' for a random result (its
+    ASD's band, grms at the shown level, dB on the ASD, records); swept parts left out."""
+    table = base.get("asd_g2", base.get("asd"))
+    freqs = [_number(p[0]) for p in table if isinstance(p, (list, tuple)) and len(p) == 2] \
+        if isinstance(table, list) else []
+    freqs = [f for f in freqs if f is not None]
+    text = "base random" + (f" {min(freqs):.4g}-{max(freqs):.4g} Hz" if freqs else "")
+    grms = ds.get("base_grms_spectrum")
+    if grms is not None and grms.ndim == 0 and _number(grms.values.item()) is not None:
+        text += f", {float(grms.values):.3g} grms"
+    scale = _number(get("base", "asd_scale"))
+    if scale is not None:
+        text += f" ({scale:+.3g} dB)"
+    records, duration = _number(base.get("realisations")), _number(base.get("duration"))
+    if records is not None and duration is not None:
+        text += f", {int(records)} record{'s' if records != 1 else ''} of {duration:.4g} s"
     return text
 
 

@@ -26,6 +26,10 @@ from ..schema import BY_AXIS
 
 _TIME_DIMS = ("elapsed_time", "time")     # the dimension of stored histories (new, old name)
 DIRECTION_DIM = "direction"                # a stepped sweep's up and down (continuation)
+# A random result's Monte Carlo records (sweep.models.random_scene.REALISATION_DIM): a
+# statistical dimension, not a swept axis; its clearance levels of |q| (m) another.
+REALISATION_DIM = "realisation"
+CLEARANCE_DIM = "clearance"
 _DIRECTIONS = ("up", "down")
 
 # What a result may hold. `sweep run` writes far less; a file beyond these limits was not
@@ -48,7 +52,15 @@ _OVER_AXES = ("amplitude", "settling_time", "peak_end_displacement", "dynamic_am
               "peak_fixed_end_force", "force_amplification", "damping_ratio",
               "absolute_acceleration_g", "transmissibility", "peak_amplitude",
               "peak_frequency", "sweep_duration", "floquet_multiplier", "growth_rate",
-              "floquet_mode")
+              "floquet_mode",
+              # a random result's: per realisation, and their means over the realisations
+              "rms_deflection", "peak_deflection", "peak_factor", "rms_acceleration_g",
+              "rms_deflection_mean", "rms_deflection_ci", "peak_deflection_mean",
+              "peak_deflection_ci", "rms_acceleration_g_mean", "rms_acceleration_g_ci",
+              "peak_factor_mean", "peak_factor_ci", "escape_probability", "linear_rms")
+# A random result's clearance statistics: over the swept axes, the realisations and CLEARANCE_DIM.
+_OVER_CLEARANCE = ("clearance_upcrossing_rate", "expected_exceedances",
+                   "exceedance_probability")
 # A stability result's flags (outputs.stability): CF flags like `state`'s, over the swept axes.
 # With the time-domain outputs off a result has no `state`: `stability` stands in for it.
 STABILITY = "stability"
@@ -338,7 +350,7 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
         _check_axis(ds, dim, where, unique=True)
     if DIRECTION_DIM in state.dims:
         _check_directions(ds, where)
-    for name in (*_OVER_AXES, *_HISTORIES, *_SNAPSHOTS):
+    for name in (*_OVER_AXES, *_HISTORIES, *_SNAPSHOTS, *_OVER_CLEARANCE):
         if name not in ds or name in ds.coords and name in axes:
             continue
         da = ds[name]
@@ -349,6 +361,8 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
             expected = [d for d in _TIME_DIMS if d in da.dims][:1]
         elif name in _SNAPSHOTS:
             expected = ["snapshot_time", "position"]
+        elif name in _OVER_CLEARANCE:
+            expected = [CLEARANCE_DIM]
         else:
             expected = []
         if sorted(extra) != sorted(expected) or (expected and len(da.dims) != len(axes) + len(
@@ -358,7 +372,7 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
             raise _refuse(where, f"variable '{name}' lies over ({', '.join(map(str, da.dims))})"
                                  f", not over ({want})")
         for dim in expected:
-            _check_axis(ds, dim, where, unique=False)
+            _check_axis(ds, dim, where, unique=name in _OVER_CLEARANCE)
     _check_bands(ds, axes, where)
     for key in ("title", "model_kind", "coefficients", "scene"):
         if key in ds.attrs and not isinstance(ds.attrs[key], str):
@@ -471,14 +485,45 @@ def _values_text(values: np.ndarray) -> str:
 
 def swept_axes(ds: xr.Dataset) -> list[str]:
     """The result's swept axes with more than one value, in scene order (the dims of state, of
-    `stability` in a stability-only result; a stepped sweep's `direction` is not one)."""
+    `stability` in a stability-only result; a stepped sweep's `direction` and a random
+    result's `realisation` are not)."""
     return [d for d in ds[flags_variable(ds) or "state"].dims
-            if ds.sizes[d] > 1 and d != DIRECTION_DIM]
+            if ds.sizes[d] > 1 and d not in (DIRECTION_DIM, REALISATION_DIM)]
+
+
+def is_random_result(ds: xr.Dataset) -> bool:
+    """A random base excitation's result ([base] asd_g2 / asd): statistics per realisation
+    (`rms_deflection`, m) and their means (docs/model.md sec. 11)."""
+    return "rms_deflection" in ds.data_vars
+
+
+def over_points(ds: xr.Dataset) -> xr.Dataset:
+    """A random result as the per-point figures read it: without its `realisation` dimension
+    (every per-realisation variable dropped; the means over the realisations stay) and with
+    `state` per point: `completed` where every realisation completed, else the state most of
+    those that did not ended in (e.g. `diverged` where one escaped). `ds` itself when it
+    has no realisation dimension."""
+    if REALISATION_DIM not in ds["state"].dims:
+        return ds
+    state = ds["state"]
+    meanings = dict(zip(np.atleast_1d(state.attrs.get("flag_values", [])).tolist(),
+                        str(state.attrs.get("flag_meanings", "")).split()))
+    values = state.transpose(..., REALISATION_DIM).values
+    summary = values[..., 0].copy()
+    for index in np.ndindex(summary.shape):
+        bad = [int(v) for v in values[index] if meanings.get(int(v)) != "completed"]
+        if bad:
+            summary[index] = max(set(bad), key=lambda v: (bad.count(v), -v))
+    out = ds.drop_dims(REALISATION_DIM)
+    out["state"] = xr.DataArray(summary, dims=[d for d in state.dims if d != REALISATION_DIM],
+                                attrs=state.attrs)
+    return out
 
 
 def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr.Dataset:
     """`ds` with each axis in `select` fixed at the given value, single-valued axes dropped to
-    scalar coordinates and the remaining axes sorted; at most two swept axes may remain.
+    scalar coordinates and the remaining axes sorted; at most two swept axes may remain (a
+    random result's `realisation` is not one: it stays whole, and cannot be selected).
 
     A value must be one of the axis's coordinate values (to 1e-6 relative). Raises UserError
     for an unknown axis, a value not on the axis, or more than two remaining swept axes.
@@ -486,12 +531,14 @@ def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr
     name = flags_variable(ds)
     if name is None:
         raise UserError("not a cable-sweep result: no 'state' variable")
-    axes = [d for d in ds[name].dims if d != DIRECTION_DIM]
+    axes = [d for d in ds[name].dims if d not in (DIRECTION_DIM, REALISATION_DIM)]
     for dim, value in (select or {}).items():
         shown = f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
         if dim not in axes:
-            raise UserError(f"select {dim}={shown}: '{dim}' is not a swept axis of this result "
-                            f"(its axes: {', '.join(axes) or 'none'})")
+            records = (" (the random records: the figures show statistics over them)"
+                       if dim == REALISATION_DIM and dim in ds[name].dims else "")
+            raise UserError(f"select {dim}={shown}: '{dim}' is not a swept axis of this result"
+                            f"{records} (its axes: {', '.join(axes) or 'none'})")
         coord = np.asarray(ds[dim].values, dtype=float)
         try:
             target = float(value)
