@@ -48,7 +48,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # the checkout's sweep/kernels
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common
 
-from bench_common import markdown_table, parameter_table, write_json  # noqa: E402
+from bench_common import machine, markdown_table, parameter_table, write_json  # noqa: E402
 from sweep.kernels import oscillator as osc  # noqa: E402
 from sweep.models.transverse import set_constant_stiffness  # noqa: E402
 from sweep.kernels import transverse as tk  # noqa: E402
@@ -126,20 +126,6 @@ def kernel_inputs(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     settings = settings_vector(scene)
     set_constant_stiffness(settings, {c: table[:, osc.PARAM_NAMES.index(c)] for c in ("k1", "g1")})
     return table, settings
-
-
-def machine() -> str:
-    """The CPU's model name (from /proc/cpuinfo where there is one) and the core count."""
-    name = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                name = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    import os
-    return f"{name}, {os.cpu_count()} cores"
 
 
 def main() -> None:

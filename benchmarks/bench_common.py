@@ -97,6 +97,22 @@ def best_time(fn: Callable[[], Any], min_total: float = 0.2, max_repeats: int = 
     return min(times)
 
 
+def machine() -> str:
+    """The CPU's model name (from /proc/cpuinfo where there is one) and the CPUs this process
+    may use."""
+    import os
+    import platform
+    name = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                name = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{name}, {len(os.sched_getaffinity(0))} CPUs"
+
+
 def markdown_table(headers: Sequence[str], rows: Sequence[Sequence[Any]]) -> str:
     """A GitHub Markdown table; cells are str()-ed (format numbers before)."""
     lines = ["| " + " | ".join(headers) + " |",

@@ -64,7 +64,7 @@ import numba as nb  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.integrate import DOP853, solve_ivp  # noqa: E402
 
-from bench_common import markdown_table  # noqa: E402
+from bench_common import machine, markdown_table  # noqa: E402
 
 import sweep  # noqa: E402
 from sweep import grid  # noqa: E402
@@ -278,19 +278,6 @@ def scene_wall(repeats: int) -> float:
         sweep.run(scene, progress=False)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
-
-
-def machine() -> str:
-    """The CPU's model name (/proc/cpuinfo) and the number of CPUs this process may use."""
-    name = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                name = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{name}, {len(os.sched_getaffinity(0))} CPUs"
 
 
 def main() -> None:
