@@ -140,28 +140,40 @@ def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, A
     end load) under the same spectrum at each level: the root of the integral of
     |H(f)|^2 W(f) over the spectrum, H the midspan's receptance summed over the modes, mode n
     at f1 times its basis frequency ratio with damping ratio zeta, weighted by its midspan
-    value and participation (sweep/models/random.py `linear_mean_square`); on the axes it
-    depends on. NaN where the basis varies over the grid (elastic ends swept)."""
-    from .basis import BasisFamily
+    value and participation (sweep/models/random.py `linear_mean_square`; elastic ends swept
+    over the grid: each point's own basis); on the axes it depends on."""
+    from .basis import BasisFamily, end_stiffness
     from .random import linear_mean_square
     f, w = random.spectrum
+    mode = "mode_"                        # the modes' axis of this sum (dropped by it)
+    if n_modes == 1:
+        ratio = xr.DataArray(np.ones(1), dims=mode)
+        weight = xr.DataArray(np.ones(1), dims=mode)
+        gamma = derived(coeffs["participation"], coords)
+    elif isinstance(basis, BasisFamily):  # elastic ends varying: each point's own basis
+        stiffness = derived(end_stiffness("elastic", params["clamp_rotational_stiffness"],
+                                          params["length"],
+                                          params["youngs_modulus"] * params["inertia"]), coords)
+        at = basis.index(np.asarray(stiffness.values, float))
+        ratios = np.array([b.frequency_ratio / b.frequency_ratio[0] for b in basis.bases])
+        weights = np.array([b.midspan * b.participation_ratio for b in basis.bases])
+        ratio = xr.DataArray(ratios[at], dims=stiffness.dims + (mode,))
+        weight = xr.DataArray(weights[at], dims=stiffness.dims + (mode,))
+        gamma = derived(4.0 / np.pi, coords)
+    else:
+        ratio = xr.DataArray(basis.frequency_ratio / basis.frequency_ratio[0], dims=mode)
+        weight = xr.DataArray(basis.midspan * basis.participation_ratio, dims=mode)
+        gamma = derived(4.0 / np.pi, coords)
     f1 = derived(coeffs["natural_frequency"], coords)
     zeta = derived(params["damping_ratio"], coords)
     level = derived(coeffs["base_accel"], coords)
-    if n_modes == 1:
-        ratio, weight = np.ones(1), np.ones(1)
-        gamma = derived(coeffs["participation"], coords)
-    else:
-        ratio = basis.frequency_ratio / basis.frequency_ratio[0] if not isinstance(
-            basis, BasisFamily) else np.full(n_modes, np.nan)
-        weight = basis.midspan * basis.participation_ratio if not isinstance(
-            basis, BasisFamily) else np.full(n_modes, np.nan)
-        gamma = derived(4.0 / np.pi, coords)
-    f1, zeta, gamma, level = xr.broadcast(f1, zeta, gamma, level)
-    omega = 2.0 * np.pi * f1.values[..., None] * ratio
-    with np.errstate(invalid="ignore"):
-        ms = linear_mean_square(f, w, omega, 2.0 * zeta.values[..., None] * omega,
-                                gamma.values[..., None] * weight)
+    f1, zeta, gamma, level, ratio, weight = xr.broadcast(f1, zeta, gamma, level, ratio, weight)
+    order = [d for d in f1.dims if d != mode] + [mode]
+    omega = 2.0 * np.pi * (f1 * ratio).transpose(*order).values
+    ms = linear_mean_square(f, w, omega, 2.0 * zeta.transpose(*order).values * omega,
+                            (gamma * weight).transpose(*order).values)
+    f1 = f1.isel({mode: 0}, drop=True).transpose(*order[:-1])
+    level = level.isel({mode: 0}, drop=True).transpose(*order[:-1])
     out = f1.copy(data=np.sqrt(ms) * level.values)
     out.attrs = {"units": "m", "long_name": "exact RMS midspan deflection of the same span "
                  "made linear (no stretching, no end load) under the same spectrum: beside "
