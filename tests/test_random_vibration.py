@@ -238,6 +238,8 @@ def test_the_dataset_has_a_realisation_dimension_and_means():
     assert ds.clearance.values.tolist() == [1e-4, 2e-4]
     assert ds.exceedance_probability.dims == ("base_asd_scale", "realisation", "clearance")
     assert set(np.unique(ds.state.values)) == {8}
+    assert float(ds.escape_probability.max()) == 0.0
+    assert np.all(np.isnan(ds.escape_time_mean.values))
 
 
 @pytest.mark.parametrize("overrides, words", [

@@ -267,6 +267,10 @@ def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
     data["escape_probability"] = escaped.mean(REALISATION_DIM).assign_attrs(
         units="1", long_name="fraction of the realisations in which the span escaped "
         "(diverged) within the run: a softening span's measure, where an RMS means nothing")
+    failed_at = xr.DataArray(reals[:, tk.FAILURE_TIME].reshape(shape), dims=dims)
+    data["escape_time_mean"] = failed_at.where(escaped).mean(REALISATION_DIM).assign_attrs(
+        units="s", long_name="mean time of escape (divergence) over the realisations that "
+        "escaped; NaN where none did")
     extra: dict[str, xr.DataArray] = {}
     if random.clearance:
         levels = xr.DataArray(np.array(random.clearance), dims=CLEARANCE_DIM,
