@@ -84,8 +84,8 @@ T_FINAL = T_TAIL + 1    # this trajectory's end time (s): t_end, or the moved ta
 N_SLOTS = T_FINAL + 1
 # The record kind's statistics (a random base acceleration, kernels.excitation), after the
 # slots every driver keeps: only the scalar drivers run records, and they allocate
-# SCALAR_SLOTS, zeroed. The window starts at the first step end at or after the tail window's
-# start and ends with the run; over it (`observe_random`):
+# SCALAR_SLOTS, zeroed. The window starts with the first step that starts at or after the tail
+# window's start and ends with the run; over it (`observe_random`):
 IN_WINDOW = N_SLOTS      # 1.0 once the window has started
 W_START = IN_WINDOW + 1  # when it started (s)
 W_END = W_START + 1      # the last step end in it (s)
@@ -770,7 +770,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     acc[FV] = K[last, 1]
 
 
-def _quintic_gram() -> tuple[np.ndarray, np.ndarray]:
+def _quintic_gram() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(M, D, E): the Gram matrices over [0, 1] of the quintic Hermite basis H_i (the
     polynomials of degree 5 with H_i's value, slope and second derivative at 0 and 1 the unit
     vector e_i, in the order value, slope, second derivative at 0, then at 1) and of their
@@ -836,10 +836,9 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
     deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
     m/s^2; qe its extremum inside the step where has_ext), once the step starts at or after
     the tail window's start: the integrals of q^2, q'^2 and q''^2 on the quintic Hermite
-    through q, q', q'' at both ends (`_quintic_squares`), of (q'' + a_b)^2 by the trapezoidal rule
-    (SCALAR_SLOTS), and
-    the crossings of zero and of settings' levels on the step's monotone pieces, q_old to qe
-    to q_new (a level grazed inside a step counts)."""
+    through q, q', q'' at both ends (`_quintic_squares`) and of (q'' + a_b)^2 by the
+    trapezoidal rule (SCALAR_SLOTS), and the crossings of zero and of settings' levels on the
+    step's monotone pieces, q_old to qe to q_new (a level grazed inside a step counts)."""
     if t < acc[T_TAIL]:
         return
     if acc[IN_WINDOW] == 0.0:

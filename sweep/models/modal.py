@@ -332,11 +332,12 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
     level (no [base] table)."""
     levels = p.get("base_levels_g")
     if p.get("base_asd") is not None:     # the record kind: level factor, sample rate, record
+        from .random_scene import transient_time
         block = excitation.block(random_level(p), p["base_sample_rate"])
         block["base_phase"] = p["realisation"]
-        with np.errstate(divide="ignore"):   # the row's statistics start after its transient
-            block["sweep_end"] = (np.log(1.0 / p["statistics_tolerance"])
-                                  / (p["damping_ratio"] * omega_1))
+        # the row's statistics start after its own start-up transient
+        block["sweep_end"] = transient_time(omega_1, p["damping_ratio"],
+                                            p["statistics_tolerance"])
         return {"participation": PARTICIPATION, **block}
     if p.get("base_acceleration") is None and p.get("base_acceleration_g") is None \
             and levels is None:

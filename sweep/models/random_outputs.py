@@ -228,16 +228,16 @@ def realised_grms(records: np.ndarray, random: RandomInputs) -> np.ndarray:
     return np.sqrt(np.mean(run * run, axis=1)) / STANDARD_GRAVITY
 
 
-def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
-            dims: tuple[str, ...], shape: tuple[int, ...], coords: dict[str, xr.DataArray],
-            random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
-            records: np.ndarray, basis: Any, n_modes: int,
-            loads: dict[str, xr.DataArray] | None = None) -> tuple[dict[str, xr.DataArray], dict[str, xr.DataArray]]:
+def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
+            shape: tuple[int, ...], coords: dict[str, xr.DataArray], random: RandomInputs,
+            coeffs: dict[str, Any], params: dict[str, Any], records: np.ndarray, basis: Any,
+            n_modes: int, loads: dict[str, xr.DataArray] | None = None
+            ) -> tuple[dict[str, xr.DataArray], dict[str, xr.DataArray]]:
     """The random outputs of a run (variables, extra coordinates): OUTPUTS, the acceleration
     in g, the peak factor, each MEANS statistic's mean and interval over the realisations,
     the escape probability, the clearance levels' rates and exceedances, the linear RMS and
-    the input's grms. reals, states: the kernel's (grid order); amplitude: the peak |q| over
-    the window (m) per point; loads: the span's load outputs (for the strains' moments)."""
+    the input's grms. reals, states: the kernel's (grid order; the peak |q| over the window is
+    reals' AMPLITUDE); loads: the span's load outputs (for the strains' moments)."""
     from .random import grms
     data: dict[str, xr.DataArray] = {}
     for name, column, units, long_name in OUTPUTS:
@@ -247,7 +247,7 @@ def outputs(reals: np.ndarray, states: np.ndarray, amplitude: np.ndarray,
     data["rms_acceleration_g"].attrs = {
         "units": G_UNITS, "long_name": "RMS absolute midspan acceleration in g "
                                        f"({STANDARD_GRAVITY:g} m s-2), grms"}
-    peak = xr.DataArray(amplitude.reshape(shape), dims=dims, attrs={
+    peak = xr.DataArray(reals[:, tk.AMPLITUDE].reshape(shape), dims=dims, attrs={
         "units": "m", "long_name": "largest |midspan deflection| over the statistics window"})
     data["peak_deflection"] = peak
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -1,6 +1,6 @@
 """The scene rules of a random base acceleration (docs/model.md sec. 11): which keys it takes
-and refuses, its defaults, and the kernel settings it sets (the statistics window, the
-clearance levels). The spectrum and its records are sweep/models/random.py's; the outputs
+and refuses, its defaults, and how long its start-up transient lasts. The spectrum and its
+records are sweep/models/random.py's; the kernel settings and the outputs
 sweep/models/random_outputs.py's.
 
 A scene is random when it gives ``base.asd_g2`` (g^2/Hz) or ``base.asd`` ((m/s^2)^2/Hz): the
@@ -18,6 +18,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from sweep.kernels import layout as tk        # plain constants: no Numba is imported
+
 from .. import schema
 from ..scene.messages import _fail, _show
 
@@ -31,12 +33,13 @@ SINE_KEYS: tuple[str, ...] = ("base.acceleration", "base.acceleration_g", "base.
                               "base.frequency", "base.frequency_ratio", "base.sweep.start",
                               "base.sweep.stop", "base.sweep.rate", "base.sweep.ramp_cycles",
                               "base.sweep.direction")
-MAX_LEVELS = 4
-"""Most clearance levels (kernels.layout.MAX_LEVELS)."""
+MAX_LEVELS = tk.MAX_LEVELS
+"""Most clearance levels: the kernels count the crossings of this many."""
 REALISATION_DIM = "realisation"
 DEFAULT_RTOL = 1e-6
 """solver.rtol of a random scene that gives none: its RMS is a statistic whose error over a
-record is about 1 % (docs/model.md sec. 11.3); 1e-6 integrates a record to far better."""
+record is about 1 % (docs/model.md sec. 11, "How long a record"); 1e-6 integrates a record to
+far better."""
 
 
 def spectrum_key(values: Mapping[str, Any]) -> str | None:
@@ -128,9 +131,9 @@ def _check_sampling(given: Mapping[str, Any], key: str) -> None:
 
 def defaults(values: dict[str, Any], mentioned: set[str]) -> None:
     """A random scene's defaults: its level 0 dB, one record, seed 0, the scalar driver,
-    DOP853 at rtol DEFAULT_RTOL, t_end the
-    record's length, and no settling time or response period (they mean nothing for a
-    random response)."""
+    DOP853 at rtol DEFAULT_RTOL, t_end the record's length, the statistics over the whole
+    record after its start-up transient (metrics.tail 1), and no settling time or response
+    period (they mean nothing for a random response)."""
     for dotted, value in (("base.asd_scale", 0.0), ("base.realisations", 1), ("base.seed", 0),
                           ("solver.driver", "scalar"), ("solver.method", "dop853"),
                           ("solver.rtol", DEFAULT_RTOL),
@@ -148,14 +151,20 @@ def sample_rate(values: Mapping[str, Any]) -> float:
     return float(given) if given is not None else 10.0 * float(values[spectrum_key(values)][-1][0])
 
 
-def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float) -> float:
-    """How long (s) the start-up transient of the slowest point takes to decay to
-    `tolerance` of its size: ln(1/tolerance) / (zeta w1), the largest over the grid (mode 1
-    decays slowest: every mode's zeta w_n is w_n / w1 times mode 1's). Infinite undamped."""
+def transient_time(omega_1: Any, damping_ratio: Any, tolerance: Any) -> Any:
+    """How long (s) a span's start-up transient takes to decay to `tolerance` of its size:
+    ln(1/tolerance) / (zeta w1), w1 (rad/s) its first mode's (mode 1 decays slowest: every
+    mode's zeta w_n is w_n / w1 times mode 1's); infinite undamped. Element-wise: each row's
+    statistics start after its own (sweep/models/modal.py's record block)."""
     with np.errstate(divide="ignore"):
-        rate = np.asarray(damping_ratio * 2.0 * math.pi * natural_frequency, float)
-    slowest = float(np.min(rate))
-    return math.log(1.0 / tolerance) / slowest if slowest > 0.0 else math.inf
+        return np.log(1.0 / tolerance) / (damping_ratio * omega_1)
+
+
+def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float) -> float:
+    """The longest start-up transient (s, `transient_time`) over the grid: of the least-damped
+    point, natural_frequency its f1 (Hz)."""
+    return float(np.max(np.asarray(
+        transient_time(2.0 * math.pi * natural_frequency, damping_ratio, tolerance), float)))
 
 
 def check_duration(t_end: float, startup: float) -> None:

@@ -769,8 +769,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                                        dims, shape, coords, inputs.swept))
     if inputs.random is not None:
         variables, extra = random_outputs.outputs(
-            result.reals, result.states, result.reals[:, tk.AMPLITUDE], dims, shape, coords,
-            inputs.random, coeffs, inputs.params, records, inputs.basis, inputs.n_modes, data)
+            result.reals, result.states, dims, shape, coords, inputs.random, coeffs,
+            inputs.params, records, inputs.basis, inputs.n_modes, data)
         data.update(variables)
         coords = {**coords, **extra}
     elif inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
