@@ -242,7 +242,8 @@ KEYS: tuple[Key, ...] = (
                   "thread (SciPy's arithmetic exactly, the reference)"),
     Key("solver", "method", "str", "rk45", choices=("rk45", "dop853"),
         long_name="transverse integrator: Dormand-Prince 5(4) step for step as SciPy's RK45, or "
-                  "8(5,3) step for step as SciPy's DOP853 (longer steps; faster at equal error)"),
+                  "8(5,3) step for step as SciPy's DOP853 (longer steps; faster at equal error); "
+                  "default rk45 with one mode, dop853 with model.modes >= 2 or a spectrum"),
     Key("solver", "controller", "str", "scipy", choices=("scipy", "pi"),
         long_name="transverse step-size controller: SciPy RK45's (step for step as solve_ivp) "
                   "or PI (Gustafsson; fewer rejected steps)"),

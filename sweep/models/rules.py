@@ -142,6 +142,14 @@ DEFAULT_T_END = 5.0
 DEFAULT_TRANSITS = 8.0
 """solver.transits of a longitudinal scene that gives neither solver.t_end nor transits."""
 
+MULTI_MODE_METHOD = "dop853"
+"""solver.method of a scene with model.modes >= 2 that gives none. Measured on the multi-mode
+built-in scenes' samples (benchmarks/workloads.py, benchmarks/RESULTS.md): at the default rtol
+1e-8 DOP853 runs harness-base-sine 1.75x, harness-clamps 2.0x and harness-stepped-sine 2.4x
+faster than RK45, its headline output within 2e-9 of the rtol 1e-12 reference on each (RK45:
+within 9e-9). A one-mode scene keeps RK45 (the contract's default; DOP853 gains 1.1-1.4x there,
+`solver.method = "dop853"`)."""
+
 SWEEP_MAX_STEPS = 20_000_000
 """solver.max_steps of a swept scene that gives none: a 130 s sweep to 100 Hz takes up to ~1e6
 RK45 steps at rtol = 1e-8 (about 50 per cycle of a short span's f1), 10x that at 1e-10."""
@@ -949,10 +957,13 @@ def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
 
 def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
                          mentioned: set[str]) -> None:
-    """solver.t_end 5 s, and the paper preset's initial.velocity without an initial condition."""
+    """solver.t_end 5 s, DOP853 for several modes (MULTI_MODE_METHOD), and the paper preset's
+    initial.velocity without an initial condition."""
     _shared_defaults(values, mentioned)
     if random_scene.is_random(values):
         random_scene.defaults(values, mentioned)
+    elif values["model.modes"] > 1 and "solver.method" not in mentioned:
+        values["solver.method"] = MULTI_MODE_METHOD
     swept = any(d in mentioned for d in SWEEP_KEYS)
     if "solver.t_end" not in mentioned and not swept and not random_scene.is_random(values):
         values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps

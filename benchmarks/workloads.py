@@ -1,0 +1,241 @@
+"""The built-in scenes as shipped against the engine's other settings and its peers, each at the
+scene's own accuracy: what the defaults buy, and how far ahead of a peer they are.
+
+What it measures
+----------------
+For each built-in time-domain scene (or --scene NAME), on a sample of its grid (SAMPLES below:
+a few points that keep the scene's regimes, below, at and above resonance; `--set` adds
+overrides):
+
+- the reference: the sample with solver.method = "dop853", rtol 1e-12 and the scalar driver,
+  which is SciPy's DOP853 step for step (tests/test_modal_driver.py, test_transverse.py check
+  the equality), so an independent SciPy solution at rtol 1e-12;
+- the scene as shipped and each of the engine's settings (method rk45 / dop853 x rtol 1e-6 ..
+  1e-10, the shipped driver): its time per point (best of --repeats after a compile run, one
+  thread: run.threads = 1) and its error: max |x - x_ref| / max |x_ref| of the scene's
+  headline output x (`amplitude`, else `peak_amplitude`, else `rms_deflection`) over the
+  sample;
+- the fastest setting whose error is at most the shipped run's ("best at equal error");
+- peers at the same error: SciPy `solve_ivp` on the sample's points with the System's own
+  compiled right-hand side (`kernels.modes.derivative` or `kernels.oscillator.acceleration`),
+  at the method and rtol of the scalar driver's setting that reaches the shipped error (SciPy
+  then takes the same steps, so reaches the same error); numbalsoda and diffrax when
+  importable (else reported as skipped, with the line that installs them). A stepped sine or a
+  sine sweep has no SciPy peer here (benchmarks/stepped_sweep.py, sine_sweep_cost.py); a
+  random scene's peers are in benchmarks/random_cost.py.
+
+Command
+-------
+    PYTHONPATH=. python benchmarks/workloads.py [--scene NAME ...] [--check R] [--repeats 3]
+
+Prints one Markdown table per scene; with --check R it exits 1 when a scene's shipped run is
+less than R times faster than its fastest peer.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # the checkout's sweep/kernels
+sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common
+
+from bench_common import machine, markdown_table  # noqa: E402
+
+import sweep  # noqa: E402
+
+SAMPLES: dict[str, dict[str, Any]] = {
+    "paper-fig5": {},
+    "harness-parametric": {"axes.length": [0.3, 0.6, 1.0],
+                           "axes.frequency_ratio": [0.8, 1.0, 1.9, 2.0, 2.5]},
+    "harness-base-sine": {"axes.length": [0.3, 0.5, 0.7],
+                          "axes.base_frequency": {"start": 10.0, "stop": 80.0, "num": 4,
+                                                  "spacing": "log"}},
+    "harness-clamps": {"axes.length": [0.15, 0.3, 0.45],
+                       "axes.clamp_rotational_stiffness": [0.01, 1.0, 100.0]},
+    "harness-stepped-sine": {"axes.length": [0.5],
+                             "axes.base_frequency_ratio": {"start": 0.8, "stop": 2.0, "num": 13}},
+    "launch-sine-qualification": {"axes.length": [0.15, 0.35]},
+    "launch-random-gevs": {"axes.length": [0.15, 0.3], "axes.base_asd_scale": [0.0],
+                           "base.realisations": 2},
+}
+RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+HEADLINE = ("amplitude", "peak_amplitude", "rms_deflection")
+INSTALL = {"numbalsoda": "pip install numbalsoda (needs cmake and a C++ compiler)",
+           "diffrax": "pip install diffrax jax"}
+
+
+def headline(ds: Any) -> np.ndarray:
+    """The scene's headline output, flattened (m)."""
+    for name in HEADLINE:
+        if name in ds:
+            return np.asarray(ds[name].values, float).ravel()
+    raise SystemExit(f"no headline output ({', '.join(HEADLINE)}) in the dataset")
+
+
+def error(x: np.ndarray, ref: np.ndarray) -> float:
+    """max |x - ref| / max |ref| over the points both have (NaN where a point has none)."""
+    ok = np.isfinite(x) & np.isfinite(ref)
+    if not ok.any():
+        return math.nan
+    return float(np.max(np.abs(x[ok] - ref[ok])) / np.max(np.abs(ref[ok])))
+
+
+def timed(name: str, overrides: dict[str, Any], repeats: int) -> tuple[float, np.ndarray, Any]:
+    """(best wall time per point (s) on one thread, headline, dataset) of scene `name`."""
+    scene = sweep.load_scene(name, overrides={**overrides, "run.threads": 1})
+    ds = sweep.run(scene, progress=False)                   # compile, or load the cache
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        ds = sweep.run(scene, progress=False)
+        best = min(best, time.perf_counter() - start)
+    points = headline(ds).size
+    return best / points, headline(ds), ds
+
+
+def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -> float | None:
+    """SciPy solve_ivp's time per point (s) on the sample with the System's compiled
+    right-hand side, at (method, rtol) and the scene's own atol; None where it has no peer
+    here (a sweep, continuation or random records)."""
+    from scipy.integrate import solve_ivp
+
+    from sweep.kernels import layout as tk
+    from sweep.kernels import modes as md
+    from sweep.kernels import oscillator as osc
+    from sweep.models import transverse as tm
+    scene = sweep.load_scene(name, overrides={**overrides, "solver.method": method,
+                                              "solver.rtol": rtol, "solver.driver": "scalar"})
+    inputs = tm.resolve(scene)
+    if inputs.swept or inputs.continuation is not None or getattr(inputs, "records", None) \
+            is not None or scene.values.get("base.asd_g2") is not None \
+            or scene.values.get("base.asd") is not None:
+        return None
+    settings = tm.settings_vector(scene)
+    t_end = float(settings[tk.T_END])
+    rtol_s = float(settings[tk.RTOL])
+    c = float(settings[tk.ATOL_SCALE]) * rtol_s        # kernels/trajectory.py point_atol
+
+    def tolerances(q_scale: float, v_scale: float, n: int) -> np.ndarray:
+        return np.concatenate((np.full(n, settings[tk.ATOL] + c * q_scale),
+                               np.full(n, settings[tk.ATOL] + c * v_scale)))
+
+    points = np.arange(int(np.prod(inputs.shape)))
+    elapsed = 0.0
+    if inputs.n_modes == 1:
+        from bench_common import parameter_table, scipy_rhs
+        rows = parameter_table(scene)
+        for row in rows:
+            start = time.perf_counter()
+            solve_ivp(scipy_rhs(row), (0.0, t_end), [row[osc.Q0], row[osc.V0]],
+                      method=method.upper(), rtol=rtol_s,
+                      atol=tolerances(row[osc.Q_SCALE], row[osc.V_SCALE], 1))
+            elapsed += time.perf_counter() - start
+        return elapsed / len(rows)
+    rows = tm.modal_rows(inputs, points)
+    bases = inputs.basis.kernel_arrays()
+    n = inputs.n_modes
+    for row in rows:
+        arrays = bases if isinstance(bases, tuple) else bases[int(row[-1])]
+        pp = np.zeros(md.prepared_size(n))
+        md.prepare(row, n, pp, arrays[md.RATIOS])
+        S = md.scratch(pp, n, arrays[md.TABLES], arrays[md.COUPLING])
+        T = arrays[md.TABLES]
+        base = True if row[md.BASE_ACCEL] != 0.0 else None
+
+        def rhs(t: float, y: np.ndarray) -> np.ndarray:
+            dy = np.empty(2 * n)
+            md.derivative(t, y, dy, S, n, T, base)
+            return dy
+
+        y0 = row[md.N_FIXED:md.N_FIXED + 2 * n]
+        atol = tolerances(row[md.Q_SCALE], row[md.V_SCALE], n)
+        rhs(0.0, y0)                                          # compile
+        start = time.perf_counter()
+        solve_ivp(rhs, (0.0, t_end), y0, method=method.upper(), rtol=rtol_s, atol=atol)
+        elapsed += time.perf_counter() - start
+    return elapsed / len(rows)
+
+
+def optional_peers() -> list[str]:
+    """One line per optional peer not importable here."""
+    lines = []
+    for module, line in INSTALL.items():
+        try:
+            __import__(module)
+        except ImportError:
+            lines.append(f"{module}: skipped (not importable; {line})")
+    return lines
+
+
+def scene_table(name: str, extra: dict[str, Any], repeats: int) -> tuple[str, float | None]:
+    """The scene's Markdown table and its shipped run's ratio to its fastest peer."""
+    sample = {**SAMPLES[name], **extra}
+    shipped = sweep.load_scene(name, overrides=sample).values
+    _, ref, _ = timed(name, {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
+                             "solver.driver": "scalar"}, 1)
+    t_ship, x, _ = timed(name, sample, repeats)
+    e_ship = error(x, ref)
+    rows = [["as shipped", shipped["solver.method"], f"{shipped['solver.rtol']:g}",
+             shipped["solver.driver"], f"{t_ship * 1e3:.3g}", f"{e_ship:.2g}", "1.00"]]
+    best = (t_ship, "as shipped")
+    for method in ("rk45", "dop853"):
+        for rtol in RTOLS:
+            t, x, _ = timed(name, {**sample, "solver.method": method, "solver.rtol": rtol},
+                            repeats)
+            e = error(x, ref)
+            rows.append(["", method, f"{rtol:g}", shipped["solver.driver"], f"{t * 1e3:.3g}",
+                         f"{e:.2g}", f"{t_ship / t:.2f}"])
+            if e <= e_ship and t < best[0]:
+                best = (t, f"{method} rtol {rtol:g}")
+    # the SciPy peer: the scalar setting (shipped method) that reaches the shipped error
+    peer_rtol = next((r for r in sorted(RTOLS, reverse=True)
+                      if error(timed(name, {**sample, "solver.driver": "scalar",
+                                            "solver.rtol": r}, 0)[1], ref) <= e_ship), None)
+    ratio = None
+    if peer_rtol is not None:
+        t_peer = scipy_peer(name, sample, shipped["solver.method"], peer_rtol)
+        if t_peer is not None:
+            ratio = t_peer / t_ship
+            rows.append([f"SciPy solve_ivp", shipped["solver.method"], f"{peer_rtol:g}", "-",
+                         f"{t_peer * 1e3:.3g}", f"<= {e_ship:.2g}", f"{ratio:.1f}"])
+    table = markdown_table(["run", "method", "rtol", "driver", "ms per point (1 thread)",
+                            "error", "shipped speed-up"], rows)
+    return (f"### {name}\n\n{len(x)} points of the sample; error against DOP853 at rtol 1e-12 "
+            f"(SciPy's steps). Fastest at the shipped error or better: {best[1]} "
+            f"({t_ship / best[0]:.2f}x the shipped run).\n\n{table}\n"), ratio
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--scene", nargs="+", default=list(SAMPLES))
+    parser.add_argument("--check", type=float, default=None)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    print(f"Machine: {machine()}\n")
+    for line in optional_peers():
+        print(f"- {line}")
+    print()
+    failed = []
+    for name in args.scene:
+        if name not in SAMPLES:
+            raise SystemExit(f"--scene {name}: not a built-in time-domain scene "
+                             f"({', '.join(SAMPLES)})")
+        text, ratio = scene_table(name, {}, args.repeats)
+        print(text, flush=True)
+        if args.check is not None and ratio is not None and ratio < args.check:
+            failed.append(f"{name}: {ratio:.2f}x its fastest peer, below {args.check:g}")
+    print(f"    PYTHONPATH=. python benchmarks/workloads.py {' '.join(sys.argv[1:])}")
+    if failed:
+        print("\n".join(failed), file=sys.stderr)
+        raise SystemExit(1)
+
+
+if __name__ == "__main__":
+    main()
