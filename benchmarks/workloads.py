@@ -19,14 +19,17 @@ overrides):
 - peers at the same error: SciPy `solve_ivp` on the sample's points with the System's own
   compiled right-hand side (`kernels.modes.derivative` or `kernels.oscillator.acceleration`),
   at the method and rtol of the scalar driver's setting that reaches the shipped error (SciPy
-  then takes the same steps, so reaches the same error); numbalsoda and diffrax when
-  importable (else reported as skipped, with the line that installs them). A stepped sine or a
+  then takes the same steps, so reaches the same error). numbalsoda and diffrax are not run by
+  this script yet (benchmarks/work_precision.py runs both on the one-mode reference sweep):
+  each is listed, as not importable with the line that installs it, or as not run. The
+  shipped run is also timed on 2 threads (the ratio to one thread). A stepped sine or a
   sine sweep has no SciPy peer here (benchmarks/stepped_sweep.py, sine_sweep_cost.py); a
   random scene's peers are in benchmarks/random_cost.py.
 
 Command
 -------
     PYTHONPATH=. python benchmarks/workloads.py [--scene NAME ...] [--check R] [--repeats 3]
+        [--shipped-only]
 
 Prints one Markdown table per scene; with --check R it exits 1 when a scene's shipped run is
 less than R times faster than its fastest peer.
@@ -87,9 +90,10 @@ def error(x: np.ndarray, ref: np.ndarray) -> float:
     return float(np.max(np.abs(x[ok] - ref[ok])) / np.max(np.abs(ref[ok])))
 
 
-def timed(name: str, overrides: dict[str, Any], repeats: int) -> tuple[float, np.ndarray, Any]:
-    """(best wall time per point (s) on one thread, headline, dataset) of scene `name`."""
-    scene = sweep.load_scene(name, overrides={**overrides, "run.threads": 1})
+def timed(name: str, overrides: dict[str, Any], repeats: int,
+          threads: int = 1) -> tuple[float, np.ndarray, Any]:
+    """(best wall time per point (s) on `threads` threads, headline, dataset) of scene `name`."""
+    scene = sweep.load_scene(name, overrides={**overrides, "run.threads": threads})
     ds = sweep.run(scene, progress=False)                   # compile, or load the cache
     best = math.inf
     for _ in range(repeats):
@@ -164,28 +168,32 @@ def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -
 
 
 def optional_peers() -> list[str]:
-    """One line per optional peer not importable here."""
+    """One line per optional peer: not importable (with its install line), or not run."""
     lines = []
     for module, line in INSTALL.items():
         try:
             __import__(module)
+            lines.append(f"{module}: importable, not run by this script yet")
         except ImportError:
             lines.append(f"{module}: skipped (not importable; {line})")
     return lines
 
 
-def scene_table(name: str, extra: dict[str, Any], repeats: int) -> tuple[str, float | None]:
-    """The scene's Markdown table and its shipped run's ratio to its fastest peer."""
+def scene_table(name: str, extra: dict[str, Any], repeats: int,
+                shipped_only: bool = False) -> tuple[str, float | None]:
+    """The scene's Markdown table and its shipped run's ratio to its fastest peer; with
+    shipped_only, only the shipped run (on 1 and 2 threads) and its peers."""
     sample = {**SAMPLES[name], **extra}
     shipped = sweep.load_scene(name, overrides=sample).values
     _, ref, _ = timed(name, {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
                              "solver.driver": "scalar"}, 1)
     t_ship, x, _ = timed(name, sample, repeats)
+    t_two = timed(name, sample, repeats, threads=2)[0]
     e_ship = error(x, ref)
     rows = [["as shipped", shipped["solver.method"], f"{shipped['solver.rtol']:g}",
              shipped["solver.driver"], f"{t_ship * 1e3:.3g}", f"{e_ship:.2g}", "1.00"]]
     best = (t_ship, "as shipped")
-    for method in ("rk45", "dop853"):
+    for method in () if shipped_only else ("rk45", "dop853"):
         for rtol in RTOLS:
             t, x, _ = timed(name, {**sample, "solver.method": method, "solver.rtol": rtol},
                             repeats)
@@ -209,7 +217,9 @@ def scene_table(name: str, extra: dict[str, Any], repeats: int) -> tuple[str, fl
                             "error", "shipped speed-up"], rows)
     return (f"### {name}\n\n{len(x)} points of the sample; error against DOP853 at rtol 1e-12 "
             f"(SciPy's steps). Fastest at the shipped error or better: {best[1]} "
-            f"({t_ship / best[0]:.2f}x the shipped run).\n\n{table}\n"), ratio
+            f"({t_ship / best[0]:.2f}x the shipped run). The shipped run on 2 threads: "
+            f"{t_two * 1e3:.3g} ms per point, {t_ship / t_two:.2f}x one thread."
+            f"\n\n{table}\n"), ratio
 
 
 def main() -> None:
@@ -217,6 +227,8 @@ def main() -> None:
     parser.add_argument("--scene", nargs="+", default=list(SAMPLES))
     parser.add_argument("--check", type=float, default=None)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--shipped-only", action="store_true",
+                        help="only the shipped run (1 and 2 threads) and its peers")
     args = parser.parse_args()
     print(f"Machine: {machine()}\n")
     for line in optional_peers():
@@ -227,7 +239,7 @@ def main() -> None:
         if name not in SAMPLES:
             raise SystemExit(f"--scene {name}: not a built-in time-domain scene "
                              f"({', '.join(SAMPLES)})")
-        text, ratio = scene_table(name, {}, args.repeats)
+        text, ratio = scene_table(name, {}, args.repeats, args.shipped_only)
         print(text, flush=True)
         if args.check is not None and ratio is not None and ratio < args.check:
             failed.append(f"{name}: {ratio:.2f}x its fastest peer, below {args.check:g}")

@@ -206,6 +206,12 @@ KEYS: tuple[Key, ...] = (
     Key("base", "sample_rate", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
         long_name="random base acceleration: the records' sample rate (default 10 x the "
                   "spectrum's top frequency)"),
+    Key("base", "rms_accuracy", "float", None, units="1", minimum=0.0, exclusive_min=True,
+        maximum=1.0,
+        long_name="random base acceleration: the accuracy asked of the RMS deflection's mean "
+                  "over the realisations, the relative half-width of its 95 % confidence "
+                  "interval (0.02: +-2 %); a scene whose realisations cannot reach it at some "
+                  "point is refused, with the count that does"),
     Key("base", "test_duration", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="random base acceleration: the test's duration for the expected number of "
                   "exceedances of outputs.clearance (default base.duration; GEVS: 120 s an "

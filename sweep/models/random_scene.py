@@ -8,7 +8,9 @@ records replace the sine ([base] acceleration, frequency, sweep and levels_g are
 them), every grid point sees the same ``base.realisations`` records (a ``realisation``
 dimension), the run ends with the record (``base.duration``; ``solver.t_end`` may be shorter,
 never longer: the record is periodic), and the statistics are taken after the start-up
-transient has decayed (`startup_time`).
+transient has decayed (`startup_time`). With ``base.rms_accuracy`` a scene whose realisations
+are too few for that accuracy at some point is refused, with the count that reaches it
+(`check_accuracy`).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ RANDOM_KEYS: tuple[str, str] = ("base.asd_g2", "base.asd")
 """The two spellings of the spectrum (g^2/Hz and (m/s^2)^2/Hz)."""
 RANDOM_ONLY: tuple[str, ...] = ("base.asd_scale", "base.duration", "base.realisations",
                                 "base.seed", "base.sample_rate", "base.test_duration",
-                                "outputs.clearance")
+                                "base.rms_accuracy", "outputs.clearance")
 """Keys that mean something only with a spectrum."""
 SINE_KEYS: tuple[str, ...] = ("base.acceleration", "base.acceleration_g", "base.levels_g",
                               "base.frequency", "base.frequency_ratio", "base.sweep.start",
@@ -165,6 +167,72 @@ def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float) -
     point, natural_frequency its f1 (Hz)."""
     return float(np.max(np.asarray(
         transient_time(2.0 * math.pi * natural_frequency, damping_ratio, tolerance), float)))
+
+
+CONFIDENCE_Z = 1.96
+"""The normal quantile of a two-sided 95 % interval (base.rms_accuracy's confidence)."""
+
+
+def statistics_window(t_end: Any, tail: float, transient: Any) -> Any:
+    """The length (s) of a point's statistics window: from the later of the tail window's
+    start (the last `tail` of [0, t_end]) and the end of its start-up transient (s), to t_end
+    (kernels.trajectory.delay_window)."""
+    return t_end - np.maximum(t_end * (1.0 - tail), transient)
+
+
+def rms_relative_error(omega_1: Any, damping_ratio: Any, window: Any, realisations: int) -> Any:
+    """The relative standard error of the RMS response's mean over `realisations` records of
+    `window` seconds each, of a span whose first mode (omega_1 rad/s, damping_ratio) carries the
+    response: 1 / (2 sqrt(zeta w1 R T)) (docs/model.md sec. 11.3: a mean square from a record
+    of T seconds errs by 1 / sqrt(zeta w1 T), the RMS by half of that). A hardening span's
+    response is broader-band than the linear one's, so it errs less: the figure is an upper
+    bound there (tests/test_random_accuracy.py checks it on a linear span)."""
+    return 1.0 / (2.0 * np.sqrt(damping_ratio * omega_1 * realisations * window))
+
+
+def required_realisations(accuracy: float, omega_1: Any, damping_ratio: Any,
+                          window: Any) -> int:
+    """The fewest realisations whose mean RMS has a 95 % half-width of at most `accuracy`
+    (relative) at every point: CONFIDENCE_Z rms_relative_error <= accuracy."""
+    need = (CONFIDENCE_Z / (2.0 * accuracy)) ** 2 / (damping_ratio * omega_1 * window)
+    return int(np.max(np.ceil(np.asarray(need, float) - 1e-9)))
+
+
+def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
+                   damping_ratio: Any) -> None:
+    """Refuse (one line) base.realisations too few for base.rms_accuracy at some point of
+    the grid (natural_frequency: f1 in Hz, damping_ratio: at the grid's corners, where zeta w1
+    and so the window and the error take their extremes). Points whose window is empty are
+    left to `check_duration`."""
+    accuracy = values.get("base.rms_accuracy")
+    if accuracy is None:
+        return
+    omega, zeta = np.broadcast_arrays(
+        2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
+        np.atleast_1d(np.asarray(damping_ratio, float)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        window = statistics_window(float(values["solver.t_end"]),
+                                   float(values["metrics.tail"]),
+                                   transient_time(omega, zeta, float(values["metrics.tolerance"])))
+        ok = (window > 0.0) & np.isfinite(window) & (zeta > 0.0)
+        if not ok.any():
+            return
+        omega, zeta, window = omega[ok], zeta[ok], window[ok]
+        realisations = int(values["base.realisations"])
+        half = CONFIDENCE_Z * rms_relative_error(omega, zeta, window, realisations)
+    worst = int(np.argmax(half))
+    if half[worst] <= accuracy:
+        return
+    need = required_realisations(accuracy, omega, zeta, window)
+    _fail("scene key 'base.realisations'",
+          f"{realisations} record{'s' if realisations != 1 else ''} of {window[worst]:.3g} s "
+          f"after the start-up transient give{'s' if realisations == 1 else ''} the mean RMS "
+          f"deflection to +-"
+          f"{100.0 * half[worst]:.2g} % (95 %) at f1 = {omega[worst] / (2.0 * math.pi):.4g} "
+          f"Hz, zeta = {zeta[worst]:g}, not the +-{100.0 * accuracy:g} % of "
+          f"base.rms_accuracy = {_show(accuracy)}",
+          f"give base.realisations = {need} or more, a longer base.duration or a looser "
+          "base.rms_accuracy")
 
 
 def check_duration(t_end: float, startup: float) -> None:

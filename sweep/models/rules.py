@@ -833,6 +833,9 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
             _check_fixed_frequency_in_table(values, axes, params, derived)
             _check_base_frequency_ratio(values, axes, params, derived)
             _check_stability_frequency(values, axes, derived)
+            if random_scene.is_random(values):
+                random_scene.check_accuracy(values, derived["natural_frequency"],
+                                            params["damping_ratio"])
         return
     name, coefficient = bad[0]
     corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0
