@@ -176,14 +176,22 @@ def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, fami
                   stop: threading.Event | None) -> dict[str, np.ndarray]:
     """`modes_chunk` of rows whose basis varies (the last column: an index into `family`):
     one kernel call per basis on its rows, whose finished rows are reported under their
-    places in `params`."""
+    places in `params`. The bases' calls run side by side, one thread each, when there are
+    threads for more than one (a basis' rows are often too few to spread over threads
+    themselves: harness-clamps' 7 spans per clamp stiffness ran on one of two threads)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from .threads import thread_count
     index = params[:, -1].astype(np.int64)
     rows = np.ascontiguousarray(params[:, :-1])
     out = modes_outputs(params.shape[0], n_samples, modes_of(family), n_bands)
     lock = threading.Lock()
-    for b in np.unique(index):
+    bases = np.unique(index)
+    workers = min(thread_count(threads), bases.size)
+
+    def solve(b: int) -> None:
         if stop is not None and stop.is_set():
-            break
+            return
         at = np.flatnonzero(index == b)
 
         def report(lo: int, hi: int, part: dict, at: np.ndarray = at) -> None:
@@ -194,10 +202,25 @@ def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, fami
                     on_block(a, z, out)
 
         part = modes_chunk(rows[at], settings, n_samples, family[b], driver, n_bands,
-                           per_point_end, records, threads,
+                           per_point_end, records, 1 if workers > 1 else threads,
                            report if on_block is not None else None, stop)
-        for name, values in part.items():
-            out[name][at] = values
+        with lock:
+            for name, values in part.items():
+                out[name][at] = values
+
+    if workers <= 1:
+        for b in bases:
+            solve(int(b))
+        return out
+    with ThreadPoolExecutor(workers, thread_name_prefix="cable-sweep-basis") as pool:
+        futures = [pool.submit(solve, int(b)) for b in bases]
+        try:
+            for future in futures:
+                future.result()
+        except BaseException:
+            if stop is not None:
+                stop.set()
+            raise
     return out
 
 
