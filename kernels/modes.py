@@ -493,7 +493,7 @@ def scratch(pp, n_modes, T, CP):
             np.empty((4, T.shape[2], 1)), np.empty((4, 1)), CP)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s): `lanes_derivative` with
     one lane and libm's cos and sin. S: `scratch`(prepared row, N, T, the basis' coupling);
