@@ -17,7 +17,9 @@ overrides):
   sample;
 - the fastest setting whose error is at most the shipped run's ("best at equal error");
 - peers at the same error: SciPy `solve_ivp` on the sample's points with the System's own
-  compiled right-hand side (`kernels.modes.derivative` or `kernels.oscillator.acceleration`),
+  right-hand side (several modes: the compiled `kernels.modes.derivative`; one mode:
+  `kernels.oscillator.acceleration` in Python, bench_common.scipy_rhs, as fast as a
+  hand-written closure),
   at the method and rtol of the scalar driver's setting that reaches the shipped error (SciPy
   then takes the same steps, so reaches the same error). numbalsoda and diffrax are not run by
   this script yet (benchmarks/work_precision.py runs both on the one-mode reference sweep):
@@ -108,8 +110,8 @@ def timed(name: str, overrides: dict[str, Any], repeats: int,
 
 
 def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -> float | None:
-    """SciPy solve_ivp's time per point (s) on the sample with the System's compiled
-    right-hand side, at (method, rtol) and the scene's own atol; None where it has no peer
+    """SciPy solve_ivp's time per point (s) on the sample with the System's right-hand side
+    (module docstring), at (method, rtol) and the scene's own atol; None where it has no peer
     here (a sweep, continuation or random records)."""
     from scipy.integrate import solve_ivp
 
