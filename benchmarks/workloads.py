@@ -75,7 +75,8 @@ SAMPLES: dict[str, dict[str, Any]] = {
 }
 RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 HEADLINE = ("amplitude", "peak_amplitude", "rms_deflection")
-INSTALL = {"numbalsoda": "pip install numbalsoda (its build needs cmake, a C++ compiler and gfortran)",
+INSTALL = {"numbalsoda": "pip install numbalsoda (its build needs cmake, a C++ compiler and "
+                         "gfortran)",
            "diffrax": "pip install diffrax jax"}
 
 

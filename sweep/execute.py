@@ -188,9 +188,10 @@ def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, fami
     lock = threading.Lock()
     bases = np.unique(index)
     workers = min(thread_count(threads), bases.size)
+    failed = threading.Event()           # a basis' call raised: the others not yet begun skip
 
     def solve(b: int) -> None:
-        if stop is not None and stop.is_set():
+        if failed.is_set() or (stop is not None and stop.is_set()):
             return
         at = np.flatnonzero(index == b)
 
@@ -218,6 +219,7 @@ def _family_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int, fami
             for future in futures:
                 future.result()
         except BaseException:
+            failed.set()
             if stop is not None:
                 stop.set()
             raise
