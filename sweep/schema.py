@@ -306,6 +306,15 @@ KEYS: tuple[Key, ...] = (
         long_name="random base acceleration: levels of |midspan deflection| (at most 4) whose "
                   "up-crossing rates, expected exceedances in base.test_duration and "
                   "probability of at least one are stored"),
+    Key("outputs", "response_asd", "bool", False,
+        long_name="random base acceleration: store the spectral densities (Welch) of the "
+                  "midspan deflection (m2 Hz-1) and absolute acceleration (g2 Hz-1) on a "
+                  "frequency dimension up to the spectrum's top frequency, mean over the "
+                  "realisations, beside the input spectrum"),
+    Key("outputs", "asd_resolution", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
+        long_name="random base acceleration, with outputs.response_asd: the spectra's frequency "
+                  "resolution (default: the finest that fits 8 half-overlapping Welch segments "
+                  "in the shortest statistics window)"),
     Key("outputs", "time_series", "bool", False, long_name="store q(t) at sample_interval"),
     Key("outputs", "sample_interval", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="time-series sample interval (default t_end/1000)"),

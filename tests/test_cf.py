@@ -31,7 +31,7 @@ REDUCED = {
     "harness-clamps": {"axes.length": [0.2, 0.4], "axes.clamp_rotational_stiffness": [0.1, 10.0],
                        "solver.t_end": 0.3},
     "launch-random-gevs": {"axes.length": [0.1, 0.15], "base.realisations": 2,
-                           "base.duration": 2.0},
+                           "base.duration": 2.0, "outputs.response_asd": True},
 }
 # The checker's priorities: high are its "errors", medium its "warnings", low its
 # "suggestions". A file fails on either of the first two.

@@ -29,7 +29,8 @@ RANDOM_KEYS: tuple[str, str] = ("base.asd_g2", "base.asd")
 """The two spellings of the spectrum (g^2/Hz and (m/s^2)^2/Hz)."""
 RANDOM_ONLY: tuple[str, ...] = ("base.asd_scale", "base.duration", "base.realisations",
                                 "base.seed", "base.sample_rate", "base.test_duration",
-                                "base.rms_accuracy", "outputs.clearance")
+                                "base.rms_accuracy", "outputs.clearance",
+                                "outputs.response_asd", "outputs.asd_resolution")
 """Keys that mean something only with a spectrum."""
 SINE_KEYS: tuple[str, ...] = ("base.acceleration", "base.acceleration_g", "base.levels_g",
                               "base.frequency", "base.frequency_ratio", "base.sweep.start",
@@ -118,6 +119,21 @@ def check(given: dict[str, Any], axes: Mapping[str, Any]) -> None:
                   f"{MAX_LEVELS} levels of |deflection|, each > 0 (m)",
                   "e.g. clearance = [0.001, 0.002]")
     _check_sampling(given, key)
+    _check_spectra(given)
+
+
+def _check_spectra(given: Mapping[str, Any]) -> None:
+    """outputs.asd_resolution needs outputs.response_asd; the spectra's samples are the time
+    series' (outputs.sample_interval is theirs, not the user's)."""
+    if not given.get("outputs.response_asd"):
+        if given.get("outputs.asd_resolution") is not None:
+            _fail("scene key 'outputs.asd_resolution'", "only with outputs.response_asd = true",
+                  "add response_asd = true to [outputs], or remove asd_resolution")
+        return
+    if given.get("outputs.sample_interval") is not None:
+        _fail("scene key 'outputs.sample_interval'", "with outputs.response_asd the time series "
+              "is sampled at the spectra's rate (4 x the spectrum's top frequency or more)",
+              "remove outputs.sample_interval")
 
 
 def _check_sampling(given: Mapping[str, Any], key: str) -> None:
@@ -233,6 +249,31 @@ def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
           f"base.rms_accuracy = {_show(accuracy)}",
           f"give base.realisations = {need} or more, a longer base.duration or a looser "
           "base.rms_accuracy")
+
+
+def shortest_window(values: Mapping[str, Any], natural_frequency: Any,
+                    damping_ratio: Any) -> float:
+    """The shortest statistics window (s) over the points (natural_frequency: f1 in Hz,
+    damping_ratio: on the grid, or at its corners, where zeta w1 takes its extremes)."""
+    omega, zeta = np.broadcast_arrays(
+        2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
+        np.atleast_1d(np.asarray(damping_ratio, float)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        window = statistics_window(float(values["solver.t_end"]), float(values["metrics.tail"]),
+                                   transient_time(omega, zeta, float(values["metrics.tolerance"])))
+    return float(np.min(window)) if window.size else 0.0
+
+
+def check_spectra_window(values: Mapping[str, Any], natural_frequency: Any,
+                         damping_ratio: Any) -> None:
+    """With outputs.response_asd: refuse (one line) a grid whose shortest statistics window
+    holds no Welch segment at the asked resolution (sweep/models/response_asd.py)."""
+    if not values.get("outputs.response_asd"):
+        return
+    from .response_asd import asd_rate, segment_length
+    rate = asd_rate(sample_rate(values), float(values[spectrum_key(values)][-1][0]))
+    segment_length(shortest_window(values, natural_frequency, damping_ratio), rate,
+                   values.get("outputs.asd_resolution"))
 
 
 def check_duration(t_end: float, startup: float) -> None:

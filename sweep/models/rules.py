@@ -836,6 +836,8 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
             if random_scene.is_random(values):
                 random_scene.check_accuracy(values, derived["natural_frequency"],
                                             params["damping_ratio"])
+                random_scene.check_spectra_window(values, derived["natural_frequency"],
+                                                  params["damping_ratio"])
         return
     name, coefficient = bad[0]
     corner = int(np.argmax(~np.isfinite(coefficient))) if coefficient.size > 1 else 0

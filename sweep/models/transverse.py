@@ -25,10 +25,11 @@ from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, fla
                        global_attrs, provenance)
 from ..runner import RunOptions, check_memory, placer, point_order, solve_chunked
 from ..scene import Scene
-from ..schema import BY_AXIS, G_UNITS, STANDARD_GRAVITY
-from . import excitation, loads, modal, random_outputs
+from ..schema import BY_AXIS, G2_UNITS, G_UNITS, STANDARD_GRAVITY
+from . import excitation, loads, modal, random_outputs, response_asd
 from .basis import Basis, BasisFamily, end_stiffness, span_basis
 from .random_outputs import RandomInputs
+from .random_scene import REALISATION_DIM
 
 KIND = "transverse"
 MODE_DIM = "mode"              # the dimension of per-mode outputs (model.modes >= 2)
@@ -105,6 +106,8 @@ class KernelResult:
     sample_times: np.ndarray
     modal: np.ndarray | None = None    # (n, N) each mode's tail amplitude (m); N >= 2 only
     envelope: np.ndarray | None = None  # (n, n_bands) the response envelope (m); swept only
+    spectra: dict[str, np.ndarray] | None = None   # outputs.response_asd's (n, n_freq) arrays
+    reduction: Any = None                          # and their response_asd.Reduction
 
 
 def sample_times(t_end: float, dt: float) -> np.ndarray:
@@ -213,7 +216,8 @@ class Inputs:
     swept: the base frequency is swept ([base] sweep); bands: (first band, count, bands per
     octave) of its envelope (None: no envelope); per_point_end: every point ends with its own
     sweep (no solver.t_end given); sweep_direction: base.sweep.direction (None: from start to
-    stop).
+    stop); random: a random scene's inputs (None: not random); resolution:
+    outputs.asd_resolution (Hz, None: the default).
     """
     coords: dict[str, xr.DataArray]
     dims: tuple[str, ...]
@@ -239,6 +243,7 @@ class Inputs:
     per_point_end: bool = False
     sweep_direction: str | None = None
     random: RandomInputs | None = None
+    resolution: float | None = None
 
 
 def end_stiffness_of(params: dict[str, Any]) -> Any:
@@ -267,8 +272,12 @@ def resolve(scene: Scene) -> Inputs:
     wanted = frozenset(k for k in scene.values if (k.startswith("outputs.")
                                                     or k == "solver.stop_when_steady")
                        and scene.get(k) is True)
+    random = RandomInputs.of(scene.values)
+    if random is not None and "outputs.response_asd" in wanted:   # the spectra's samples
+        settings[tk.SAMPLE_DT] = 1.0 / response_asd.asd_rate(random.sample_rate,
+                                                             float(random.spectrum[0][-1]))
     times = (sample_times(settings[tk.T_END], settings[tk.SAMPLE_DT])
-             if "outputs.time_series" in wanted else np.empty(0))
+             if wanted & {"outputs.time_series", "outputs.response_asd"} else np.empty(0))
     params = grid.parameters(scene, coords)
     swept = excitation.is_swept(scene.values, scene.swept)
     n_modes = scene.get("model.modes")
@@ -292,7 +301,7 @@ def resolve(scene: Scene) -> Inputs:
                          if swept and scene.get("outputs.envelope") else None),
                   per_point_end=swept and scene.get("solver.t_end") is None,
                   sweep_direction=scene.get("base.sweep.direction"),
-                  random=RandomInputs.of(scene.values))
+                  random=random, resolution=scene.get("outputs.asd_resolution"))
 
 
 TIME_DOMAIN_OUTPUTS = ("outputs.amplitude", "outputs.peak_amplitude", "outputs.settling_time",
@@ -376,7 +385,11 @@ def _check_time_domain_memory(inputs: Inputs) -> None:
     solve order and derived quantities would not fit in memory: the parameter rows are built
     chunk by chunk and never held for the whole grid."""
     n_points = int(np.prod(inputs.shape, dtype=np.int64))
-    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + inputs.sample_times.size
+    samples = inputs.sample_times.size
+    if "outputs.response_asd" in inputs.wanted:     # spectra kept, samples only per chunk
+        samples = (samples if "outputs.time_series" in inputs.wanted else 0) + 2 * (
+            response_asd.max_bins(inputs.random, inputs.resolution))
+    check_memory(n_points, 2.0 * (1 + 8 * (tk.N_REALS + tk.N_COUNTS + samples
                                            + (inputs.n_modes if inputs.n_modes > 1 else 0)))
                  + 40, "metrics and time series")
 
@@ -395,6 +408,11 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
                                     settings[tk.TOL])
         records = inputs.random.records()
     system = _system(inputs, settings, records)
+    reduction = None
+    if inputs.random is not None and "outputs.response_asd" in inputs.wanted:
+        reduction = _spectra(inputs, coeffs, settings)
+        system = _reduced(system, reduction, records)
+        options = response_asd.capped(options, inputs.sample_times.size)
     started = time.perf_counter()
     if inputs.continuation is not None:
         return _run_stepped(inputs, options, coeffs, system, settings, started)
@@ -402,8 +420,43 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
         return _run_directed(inputs, options, coeffs, settings, started)
     out = solve_chunked(options, system.chunk_fn, system.rows_at, system.args,
                         system.outputs(n_points))
-    return assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started,
-                    records)
+    result = _result(out, inputs)
+    if reduction is not None:
+        result.spectra = {name: out[name] for name in response_asd.NAMES}
+        result.reduction = reduction
+    return assemble(inputs, coeffs, result, time.perf_counter() - started, records)
+
+
+def _spectra(inputs: Inputs, coeffs: dict[str, Any],
+             settings: np.ndarray) -> response_asd.Reduction:
+    """outputs.response_asd's Reduction: the segment from the grid's shortest statistics
+    window, a row's record and level columns from its System's excitation block."""
+    from sweep.kernels import excitation as ex
+    from sweep.kernels import modes as md
+    from sweep.kernels import oscillator as osc
+    from .random_scene import statistics_window, transient_time
+    omega = 2.0 * np.pi * np.asarray(coeffs["natural_frequency"], float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        windows = statistics_window(settings[tk.T_END], settings[tk.TAIL], transient_time(
+            omega, np.asarray(inputs.params["damping_ratio"], float), settings[tk.TOL]))
+    block = osc.EXCITATION if inputs.n_modes == 1 else md.EXCITATION
+    return response_asd.reduction(
+        inputs.random, np.atleast_1d(windows), inputs.resolution, float(settings[tk.T_END]),
+        record_column=block + ex.RECORD, scale_column=block + ex.RECORD_SCALE,
+        window_column=tk.WINDOW, keep_series="outputs.time_series" in inputs.wanted)
+
+
+def _reduced(system: _System, reduction: response_asd.Reduction,
+             records: np.ndarray) -> _System:
+    """`system` with its chunks' time series reduced to spectra (sweep.execute.reduced_chunk)."""
+    from ..execute import reduced_chunk
+
+    def outputs(n: int) -> dict[str, np.ndarray]:
+        full = system.outputs(n)
+        return {**full, **reduction.empty(n, full["series"].shape[1])}
+
+    return _System(system.rows_at, reduced_chunk,
+                   (system.chunk_fn, system.args, reduction, records), outputs, None)
 
 
 def _run_directed(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any],
@@ -773,6 +826,13 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
             inputs.params, records, inputs.basis, inputs.n_modes, data)
         data.update(variables)
         coords = {**coords, **extra}
+        if result.spectra is not None:
+            variables, extra = response_asd.variables(
+                result.spectra, result.reduction, dims, shape, REALISATION_DIM,
+                derived(coeffs["base_accel"], coords), inputs.random.spectrum,
+                STANDARD_GRAVITY, G2_UNITS)
+            data.update(variables)
+            coords = {**coords, **extra}
     elif inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,
                                derived(coeffs["base_accel"], coords))
