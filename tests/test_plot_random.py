@@ -52,7 +52,7 @@ def test_realisation_is_not_a_swept_axis(result):
 def test_a_random_result_plots_without_select(result):
     ds, _ = result
     figures = splot.plot(ds)
-    assert {"rms", "peak", "exceedance", "peaks"} <= set(figures)
+    assert {"rms", "peak", "exceedance", "peaks", "asd"} <= set(figures)
     # Per-point figures draw the means; nothing is drawn over the realisations.
     assert "amplitude" not in figures and "state" not in figures
     assert {"rms_deflection_mean", "rms_acceleration_g_mean"} <= set(figures) | set(
@@ -122,7 +122,7 @@ def test_a_random_result_over_length_alone_plots(result):
     ds, _ = result
     one = ds.isel(base_asd_scale=[1])                         # the level a single value
     figures = splot.plot(one)
-    assert {"rms", "peak", "exceedance", "peaks"} <= set(figures)
+    assert {"rms", "peak", "exceedance", "peaks", "asd"} <= set(figures)
     assert len(_lines(figures["rms"], "linear_rms")) == 1
     assert "rms_acceleration_g_mean" in figures               # a line over length
     assert figures["rms_acceleration_g_mean"].axes[0].get_ylabel().endswith("[g]")
@@ -161,3 +161,29 @@ def test_cli_plot_writes_the_random_figures(result, tmp_path, capsys):
     written = {p.name for p in tmp_path.glob("*.png")}
     assert {f"gevs-{k}.png" for k in ("rms", "peak", "exceedance", "peaks")} <= written
     assert all(p.stat().st_size > 1000 for p in tmp_path.glob("*.png"))
+
+
+def test_asd_draws_the_response_over_the_input_spectrum(result):
+    """'asd': each span's absolute acceleration ASD (g^2/Hz) as stored, at the highest level,
+    and the input spectrum at that level dashed over it, log-log, over the spectrum's band."""
+    ds, _ = result
+    fig = splot.plot(ds)["asd"]
+    lines = _lines(fig, "acceleration_asd")
+    assert len(lines) == 3                                  # the three spans
+    top = ds.sel(base_asd_scale=0.0)
+    for line, length in zip(lines, top.length.values):
+        x, y = line.get_data()
+        stored = top.acceleration_asd.sel(length=length)
+        np.testing.assert_array_equal(y, stored.sel(frequency=x).values)
+    base, = _lines(fig, "base_asd_g2")
+    x, y = base.get_data()
+    assert x[0] >= 20.0 and x[-1] <= 2000.0
+    np.testing.assert_array_equal(y, top.base_asd_g2.sel(frequency=x).values)
+    assert max(y) == pytest.approx(0.16, rel=1e-9)          # GEVS's plateau at 0 dB
+    ax = fig.axes[0]
+    assert ax.get_xscale() == ax.get_yscale() == "log"
+    assert "g$^2$/Hz" in ax.get_ylabel() and "Hz" in ax.get_xlabel()
+    # a level chosen: its own spectrum, 3 dB down
+    quiet = splot.plot_asd(ds, select={"base_asd_scale": -3.0})
+    x, y = _lines(quiet, "base_asd_g2")[0].get_data()
+    assert max(y) == pytest.approx(0.16 * 10 ** -0.3, rel=1e-9)

@@ -56,8 +56,11 @@ def is_random(values: Mapping[str, Any]) -> bool:
 
 
 def _present(dotted: str, given: Mapping[str, Any], axes: Mapping[str, Any]) -> bool:
+    """Whether a scene gives the key (a switch turned off, as a resolved scene writes
+    outputs.response_asd = false, is not given) or sweeps it."""
     axis = schema.BY_DOTTED[dotted].axis
-    return dotted in given or (axis is not None and axis in axes)
+    return ((dotted in given and given[dotted] is not False)
+            or (axis is not None and axis in axes))
 
 
 def check(given: dict[str, Any], axes: Mapping[str, Any]) -> None:

@@ -106,14 +106,14 @@ from .labels import footer, label
 from .line import plot_line
 from .maps import _HATCHES, FLOOR, plot_map, plot_state_map  # noqa: F401
 from .overlays import PAPER_FIG5_AMPLITUDES
-from .random import plot_exceedance, plot_peak, plot_peak_factors, plot_rms
+from .random import plot_asd, plot_exceedance, plot_peak, plot_peak_factors, plot_rms
 from .result import check_result, load_result, parse_select, select_points, swept_axes
 from .series import plot_histories, plot_snapshots, plot_time_series
 from .stability import plot_growth_rate, plot_stability_chart, plot_stability_over_map
 from .style import STATE_STYLES, _edges, state_styles  # noqa: F401
 
 __all__ = ["FLOOR", "Figures", "PAPER_FIG5_AMPLITUDES", "STATE_STYLES", "footer", "label",
-           "check_result", "load_result", "parse_select", "plot", "plot_branches",
+           "check_result", "load_result", "parse_select", "plot", "plot_asd", "plot_branches",
            "plot_design",
            "plot_envelope", "plot_exceedance", "plot_growth_rate",
            "plot_histories",

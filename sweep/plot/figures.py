@@ -28,8 +28,8 @@ from .design import plot_design
 from .envelope import BAND_DIM, plot_envelope
 from .line import plot_line
 from .maps import plot_map, plot_state_map
-from .random import (peak_factors, plot_exceedance, plot_peak, plot_peak_factors, plot_rms,
-                     random_axes)
+from .random import (peak_factors, plot_asd, plot_exceedance, plot_peak, plot_peak_factors,
+                     plot_rms, random_axes)
 from .result import (CLEARANCE_DIM, DIRECTION_DIM, _scene, _time_dim, check_result,
                      is_design_result, is_random_result, over_points, select_points,
                      swept_axes)
@@ -179,14 +179,15 @@ def _random_figures(ds: xr.Dataset, figures: Figures) -> None:
     drawn = {"rms": ("rms_deflection_mean", plot_rms),
              "peak": ("peak_deflection_mean", plot_peak),
              "exceedance": ("exceedance_probability", plot_exceedance),
-             "peaks": ("peak_deflection", plot_peak_factors)}
+             "peaks": ("peak_deflection", plot_peak_factors),
+             "asd": ("acceleration_asd", plot_asd)}
     if CLEARANCE_DIM not in ds.dims:
         del drawn["exceedance"]
     for name, (var, draw) in drawn.items():
         if var not in ds:
             continue
-        why = too_many
-        if why is None and x is None and name != "peaks":     # 'peaks' pools every point
+        why = None if name == "asd" else too_many        # 'asd' picks its lines itself
+        if why is None and x is None and name not in ("peaks", "asd"):   # these pool or pick
             why = "no swept axis with more than one value"
         if why is None and (not np.isfinite(np.asarray(ds[var].values, float)).any()
                             or name == "peaks" and not peak_factors(ds).size):

@@ -6,7 +6,9 @@ figures, over the Monte Carlo records (the `realisation` dimension) rather than 
 - `plot_peak`: the mean peak deflection with its interval, the clearance levels as lines;
 - `plot_exceedance`: the probability of exceeding each clearance level in the test (1), the
   mean over the realisations;
-- `plot_peak_factors`: the empirical distribution of peak / RMS (1) over every record.
+- `plot_peak_factors`: the empirical distribution of peak / RMS (1) over every record;
+- `plot_asd` (outputs.response_asd): the absolute midspan acceleration's spectral density
+  (g^2/Hz) of a few spans over the input spectrum at the same level, log-log.
 
 Each draws against one swept axis (span length when it is swept), one line per value of at
 most one other (`MAX_LEVELS` of them).
@@ -232,5 +234,57 @@ def plot_peak_factors(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None
     ax.set_title(_title(ds, "peak factor over every record"), fontsize="medium")
     ax.grid(True, color="0.92", zorder=0)
     _plain_ticks(ax)
+    _legend(ax, handles)
+    return ax.figure
+
+
+def _spread(n: int, most: int) -> list[int]:
+    """At most `most` indices of 0..n-1, evenly spread, the first and last included."""
+    return sorted({int(round(k)) for k in np.linspace(0, n - 1, min(n, most))})
+
+
+def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
+             ax: Axes | None = None) -> Figure:
+    """The spectral density of the absolute midspan acceleration (`acceleration_asd`, g^2/Hz,
+    the mean over the realisations) against frequency (Hz), log-log, over the input spectrum
+    at the same level (`base_asd_g2`, dashed black): one line per value of the swept axis drawn
+    along elsewhere (span length when swept; at most MAX_LEVELS of them, evenly spread, the
+    first and last included), at the highest value of the other swept axis (the level, e.g.
+    base_asd_scale in dB) unless `select` fixes it. Returns the Figure."""
+    if "acceleration_asd" not in ds:
+        raise UserError("the result has no variable 'acceleration_asd' (give "
+                        "outputs.response_asd = true in a random scene)")
+    ds = select_points(ds, select)
+    axes = swept_axes(ds)
+    x = "length" if "length" in axes else (axes[0] if axes else None)
+    for other in [d for d in axes if d != x]:
+        ds = ds.isel({other: int(np.argmax(np.asarray(ds[other].values, float)))})
+    ax = ax if ax is not None else _new_axes((7.0, 5.4))
+    f = np.asarray(ds["frequency"].values, float)
+    shown = f > 0.0
+    handles = []
+    picks = [None] if x is None else _spread(ds.sizes[x], MAX_LEVELS)
+    for i, k in enumerate(picks):
+        part = ds if k is None else ds.isel({x: k})
+        y = np.asarray(part["acceleration_asd"].values, float)
+        text = (str(ds.attrs.get("title", "response")) if k is None
+                else _point_text(part, [x]))
+        line, = ax.loglog(f[shown], y[shown], color=f"C{i % 10}", lw=1.2, label=text,
+                          gid="acceleration_asd")
+        handles.append(line)
+    given = np.asarray(ds["base_asd_g2"].values, float)
+    if given.ndim > 1:                       # the level's spectrum does not depend on the span
+        given = given.reshape(-1, given.shape[-1])[0]
+    inside = shown & (given > 0.0)
+    line, = ax.loglog(f[inside], given[inside], color="k", ls="--", lw=1.4, zorder=4,
+                      label="input (base) spectrum", gid="base_asd_g2")
+    handles.append(line)
+    if inside.any():
+        ax.set_xlim(f[inside][0], f[inside][-1])
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("acceleration spectral density [g$^2$/Hz]")
+    ax.set_title(_title(ds, "absolute midspan acceleration ASD over the input, mean of "
+                        f"{_records(ds)}"), fontsize="medium")
+    ax.grid(True, which="both", color="0.92", zorder=0)
     _legend(ax, handles)
     return ax.figure
