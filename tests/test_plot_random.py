@@ -175,6 +175,12 @@ def test_asd_draws_the_response_over_the_input_spectrum(result):
         x, y = line.get_data()
         stored = top.acceleration_asd.sel(length=length)
         np.testing.assert_array_equal(y, stored.sel(frequency=x).values)
+    linear = _lines(fig, "linear_acceleration_asd")
+    for line, length in zip(linear, top.length.values):
+        x, y = line.get_data()
+        np.testing.assert_array_equal(
+            y, top.linear_acceleration_asd.sel(length=length, frequency=x).values)
+    assert len(linear) == 3
     base, = _lines(fig, "base_asd_g2")
     x, y = base.get_data()
     assert x[0] >= 20.0 and x[-1] <= 2000.0

@@ -140,6 +140,14 @@ def test_a_linear_span_meets_the_exact_asd_in_every_band(modes, bands):
         got_a = _band(ds, "acceleration_asd", lo, hi)
         assert got_q == pytest.approx(exact_q, rel=0.12), (lo, hi, got_q, exact_q)
         assert got_a == pytest.approx(exact_a, rel=0.12), (lo, hi, got_a, exact_a)
+    # the exact linear densities stored beside them are this test's closed forms
+    nu = ds.frequency.values
+    g, t = _transfer(nu, f1, zeta, modes)
+    inside = (nu >= 10.0) & (nu <= 500.0)
+    np.testing.assert_allclose(ds.linear_deflection_asd.values, np.abs(g) ** 2 * w0 * inside,
+                               rtol=1e-9, atol=0.0)
+    np.testing.assert_allclose(ds.linear_acceleration_asd.values,
+                               np.abs(t) ** 2 * w0 * inside / G ** 2, rtol=1e-9, atol=0.0)
     # the whole spectrum is the mean square the kernels integrated (same records, windows)
     total = _band(ds, "deflection_asd", 0.0, 1e9)
     assert total == pytest.approx(float((ds.rms_deflection ** 2).mean()), rel=0.03)

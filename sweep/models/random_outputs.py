@@ -27,7 +27,7 @@ from sweep.kernels import layout as tk
 from sweep.kernels import states as km
 
 from ..dataset import derived
-from ..schema import G_UNITS, STANDARD_GRAVITY
+from ..schema import G2_UNITS, G_UNITS, STANDARD_GRAVITY
 from . import random_scene
 from .random_scene import REALISATION_DIM
 
@@ -134,18 +134,16 @@ def mean_and_interval(values: xr.DataArray) -> tuple[xr.DataArray, xr.DataArray]
     return mean, (factor * spread / np.sqrt(n.where(n > 0))).where(n >= 2)
 
 
-def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
-               basis: Any, n_modes: int, coords: dict[str, xr.DataArray]) -> xr.DataArray:
-    """The exact RMS midspan deflection (m) of the same span made linear (no stretching, no
-    end load) under the same spectrum at each level: the root of the integral of
-    |H(f)|^2 W(f) over the spectrum, H the midspan's receptance summed over the modes, mode n
-    at f1 times its basis frequency ratio with damping ratio zeta, weighted by its midspan
-    value and participation (sweep/models/random.py `linear_mean_square`; elastic ends swept
-    over the grid: each point's own basis); on the axes it depends on."""
+def _linear_modes(coeffs: dict[str, Any], params: dict[str, Any], basis: Any, n_modes: int,
+                  coords: dict[str, xr.DataArray]
+                  ) -> tuple[xr.DataArray, np.ndarray, np.ndarray, np.ndarray, xr.DataArray]:
+    """The span made linear, mode by mode, on the axes it depends on: (a template on those
+    axes, omega (rad/s), 2 zeta omega (1/s) and weights (midspan value times participation),
+    each (..., mode), and the base level factor on the template's axes). Mode n at f1 times
+    its basis frequency ratio with damping ratio zeta; elastic ends swept over the grid: each
+    point's own basis."""
     from .basis import BasisFamily, end_stiffness
-    from .random import linear_mean_square
-    f, w = random.spectrum
-    mode = "mode_"                        # the modes' axis of this sum (dropped by it)
+    mode = "mode_"                        # the modes' axis of the sums (dropped by them)
     if n_modes == 1:
         ratio = xr.DataArray(np.ones(1), dims=mode)
         weight = xr.DataArray(np.ones(1), dims=mode)
@@ -170,15 +168,60 @@ def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, A
     f1, zeta, gamma, level, ratio, weight = xr.broadcast(f1, zeta, gamma, level, ratio, weight)
     order = [d for d in f1.dims if d != mode] + [mode]
     omega = 2.0 * np.pi * (f1 * ratio).transpose(*order).values
-    ms = linear_mean_square(f, w, omega, 2.0 * zeta.transpose(*order).values * omega,
-                            (gamma * weight).transpose(*order).values)
-    f1 = f1.isel({mode: 0}, drop=True).transpose(*order[:-1])
+    template = f1.isel({mode: 0}, drop=True).transpose(*order[:-1])
     level = level.isel({mode: 0}, drop=True).transpose(*order[:-1])
-    out = f1.copy(data=np.sqrt(ms) * level.values)
+    return (template, omega, 2.0 * zeta.transpose(*order).values * omega,
+            (gamma * weight).transpose(*order).values, level)
+
+
+def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
+               basis: Any, n_modes: int, coords: dict[str, xr.DataArray]) -> xr.DataArray:
+    """The exact RMS midspan deflection (m) of the same span made linear (no stretching, no
+    end load) under the same spectrum at each level: the root of the integral of
+    |H(f)|^2 W(f) over the spectrum, H the midspan's receptance summed over the modes
+    (`_linear_modes`; sweep/models/random.py `linear_mean_square`); on the axes it depends on."""
+    from .random import linear_mean_square
+    f, w = random.spectrum
+    template, omega, damping, weights, level = _linear_modes(coeffs, params, basis, n_modes,
+                                                             coords)
+    ms = linear_mean_square(f, w, omega, damping, weights)
+    out = template.copy(data=np.sqrt(ms) * level.values)
     out.attrs = {"units": "m", "long_name": "exact RMS midspan deflection of the same span "
                  "made linear (no stretching, no end load) under the same spectrum: beside "
                  "rms_deflection, the nonlinearity's effect"}
     return out
+
+
+def linear_spectra(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
+                   basis: Any, n_modes: int, coords: dict[str, xr.DataArray],
+                   frequency: xr.DataArray) -> dict[str, xr.DataArray]:
+    """The exact spectral densities of the same span made linear, at `frequency` (Hz): the
+    midspan deflection's |G|^2 W (m^2/Hz) and the absolute acceleration's |1 - w^2 G|^2 W
+    (g^2/Hz), G(f) = -sum_n weights_n / (omega_n^2 - w^2 + i 2 zeta_n omega_n w) the
+    midspan's receptance (`_linear_modes`), W the spectrum at the point's level."""
+    from .random import asd_at
+    f, w = random.spectrum
+    template, omega, damping, weights, level = _linear_modes(coeffs, params, basis, n_modes,
+                                                             coords)
+    nu = np.asarray(frequency.values, float)
+    w_nu = 2.0 * np.pi * nu
+    g = -np.sum(weights[..., None, :] / (omega[..., None, :] ** 2 - w_nu[:, None] ** 2
+                                         + 1j * damping[..., None, :] * w_nu[:, None]), axis=-1)
+    given = asd_at(nu, f, w) * (level.values[..., None] ** 2)
+    dims = template.dims + tuple(frequency.dims)
+    coords_ = {**{d: template[d] for d in template.dims if d in template.coords},
+               **{d: frequency for d in frequency.dims}}
+    deflection = xr.DataArray(np.abs(g) ** 2 * given, dims=dims, coords=coords_)
+    acceleration = xr.DataArray(np.abs(1.0 - w_nu ** 2 * g) ** 2 * given
+                                / STANDARD_GRAVITY ** 2, dims=dims, coords=coords_)
+    return {"linear_deflection_asd": deflection.assign_attrs(
+                units="m2 Hz-1", long_name="exact spectral density of the midspan deflection "
+                "of the same span made linear (no stretching, no end load) under the same "
+                "spectrum: beside deflection_asd, the nonlinearity's effect"),
+            "linear_acceleration_asd": acceleration.assign_attrs(
+                units=G2_UNITS, long_name="exact spectral density of the absolute midspan "
+                "acceleration of the same span made linear, in g^2/Hz: beside "
+                "acceleration_asd")}
 
 
 def spectral_moments(data: dict[str, xr.DataArray], n_modes: int,

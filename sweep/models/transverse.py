@@ -832,6 +832,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                 derived(coeffs["base_accel"], coords), inputs.random.spectrum,
                 STANDARD_GRAVITY, G2_UNITS)
             data.update(variables)
+            data.update(random_outputs.linear_spectra(
+                inputs.random, coeffs, inputs.params, inputs.basis, inputs.n_modes, coords,
+                extra[response_asd.FREQUENCY_DIM]))
             coords = {**coords, **extra}
     elif inputs.has_base and "outputs.absolute_acceleration" in inputs.wanted:
         outputs = base_outputs(result.reals[:, tk.ACCELERATION].reshape(shape), dims,

@@ -250,7 +250,8 @@ def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     at the same level (`base_asd_g2`, dashed black): one line per value of the swept axis drawn
     along elsewhere (span length when swept; at most MAX_LEVELS of them, evenly spread, the
     first and last included), at the highest value of the other swept axis (the level, e.g.
-    base_asd_scale in dB) unless `select` fixes it. Returns the Figure."""
+    base_asd_scale in dB) unless `select` fixes it; each span's exact linear density
+    (`linear_acceleration_asd`) dashed in its colour. Returns the Figure."""
     if "acceleration_asd" not in ds:
         raise UserError("the result has no variable 'acceleration_asd' (give "
                         "outputs.response_asd = true in a random scene)")
@@ -272,6 +273,12 @@ def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
         line, = ax.loglog(f[shown], y[shown], color=f"C{i % 10}", lw=1.2, label=text,
                           gid="acceleration_asd")
         handles.append(line)
+        if "linear_acceleration_asd" in part:
+            linear = np.asarray(part["linear_acceleration_asd"].values, float)
+            ax.loglog(f[shown], linear[shown], color=f"C{i % 10}", ls="--", lw=0.9,
+                      zorder=2, gid="linear_acceleration_asd")
+    if "linear_acceleration_asd" in ds:
+        handles.append(Line2D([], [], color="0.3", ls="--", lw=0.9, label=_LINEAR_LABEL))
     given = np.asarray(ds["base_asd_g2"].values, float)
     if given.ndim > 1:                       # the level's spectrum does not depend on the span
         given = given.reshape(-1, given.shape[-1])[0]
