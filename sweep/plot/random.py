@@ -286,12 +286,18 @@ def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     line, = ax.loglog(f[inside], given[inside], color="k", ls="--", lw=1.4, zorder=4,
                       label="input (base) spectrum", gid="base_asd_g2")
     handles.append(line)
-    if inside.any():
+    if inside.any():                         # the spectrum's band, and what lies in it
         ax.set_xlim(f[inside][0], f[inside][-1])
+        drawn = np.concatenate([np.asarray(line.get_ydata(), float)[
+            (line.get_xdata() >= f[inside][0]) & (line.get_xdata() <= f[inside][-1])]
+            for line in ax.get_lines()])
+        drawn = drawn[np.isfinite(drawn) & (drawn > 0.0)]
+        if drawn.size:
+            ax.set_ylim(drawn.min() / 2.0, drawn.max() * 2.0)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("acceleration spectral density [g$^2$/Hz]")
-    ax.set_title(_title(ds, "absolute midspan acceleration ASD over the input, mean of "
-                        f"{_records(ds)}"), fontsize="medium")
+    ax.set_title(_title(ds, f"midspan acceleration ASD, mean of {_records(ds)}"),
+                 fontsize="medium")
     ax.grid(True, which="both", color="0.92", zorder=0)
     _legend(ax, handles)
     return ax.figure
