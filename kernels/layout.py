@@ -73,7 +73,12 @@ LEVEL_RATE = 19     # level k's up-crossings by |q| per second (1/s) at LEVEL_RA
 WINDOW = LEVEL_RATE + MAX_LEVELS  # the statistics window's length (s)
 RMS_RELATIVE = WINDOW + 1  # RMS of q'' (m/s^2): with RMS_DEFLECTION and RMS_VELOCITY, q's
                     # spectral moments m0, m2, m4 are their squares
-N_REALS = RMS_RELATIVE + 1
+CURVATURE_M0 = RMS_RELATIVE + 1  # several modes, with the loads observed: the mean square
+                    # over the statistics window of the clamp's curvature times l^2, c(t) =
+                    # sum phi_n''(0) q_n (m^2); + 1: of its rate (m^2/s^2); + 2: of its second
+                    # derivative (m^2/s^4): c's spectral moments m0, m2, m4
+MID_CURVATURE_M0 = CURVATURE_M0 + 3  # the same three of the midspan's, sum phi_n''(1/2) q_n
+N_REALS = MID_CURVATURE_M0 + 3
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -29,7 +29,7 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
-from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, FAILURE_TIME, FIRST_STEP, MAX_STEP,
+from .layout import (AMPLITUDE, CLAMP_BEND, CURVATURE_M0, CLAMP_SHEAR, FAILURE_TIME, FIRST_STEP, MAX_STEP,
                      LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
                      SPAN_MAX, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
@@ -191,8 +191,10 @@ def modal_size(n_modes):
     kernels.modes.span_loads; `_observe_loads`), the shear factor kappa of the point's
     prepared row (factor_slot(N), 1/m^2, kernels.modes.shear_factor) and whether the loads
     are observed at all (factor_slot(N) + 1: settings[LOADS], 1.0 or 0.0), both set by
-    `start`."""
-    return 3 * n_modes + 9
+    `start`; under a random base acceleration with the loads observed, the integrals over the
+    statistics window of c_e^2, c_e'^2 and c_e''^2 for the clamp at s = 0 and midspan
+    (square_slot(N) + 0..2, + 3..5; m^2 s, m^2/s, m^2/s^3; `_observe_bend_squares`)."""
+    return 3 * n_modes + 15
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -221,6 +223,59 @@ def load_slot(n_modes):
 def factor_slot(n_modes):
     """The slot of the shear factor kappa (kernels.modes.shear_factor) in the accumulator."""
     return 3 * n_modes + 7
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def square_slot(n_modes):
+    """The first of the six curvature-square integrals of the modes' accumulator
+    (`modal_size`)."""
+    return 3 * n_modes + 9
+
+
+SQUARED_BENDS = (md.BEND_0, md.BEND_MID)
+"""The curvatures whose mean squares a random scene keeps: a clamp's and midspan's."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
+    """The accepted step's integrals of c^2, c'^2 and c''^2 for the curvatures SQUARED_BENDS
+    (c = sum phi_n''(s) q_n, times l^2: m), on the quintic Hermite through c, c' and c'' at
+    both ends (trajectory's, as the midspan's mean squares): f, f_new the right-hand side at
+    the step's ends (q_n'' = f[N + n])."""
+    curvature = basis[md.CLAMPS]
+    slot = square_slot(n)
+    for k in range(2):
+        e = SQUARED_BENDS[k]
+        c0 = 0.0
+        c1 = 0.0
+        r0 = 0.0
+        r1 = 0.0
+        a0 = 0.0
+        a1 = 0.0
+        for c in range(n):
+            w = curvature[e, c]
+            c0 += w * y[c]
+            c1 += w * y_new[c]
+            r0 += w * y[n + c]
+            r1 += w * y_new[n + c]
+            a0 += w * f[n + c]
+            a1 += w * f_new[n + c]
+        square, slope, curve = tj._quintic_squares(h, c0, r0, a0, c1, r1, a1)
+        modal[slot + 3 * k] += square
+        modal[slot + 3 * k + 1] += slope
+        modal[slot + 3 * k + 2] += curve
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def curvature_moments(modal, n, acc, reals):
+    """reals' CURVATURE_M0.. and MID_CURVATURE_M0.. (mean squares, `modal_size`) over the
+    statistics window of a random trajectory (acc: its watched accumulator), where the loads
+    were observed; left NaN otherwise."""
+    span = acc[tj.W_END] - acc[tj.W_START]
+    if modal[factor_slot(n) + 1] == 0.0 or acc[tj.IN_WINDOW] == 0.0 or not span > 0.0:
+        return
+    for k in range(6):
+        reals[CURVATURE_M0 + k] = modal[square_slot(n) + k] / span
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -600,6 +655,8 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, loads)
     for k in range(3):
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
+    for k in range(6):
+        modal[square_slot(n) + k] = 0.0
     midspan = basis[md.MIDSPAN]
     for i in range(n):
         modal[2 * n + 1 + i] = midspan[i]
@@ -667,6 +724,9 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                        basis, Qc)
+        if ex.is_record(base):             # the window's curvature squares, as observe_random
+            if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
+                _observe_bend_squares(y, y_new, K[0], K[n_stages], h, n, basis, modal)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
             K_mid[j, 1] = _project(K[j], weights, n, n)
@@ -756,6 +816,8 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
             load_columns(ext, n_modes, reals)
     else:
         state = span_state(state, ext, y, n_modes, settings, reals, basis)
+    if ex.is_record(base) and state == mt.COMPLETED:
+        curvature_moments(ext, n_modes, acc, reals)
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for j in range(n_modes):
         modal[j] = math.nan if failed else ext[j]

@@ -320,3 +320,50 @@ def test_a_span_without_stretching_meets_its_linear_rms(rotation, n_modes, axes)
     linear = ds.linear_rms.broadcast_like(ds.rms_deflection_mean).values
     assert np.all(half < 0.05 * mean)
     assert np.all(np.abs(mean - linear) < 2.0 * half), (mean, half, linear)
+
+
+def _clamped_beam(beta: float, s: float) -> tuple[float, float]:
+    """phi(s) and phi''(s) (per unit s^2) of the clamped-clamped beam function with root
+    beta (sigma its ratio), written here from the textbook form."""
+    sigma = (math.cosh(beta) - math.cos(beta)) / (math.sinh(beta) - math.sin(beta))
+    phi = (math.cosh(beta * s) - math.cos(beta * s)
+           - sigma * (math.sinh(beta * s) - math.sin(beta * s)))
+    curvature = beta ** 2 * (math.cosh(beta * s) + math.cos(beta * s)
+                             - sigma * (math.sinh(beta * s) + math.sin(beta * s)))
+    return phi, curvature
+
+
+def test_clamp_strain_moments_of_several_modes_meet_the_exact_linear_ones():
+    """Three clamped modes, stretching off: the kernels' mean squares of the clamp's and the
+    midspan's curvature, as bending strain (d / 2 l^2 times it) and its rate's and second
+    derivative's (m0, m2, m4), averaged over 16 records of 4 s, against the exact integrals
+    of |sum_n phi_n''(s) Gamma_n / (w_n^2 - w^2 + 2 i zeta w_n w)|^2 w^(2k) W, the beam
+    functions, participations and frequencies computed here (beta l = 4.7300, 7.8532,
+    10.9956), within about four standard errors of the resonant mean square (2.4 % each)."""
+    ds = sweep.run(scene({"clamps.axial_stiffness": 0.0, "clamps.rotation": "clamped",
+                          "cable.diameter": 2.76e-3, "model.modes": 3,
+                          "base.realisations": 16, "base.duration": 4.0}))
+    betas = (4.730040745, 7.853204624, 10.99560784)
+    rho_a, ei, length, zeta, d = 8900.0 * 6e-6, 110e9 * 2.865e-12, 0.3, 0.05, 2.76e-3
+    f1 = betas[0] ** 2 / (2 * math.pi * length ** 2) * math.sqrt(ei / rho_a)
+    assert float(ds.natural_frequency) == pytest.approx(f1, rel=1e-4)
+    gammas = [quad(lambda s: _clamped_beam(b, s)[0], 0, 1)[0]
+              / quad(lambda s: _clamped_beam(b, s)[0] ** 2, 0, 1)[0] for b in betas]
+    w0 = 0.04 * G ** 2
+    strain = 0.5 * d / length ** 2
+    for place, s in (("clamp", 0.0), ("midspan", 0.5)):
+        weights = [_clamped_beam(b, s)[1] * g for b, g in zip(betas, gammas)]
+
+        def density(f, k):
+            w = 2 * math.pi * f
+            h = sum(c / ((2 * math.pi * f1 * (b / betas[0]) ** 2) ** 2 - w * w + 2j * zeta
+                         * 2 * math.pi * f1 * (b / betas[0]) ** 2 * w)
+                    for b, c in zip(betas, weights))
+            return abs(h) ** 2 * w ** (2 * k) * w0 * strain ** 2
+
+        for k, rel in ((0, 0.1), (1, 0.1), (2, 0.15)):
+            exact = quad(density, 10.0, 500.0, args=(k,), limit=400, points=[f1])[0]
+            got = float(ds[f"{place}_strain_m{2 * k}"].mean("realisation"))
+            assert got == pytest.approx(exact, rel=rel), (place, k, got, exact)
+        assert float((ds[f"rms_{place}_bending_strain"] ** 2).mean()) == pytest.approx(
+            float(ds[f"{place}_strain_m0"].mean()), rel=1e-12)

@@ -148,6 +148,20 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
     return Peaks(q * ends["clamp_curvature"], q * ends["midspan_curvature"], stretch, shear)
 
 
+def outer_diameter(params: dict[str, Any], coords: dict[str, xr.DataArray]) -> Any:
+    """The cable's outer diameter (m) on the axes it depends on: cable.diameter, or that of
+    the solid round section of its area."""
+    if params.get("diameter") is not None:
+        return derived(params["diameter"], coords)
+    return np.sqrt(4.0 * derived(params["area"], coords) / np.pi)
+
+
+def strain_per_curvature(params: dict[str, Any], coords: dict[str, xr.DataArray]) -> Any:
+    """The outer-fibre bending strain per unit of the kernels' curvature times l^2 (1/m):
+    d / (2 l^2), as clamp_bending_strain is made from kernels.layout.CLAMP_BEND."""
+    return 0.5 * outer_diameter(params, coords) / derived(params["length"], coords) ** 2
+
+
 def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
                  dims: tuple[str, ...], shape: tuple[int, ...],
                  coords: dict[str, xr.DataArray], swept: bool = False
@@ -164,9 +178,7 @@ def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
     else:
         peaks = _one_mode_peaks(params, column(tk.PEAK if swept else tk.AMPLITUDE), coords)
     p = params
-    area = derived(p["area"], coords)
-    diameter = (derived(p["diameter"], coords) if p.get("diameter") is not None
-                else np.sqrt(4.0 * area / np.pi))
+    diameter = outer_diameter(p, coords)
     _, k_s = modal.stretching(p)
     span = Span(derived(p["length"], coords), derived(p["youngs_modulus"] * p["inertia"], coords),
                 derived(p["youngs_modulus"] * p["area"], coords), diameter,

@@ -225,13 +225,17 @@ def linear_spectra(random: RandomInputs, coeffs: dict[str, Any], params: dict[st
 
 
 def spectral_moments(data: dict[str, xr.DataArray], n_modes: int,
-                     loads: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
+                     loads: dict[str, xr.DataArray],
+                     curvatures: dict[str, tuple[xr.DataArray, ...]] | None = None
+                     ) -> dict[str, xr.DataArray]:
     """The midspan deflection's spectral moments m0 = E[q^2], m2 = E[q'^2], m4 = E[q''^2]
     (the squares of its RMS, its rate's and its second derivative's) and the irregularity
-    factor m2 / sqrt(m0 m4) (1: narrow band); with one mode, whose bending strains are
-    proportional to q, the RMS bending strain at each place the loads report and its moments
-    (the deflection's times the strain per metre squared; `loads`: the loads' variables,
-    sweep/models/loads.py), for fatigue."""
+    factor m2 / sqrt(m0 m4) (1: narrow band); where the loads report a bending strain
+    (`loads`: the loads' variables, sweep/models/loads.py), the RMS bending strain at the
+    clamp and at midspan and its moments, for fatigue: with one mode, whose strains are
+    proportional to q, the deflection's times the strain per metre squared; with several,
+    the kernels' own mean squares of each curvature (`curvatures`: place -> its m0, m2, m4
+    as strain^2, strain^2/s^2, strain^2/s^4)."""
     m0 = data["rms_deflection"] ** 2
     m2 = data["rms_velocity"] ** 2
     m4 = data["rms_relative_acceleration"] ** 2
@@ -245,19 +249,27 @@ def spectral_moments(data: dict[str, xr.DataArray], n_modes: int,
         out["irregularity_factor"] = (m2 / np.sqrt(m0 * m4)).assign_attrs(
             units="1", long_name="irregularity factor m2 / sqrt(m0 m4) of the midspan "
             "deflection (1: narrow band, every zero crossing a peak)")
-    if n_modes != 1:
-        return out
     for place in ("clamp", "midspan"):
         peak = loads.get(f"{place}_bending_strain")
         if peak is None:
             continue
-        with np.errstate(divide="ignore", invalid="ignore"):
-            per_metre = peak / data["peak_deflection"]     # one mode: strain = c q
-        out[f"rms_{place}_bending_strain"] = (per_metre * data["rms_deflection"]).assign_attrs(
+        if n_modes == 1:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                per_metre = peak / data["peak_deflection"]     # one mode: strain = c q
+            moments = (per_metre ** 2 * m0, per_metre ** 2 * m2, per_metre ** 2 * m4)
+            how = "one mode: proportional to the midspan deflection"
+        elif curvatures is not None and place in curvatures:
+            moments = curvatures[place]
+            how = ("the modes' curvatures summed, their mean square integrated in the kernels"
+                   + ("; at the clamp x = 0, whose statistics the other's share" if place ==
+                      "clamp" else ""))
+        else:
+            continue
+        out[f"rms_{place}_bending_strain"] = np.sqrt(moments[0]).assign_attrs(
             units="1", long_name=f"RMS outer-fibre bending strain at the {place} over the "
-            "statistics window (one mode: proportional to the midspan deflection)")
-        for order, value, units in ((0, m0, "1"), (2, m2, "s-2"), (4, m4, "s-4")):
-            out[f"{place}_strain_m{order}"] = (per_metre ** 2 * value).assign_attrs(
+            f"statistics window ({how})")
+        for order, value, units in zip((0, 2, 4), moments, ("1", "s-2", "s-4")):
+            out[f"{place}_strain_m{order}"] = value.assign_attrs(
                 units=units, long_name=f"spectral moment m{order} of the bending strain at "
                 f"the {place} (for fatigue: narrow-band damage from m0 and m2, Dirlik's "
                 "from m0 to m4 and m1)")
@@ -334,7 +346,15 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
             units="1", long_name="probability that |midspan deflection| exceeds the "
             "clearance level at least once in the test, 1 - exp(-expected_exceedances) "
             "(Poisson crossings, Rice)")
-    data.update(spectral_moments(data, n_modes, loads or {}))
+    curvatures = None
+    if n_modes != 1 and loads:
+        from .loads import strain_per_curvature
+        factor = strain_per_curvature(params, coords) ** 2
+        curvatures = {place: tuple((factor * xr.DataArray(
+            reals[:, first + k].reshape(shape), dims=dims)).transpose(*dims) for k in range(3))
+            for place, first in (("clamp", tk.CURVATURE_M0),
+                                 ("midspan", tk.MID_CURVATURE_M0))}
+    data.update(spectral_moments(data, n_modes, loads or {}, curvatures))
     data["linear_rms"] = linear_rms(random, coeffs, params, basis, n_modes, coords)
     f, w = random.spectrum
     level = derived(coeffs["base_accel"], coords)
