@@ -29,8 +29,8 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
-from .layout import (AMPLITUDE, CLAMP_BEND, CURVATURE_M0, CLAMP_SHEAR, FAILURE_TIME, FIRST_STEP, MAX_STEP,
-                     LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
+from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, CURVATURE_M0, FAILURE_TIME,
+                     FIRST_STEP, MAX_STEP, LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
                      SPAN_MAX, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
@@ -232,20 +232,17 @@ def square_slot(n_modes):
     return 3 * n_modes + 9
 
 
-SQUARED_BENDS = (md.BEND_0, md.BEND_MID)
-"""The curvatures whose mean squares a random scene keeps: a clamp's and midspan's."""
-
-
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
-    """The accepted step's integrals of c^2, c'^2 and c''^2 for the curvatures SQUARED_BENDS
-    (c = sum phi_n''(s) q_n, times l^2: m), on the quintic Hermite through c, c' and c'' at
-    both ends (trajectory's, as the midspan's mean squares): f, f_new the right-hand side at
-    the step's ends (q_n'' = f[N + n])."""
+    """The accepted step's integrals of c^2, c'^2 and c''^2 for the clamp's curvature at
+    s = 0 and midspan's (kernels.modes BEND_0, BEND_MID; c = sum phi_n''(s) q_n, times l^2:
+    m), on the quintic Hermite through c, c' and c'' at both ends (trajectory's, as the
+    midspan's mean squares): f, f_new the right-hand side at the step's ends (q_n'' =
+    f[N + n])."""
     curvature = basis[md.CLAMPS]
     slot = square_slot(n)
     for k in range(2):
-        e = SQUARED_BENDS[k]
+        e = md.BEND_0 if k == 0 else md.BEND_MID
         c0 = 0.0
         c1 = 0.0
         r0 = 0.0

@@ -800,21 +800,37 @@ def _quintic_gram() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 _GRAM, _SLOPE_GRAM, _CURVE_GRAM = _quintic_gram()
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _form(M, c0, c1, c2, c3, c4, c5):
+    """c^T M c for the 6 x 6 matrix M, written out: a loop over a tuple's items indexes it at
+    run time, which Numba compiles to a slow switch (277 ns for `_quintic_squares` against 28
+    written out, benchmarks/RESULTS.md)."""
+    return (c0 * (M[0, 0] * c0 + M[0, 1] * c1 + M[0, 2] * c2 + M[0, 3] * c3 + M[0, 4] * c4
+                  + M[0, 5] * c5)
+            + c1 * (M[1, 0] * c0 + M[1, 1] * c1 + M[1, 2] * c2 + M[1, 3] * c3 + M[1, 4] * c4
+                    + M[1, 5] * c5)
+            + c2 * (M[2, 0] * c0 + M[2, 1] * c1 + M[2, 2] * c2 + M[2, 3] * c3 + M[2, 4] * c4
+                    + M[2, 5] * c5)
+            + c3 * (M[3, 0] * c0 + M[3, 1] * c1 + M[3, 2] * c2 + M[3, 3] * c3 + M[3, 4] * c4
+                    + M[3, 5] * c5)
+            + c4 * (M[4, 0] * c0 + M[4, 1] * c1 + M[4, 2] * c2 + M[4, 3] * c3 + M[4, 4] * c4
+                    + M[4, 5] * c5)
+            + c5 * (M[5, 0] * c0 + M[5, 1] * c1 + M[5, 2] * c2 + M[5, 3] * c3 + M[5, 4] * c4
+                    + M[5, 5] * c5))
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _quintic_squares(h, q0, v0, a0, q1, v1, a1):
     """The integrals over a step of length h (s) of q^2, q'^2 and q''^2 on the quintic
     Hermite through q, q' = v and q'' = a at both ends: (h c^T M c, c^T D c / h,
     c^T E c / h^3), c = (q0, h v0, h^2 a0, q1, h v1, h^2 a1), M, D, E `_quintic_gram`'s."""
-    c = (1.0 * q0, h * v0, h * h * a0, 1.0 * q1, h * v1, h * h * a1)
-    square = 0.0
-    slope = 0.0
-    curve = 0.0
-    for i in range(6):
-        for j in range(6):
-            square += c[i] * _GRAM[i, j] * c[j]
-            slope += c[i] * _SLOPE_GRAM[i, j] * c[j]
-            curve += c[i] * _CURVE_GRAM[i, j] * c[j]
-    return h * square, slope / h, curve / (h * h * h)
+    c1 = h * v0
+    c2 = h * h * a0
+    c4 = h * v1
+    c5 = h * h * a1
+    return (h * _form(_GRAM, q0, c1, c2, q1, c4, c5),
+            _form(_SLOPE_GRAM, q0, c1, c2, q1, c4, c5) / h,
+            _form(_CURVE_GRAM, q0, c1, c2, q1, c4, c5) / (h * h * h))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
