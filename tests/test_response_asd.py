@@ -212,3 +212,22 @@ def test_a_finer_resolution_is_kept():
     ds = sweep.run(scene({"outputs.asd_resolution": 4.0}), progress=False)
     df = float(ds.frequency[1] - ds.frequency[0])
     assert 2.0 < df <= 4.0 < float(coarse.frequency[1])
+
+
+def test_a_run_too_short_for_the_start_up_is_refused_for_that_not_the_spectra():
+    with pytest.raises(SceneError) as err:
+        sweep.run(scene({"base.duration": 0.3}), progress=False)
+    assert "start-up transient" in str(err.value) and "response_asd" not in str(err.value)
+
+
+def test_points_get_their_own_spectra():
+    """[points]: the spectra on (point, frequency), each point's linear density its own."""
+    text = ["[cable]", "inertia = 2.865e-12", "[base]", f"asd_g2 = {FLAT}", "duration = 1.0",
+            "seed = 3", "[outputs]", "response_asd = true", "[points]",
+            "length = [0.3, 0.25]", "damping_ratio = [0.05, 0.04]"]
+    ds = sweep.run(sweep.load_scene_text("\n".join(text) + "\n"), progress=False)
+    assert ds.acceleration_asd.dims == ("point", "frequency")
+    assert ds.linear_deflection_asd.dims == ("point", "frequency")
+    peaks = ds.linear_deflection_asd.idxmax("frequency").values
+    f1 = ds.natural_frequency.values
+    assert np.all(np.abs(peaks - f1) <= float(ds.frequency[1]))    # each its own resonance

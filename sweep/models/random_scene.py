@@ -274,9 +274,11 @@ def check_spectra_window(values: Mapping[str, Any], natural_frequency: Any,
     if not values.get("outputs.response_asd"):
         return
     from .response_asd import asd_rate, segment_length
+    window = shortest_window(values, natural_frequency, damping_ratio)
+    if not window > 0.1 * float(values["solver.t_end"]):
+        return                  # a run too short for the start-up: check_duration's refusal
     rate = asd_rate(sample_rate(values), float(values[spectrum_key(values)][-1][0]))
-    segment_length(shortest_window(values, natural_frequency, damping_ratio), rate,
-                   values.get("outputs.asd_resolution"))
+    segment_length(window, rate, values.get("outputs.asd_resolution"))
 
 
 def check_duration(t_end: float, startup: float) -> None:

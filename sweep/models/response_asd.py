@@ -73,8 +73,8 @@ def segment_length(window: float, rate: float, resolution: float | None) -> int:
               f"the shortest statistics window ({window:.3g} s, after the start-up transient) "
               + (f"holds no Welch segment at {_show(resolution)} Hz"
                  if resolution is not None else "is too short for a spectrum"),
-              (f"give outputs.asd_resolution = {coarsest:.3g} (Hz) or coarser, " if finest >= 16
-               else "") + "or a longer base.duration")
+              (f"give outputs.asd_resolution = {coarsest:.3g} (Hz) or coarser, or a longer "
+               "base.duration" if finest >= 16 else "give a longer base.duration"))
     return n
 
 
