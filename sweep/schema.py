@@ -308,8 +308,8 @@ KEYS: tuple[Key, ...] = (
                   "probability of at least one are stored"),
     Key("outputs", "response_asd", "bool", False,
         long_name="random base acceleration: store the spectral densities (Welch) of the "
-                  "midspan deflection (m2 Hz-1) and absolute acceleration (g2 Hz-1) on a "
-                  "frequency dimension up to the spectrum's top frequency, mean over the "
+                  "midspan deflection (m2 Hz-1) and absolute acceleration (g2 Hz-1) on an "
+                  "asd_frequency dimension up to the spectrum's top frequency, mean over the "
                   "realisations, beside the input spectrum"),
     Key("outputs", "asd_resolution", "float", None, units="Hz", minimum=0.0, exclusive_min=True,
         long_name="random base acceleration, with outputs.response_asd: the spectra's frequency "

@@ -174,17 +174,17 @@ def test_asd_draws_the_response_over_the_input_spectrum(result):
     for line, length in zip(lines, top.length.values):
         x, y = line.get_data()
         stored = top.acceleration_asd.sel(length=length)
-        np.testing.assert_array_equal(y, stored.sel(frequency=x).values)
+        np.testing.assert_array_equal(y, stored.sel(asd_frequency=x).values)
     linear = _lines(fig, "linear_acceleration_asd")
     for line, length in zip(linear, top.length.values):
         x, y = line.get_data()
         np.testing.assert_array_equal(
-            y, top.linear_acceleration_asd.sel(length=length, frequency=x).values)
+            y, top.linear_acceleration_asd.sel(length=length, asd_frequency=x).values)
     assert len(linear) == 3
     base, = _lines(fig, "base_asd_g2")
     x, y = base.get_data()
     assert x[0] >= 20.0 and x[-1] <= 2000.0
-    np.testing.assert_array_equal(y, top.base_asd_g2.sel(frequency=x).values)
+    np.testing.assert_array_equal(y, top.base_asd_g2.sel(asd_frequency=x).values)
     assert max(y) == pytest.approx(0.16, rel=1e-9)          # GEVS's plateau at 0 dB
     ax = fig.axes[0]
     assert ax.get_xscale() == ax.get_yscale() == "log"

@@ -112,10 +112,10 @@ def _transfer(f, f1, zeta, modes):
 
 
 def _band(ds, name, lo, hi):
-    f = ds.frequency.values
+    f = ds.asd_frequency.values
     df = f[1] - f[0]
     inside = (f >= lo) & (f < hi)
-    return float(ds[name].isel(frequency=np.flatnonzero(inside)).sum("frequency")) * df
+    return float(ds[name].isel(asd_frequency=np.flatnonzero(inside)).sum("asd_frequency")) * df
 
 
 @pytest.mark.parametrize("modes, bands", [
@@ -141,7 +141,7 @@ def test_a_linear_span_meets_the_exact_asd_in_every_band(modes, bands):
         assert got_q == pytest.approx(exact_q, rel=0.12), (lo, hi, got_q, exact_q)
         assert got_a == pytest.approx(exact_a, rel=0.12), (lo, hi, got_a, exact_a)
     # the exact linear densities stored beside them are this test's closed forms
-    nu = ds.frequency.values
+    nu = ds.asd_frequency.values
     g, t = _transfer(nu, f1, zeta, modes)
     inside = (nu >= 10.0) & (nu <= 500.0)
     np.testing.assert_allclose(ds.linear_deflection_asd.values, np.abs(g) ** 2 * w0 * inside,
@@ -152,8 +152,8 @@ def test_a_linear_span_meets_the_exact_asd_in_every_band(modes, bands):
     total = _band(ds, "deflection_asd", 0.0, 1e9)
     assert total == pytest.approx(float((ds.rms_deflection ** 2).mean()), rel=0.03)
     # the input beside it: the spectrum in g^2/Hz inside its band, 0 outside
-    assert float(ds.base_asd_g2.sel(frequency=100.0, method="nearest")) == pytest.approx(0.04)
-    assert float(ds.base_asd_g2.sel(frequency=5.0, method="nearest")) == 0.0
+    assert float(ds.base_asd_g2.sel(asd_frequency=100.0, method="nearest")) == pytest.approx(0.04)
+    assert float(ds.base_asd_g2.sel(asd_frequency=5.0, method="nearest")) == 0.0
     assert ds.acceleration_asd.attrs["units"] == f"{G ** 2:.10g} m2 s-4 Hz-1"
     assert ds.deflection_asd.attrs["units"] == "m2 Hz-1"
 
@@ -167,18 +167,18 @@ def test_the_spectra_select_and_do_not_depend_on_threads_or_chunks():
                       threads=1, progress=False)
     for name in ("deflection_asd", "acceleration_asd", "base_asd_g2"):
         np.testing.assert_array_equal(ds[name].values, again[name].values)
-    assert ds.deflection_asd.dims == ("base_asd_scale", "frequency")
+    assert ds.deflection_asd.dims == ("base_asd_scale", "asd_frequency")
     assert "displacement" not in ds
-    df = float(ds.frequency[1])
+    df = float(ds.asd_frequency[1])
     for level in (-6.0, 0.0):   # each level's own mean square (Welch's Hann segments weigh
         # the window's samples unevenly: a 0.7 s window's two figures differ by a few %)
         total = float(ds.deflection_asd.sel(base_asd_scale=level).sum()) * df
         ms = float((ds.rms_deflection.sel(base_asd_scale=level) ** 2).mean())
         assert total == pytest.approx(ms, rel=0.1)
-    assert float(ds.base_asd_g2.sel(base_asd_scale=-6.0, frequency=100.0, method="nearest")) \
+    assert float(ds.base_asd_g2.sel(base_asd_scale=-6.0, asd_frequency=100.0, method="nearest")) \
         == pytest.approx(0.04 * 10 ** (-6 / 10))
-    assert ds.frequency.attrs["units"] == "Hz"
-    assert float(ds.frequency[-1]) <= 500.0
+    assert ds.asd_frequency.attrs["units"] == "Hz"
+    assert float(ds.asd_frequency[-1]) <= 500.0
 
 
 def test_time_series_and_spectra_together():
@@ -210,8 +210,8 @@ def test_a_finer_resolution_is_kept():
     """A resolution finer than the default's: the power-of-two segment at or below it."""
     coarse = sweep.run(scene(), progress=False)
     ds = sweep.run(scene({"outputs.asd_resolution": 4.0}), progress=False)
-    df = float(ds.frequency[1] - ds.frequency[0])
-    assert 2.0 < df <= 4.0 < float(coarse.frequency[1])
+    df = float(ds.asd_frequency[1] - ds.asd_frequency[0])
+    assert 2.0 < df <= 4.0 < float(coarse.asd_frequency[1])
 
 
 def test_a_run_too_short_for_the_start_up_is_refused_for_that_not_the_spectra():
@@ -226,8 +226,18 @@ def test_points_get_their_own_spectra():
             "seed = 3", "[outputs]", "response_asd = true", "[points]",
             "length = [0.3, 0.25]", "damping_ratio = [0.05, 0.04]"]
     ds = sweep.run(sweep.load_scene_text("\n".join(text) + "\n"), progress=False)
-    assert ds.acceleration_asd.dims == ("point", "frequency")
-    assert ds.linear_deflection_asd.dims == ("point", "frequency")
-    peaks = ds.linear_deflection_asd.idxmax("frequency").values
+    assert ds.acceleration_asd.dims == ("point", "asd_frequency")
+    assert ds.linear_deflection_asd.dims == ("point", "asd_frequency")
+    peaks = ds.linear_deflection_asd.idxmax("asd_frequency").values
     f1 = ds.natural_frequency.values
-    assert np.all(np.abs(peaks - f1) <= float(ds.frequency[1]))    # each its own resonance
+    assert np.all(np.abs(peaks - f1) <= float(ds.asd_frequency[1]))    # each its own resonance
+
+
+def test_an_end_loads_frequency_axis_and_the_spectra_are_two_dimensions():
+    """A harmonic end load swept in `frequency` (Hz) beside the spectra's `asd_frequency`."""
+    sc = scene({"load.type": "harmonic", "load.amplitude": 1.0},
+               axes={"frequency": [30.0, 60.0]})
+    ds = sweep.run(sc, progress=False)
+    assert ds.acceleration_asd.dims == ("frequency", "asd_frequency")
+    assert ds.frequency.values.tolist() == [30.0, 60.0]
+    assert float(ds.asd_frequency[-1]) <= 500.0

@@ -1,7 +1,7 @@
 """The response's acceleration spectral densities of a random scene (outputs.response_asd,
 docs/model.md sec. 11.6): Welch's estimate of the midspan deflection's ASD (m^2/Hz) and of the
 midspan's absolute acceleration (g^2/Hz) over each record's statistics window, averaged over the
-realisations, on a `frequency` dimension up to the spectrum's top frequency, with the input
+realisations, on an `asd_frequency` dimension up to the spectrum's top frequency, with the input
 spectrum beside them.
 
 How. The kernels sample q(t) on their dense output at fs_asd = fs / m (fs the records' rate,
@@ -34,7 +34,8 @@ import xarray as xr
 
 from ..scene.messages import _fail, _show
 
-FREQUENCY_DIM = "frequency"
+FREQUENCY_DIM = "asd_frequency"
+"""The spectra's dimension (Hz); not `frequency`, which is an end load's axis."""
 SEGMENTS = 8
 """Half-overlapping Welch segments in the shortest statistics window, by default."""
 OVERSAMPLING = 4.0

@@ -27,7 +27,8 @@ from matplotlib.patches import Patch
 
 from ..errors import UserError
 from .labels import _point_text, _title, label
-from .result import CLEARANCE_DIM, REALISATION_DIM, select_points, swept_axes
+from .result import (ASD_FREQUENCY_DIM, CLEARANCE_DIM, REALISATION_DIM, select_points,
+                     swept_axes)
 from .style import _legend, _new_axes, _plain_ticks, _unit
 
 MAX_LEVELS = 5
@@ -261,7 +262,7 @@ def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     for other in [d for d in axes if d != x]:
         ds = ds.isel({other: int(np.argmax(np.asarray(ds[other].values, float)))})
     ax = ax if ax is not None else _new_axes((7.0, 5.4))
-    f = np.asarray(ds["frequency"].values, float)
+    f = np.asarray(ds[ASD_FREQUENCY_DIM].values, float)
     shown = f > 0.0
     handles = []
     picks = [None] if x is None else _spread(ds.sizes[x], MAX_LEVELS)

@@ -30,6 +30,7 @@ DIRECTION_DIM = "direction"                # a stepped sweep's up and down (cont
 # statistical dimension, not a swept axis; its clearance levels of |q| (m) another.
 REALISATION_DIM = "realisation"
 CLEARANCE_DIM = "clearance"
+ASD_FREQUENCY_DIM = "asd_frequency"   # its spectra's (sweep.models.response_asd.FREQUENCY_DIM)
 _DIRECTIONS = ("up", "down")
 
 # What a result may hold. `sweep run` writes far less; a file beyond these limits was not
