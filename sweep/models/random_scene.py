@@ -254,6 +254,22 @@ def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
           "base.rms_accuracy")
 
 
+def check_spectra_samples(given: Mapping[str, Any], most: int) -> None:
+    """With outputs.response_asd: refuse (one line) a run whose samples for the spectra
+    (solver.t_end, or base.duration, at the spectra's rate) are more than `most` a point (the
+    time series' limit, rules.MAX_SAMPLES)."""
+    if not given.get("outputs.response_asd"):
+        return
+    from .response_asd import asd_rate
+    rate = asd_rate(sample_rate(given), float(given[spectrum_key(given)][-1][0]))
+    t_end = float(given.get("solver.t_end") or given["base.duration"])
+    if t_end * rate <= most:
+        return
+    _fail("scene key 'outputs.response_asd'", f"the spectra sample a run of {t_end:.6g} s at "
+          f"{rate:g} Hz: {t_end * rate:.3g} samples a point, more than {most:,}",
+          f"give base.duration of at most {most / rate:.6g} s, or remove response_asd")
+
+
 def shortest_window(values: Mapping[str, Any], natural_frequency: Any,
                     damping_ratio: Any) -> float:
     """The shortest statistics window (s) over the points (natural_frequency: f1 in Hz,

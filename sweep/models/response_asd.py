@@ -48,7 +48,8 @@ NAMES = ("deflection_asd", "acceleration_asd")
 def decimation(sample_rate: float, top: float) -> int:
     """m: the ASD's samples are every m-th of the records' (fs = sample_rate Hz, the
     spectrum's top frequency `top` Hz)."""
-    return max(1, int(math.floor(sample_rate / (OVERSAMPLING * top) + 1e-9)))
+    ratio = sample_rate / (OVERSAMPLING * top)
+    return max(1, int(math.floor(ratio + 1e-9))) if math.isfinite(ratio) else 1
 
 
 def asd_rate(sample_rate: float, top: float) -> float:
@@ -61,11 +62,12 @@ def segment_length(window: float, rate: float, resolution: float | None) -> int:
     s sampled at `rate` Hz: the shortest at least rate / resolution long, or without a
     resolution the longest that fits SEGMENTS half-overlapping segments. Refuses (one line)
     a window that holds no segment at that resolution."""
-    fits = (window * rate - 2.0) if math.isfinite(window) else 0.0
+    most = 2.0 ** 52               # beyond any record that fits in memory: no overflow below
+    fits = min(window * rate - 2.0, most) if math.isfinite(window) else 0.0
     if resolution is None:
         n = 2 ** int(math.floor(math.log2(max(fits * 2.0 / (SEGMENTS + 1), 2.0))))
     else:
-        n = 2 ** int(math.ceil(math.log2(max(rate / resolution, 2.0))))
+        n = 2 ** int(math.ceil(math.log2(min(max(rate / resolution, 2.0), most))))
     if n < 16 or n > fits:
         finest = 2 ** int(math.floor(math.log2(max(fits, 1.0))))
         coarsest = rate / max(finest, 1)
@@ -84,7 +86,7 @@ def max_bins(random: Any, resolution: float | None) -> int:
     spectrum's top frequency over the resolution, or over the finest the run allows."""
     top = float(random.spectrum[0][-1])
     finest = resolution if resolution is not None else (SEGMENTS + 1) / (2.0 * random.t_end)
-    return int(math.ceil(2.0 * top / finest)) + 1
+    return int(min(math.ceil(2.0 * top / finest), 2.0 ** 52)) + 1   # no overflow for absurd input
 
 
 CHUNK_BYTES = 256e6

@@ -220,6 +220,7 @@ def check_base(given: dict[str, Any], axes: dict[str, np.ndarray], has_table: bo
     _check_envelope(given, axes)
     random_scene.check(given, axes)
     if random_scene.is_random(given):
+        random_scene.check_spectra_samples(given, MAX_SAMPLES)
         return                          # a spectrum instead of a level and a frequency
     if not named and not has_table:
         return
