@@ -125,32 +125,28 @@ def reduced_chunk(params: np.ndarray, inner: Callable[..., dict], inner_args: tu
                   stop: threading.Event | None = None) -> dict[str, np.ndarray]:
     """inner(params, *inner_args) (`transverse_chunk` or `modes_chunk`) with its time series
     reduced row block by row block as soon as each is final: `reduction` (a model's, e.g.
-    sweep/models/response_asd.py's Reduction) gives empty(n, n_samples), the arrays that
-    replace or join inner's, and fill(params, records, solved, out, lo, hi), their rows lo..hi-1
-    from inner's outputs. The chunk's long series lives only for the call. on_block and stop
-    as `transverse_chunk`'s."""
+    sweep/models/response_asd.py's Reduction) gives empty(n), the arrays that
+    replace or join inner's (an empty series in place of the long one, unless the series is
+    kept), and fill(params, records, solved, out, lo, hi), their rows lo..hi-1 from inner's
+    outputs. A long series not kept lives only for the call. on_block and stop as
+    `transverse_chunk`'s."""
     reduced: dict[str, np.ndarray] = {}
 
     def outputs_of(solved: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         if not reduced:
             reduced.update(solved)
-            reduced.update(reduction.empty(params.shape[0], solved["series"].shape[1]))
+            reduced.update(reduction.empty(params.shape[0]))
         return reduced
 
     def report(lo: int, hi: int, solved: dict[str, np.ndarray]) -> None:
         out = outputs_of(solved)
         reduction.fill(params, records, solved, out, lo, hi)
-        if out["series"] is not solved["series"] and out["series"].shape[1]:
-            out["series"][lo:hi] = solved["series"][lo:hi]
         on_block(lo, hi, out)
 
     solved = inner(params, *inner_args, threads=threads,
                    on_block=None if on_block is None else report, stop=stop)
     if on_block is None:
-        out = outputs_of(solved)
-        reduction.fill(params, records, solved, out, 0, params.shape[0])
-        if out["series"].shape[1]:
-            out["series"][:] = solved["series"]
+        reduction.fill(params, records, solved, outputs_of(solved), 0, params.shape[0])
     return outputs_of(solved)
 
 
@@ -799,8 +795,7 @@ def chunk_template(chunk_fn: Callable[..., dict], args: tuple) -> dict[str, np.n
         return modes_outputs(0, n_samples, modes_of(basis), n_bands)
     if chunk_fn is reduced_chunk:
         inner, inner_args, reduction = args[0], args[1], args[2]
-        template = chunk_template(inner, inner_args)
-        return {**template, **reduction.empty(0, template["series"].shape[1])}
+        return {**chunk_template(inner, inner_args), **reduction.empty(0)}
     if chunk_fn is stepped_chunk:
         kernel, kernel_args, dwells = args[0], args[1], args[2]
         return {k: np.empty((0, dwells) + v.shape[1:], v.dtype)

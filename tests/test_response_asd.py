@@ -82,7 +82,7 @@ def test_the_absolute_acceleration_asd_is_welchs_of_the_exact_signal():
                                  keep_series=False)
     window = 3.0                                          # s, the last 3 s
     solved = {"series": q[None, :], "reals": np.array([[window]])}
-    out = red.empty(1, q.size)
+    out = red.empty(1)
     red.fill(np.array([[1.0, 0.5]]), records, solved, out, 0, 1)
     first = int(math.ceil((t_end - window) * rate))
     exact = q2 + 0.5 * (ab * np.sin(np.outer(t, w) + pb)).sum(1)

@@ -260,8 +260,7 @@ def check_spectra_samples(given: Mapping[str, Any], most: int) -> None:
     time series' limit, rules.MAX_SAMPLES)."""
     if not given.get("outputs.response_asd"):
         return
-    from .response_asd import asd_rate
-    rate = asd_rate(sample_rate(given), float(given[spectrum_key(given)][-1][0]))
+    rate = spectra_rate(given)
     t_end = float(given.get("solver.t_end") or given["base.duration"])
     if t_end * rate <= most:
         return
@@ -270,16 +269,24 @@ def check_spectra_samples(given: Mapping[str, Any], most: int) -> None:
           f"give base.duration of at most {most / rate:.6g} s, or remove response_asd")
 
 
-def shortest_window(values: Mapping[str, Any], natural_frequency: Any,
+def spectra_rate(values: Mapping[str, Any]) -> float:
+    """The rate (Hz) the spectra sample the response at (outputs.response_asd,
+    sweep/models/response_asd.py `asd_rate`), from a scene's values."""
+    from .response_asd import asd_rate
+    return asd_rate(sample_rate(values), float(values[spectrum_key(values)][-1][0]))
+
+
+def shortest_window(t_end: float, tail: float, tolerance: float, natural_frequency: Any,
                     damping_ratio: Any) -> float:
-    """The shortest statistics window (s) over the points (natural_frequency: f1 in Hz,
-    damping_ratio: on the grid, or at its corners, where zeta w1 takes its extremes)."""
+    """The shortest statistics window (s, `statistics_window`) over the points of a run of
+    t_end s (tail: metrics.tail; tolerance: metrics.tolerance, for the start-up transient):
+    natural_frequency f1 (Hz) and damping_ratio on the grid, or at its corners, where zeta w1
+    takes its extremes."""
     omega, zeta = np.broadcast_arrays(
         2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
         np.atleast_1d(np.asarray(damping_ratio, float)))
     with np.errstate(divide="ignore", invalid="ignore"):
-        window = statistics_window(float(values["solver.t_end"]), float(values["metrics.tail"]),
-                                   transient_time(omega, zeta, float(values["metrics.tolerance"])))
+        window = statistics_window(t_end, tail, transient_time(omega, zeta, tolerance))
     return float(np.min(window)) if window.size else 0.0
 
 
@@ -289,12 +296,14 @@ def check_spectra_window(values: Mapping[str, Any], natural_frequency: Any,
     holds no Welch segment at the asked resolution (sweep/models/response_asd.py)."""
     if not values.get("outputs.response_asd"):
         return
-    from .response_asd import asd_rate, segment_length
-    window = shortest_window(values, natural_frequency, damping_ratio)
-    if not window > 0.1 * float(values["solver.t_end"]):
+    from .response_asd import segment_length
+    t_end = float(values["solver.t_end"])
+    window = shortest_window(t_end, float(values["metrics.tail"]),
+                             float(values["metrics.tolerance"]), natural_frequency,
+                             damping_ratio)
+    if not window > 0.1 * t_end:
         return                  # a run too short for the start-up: check_duration's refusal
-    rate = asd_rate(sample_rate(values), float(values[spectrum_key(values)][-1][0]))
-    segment_length(window, rate, values.get("outputs.asd_resolution"))
+    segment_length(window, spectra_rate(values), values.get("outputs.asd_resolution"))
 
 
 def check_duration(t_end: float, startup: float) -> None:

@@ -108,9 +108,8 @@ def welch(x: np.ndarray, fs: float, nperseg: int) -> tuple[np.ndarray, np.ndarra
     window (periodic), segments of nperseg samples overlapping by half, each segment's mean
     removed, the segments' periodograms averaged; as scipy.signal.welch(x, fs, nperseg=nperseg)
     with its defaults. Returns (f Hz, density in x's units^2 / Hz)."""
-    seg = _segments(np.asarray(x, float), nperseg)
     window = _hann(nperseg)
-    spectra = np.fft.rfft((seg - seg.mean(axis=-1, keepdims=True)) * window, axis=-1)
+    spectra = _transforms(np.asarray(x, float), window, nperseg // 2 + 1)
     return (np.fft.rfftfreq(nperseg, 1.0 / fs),
             _density(np.abs(spectra) ** 2, window, fs).mean(axis=-2))
 
@@ -126,6 +125,14 @@ def _segments(x: np.ndarray, nperseg: int) -> np.ndarray:
     count = 1 + (x.shape[-1] - nperseg) // step
     view = np.lib.stride_tricks.sliding_window_view(x, nperseg, axis=-1)
     return view[..., :count * step:step, :]
+
+
+def _transforms(x: np.ndarray, window: np.ndarray, n_freq: int) -> np.ndarray:
+    """The first n_freq bins of the rfft of each of x's half-overlapping segments (last
+    axis; `_segments`, window.size samples), its mean removed and `window` applied."""
+    segments = _segments(x, window.size)
+    centred = segments - segments.mean(axis=-1, keepdims=True)
+    return np.fft.rfft(centred * window, axis=-1)[..., :n_freq]
 
 
 def _density(power: np.ndarray, window: np.ndarray, fs: float) -> np.ndarray:
@@ -147,7 +154,8 @@ class Reduction:
     segment), n_freq (bins kept, 0 .. the spectrum's top frequency), t_end (s, the run's end:
     each window ends there), record_column and scale_column (a row's realisation and level
     factor, kernels.excitation's RECORD and RECORD_SCALE in the System's excitation block),
-    keep_series (outputs.time_series: the samples stay as the result's q(t) too)."""
+    keep_series (outputs.time_series: the samples stay as the result's q(t) too; `empty`
+    then leaves the System's series in place)."""
     rate: float
     decimation: int
     nperseg: int
@@ -162,10 +170,12 @@ class Reduction:
         """The bins' frequencies (Hz)."""
         return np.arange(self.n_freq) * (self.rate / self.nperseg)
 
-    def empty(self, n: int, n_samples: int) -> dict[str, np.ndarray]:
-        """The reduced outputs of n points (NaN until filled), and the series kept or not."""
+    def empty(self, n: int) -> dict[str, np.ndarray]:
+        """The reduced outputs of n points (NaN until filled); without keep_series an empty
+        series (n, 0) in place of the System's (n, n_samples)."""
         out = {name: np.full((n, self.n_freq), np.nan) for name in NAMES}
-        out["series"] = np.empty((n, n_samples if self.keep_series else 0))
+        if not self.keep_series:
+            out["series"] = np.empty((n, 0))
         return out
 
     def fill(self, params: np.ndarray, records: np.ndarray, solved: dict[str, np.ndarray],
@@ -181,37 +191,33 @@ class Reduction:
         n_rec = records.shape[2]
         for i in range(lo, hi):
             length = solved["reals"][i, self.window_column]
-            first = int(math.ceil((self.t_end - length) * self.rate - 1e-6))
-            q = series[i, max(first, 0):]
-            if not (np.isfinite(length) and q.size >= self.nperseg + 2
-                    and np.all(np.isfinite(q))):
-                continue                                   # escaped, or no window: NaN
-            k = np.arange(max(first, 0) + 1, max(first, 0) + q.size - 1)
+            if not np.isfinite(length):
+                continue                                   # no window: NaN
+            first = max(int(math.ceil((self.t_end - length) * self.rate - 1e-6)), 0)
+            q = series[i, first:]
+            if not (q.size >= self.nperseg + 2 and np.all(np.isfinite(q))):
+                continue                                   # escaped, or too short: NaN
+            k = np.arange(first + 1, first + q.size - 1)
             a_rel = (q[2:] - 2.0 * q[1:-1] + q[:-2]) * (self.rate * self.rate)
             a_base = (params[i, self.scale_column]
                       * records[int(params[i, self.record_column]), 0,
                                 (k * self.decimation) % n_rec])
-            seg_q = _segments(q[1:-1], self.nperseg)
-            seg_r = _segments(a_rel, self.nperseg)
-            seg_b = _segments(a_base, self.nperseg)
-            fq = np.fft.rfft((seg_q - seg_q.mean(-1, keepdims=True)) * window)[..., :self.n_freq]
-            fr = np.fft.rfft((seg_r - seg_r.mean(-1, keepdims=True)) * window)[..., :self.n_freq]
-            fb = np.fft.rfft((seg_b - seg_b.mean(-1, keepdims=True)) * window)[..., :self.n_freq]
+            fq = _transforms(q[1:-1], window, self.n_freq)
+            fr = _transforms(a_rel, window, self.n_freq)
+            fb = _transforms(a_base, window, self.n_freq)
             out["deflection_asd"][i] = _density(np.abs(fq) ** 2, window, self.rate).mean(-2)
             out["acceleration_asd"][i] = _density(np.abs(fr * gain + fb) ** 2, window,
                                                   self.rate).mean(-2)
 
 
-def reduction(random: Any, windows: np.ndarray, resolution: float | None, t_end: float,
+def reduction(random: Any, shortest: float, resolution: float | None, t_end: float,
               record_column: int, scale_column: int, window_column: int,
               keep_series: bool) -> Reduction:
-    """The Reduction of a random scene (random: its RandomInputs; windows: every point's
-    statistics window, s, whose shortest sets the segment)."""
+    """The Reduction of a random scene (random: its RandomInputs; shortest: the grid's
+    shortest statistics window, s, which sets the segment)."""
     top = float(random.spectrum[0][-1])
     m = decimation(random.sample_rate, top)
-    rate = random.sample_rate / m
-    finite = np.asarray(windows, float)
-    shortest = float(np.min(finite)) if finite.size else 0.0
+    rate = asd_rate(random.sample_rate, top)
     nperseg = segment_length(shortest, rate, resolution)
     n_freq = min(int(math.floor(top * nperseg / rate + 1e-9)) + 1, nperseg // 2 + 1)
     return Reduction(rate=rate, decimation=m, nperseg=nperseg, n_freq=n_freq, t_end=t_end,

@@ -434,14 +434,13 @@ def _spectra(inputs: Inputs, coeffs: dict[str, Any],
     from sweep.kernels import excitation as ex
     from sweep.kernels import modes as md
     from sweep.kernels import oscillator as osc
-    from .random_scene import statistics_window, transient_time
-    omega = 2.0 * np.pi * np.asarray(coeffs["natural_frequency"], float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        windows = statistics_window(settings[tk.T_END], settings[tk.TAIL], transient_time(
-            omega, np.asarray(inputs.params["damping_ratio"], float), settings[tk.TOL]))
+    from .random_scene import shortest_window
+    t_end = float(settings[tk.T_END])
+    window = shortest_window(t_end, float(settings[tk.TAIL]), float(settings[tk.TOL]),
+                             coeffs["natural_frequency"], inputs.params["damping_ratio"])
     block = osc.EXCITATION if inputs.n_modes == 1 else md.EXCITATION
     return response_asd.reduction(
-        inputs.random, np.atleast_1d(windows), inputs.resolution, float(settings[tk.T_END]),
+        inputs.random, window, inputs.resolution, t_end,
         record_column=block + ex.RECORD, scale_column=block + ex.RECORD_SCALE,
         window_column=tk.WINDOW, keep_series="outputs.time_series" in inputs.wanted)
 
@@ -452,8 +451,7 @@ def _reduced(system: _System, reduction: response_asd.Reduction,
     from ..execute import reduced_chunk
 
     def outputs(n: int) -> dict[str, np.ndarray]:
-        full = system.outputs(n)
-        return {**full, **reduction.empty(n, full["series"].shape[1])}
+        return {**system.outputs(n), **reduction.empty(n)}
 
     return _System(system.rows_at, reduced_chunk,
                    (system.chunk_fn, system.args, reduction, records), outputs, None)
