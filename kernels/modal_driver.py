@@ -264,6 +264,17 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def observe_random_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
+    """The record kind's modal statistics of the accepted step [t, t + h] (K: its stages, the
+    last f(t + h, y_new)), as trajectory.observe_random's for the midspan: the curvature
+    squares at the clamp and midspan (`_observe_bend_squares`) once the step starts in the
+    statistics window, where the scene observes the loads. Nothing for the sine kinds."""
+    if ex.is_record(base):
+        if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
+            _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, basis, modal)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def curvature_moments(modal, n, acc, reals):
     """reals' CURVATURE_M0.. and MID_CURVATURE_M0.. (mean squares, `modal_size`) over the
     statistics window of a random trajectory (acc: its watched accumulator), where the loads
@@ -721,9 +732,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                        basis, Qc)
-        if ex.is_record(base):             # the window's curvature squares, as observe_random
-            if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
-                _observe_bend_squares(y, y_new, K[0], K[n_stages], h, n, basis, modal)
+        observe_random_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
             K_mid[j, 1] = _project(K[j], weights, n, n)

@@ -34,6 +34,11 @@ So do a lane's unusual steps to try (trajectory.next_attempt). A lane whose traj
 classified as modal_driver.solve_point does and takes the next point of the block. Set-up
 (f(0), SciPy's initial step) is the scalar driver's arithmetic.
 
+A random base acceleration (the record kind, kernels.excitation) runs here too: the right-hand
+side reads each lane's record, and every accepted step goes to the scalar path, whose
+`record_step` and `modal_driver.observe_random_modes` accumulate the statistics (the lanes'
+accumulator then has the record's slots, trajectory.SCALAR_SLOTS).
+
 Not bit for bit the scalar driver's (fast_cos, fast_sin, inv_fifth_root to an ulp or two; the
 loops fuse multiply-adds), so results equal its results to what a trajectory makes of
 round-off (tests/test_modal_lanes.py measures that spread with a one-ulp change of q_1(0)).
@@ -47,6 +52,7 @@ import numpy as np
 
 from . import dop853
 from . import dopri5
+from . import excitation as ex
 from . import metrics as mt
 from . import modal_driver as drv
 from . import modes as md
@@ -309,11 +315,13 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     output: no extremum of the midspan deflection or of any mode (EV), no divergence, not the
     tail's start, no time-series sample, no threshold crossing) gets the Observer's step-end
     metrics (trajectory.observe_step_end, as in record_step) and moves to its end (MOVE 1);
-    any other is left to the scalar path (FLAG 2). Returns how many lanes it flagged."""
+    any other is left to the scalar path (FLAG 2), and so is every step of a random record
+    (its statistics are record_step's). Returns how many lanes it flagged."""
     L = LANES
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
+    record = ex.is_record(base)     # a random record's statistics: every step's (record_step)
     n_flagged = 0
     for l in range(n_run):
         t_tail = W[tj.T_TAIL * L + l]          # the lane's own tail window start
@@ -335,7 +343,7 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
         event = active & accepted & ((EV[l] != 0.0) | extremum | (not bounded) | straddles
-                                     | due | crosses)
+                                     | due | crosses | record)
         done = active & accepted & (not event)
         FLAG[l] = 2.0 if event else 0.0
         MOVE[l] = 1.0 if done else 0.0
@@ -456,6 +464,8 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
     for c in range(MOD.shape[0]):
         ml[c] = MOD[c, j]
     state = drv.span_state(state, ml, yl, n, settings, reals[point], basis)
+    if ex.is_record(base) and state == mt.COMPLETED:
+        drv.curvature_moments(ml, n, acc, reals[point])
     failed = state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS
     for c in range(n):
         modal[point, c] = math.nan if failed else MOD[c, j]
@@ -495,6 +505,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
     t_tail = acc[tj.T_TAIL]
     drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, basis,
                        Qc)
+    drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis, ml, base)
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
         Kmid[r, 1] = KM[r, 1, j]
@@ -535,7 +546,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     T = basis[md.TABLES]
     nodes = T.shape[2]
     weights = basis[md.MIDSPAN]
-    W = np.zeros(tj.N_SLOTS * L)
+    slots = tj.SCALAR_SLOTS if ex.is_record(base) else tj.N_SLOTS   # a record's statistics
+    W = np.zeros(slots * L)
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
     Y = np.zeros((dim, L))
@@ -619,13 +631,14 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS],
-                     basis[md.COUPLING], LD)
+        if not ex.is_record(base):       # (a record's every step is the scalar path's)
+            _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS],
+                         basis[md.COUPLING], LD)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING],
                     LD)
-        if base is not None:
+        if base is not None and not ex.is_record(base):
             tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
         if n_flagged > 0:
             for j in range(n_run):

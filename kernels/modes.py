@@ -368,7 +368,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis' tables
     (sweep.models.basis: the shapes' derivatives at the quadrature nodes and the projection
     weights); FLD (4, nodes, lanes) and SC (4, lanes): scratch. fast: None (libm's cos and
-    sin) or True (vecmath's vectorisable ones); base: None (no base excitation term) or True;
+    sin) or True (vecmath's vectorisable ones); base: None (no base excitation term), True
+    (a sine kind) or the records of a random base acceleration (kernels.excitation: read lane
+    by lane, fast or not);
     CP: the basis' coupling A_ij / pi^2 (basis[COUPLING]), for the uniform stretching tension
     N = k_s e, e = (k^2 l / 2) sum CP_ij q_i q_j, which adds -N k^2 b / rho A to F (a lane whose
     TENSION is 0 has none; when no lane has one it is not computed). A lane whose S_ENERGY is
@@ -407,8 +409,8 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         for l in range(n_run):
             SC[0, l] -= PP[sc + S_TENSION, l] * SC[3, l]
     if base is not None:
-        if fast is None:                # libm, and any excitation (kernels.excitation)
-            flat = PP.reshape(PP.size)
+        if fast is None or ex.is_record(base):   # libm, and any excitation (kernels.excitation);
+            flat = PP.reshape(PP.size)           # a record's samples, lane by lane
             lanes = PP.shape[1]
             for l in range(n_run):
                 SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes,

@@ -114,8 +114,9 @@ def base_acceleration(t, p, o, s, fast, base):
     """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation
     block's own (kernels.excitation: fixed or swept frequency, constant or tabled level, or a
     random record where `base` is the records); fast True (the lanes, which take
-    fixed-frequency, fixed-level rows only): A sin(w_b t + phi_b) with vecmath's fast_sin."""
-    if fast is None:
+    fixed-frequency, fixed-level sine rows and records): A sin(w_b t + phi_b) with vecmath's
+    fast_sin, or the record as above."""
+    if fast is None or ex.is_record(base):
         return _excitation_signal(t, p, o, s, base)
     x = p[o + BASE_OMEGA * s] * t + p[o + BASE_PHASE * s]
     return p[o + BASE_ACCEL * s] * fast_sin(x)

@@ -83,8 +83,8 @@ T_TAIL = INTERP + 12   # this trajectory's tail window start (s): t_end (1 - tai
 T_FINAL = T_TAIL + 1    # this trajectory's end time (s): t_end, or the moved tail window's end
 N_SLOTS = T_FINAL + 1
 # The record kind's statistics (a random base acceleration, kernels.excitation), after the
-# slots every driver keeps: only the scalar drivers run records, and they allocate
-# SCALAR_SLOTS, zeroed. The window starts with the first step that starts at or after the tail
+# slots every driver keeps: the drivers that run records (the scalar ones, the multi-mode
+# lanes) allocate SCALAR_SLOTS, and `delay_window` zeroes them. The window starts with the first step that starts at or after the tail
 # window's start and ends with the run; over it (`observe_random`):
 IN_WINDOW = N_SLOTS      # 1.0 once the window has started
 W_START = IN_WINDOW + 1  # when it started (s)
@@ -168,7 +168,11 @@ def start(p, o, s, settings, acc, series, parametric, base):
 def delay_window(acc, start):
     """A random record's own statistics window: the tail window starts no earlier than
     `start` (s, the row's start-up transient's end), so that a point's statistics depend on
-    its own row only, not on the grid's slowest point. Called right after `begin`."""
+    its own row only, not on the grid's slowest point; and the statistics' slots (IN_WINDOW
+    .. SCALAR_SLOTS) zeroed, for a lanes driver's accumulator that held a row before. Called
+    right after `begin`."""
+    for k in range(N_SLOTS, SCALAR_SLOTS):
+        acc[k] = 0.0
     if start <= acc[T_TAIL]:
         return
     acc[T_TAIL] = start

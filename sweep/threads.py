@@ -122,7 +122,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
     parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
-    base = _random_base(records, driver, base)
+    base = _random_base(records, driver, base, lanes_take_records=False)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept:
@@ -185,7 +185,8 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         from sweep.kernels import modal_lanes as kernel
     else:
         kernel = modal_driver
-    base = _random_base(records, driver, True if settings[tk.BASE] != 0.0 else None)
+    base = _random_base(records, driver, True if settings[tk.BASE] != 0.0 else None,
+                        lanes_take_records=True)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept and driver != "scalar":
@@ -219,13 +220,15 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
                tick=watch.ticker())
 
 
-def _random_base(records: np.ndarray | None, driver: str, base: bool | None) -> Any:
+def _random_base(records: np.ndarray | None, driver: str, base: bool | None,
+                 lanes_take_records: bool) -> Any:
     """The kernels' `base` switch: the records of a random base acceleration (the scalar
-    driver only), else `base` as it is (None or True: a sine kind)."""
+    driver, or the lanes where they take records: the multi-mode System's), else `base` as
+    it is (None or True: a sine kind)."""
     if records is None:
         return base
-    if driver != "scalar":
-        raise ValueError("a random base acceleration takes driver 'scalar'")
+    if driver != "scalar" and not lanes_take_records:
+        raise ValueError("a random base acceleration of one mode takes driver 'scalar'")
     return np.ascontiguousarray(records, dtype=np.float64)
 
 
