@@ -13,8 +13,8 @@ overrides):
 - the scene as shipped and each of the engine's settings (method rk45 / dop853 x rtol 1e-6 ..
   1e-10, the shipped driver): its time per point (best of --repeats after a compile run, one
   thread: run.threads = 1) and its error: max |x - x_ref| / max |x_ref| of the scene's
-  headline output x (`amplitude`, else `peak_amplitude`, else `rms_deflection`) over the
-  sample;
+  headline output x (a random scene's `rms_deflection`, else `amplitude`, else
+  `peak_amplitude`) over the sample;
 - the fastest setting whose error is at most the shipped run's ("best at equal error");
 - peers at the same error: SciPy `solve_ivp` on the sample's points with the System's own
   right-hand side (several modes: the compiled `kernels.modes.derivative`; one mode:
@@ -26,8 +26,13 @@ overrides):
   each is listed, as not importable with the line that installs it, or as not run. A sample
   is too small to spread over threads: how two threads scale is measured on the whole scenes
   (benchmarks/RESULTS.md gives the command). A stepped sine or a
-  sine sweep has no SciPy peer here (benchmarks/stepped_sweep.py, sine_sweep_cost.py); a
-  random scene's peers are in benchmarks/random_cost.py.
+  sine sweep has no SciPy peer here (benchmarks/stepped_sweep.py, sine_sweep_cost.py);
+- a random scene of one mode (its sample: one span, one level): a hand-written fixed-step
+  RK4 loop in Numba on the same records (benchmarks/random_cost.py `rk4_rms_over`, the
+  coefficients the engine takes), its RMS over each point's window of the reference run, at
+  the widest step 1 / (m fs), m = 0.25 .. 4, that reaches the shipped error; its time per
+  point is the loop's alone (the engine's includes the records' synthesis and the dataset).
+  SciPy on a record is in benchmarks/random_cost.py (110-160x the engine).
 
 Command
 -------
@@ -74,7 +79,8 @@ SAMPLES: dict[str, dict[str, Any]] = {
                            "base.realisations": 2},
 }
 RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
-HEADLINE = ("amplitude", "peak_amplitude", "rms_deflection")
+HEADLINE = ("rms_deflection", "amplitude", "peak_amplitude")   # a random scene's: its RMS
+RK4_STEPS = (0.25, 0.5, 1.0, 2.0, 4.0)   # the RK4 peer's steps 1 / (m fs), widest first
 INSTALL = {"numbalsoda": "pip install numbalsoda (its build needs cmake, a C++ compiler and "
                          "gfortran)",
            "diffrax": "pip install diffrax jax"}
@@ -96,9 +102,10 @@ def error(x: np.ndarray, ref: np.ndarray) -> float:
     return float(np.max(np.abs(x[ok] - ref[ok])) / np.max(np.abs(ref[ok])))
 
 
-def timed(name: str, overrides: dict[str, Any], repeats: int) -> tuple[float, np.ndarray]:
+def timed(name: str, overrides: dict[str, Any],
+          repeats: int) -> tuple[float, np.ndarray, Any]:
     """(best wall time per point (s) on one thread over `repeats` runs after a first one, inf
-    with none; headline) of scene `name`."""
+    with none; headline; the dataset) of scene `name`."""
     scene = sweep.load_scene(name, overrides={**overrides, "run.threads": 1})
     ds = sweep.run(scene, progress=False)                   # compile, or load the cache
     best = math.inf
@@ -107,7 +114,7 @@ def timed(name: str, overrides: dict[str, Any], repeats: int) -> tuple[float, np
         ds = sweep.run(scene, progress=False)
         best = min(best, time.perf_counter() - start)
     x = headline(ds)
-    return best / x.size, x
+    return best / x.size, x, ds
 
 
 def has_scipy_peer(name: str, overrides: dict[str, Any]) -> bool:
@@ -175,6 +182,54 @@ def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -
     return elapsed / len(rows)
 
 
+def is_random(name: str, overrides: dict[str, Any]) -> bool:
+    """Whether the scene is a random one of one mode (`rk4_peer` runs it)."""
+    from sweep.models import transverse as tm
+    inputs = tm.resolve(sweep.load_scene(name, overrides=overrides))
+    return inputs.random is not None and inputs.n_modes == 1
+
+
+def rk4_peer(name: str, sample: dict[str, Any], ref: np.ndarray, ref_ds: Any, e_ship: float,
+             t_ship: float, repeats: int) -> tuple[list[str], float | None]:
+    """The random scene's peer: a hand-written fixed-step RK4 loop in Numba
+    (benchmarks/random_cost.py `rk4_rms_over`) on the sample's own records and coefficients,
+    its RMS deflection over each point's window of the reference run, at the widest step
+    1 / (m fs), m in RK4_STEPS, whose error is at most the shipped run's: (its table row, the
+    shipped run's speed against it)."""
+    import random_cost
+    scene = sweep.load_scene(name, overrides=sample)
+    if len(scene.axes["length"]) != 1 or len(scene.axes["base_asd_scale"]) != 1:
+        raise SystemExit(f"{name}: the RK4 peer takes a sample of one span at one level")
+    case = random_cost.Case(float(scene.axes["length"][0]),
+                            float(scene.axes["base_asd_scale"][0]),
+                            int(scene.values["base.realisations"]))
+    t_end = case.t_end
+    starts = t_end - np.asarray(ref_ds["statistics_window"].values, float).ravel()
+    if starts.size != case.records.shape[0] or ref.size != starts.size:
+        raise SystemExit(f"{name}: expected one point per record in the sample")
+
+    def run(m: float) -> np.ndarray:
+        return np.array([random_cost.rk4_rms_over(case.records[r, 0], case.records[r, 1],
+                                                  case.fs, case.coef, t_end, starts[r], m)
+                         for r in range(starts.size)])
+    for m in RK4_STEPS:
+        rms = run(m)                                     # (compiles on the first)
+        e = error(rms, ref)
+        if e <= e_ship:
+            t = min(_wall(lambda: run(m)) for _ in range(max(repeats, 1))) / starts.size
+            return (["RK4 (Numba, 30 lines)", "rk4", f"h = 1/({m:g} fs)", "-",
+                     f"{t * 1e3:.3g}", f"{e:.2g}", f"{t / t_ship:.2f}"], t / t_ship)
+    return (["RK4 (Numba, 30 lines)", "rk4", f"h >= 1/({RK4_STEPS[-1]:g} fs)", "-", "-",
+             f"> {e_ship:.2g}", "-"], None)
+
+
+def _wall(fn) -> float:
+    """Wall time (s) of fn()."""
+    start = time.perf_counter()
+    fn()
+    return time.perf_counter() - start
+
+
 def optional_peers() -> list[str]:
     """One line per optional peer: not importable (with its install line), or not run."""
     lines = []
@@ -193,17 +248,17 @@ def scene_table(name: str, repeats: int,
     shipped_only, only the shipped run and its peers."""
     sample = SAMPLES[name]
     shipped = sweep.load_scene(name, overrides=sample).values
-    _, ref = timed(name, {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
-                          "solver.driver": "scalar"}, 0)
-    t_ship, x = timed(name, sample, repeats)
+    _, ref, ref_ds = timed(name, {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
+                                  "solver.driver": "scalar"}, 0)
+    t_ship, x, _ = timed(name, sample, repeats)
     e_ship = error(x, ref)
     rows = [["as shipped", shipped["solver.method"], f"{shipped['solver.rtol']:g}",
              shipped["solver.driver"], f"{t_ship * 1e3:.3g}", f"{e_ship:.2g}", "1.00"]]
     best = (t_ship, "as shipped")
     for method in () if shipped_only else ("rk45", "dop853"):
         for rtol in RTOLS:
-            t, y = timed(name, {**sample, "solver.method": method, "solver.rtol": rtol},
-                         repeats)
+            t, y, _ = timed(name, {**sample, "solver.method": method, "solver.rtol": rtol},
+                            repeats)
             e = error(y, ref)
             rows.append(["", method, f"{rtol:g}", shipped["solver.driver"], f"{t * 1e3:.3g}",
                          f"{e:.2g}", f"{t_ship / t:.2f}"])
@@ -215,6 +270,9 @@ def scene_table(name: str, repeats: int,
         (r for r in sorted(RTOLS, reverse=True)
          if error(timed(name, {**sample, "solver.driver": "scalar", "solver.rtol": r}, 0)[1],
                   ref) <= e_ship), None)
+    if is_random(name, sample):
+        row, ratio = rk4_peer(name, sample, ref, ref_ds, e_ship, t_ship, repeats)
+        rows.append(row)
     if peer_rtol is not None:
         t_peer = scipy_peer(name, sample, shipped["solver.method"], peer_rtol)
         ratio = t_peer / t_ship
