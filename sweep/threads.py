@@ -9,10 +9,12 @@ took ~3 s on a cold cache), and a point's result never depends on the blocks or 
 threads.
 
 Blocks are also sized by time: once a thread has timed a block, its next one takes about
-BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points). A block of slow points (several modes:
-64 of them took 17 s) is not waited for: a watcher thread looks every WATCH_SECONDS at the rows
-of the blocks in progress, and a caller's `on_block(lo, hi)` hears of rows as soon as they are
-final (a checkpoint, a progress bar), every WATCH_SECONDS or so, whatever the block. A `stop`
+BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points on the lanes, whose lanes drain at a
+block's end; SCALAR_BLOCK on a scalar driver, which has none). A block of slow points
+(several modes: 64 of them took 17 s) is not waited for: a watcher thread looks every
+WATCH_SECONDS at the rows of the blocks in progress, and a caller's `on_block(lo, hi)` hears
+of rows as soon as they are final (a checkpoint, a progress bar), every WATCH_SECONDS or so,
+whatever the block. A `stop`
 event (an interrupt) reaches the kernels through their `halt` flag, which the watcher sets:
 they return at once (the lanes drivers) or before their next row (the scalar ones), the rows
 not finished left unsolved for a resume to compute.
@@ -41,6 +43,9 @@ BLOCK_SECONDS = 2.0    # a timed block takes about this long on one thread (s)
 MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
                        # its end, which costs more the fewer points each lane gets)
 SOLO_BLOCK = 8192      # at most, on one thread (nothing to balance: fewer drains)
+SCALAR_BLOCK = 4       # points per block, at least, on a scalar driver: it has no lanes to
+                       # drain, so its blocks shrink further and the threads end together
+                       # (a 144-point random scene: 2 threads 1.9x one, not 1.6x)
 COMPILE_AHEAD = threading.Event()
 """Set by sweep.warmup (`sweep compile`): the follow-up passes a block needs only when some
 point ends in a particular way (a second pass, a mode judged off midspan) are compiled even
@@ -66,26 +71,29 @@ def thread_count(threads: int = 0) -> int:
     return min(threads, limit) if threads > 0 else limit
 
 
-def next_block(lo: int, n: int, n_threads: int, cap: int = MAX_BLOCK) -> int:
+def next_block(lo: int, n: int, n_threads: int, cap: int = MAX_BLOCK,
+               least: int = MIN_BLOCK) -> int:
     """End of the block that starts at row `lo` of n, on n_threads threads: guided scheduling,
-    blocks shrinking with the points left, from `cap` (at most MAX_BLOCK) down to MIN_BLOCK
-    (or to an equal share of a small grid, or to `cap`), so the threads finish together while
-    blocks stay long enough to keep the lanes full. One thread takes blocks of `cap` (at most
-    SOLO_BLOCK)."""
+    blocks shrinking with the points left, from `cap` (at most MAX_BLOCK) down to `least`
+    (MIN_BLOCK for the lanes, SCALAR_BLOCK for a scalar driver; or to an equal share of a
+    small grid, or to `cap`), so the threads finish together while blocks stay long enough to
+    keep the lanes full. One thread takes blocks of `cap` (at most SOLO_BLOCK)."""
     if n_threads == 1:
         return min(n, lo + min(cap, SOLO_BLOCK))    # nothing to balance: fewer lane drains
     cap = min(cap, MAX_BLOCK)
-    floor = min(MIN_BLOCK, cap, -(-n // n_threads))
+    floor = min(least, cap, -(-n // n_threads))
     size = (n - lo) // (SHARE * n_threads)
     return min(n, lo + max(floor, min(cap, size)))
 
 
-def timed_cap(points: int, seconds: float, most: int = MAX_BLOCK) -> int:
+def timed_cap(points: int, seconds: float, most: int = MAX_BLOCK,
+              least: int = MIN_TIMED_BLOCK) -> int:
     """Points the next block of a thread gets so it takes about BLOCK_SECONDS, from the last
-    block's `points` in `seconds` (s): between MIN_TIMED_BLOCK and `most`."""
+    block's `points` in `seconds` (s): between `least` (MIN_TIMED_BLOCK for the lanes) and
+    `most`."""
     if seconds <= 0.0:
         return most
-    return max(MIN_TIMED_BLOCK, min(most, int(points * BLOCK_SECONDS / seconds)))
+    return max(least, min(most, int(points * BLOCK_SECONDS / seconds)))
 
 
 def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarray,
@@ -158,7 +166,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
 
     watch = Watch(states, on_block, stop)
     run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.ticker())
+               tick=watch.ticker(), lanes=driver == "lanes")
 
 
 def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.ndarray,
@@ -217,7 +225,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
 
     watch = Watch(states, on_block, stop)
     run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.ticker())
+               tick=watch.ticker(), lanes=driver == "lanes")
 
 
 def _random_base(records: np.ndarray | None, driver: str, base: bool | None,
@@ -259,14 +267,16 @@ def swept_settings(settings: np.ndarray, durations: np.ndarray | None, i: int) -
 
 def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
                stop: threading.Event | None, one_at_a_time: bool = False,
-               tick: Callable[[], None] | None = None) -> None:
+               tick: Callable[[], None] | None = None, lanes: bool = True) -> None:
     """Run solve_block(lo, hi) over blocks covering rows 0..n-1 on `threads` threads (0: all),
     guided scheduling and timed blocks (module docstring); with `stop` set no new block starts.
     one_at_a_time: every block one row, a thread for every row (points that each take long:
     a sine sweep's). tick(): called every WATCH_SECONDS from a thread of its own while the
-    blocks run (`Watch.tick`)."""
+    blocks run (`Watch.tick`). lanes: whether solve_block runs lanes, which drain at a block's
+    end (blocks of at least MIN_BLOCK points, a thread per LANES_PER_THREAD); False: a scalar
+    driver (SCALAR_BLOCK)."""
     if tick is None:
-        _run_blocks(solve_block, n, threads, stop, one_at_a_time)
+        _run_blocks(solve_block, n, threads, stop, one_at_a_time, lanes)
         return
     done = threading.Event()
 
@@ -277,16 +287,17 @@ def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
     watching = threading.Thread(target=watcher, name="cable-sweep-watch", daemon=True)
     watching.start()
     try:
-        _run_blocks(solve_block, n, threads, stop, one_at_a_time)
+        _run_blocks(solve_block, n, threads, stop, one_at_a_time, lanes)
     finally:
         done.set()
         watching.join()
 
 
 def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
-                stop: threading.Event | None, one_at_a_time: bool) -> None:
+                stop: threading.Event | None, one_at_a_time: bool, lanes: bool) -> None:
     """`run_blocks` without the watcher."""
-    per_thread = 1 if one_at_a_time else LANES_PER_THREAD
+    per_thread = LANES_PER_THREAD if lanes and not one_at_a_time else 1
+    least, least_timed = (MIN_BLOCK, MIN_TIMED_BLOCK) if lanes else (SCALAR_BLOCK, SCALAR_BLOCK)
     n_threads = max(1, min(thread_count(threads), -(-n // per_thread)))
     stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
     most = SOLO_BLOCK if n_threads == 1 else MAX_BLOCK
@@ -295,16 +306,17 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
 
     def work() -> None:
         nonlocal start
-        cap = MIN_TIMED_BLOCK            # the first block is short: it times the points
+        cap = least_timed                # the first block is short: it times the points
         while not stop.is_set():
             with lock:
                 lo = start
-                hi = start = lo + 1 if one_at_a_time else next_block(lo, n, n_threads, cap)
+                hi = start = lo + 1 if one_at_a_time else next_block(lo, n, n_threads, cap,
+                                                                     least)
             if lo >= n:
                 return
             began = time.perf_counter()
             solve_block(lo, hi)
-            cap = timed_cap(hi - lo, time.perf_counter() - began, most)
+            cap = timed_cap(hi - lo, time.perf_counter() - began, most, least_timed)
 
     if n_threads == 1:
         work()

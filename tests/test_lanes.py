@@ -235,18 +235,25 @@ def test_second_pass_points_in_a_threaded_lanes_batch(method):
             np.testing.assert_array_equal(got, want)
 
 
-def test_guided_blocks_cover_every_row_once():
-    from sweep.threads import MIN_BLOCK, next_block
-    for n, threads in ((1, 2), (100, 2), (129, 2), (10_000, 2), (77_777, 3)):
+@pytest.mark.parametrize("least", ["lanes", "scalar"])
+def test_guided_blocks_cover_every_row_once(least):
+    """Blocks of at least MIN_BLOCK rows for the lanes, SCALAR_BLOCK for a scalar driver (or
+    the grid's share, or what is left): every row once, every thread a block; a scalar
+    driver's small grid ends in blocks of a few rows, so its threads end together."""
+    from sweep.threads import MIN_BLOCK, SCALAR_BLOCK, next_block
+    floor = MIN_BLOCK if least == "lanes" else SCALAR_BLOCK
+    for n, threads in ((1, 2), (100, 2), (129, 2), (144, 2), (10_000, 2), (77_777, 3)):
         lo, seen = 0, []
         while lo < n:
-            hi = next_block(lo, n, threads)
-            assert hi > lo and (hi - lo >= min(MIN_BLOCK, -(-n // threads)) or hi == n)
+            hi = next_block(lo, n, threads, least=floor)
+            assert hi > lo and (hi - lo >= min(floor, -(-n // threads)) or hi == n)
             seen.append((lo, hi))
             lo = hi
         assert seen[0][0] == 0 and seen[-1][1] == n
         assert len(seen) >= min(threads, n)       # every thread gets a block, small grids too
         assert all(a[1] == b[0] for a, b in zip(seen, seen[1:]))
+        if least == "scalar" and n >= 100:
+            assert seen[-1][1] - seen[-1][0] <= 2 * SCALAR_BLOCK, seen[-3:]
 
 
 def test_sweep_run_refuses_a_negative_thread_count():
