@@ -45,7 +45,7 @@ MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's
 SOLO_BLOCK = 8192      # at most, on one thread (nothing to balance: fewer drains)
 SCALAR_BLOCK = 4       # points per block, at least, on a scalar driver: it has no lanes to
                        # drain, so its blocks shrink further and the threads end together
-                       # (a 144-point random scene: 2 threads 1.9x one, not 1.6x)
+                       # (benchmarks/RESULTS.md: a 144-point random scene, about 5 % less)
 COMPILE_AHEAD = threading.Event()
 """Set by sweep.warmup (`sweep compile`): the follow-up passes a block needs only when some
 point ends in a particular way (a second pass, a mode judged off midspan) are compiled even
