@@ -199,40 +199,9 @@ def _force(C, K, G3, H5, q, v):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def rk4_rms(x, dx, fs, coef, t_end, t_tail, m):
-    """(RMS of q over [t0, t_end], t0): classical RK4 at step h = 1 / (m fs) from rest, z' = q^2
-    integrated beside q, q'; t0 the first step start at or after t_tail."""
-    C, K, G3, H5, B = coef
-    h = 1.0 / (m * fs)
-    steps = int(round(t_end * fs * m))
-    first = int(math.ceil(t_tail / h - 1e-9))
-    q = v = z = 0.0
-    a0 = _hermite(x, dx, fs, 0.0)
-    for i in range(steps):
-        t = i * h
-        a_half = _hermite(x, dx, fs, t + 0.5 * h)
-        a1 = _hermite(x, dx, fs, t + h)
-        q1, v1 = q, v
-        f1 = _force(C, K, G3, H5, q1, v1) - B * a0
-        q2, v2 = q + 0.5 * h * v1, v + 0.5 * h * f1
-        f2 = _force(C, K, G3, H5, q2, v2) - B * a_half
-        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * f2
-        f3 = _force(C, K, G3, H5, q3, v3) - B * a_half
-        q4, v4 = q + h * v3, v + h * f3
-        f4 = _force(C, K, G3, H5, q4, v4) - B * a1
-        if i >= first:
-            z += h / 6.0 * (q1 * q1 + 2.0 * q2 * q2 + 2.0 * q3 * q3 + q4 * q4)
-        q += h / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4)
-        v += h / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4)
-        a0 = a1
-    t0 = first * h
-    return math.sqrt(z / (t_end - t0)), t0
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
 def rk4_rms_over(x, dx, fs, coef, t_end, t0, m):
     """RMS of q (m) over [t0, t_end] (s) by the classical RK4 at step h = 1 / (m fs) from rest,
-    z' = q^2 integrated beside q, q' (as `rk4_rms`), z(t0) read on the cubic Hermite through
+    z' = q^2 integrated beside q, q', z(t0) read on the cubic Hermite through
     z and z' = q^2 at the ends of the step that holds t0: the window of another solver's run,
     not one of RK4's grid points."""
     C, K, G3, H5, B = coef
@@ -256,8 +225,8 @@ def rk4_rms_over(x, dx, fs, coef, t_end, t0, m):
         z_new = z + h / 6.0 * (q1 * q1 + 2.0 * q2 * q2 + 2.0 * q3 * q3 + q4 * q4)
         q_new = q + h / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4)
         v += h / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4)
-        if t < t0 <= t + h:
-            u = (t0 - t) / h
+        if math.isnan(z0) and t0 <= t + h:           # the step that holds t0
+            u = max(0.0, min(1.0, (t0 - t) / h))
             u2 = u * u
             u3 = u2 * u
             z0 = ((2.0 * u3 - 3.0 * u2 + 1.0) * z + (u3 - 2.0 * u2 + u) * h * q * q
@@ -266,6 +235,14 @@ def rk4_rms_over(x, dx, fs, coef, t_end, t0, m):
         q = q_new
         a0 = a1
     return math.sqrt((z - z0) / (t_end - t0))
+
+
+def rk4_rms(x, dx, fs, coef, t_end, t_tail, m):
+    """(RMS of q over [t0, t_end], t0) by `rk4_rms_over`, t0 the first step start of RK4's own
+    grid (step 1 / (m fs)) at or after t_tail."""
+    h = 1.0 / (m * fs)
+    t0 = math.ceil(t_tail / h - 1e-9) * h
+    return rk4_rms_over(x, dx, fs, coef, t_end, t0, m), t0
 
 
 def best(fn, repeats: int) -> float:
