@@ -333,6 +333,16 @@ def base_acceleration(t, pp, n_modes, base):
 _CONTRACT = {"contract"}
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+def _eq17_bending(a, b, c, d, beta_b, beta_q):
+    """Eq.17's nonlinear bending terms at a node, from the fields (a, b, c, d) there (module
+    docstring): beta_b (-3 b^3 - 11 a b c - 3 a^2 d) + 10.5 beta_q a^2 b^3 (per unit rho A);
+    both forms of the right-hand side take them from here."""
+    a2 = a * a
+    b2 = b * b
+    return beta_b * (-3.0 * b2 * b - 11.0 * a * b * c - 3.0 * a2 * d) + 10.5 * beta_q * a2 * b2 * b
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
     """The nonlinear forces at the nodes (per unit rho A, in the fields' units) of lanes
@@ -353,9 +363,7 @@ def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
             e = PP[sc + S_ENERGY, l]
             beta_b = PP[sc + S_BETA_B, l]
             beta_q = PP[sc + S_BETA_Q, l]
-            FLD[0, j, l] = ((1.0 - e) * (beta_b * (-3.0 * b2 * b - 11.0 * a * b * c
-                                                    - 3.0 * a2 * d)
-                                         + 10.5 * beta_q * a2 * b2 * b)
+            FLD[0, j, l] = ((1.0 - e) * _eq17_bending(a, b, c, d, beta_b, beta_q)
                             + (SC[0, l] - SC[1, l] * a2) * b)
             FLD[1, j, l] = e * a * b2 * (12.0 * beta_q * a2 - 3.0 * beta_b)
             FLD[2, j, l] = e * a2 * b * (6.0 * beta_q * a2 - 3.0 * beta_b)
@@ -454,13 +462,10 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                 b = FLD[1, j, l]
                 c = FLD[2, j, l]
                 d = FLD[3, j, l]
-                a2 = a * a
-                b2 = b * b
                 # the membrane and the axial load's linear term share their factor b
-                FLD[0, j, l] = (PP[sc + S_BETA_B, l] * (-3.0 * b2 * b - 11.0 * a * b * c
-                                                         - 3.0 * a2 * d)
-                                + (SC[0, l] - SC[1, l] * a2) * b
-                                + 10.5 * PP[sc + S_BETA_Q, l] * a2 * b2 * b)
+                FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
+                                              PP[sc + S_BETA_Q, l])
+                                + (SC[0, l] - SC[1, l] * a * a) * b)
     for i in range(n):
         w = T[4, i, 0]
         for l in range(n_run):
