@@ -183,7 +183,8 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
     tail amplitude (m), and final (n, 2 N), the final state (m, m/s).
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
     (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off. A swept base
-    frequency takes the scalar driver, with envelope and durations as `solve_transverse`'s."""
+    frequency takes the scalar driver, with envelope and durations as `solve_transverse`'s;
+    records (a random base acceleration's) run on either driver."""
     from sweep.kernels import layout as tk
     from sweep.kernels import metrics as mt
     from sweep.kernels import modal_driver
