@@ -216,18 +216,11 @@ def rk4_peer(name: str, sample: dict[str, Any], ref: np.ndarray, ref_ds: Any, e_
         rms = run(m)                                     # (compiles on the first)
         e = error(rms, ref)
         if e <= e_ship:
-            t = min(_wall(lambda: run(m)) for _ in range(max(repeats, 1))) / starts.size
+            t = random_cost.best(lambda: run(m), max(repeats, 1)) / starts.size
             return (["RK4 (Numba, 30 lines)", "rk4", f"h = 1/({m:g} fs)", "-",
                      f"{t * 1e3:.3g}", f"{e:.2g}", f"{t / t_ship:.2f}"], t / t_ship)
     return (["RK4 (Numba, 30 lines)", "rk4", f"h >= 1/({RK4_STEPS[-1]:g} fs)", "-", "-",
              f"> {e_ship:.2g}", "-"], None)
-
-
-def _wall(fn) -> float:
-    """Wall time (s) of fn()."""
-    start = time.perf_counter()
-    fn()
-    return time.perf_counter() - start
 
 
 def optional_peers() -> list[str]:

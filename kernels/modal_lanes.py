@@ -546,7 +546,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     T = basis[md.TABLES]
     nodes = T.shape[2]
     weights = basis[md.MIDSPAN]
-    slots = tj.SCALAR_SLOTS if ex.is_record(base) else tj.N_SLOTS   # a record's statistics
+    record = ex.is_record(base)      # a random record: every accepted step is the scalar
+    slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # path's, with its statistics' slots
     W = np.zeros(slots * L)
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
@@ -631,14 +632,15 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        if not ex.is_record(base):       # (a record's every step is the scalar path's)
+        if not record:                   # (a record's: no events to find, no ordinary step)
             _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS],
                          basis[md.COUPLING], LD)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING],
-                    LD)
-        if base is not None and not ex.is_record(base):
+        if not record:
+            _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
+                        basis[md.COUPLING], LD)
+        if base is not None and not record:
             tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
         if n_flagged > 0:
             for j in range(n_run):

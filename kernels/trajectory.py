@@ -84,8 +84,9 @@ T_FINAL = T_TAIL + 1    # this trajectory's end time (s): t_end, or the moved ta
 N_SLOTS = T_FINAL + 1
 # The record kind's statistics (a random base acceleration, kernels.excitation), after the
 # slots every driver keeps: the drivers that run records (the scalar ones, the multi-mode
-# lanes) allocate SCALAR_SLOTS, and `delay_window` zeroes them. The window starts with the first step that starts at or after the tail
-# window's start and ends with the run; over it (`observe_random`):
+# lanes) allocate SCALAR_SLOTS, and `delay_window` zeroes them. The window starts with the
+# first step that starts at or after the tail window's start and ends with the run; over it
+# (`observe_random`):
 IN_WINDOW = N_SLOTS      # 1.0 once the window has started
 W_START = IN_WINDOW + 1  # when it started (s)
 W_END = W_START + 1      # the last step end in it (s)

@@ -14,10 +14,9 @@ block's end; SCALAR_BLOCK on a scalar driver, which has none). A block of slow p
 (several modes: 64 of them took 17 s) is not waited for: a watcher thread looks every
 WATCH_SECONDS at the rows of the blocks in progress, and a caller's `on_block(lo, hi)` hears
 of rows as soon as they are final (a checkpoint, a progress bar), every WATCH_SECONDS or so,
-whatever the block. A `stop`
-event (an interrupt) reaches the kernels through their `halt` flag, which the watcher sets:
-they return at once (the lanes drivers) or before their next row (the scalar ones), the rows
-not finished left unsolved for a resume to compute.
+whatever the block. A `stop` event (an interrupt) reaches the kernels through their `halt`
+flag, which the watcher sets: they return at once (the lanes drivers) or before their next row
+(the scalar ones), the rows not finished left unsolved for a resume to compute.
 
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
 `kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one (or
