@@ -273,8 +273,9 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP, LD):
             v0 = Y[n + i, l]
             v1 = YN[n + i, l]
             turns = ((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0))
+            tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
-            EV[l] = 1.0 if turns | bad else EV[l]
+            EV[l] = 1.0 if (turns & tail) | bad else EV[l]
     for l in range(n_run):
         r0 = 0.0
         r1 = 0.0

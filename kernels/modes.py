@@ -370,6 +370,23 @@ def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
+    """`_energy_forces` where every lane's bending terms come from the span's energy: from
+    the fields FLD[0..1] = (a, b) alone (c and d are not computed then), the same three
+    parts, the same arithmetic (so the same bits) without Eq.17's terms."""
+    for j in range(nodes):
+        for l in range(n_run):
+            a = FLD[0, j, l]
+            b = FLD[1, j, l]
+            a2 = a * a
+            beta_b = PP[sc + S_BETA_B, l]
+            beta_q = PP[sc + S_BETA_Q, l]
+            FLD[0, j, l] = (SC[0, l] - SC[1, l] * a2) * b
+            FLD[1, j, l] = a * (b * b) * (12.0 * beta_q * a2 - 3.0 * beta_b)
+            FLD[2, j, l] = a2 * b * (6.0 * beta_q * a2 - 3.0 * beta_b)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
@@ -427,33 +444,26 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             for l in range(n_run):
                 x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]
                 SC[2, l] = PP[sc + S_BASE_ACCEL, l] * fast_sin(x)
-    for j in range(nodes):
-        t0 = T[0, 0, j]
-        t1 = T[1, 0, j]
-        t2 = T[2, 0, j]
-        t3 = T[3, 0, j]
-        for l in range(n_run):
-            q = X[0, l]
-            FLD[0, j, l] = t0 * q
-            FLD[1, j, l] = t1 * q
-            FLD[2, j, l] = t2 * q
-            FLD[3, j, l] = t3 * q
-    for i in range(1, n):
-        for j in range(nodes):
-            t0 = T[0, i, j]
-            t1 = T[1, i, j]
-            t2 = T[2, i, j]
-            t3 = T[3, i, j]
-            for l in range(n_run):
-                q = X[i, l]
-                FLD[0, j, l] += t0 * q
-                FLD[1, j, l] += t1 * q
-                FLD[2, j, l] += t2 * q
-                FLD[3, j, l] += t3 * q
-    energy = False
+    energy = False                      # some lane's bending terms from the span's energy
+    eq17 = False                        # some lane's Eq.17's (which alone read c and d)
     for l in range(n_run):
         energy = energy or PP[sc + S_ENERGY, l] != 0.0
-    if energy:
+        eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
+    fields = 4 if eq17 else 2
+    for j in range(nodes):
+        for f in range(fields):
+            t = T[f, 0, j]
+            for l in range(n_run):
+                FLD[f, j, l] = t * X[0, l]
+    for i in range(1, n):
+        for j in range(nodes):
+            for f in range(fields):
+                t = T[f, i, j]
+                for l in range(n_run):
+                    FLD[f, j, l] += t * X[i, l]
+    if energy and not eq17:
+        _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
+    elif energy:
         _energy_forces(PP, sc, FLD, SC, nodes, n_run)
     else:
         for j in range(nodes):

@@ -142,6 +142,17 @@ DEFAULT_T_END = 5.0
 DEFAULT_TRANSITS = 8.0
 """solver.transits of a longitudinal scene that gives neither solver.t_end nor transits."""
 
+LANES_LEAST_POINTS = 4
+"""Points that share one set of mode shapes, at least, for a scene of several modes to run on the
+lock-step lanes by default; with fewer (a single span; elastic clamps whose K = k_t l / EI
+differs at every point, each K its own basis and so its own kernel call) the scalar driver is
+the default. Measured (benchmarks/lanes_occupancy.py): 1 point a basis ran 3.6x faster on
+the scalar driver, 4 points 0.9x, 8 points 0.58x (the lanes' vector loops and per-step
+bookkeeping cost nearly as much for one running lane as for sixteen)."""
+BASIS_KEYS_EXEMPT = frozenset({"cable.damping_ratio", "cable.density", "cable.linear_mass"})
+"""cable.* keys that do not move K = k_t l / EI (every other cable key may: the length and
+the cable's bending rigidity, however it is given)."""
+
 MULTI_MODE_METHOD = "dop853"
 """solver.method of a scene with model.modes >= 2 that gives none. Measured on the multi-mode
 built-in scenes' samples (benchmarks/workloads.py, benchmarks/RESULTS.md): at the default rtol
@@ -961,15 +972,41 @@ def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
         values["cable.inertia"] = default_inertia(values["cable.area"])
 
 
+def points_per_basis(values: Mapping[str, Any], swept: Swept) -> int:
+    """How many points of the grid share one set of mode shapes (at least): all of them, but
+    with elastic clamps only the points along the axes (and [points]) that leave K = k_t l /
+    EI as it is (`BASIS_KEYS_EXEMPT`, and every key outside [cable] and the clamps' rotational
+    stiffness)."""
+    elastic = values["clamps.rotation"] == "elastic"
+
+    def moves_basis(name: str) -> bool:
+        dotted = schema.BY_AXIS[name].dotted
+        return elastic and (dotted == "clamps.rotational_stiffness" or (
+            dotted.startswith("cable.") and dotted not in BASIS_KEYS_EXEMPT))
+
+    count = 1
+    for name, axis in swept.items():
+        if name not in swept.zipped and not moves_basis(name):
+            count *= len(axis)
+    if swept.zipped and not any(moves_basis(name) for name in swept.zipped):
+        count *= len(swept[next(iter(swept.zipped))])
+    return count
+
+
 def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
-                         mentioned: set[str]) -> None:
-    """solver.t_end 5 s, DOP853 for several modes (MULTI_MODE_METHOD), and the paper preset's
+                         mentioned: set[str], swept: Swept) -> None:
+    """solver.t_end 5 s, DOP853 for several modes (MULTI_MODE_METHOD) and the scalar driver
+    where fewer than LANES_LEAST_POINTS points share a basis, and the paper preset's
     initial.velocity without an initial condition."""
     _shared_defaults(values, mentioned)
     if random_scene.is_random(values):
         random_scene.defaults(values, mentioned)
-    elif values["model.modes"] > 1 and "solver.method" not in mentioned:
-        values["solver.method"] = MULTI_MODE_METHOD
+    elif values["model.modes"] > 1:
+        if "solver.method" not in mentioned:
+            values["solver.method"] = MULTI_MODE_METHOD
+        if ("solver.driver" not in mentioned
+                and points_per_basis(values, swept) < LANES_LEAST_POINTS):
+            values["solver.driver"] = "scalar"
     swept = any(d in mentioned for d in SWEEP_KEYS)
     if "solver.t_end" not in mentioned and not swept and not random_scene.is_random(values):
         values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps
@@ -990,7 +1027,7 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
 
 
 def _longitudinal_defaults(values: dict[str, Any], given: dict[str, Any],
-                           mentioned: set[str]) -> None:
+                           mentioned: set[str], swept: Swept) -> None:
     """load.type 'constant', and 8 transits without an end time."""
     _shared_defaults(values, mentioned)
     values["load.type"] = given.get("load.type", LONGITUDINAL_LOAD)
@@ -1027,13 +1064,14 @@ class Rules:
 
     check(given, axes): refuse keys and axes the kind cannot take (given: dotted key -> the
         checked value; axes: axis name -> values), before any default is applied.
-    defaults(values, given, mentioned): write the kind's defaults into `values` (every dotted
-        key -> value, the schema's defaults applied); `mentioned`: the keys given or swept.
+    defaults(values, given, mentioned, swept): write the kind's defaults into `values` (every
+        dotted key -> value, the schema's defaults applied); `mentioned`: the keys given or
+        swept; `swept`: the axes and [points] (their values).
     check_resolved(values, axes, given): refuse (or warn about) the resolved scene.
     """
 
     check: Callable[[dict[str, Any], dict[str, np.ndarray]], None]
-    defaults: Callable[[dict[str, Any], dict[str, Any], set[str]], None]
+    defaults: Callable[[dict[str, Any], dict[str, Any], set[str], Swept], None]
     check_resolved: Callable[[dict[str, Any], dict[str, np.ndarray], dict[str, Any]], None]
 
 

@@ -121,5 +121,5 @@ def _resolve(given: dict[str, Any], axes: dict[str, np.ndarray],
     swept = {schema.BY_AXIS[a].dotted for a in axes}
     values = {k.dotted: None if k.dotted in swept else given.get(k.dotted, k.default)
               for k in schema.KEYS}
-    kind.defaults(values, given, set(given) | swept)
+    kind.defaults(values, given, set(given) | swept, Swept.of(axes))
     return values
