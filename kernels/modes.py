@@ -449,18 +449,22 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     for l in range(n_run):
         energy = energy or PP[sc + S_ENERGY, l] != 0.0
         eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-    fields = 4 if eq17 else 2
-    for j in range(nodes):
-        for f in range(fields):
-            t = T[f, 0, j]
-            for l in range(n_run):
-                FLD[f, j, l] = t * X[0, l]
-    for i in range(1, n):
+    for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
         for j in range(nodes):
-            for f in range(fields):
-                t = T[f, i, j]
+            t0 = T[f, 0, j]
+            t1 = T[f + 1, 0, j]
+            for l in range(n_run):
+                q = X[0, l]
+                FLD[f, j, l] = t0 * q
+                FLD[f + 1, j, l] = t1 * q
+        for i in range(1, n):
+            for j in range(nodes):
+                t0 = T[f, i, j]
+                t1 = T[f + 1, i, j]
                 for l in range(n_run):
-                    FLD[f, j, l] += t * X[i, l]
+                    q = X[i, l]
+                    FLD[f, j, l] += t0 * q
+                    FLD[f + 1, j, l] += t1 * q
     if energy and not eq17:
         _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
     elif energy:

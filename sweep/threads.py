@@ -42,6 +42,10 @@ BLOCK_SECONDS = 2.0    # a timed block takes about this long on one thread (s)
 MIN_TIMED_BLOCK = 64   # points per timed block, at least (4 per lane: a block's lanes drain at
                        # its end, which costs more the fewer points each lane gets)
 SOLO_BLOCK = 8192      # at most, on one thread (nothing to balance: fewer drains)
+TAIL_SHARE = 4         # on one thread, a block takes the points after it too when they are
+                       # fewer than 1/TAIL_SHARE of it: a block of a few points costs the lanes
+                       # a drain of their own at a fraction of their speed (harness-base-sine's
+                       # 130 points were blocks of 64, 64 and 2)
 SCALAR_BLOCK = 4       # points per block, at least, on a scalar driver: it has no lanes to
                        # drain, so its blocks shrink further and the threads end together
                        # (benchmarks/RESULTS.md: a 144-point random scene, about 5 % less)
@@ -77,8 +81,9 @@ def next_block(lo: int, n: int, n_threads: int, cap: int = MAX_BLOCK,
     (MIN_BLOCK for the lanes, SCALAR_BLOCK for a scalar driver; or to an equal share of a
     small grid, or to `cap`), so the threads finish together while blocks stay long enough to
     keep the lanes full. One thread takes blocks of `cap` (at most SOLO_BLOCK)."""
-    if n_threads == 1:
-        return min(n, lo + min(cap, SOLO_BLOCK))    # nothing to balance: fewer lane drains
+    if n_threads == 1:                              # nothing to balance: fewer lane drains
+        hi = min(n, lo + min(cap, SOLO_BLOCK))
+        return n if n - hi < (hi - lo) // TAIL_SHARE else hi
     cap = min(cap, MAX_BLOCK)
     floor = min(least, cap, -(-n // n_threads))
     size = (n - lo) // (SHARE * n_threads)

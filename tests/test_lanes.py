@@ -355,3 +355,13 @@ def test_lanes_stay_in_bounds_as_lanes_reload_and_buffers_grow(tmp_path):
     np.testing.assert_array_equal(a[0], b[0])
     np.testing.assert_array_equal(a[2], b[2])
     _assert_equal_to_round_off(rows, s, a, b, 101)
+
+
+def test_one_thread_takes_a_small_remainder_into_its_block():
+    """On one thread a block takes the few points after it (fewer than 1/TAIL_SHARE of it)
+    rather than leaving them a block, and a drain, of their own."""
+    from sweep.threads import TAIL_SHARE, next_block
+    assert next_block(0, 130, 1, cap=64) == 64
+    assert next_block(64, 130, 1, cap=64) == 130            # 2 left: taken
+    assert next_block(0, 64 + 64 // TAIL_SHARE, 1, cap=64) == 64   # a quarter left: its own
+    assert next_block(0, 64 + 64 // TAIL_SHARE - 1, 1, cap=64) == 64 + 64 // TAIL_SHARE - 1

@@ -848,3 +848,48 @@ def test_longitudinal_snapshot_after_every_spans_end_refused_by_load_scene():
     # A denser cable on a density axis is slower: its spans end later, and the time is kept.
     denser = LONG + "[solver]\ntransits = 2.0\n[axes]\ndensity = [8900.0, 20000.0]\n[outputs]\n"
     assert load_scene_text(denser + f"snapshot_times = [{longest * 1.001!r}]")
+
+
+# --------------------------------------------------------------------------- the default driver
+
+ELASTIC = '[model]\nmodes = 3\n[clamps]\nrotation = "elastic"\nrotational_stiffness = 1.0\n'
+
+
+@pytest.mark.parametrize("text, overrides, expected", [
+    # several modes: the lanes where at least 4 points share a basis, else the scalar driver
+    ("[model]\nmodes = 3", {}, "scalar"),                                   # one span
+    ("[model]\nmodes = 3", {"axes.length": [0.3, 0.4, 0.5]}, "scalar"),
+    ("[model]\nmodes = 3", {"axes.length": [0.3, 0.4, 0.5, 0.6]}, "lanes"),
+    # elastic clamps: K = k_t l / EI, a basis per length and per stiffness
+    (ELASTIC, {"axes.length": [0.2, 0.3, 0.4, 0.5, 0.6]}, "scalar"),
+    (ELASTIC, {"axes.length": [0.2, 0.3], "axes.load_amplitude": [0.0, 1.0, 2.0, 3.0]},
+     "lanes"),
+    (ELASTIC, {"axes.length": [0.2, 0.3], "axes.load_amplitude": [1.0, 2.0],
+               "axes.damping_ratio": [0.01, 0.02]}, "lanes"),
+    (ELASTIC, {"axes.length": [0.2, 0.3], "axes.youngs_modulus": [1e11, 2e11],
+               "axes.load_amplitude": [1.0, 2.0]}, "scalar"),
+    (ELASTIC.replace("rotational_stiffness = 1.0\n", ""),
+     {"axes.clamp_rotational_stiffness": [0.1, 1.0, 10.0, 100.0]}, "scalar"),
+    ('[model]\nmodes = 3\n[clamps]\nrotation = "clamped"', {"axes.length": [0.2, 0.3, 0.4, 0.5]},
+     "lanes"),
+    # one mode: always the lanes (their cost barely depends on how many run)
+    ("", {}, "lanes"),
+    # what a scene gives is kept
+    ('[model]\nmodes = 3\n[solver]\ndriver = "lanes"', {}, "lanes"),
+    (ELASTIC + '[solver]\ndriver = "lanes"', {"axes.length": [0.2, 0.3]}, "lanes"),
+])
+def test_default_driver_follows_the_points_that_share_a_basis(text, overrides, expected):
+    assert load_scene_text(text, overrides=overrides).get("solver.driver") == expected
+
+
+def test_default_driver_with_points_that_vary_together():
+    text = ELASTIC + "[points]\nlength = [0.2, 0.3, 0.4, 0.5]\nload_amplitude = [1.0, 2.0, 3.0, 4.0]\n"
+    assert load_scene_text(text).get("solver.driver") == "scalar"      # every point its own K
+    text = ELASTIC + "[points]\nload_amplitude = [1.0, 2.0, 3.0, 4.0]\ndamping_ratio = [0.01, 0.02, 0.03, 0.04]\n"
+    assert load_scene_text(text).get("solver.driver") == "lanes"       # one K for all four
+
+
+def test_harness_clamps_runs_on_the_scalar_driver():
+    """35 points, each its own K = k_t l / EI (benchmarks/lanes_occupancy.py: 4x faster)."""
+    from sweep import load_scene
+    assert load_scene("harness-clamps").get("solver.driver") == "scalar"
