@@ -30,7 +30,7 @@ from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
 from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, CURVATURE_M0, FAILURE_TIME,
-                     FIRST_STEP, MAX_STEP, LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PERIOD, RHS_EVALS, RTOL, SETTLING,
+                     FIRST_STEP, MAX_STEP, LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PEAK, PERIOD, RHS_EVALS, RTOL, SETTLING,
                      SPAN_MAX, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
@@ -566,7 +566,9 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def span_state(state, modal, y, n_modes, settings, reals, basis):
     """The state judged from the whole response, and reals[SPAN_MAX]: a point whose midspan
-    deflection decayed (DECAYED) while some mode's tail amplitude exceeds settings[TOL] x the
+    deflection decayed (DECAYED), or moved by less than HIDDEN_FLOOR x the largest mode's peak
+    over the whole run (the modes' round-off at a node of every moving mode: whatever state
+    that noise was given), while some mode's tail amplitude exceeds settings[TOL] x the
     largest mode's peak has not decayed: a mode with a node at midspan (an even one) kept
     moving; it is left OFF_MIDSPAN for `judge_off_midspan`. A point whose midspan is STEADY
     while a mode with a node at midspan has a tail amplitude above HIDDEN_FLOOR x that peak is
@@ -581,11 +583,15 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
     final = md.span_maximum(y, n, basis)
     reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
     load_columns(modal, n, reals)
-    if state != mt.DECAYED and state != mt.STEADY:
-        return state
     peak = 0.0
     for i in range(n):
         peak = max(peak, modal[n + i])
+    if ((state == mt.STEADY or state == mt.MODULATED or state == mt.UNSETTLED)
+            and reals[PEAK] < HIDDEN_FLOOR * peak):
+        state = mt.DECAYED      # the midspan moved by the modes' round-off alone (a node of
+                                # every moving mode): its own state says nothing
+    if state != mt.DECAYED and state != mt.STEADY:
+        return state
     for i in range(n):
         if state == mt.DECAYED and modal[i] > settings[TOL] * peak:
             return mt.OFF_MIDSPAN
