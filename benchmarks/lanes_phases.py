@@ -1,0 +1,139 @@
+"""Where a multi-mode lanes run spends its time: each phase of kernels/modal_lanes.py's loop.
+
+What it measures
+----------------
+A copy of kernels/modal_lanes.py compiled with a time-stamp-counter read (rdtsc, from a
+five-line C helper built here with the system's C compiler) before each phase of
+`solve_block`'s main loop, run on the largest block of a built-in scene as `sweep.run` gives it
+to the kernel (one thread): the share of the cycles in loading and ending lanes with the next
+attempt's set-up, the attempt (the stages' right-hand sides and sums, the error), the
+controller and midspan projection, the modes' event test, `_finish`, the modes' step-end update,
+the steps handed to the scalar path (`_flagged_lane`: extrema, crests, samples) and the lanes'
+advance. The copy is compiled once untimed, then timed once. A diagnostic: the shares say
+where to look, the kernels' own timings are benchmarks/modes_cost.py's and workloads.py's.
+
+Command
+-------
+    PYTHONPATH=. python benchmarks/lanes_phases.py [NAME] [--set KEY=VALUE ...]
+
+e.g. `PYTHONPATH=. python benchmarks/lanes_phases.py harness-base-sine --set
+"axes.base_frequency={start=5.0,stop=100.0,num=16,spacing=\\"log\\"}" --set
+"axes.length=[0.2,0.35,0.5,0.65,0.8]" --set solver.t_end=2.0`. Needs a C compiler (cc); says
+so and stops without one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+import types
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+HELPER = "#include <stdint.h>\n#include <x86intrin.h>\nuint64_t rdtsc(void) { return __rdtsc(); }\n"
+# each phase ends where the next begins; the first is the loop's own top (the interrupt test)
+PHASES = [("        _prepare(W, H, FLAG, settings, n_run)\n", "loop top"),
+          ("        _attempt(W, Y, YN, K, ST, TT, H, ERR,", "next attempt, lanes loaded and ended"),
+          ("        _control(W, H, ERR, SC, settings, n_run)\n", "attempt (stages, error)"),
+          ("        if not record:                   # (a record's: no events to find, no ordinary "
+           "step)\n", "controller, midspan projection"),
+          ("        n_flagged = _finish(", "modes' event test"),
+          ("        if not record:\n            _tail_modes", "_finish"),
+          ("        if n_flagged > 0:\n", "modes' step-end update, refinement"),
+          ("        _advance(Y, YN, K, MOVE, dim, n_stages, n_run)\n",
+           "steps handed to the scalar path")]
+
+
+def timer() -> ctypes._CFuncPtr:
+    """rdtsc() from a helper compiled now (exits with a message without a C compiler)."""
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        sys.exit("lanes_phases: no C compiler (cc) to build the time-stamp-counter helper")
+    work = Path(tempfile.mkdtemp())
+    (work / "rdtsc.c").write_text(HELPER)
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(work / "rdtsc.so"),
+                    str(work / "rdtsc.c")], check=True)
+    lib = ctypes.CDLL(str(work / "rdtsc.so"))
+    lib.rdtsc.restype = ctypes.c_uint64
+    lib.rdtsc.argtypes = []
+    return lib.rdtsc
+
+
+def instrumented(rdtsc: ctypes._CFuncPtr) -> types.ModuleType:
+    """kernels/modal_lanes.py with a cycle count per phase (`solve_block(..., halt, cycles)`)."""
+    src = (ROOT / "kernels" / "modal_lanes.py").read_text()
+    src = src.replace("from . import", "from sweep.kernels import").replace(
+        "from .", "from sweep.kernels.").replace("cache=True", "cache=False")
+    src = src.replace("                base, eighth, steady, halt):",
+                      "                base, eighth, steady, halt, cycles):", 1)
+    head, loop = src.split("    while True:\n        if halt[0] != 0:", 1)
+    loop = "    while True:\n        if halt[0] != 0:" + loop
+    for k, (text, _) in enumerate(PHASES):
+        if loop.count(text) != 1:
+            sys.exit(f"lanes_phases: kernels/modal_lanes.py changed: no {text.strip()!r}")
+        loop = loop.replace(text, f"        _c = rdtsc(); cycles[{k}] += _c - _t0; _t0 = _c\n"
+                            + text)
+    last = PHASES[-1][0]
+    loop = loop.replace(last, last + f"        _c = rdtsc(); cycles[{len(PHASES)}] += _c - _t0; "
+                        "_t0 = _c\n")
+    module = types.ModuleType("modal_lanes_phases")
+    module.__dict__["rdtsc"] = rdtsc
+    exec(compile(head + "    _t0 = rdtsc()\n" + loop, "modal_lanes_phases", "exec"),
+         module.__dict__)
+    return module
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("scene", nargs="?", default="harness-base-sine")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    args = parser.parse_args()
+    import sweep
+    import sweep.threads as threads
+    overrides = {"run.threads": 1, "solver.driver": "lanes"}
+    for item in args.set:
+        key, _, value = item.partition("=")
+        overrides[key] = tomllib.loads(f"v = {value}")["v"]
+    calls = []
+    original = threads.call
+
+    def spy(fn, *call_args):
+        if getattr(fn, "__name__", "") == "solve_block" and "modal_lanes" in fn.__module__:
+            calls.append(call_args)
+        return original(fn, *call_args)
+
+    threads.call = spy
+    sweep.run(sweep.load_scene(args.scene, overrides), progress=False)
+    threads.call = original
+    if not calls:
+        sys.exit(f"lanes_phases: {args.scene} ran no multi-mode lanes (model.modes >= 2?)")
+    block = max(calls, key=lambda a: a[4] - a[3])
+    module = instrumented(timer())
+    cycles = np.zeros(len(PHASES) + 1, np.uint64)
+    for timed in (False, True):
+        cycles[:] = 0
+        fresh = [a.copy() if isinstance(a, np.ndarray) and a.flags.writeable else a
+                 for a in block]
+        start = time.perf_counter()
+        module.solve_block(*fresh, cycles)
+        wall = time.perf_counter() - start
+    names = [name for _, name in PHASES] + ["lanes' advance"]
+    total = float(cycles.sum())
+    print(f"{args.scene}: block of rows {block[3]}..{block[4]}, {wall * 1e3:.0f} ms")
+    for name, value in zip(names, cycles):
+        print(f"  {name:40s} {100.0 * float(value) / total:5.1f} %")
+    print("\n    PYTHONPATH=. python benchmarks/lanes_phases.py " + " ".join(sys.argv[1:]))
+
+
+if __name__ == "__main__":
+    main()
