@@ -82,9 +82,7 @@ def one_state_loop(row, basis, calls):
     """`calls` evaluations of one state through `derivative` (the scalar driver's)."""
     n = md.basis_modes(basis)
     T = basis[md.TABLES]
-    pp = np.empty(md.prepared_size(n))
-    md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, T, basis[md.COUPLING])
+    S = md.row_scratch(row, basis)
     y = np.full(2 * n, 1e-3)
     dy = np.empty(2 * n)
     total = 0.0

@@ -767,9 +767,7 @@ def at_rest(row, basis, t, y, band, base):
     for one mode). basis: the span's (kernels.modes)."""
     n = md.basis_modes(basis)
     T = basis[md.TABLES]
-    pp = np.empty(md.prepared_size(n))
-    md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, T, basis[md.COUPLING])
+    S = md.row_scratch(row, basis)
     z = np.empty(2 * n)
     f = np.empty(2 * n)
     for i in range(n):

@@ -528,6 +528,17 @@ def scratch(pp, n_modes, T, CP):
             np.empty((4, T.shape[2], 1)), np.empty((4, 1)), CP)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def row_scratch(row, basis):
+    """`scratch` for raw row `row` (columns above) of a span of `basis` (the tuple the kernels
+    take): the row prepared (`prepare`), ready for `derivative(t, y, dy, S, N, basis[TABLES],
+    base)`."""
+    n = basis_modes(basis)
+    pp = np.empty(prepared_size(n))
+    prepare(row, n, pp, basis[RATIOS])
+    return scratch(pp, n, basis[TABLES], basis[COUPLING])
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s), dy = (q', q'') (m/s,

@@ -468,9 +468,7 @@ def test_the_one_state_right_hand_side_is_the_lanes_one(rotation, membrane):
     def both(row, basis, y, t, base):
         n = md.basis_modes(basis)
         T = basis[md.TABLES]
-        pp = np.empty(md.prepared_size(n))
-        md.prepare(row, n, pp, basis[md.RATIOS])
-        S = md.scratch(pp, n, T, basis[md.COUPLING])
+        S = md.row_scratch(row, basis)
         dy = np.empty(2 * n)
         md.derivative(t, y, dy, S, n, T, base)
         PP, X, K, tt, FLD, SC, CP = S
