@@ -893,3 +893,19 @@ def test_harness_clamps_runs_on_the_scalar_driver():
     """35 points, each its own K = k_t l / EI (benchmarks/lanes_occupancy.py: 4x faster)."""
     from sweep import load_scene
     assert load_scene("harness-clamps").get("solver.driver") == "scalar"
+
+
+@pytest.mark.parametrize("overrides, expected", [
+    ({"model.modes": 3}, "lanes"),                       # 9 spans x 2 levels x 8 records a basis
+    ({"model.modes": 1}, "scalar"),                      # one mode: always the scalar driver
+    ({"model.modes": 3, "base.realisations": 1, "axes.length": [0.1]}, "scalar"),   # 2 records
+    ({"model.modes": 3, "base.realisations": 4}, "lanes"),                          # 9 x 2 x 4
+    ({"model.modes": 3, "base.realisations": 1, "clamps.rotation": "elastic",
+      "clamps.rotational_stiffness": 1.0, "cable.diameter": "3 mm"}, "scalar"),     # 2 a basis
+    ({"model.modes": 3, "clamps.rotation": "elastic", "clamps.rotational_stiffness": 1.0,
+      "cable.diameter": "3 mm"}, "lanes"),                                          # 16 a basis
+    ({"model.modes": 3, "base.realisations": 1, "solver.driver": "lanes"}, "lanes"),
+])
+def test_a_random_scene_counts_its_records_for_the_default_driver(overrides, expected):
+    from sweep import load_scene
+    assert load_scene("launch-random-gevs", overrides).get("solver.driver") == expected

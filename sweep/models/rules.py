@@ -149,6 +149,11 @@ differs at every point, each K its own basis and so its own kernel call) the sca
 the default. Measured (benchmarks/lanes_occupancy.py): 1 point a basis ran 3.6x faster on
 the scalar driver, 4 points 0.9x, 8 points 0.58x (the lanes' vector loops and per-step
 bookkeeping cost nearly as much for one running lane as for sixteen)."""
+RANDOM_LANES_LEAST_POINTS = 8
+"""The same for a random scene, counting each record (base.realisations) as a point: every
+accepted step of a record goes to the lanes' scalar path, so they need more company. Measured
+(elastic clamps, 3 modes, one basis a span, 2 s GEVS records, one thread): the lanes took 2.79x
+the scalar driver's time with 1 record a basis, 1.23x with 4, 0.77x with 8."""
 BASIS_KEYS_EXEMPT = frozenset({"cable.damping_ratio", "cable.density", "cable.linear_mass"})
 """cable.* keys that do not move K = k_t l / EI (every other cable key may: the length and
 the cable's bending rigidity, however it is given)."""
@@ -996,11 +1001,16 @@ def points_per_basis(values: Mapping[str, Any], swept: Swept) -> int:
 def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
                          mentioned: set[str], swept: Swept) -> None:
     """solver.t_end 5 s, DOP853 for several modes (MULTI_MODE_METHOD) and the scalar driver
-    where fewer than LANES_LEAST_POINTS points share a basis, and the paper preset's
-    initial.velocity without an initial condition."""
+    where fewer than LANES_LEAST_POINTS points share a basis (RANDOM_LANES_LEAST_POINTS
+    records for a random scene), and the paper preset's initial.velocity without an initial
+    condition."""
     _shared_defaults(values, mentioned)
     if random_scene.is_random(values):
         random_scene.defaults(values, mentioned)
+        if (values["model.modes"] > 1 and "solver.driver" not in mentioned
+                and points_per_basis(values, swept) * values["base.realisations"]
+                < RANDOM_LANES_LEAST_POINTS):
+            values["solver.driver"] = "scalar"
     elif values["model.modes"] > 1:
         if "solver.method" not in mentioned:
             values["solver.method"] = MULTI_MODE_METHOD
