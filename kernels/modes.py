@@ -350,7 +350,8 @@ def _energy_bending(a, b, beta_b, beta_q):
     projected on d2phi_m/dxi2) = (a b^2 (12 beta_q a^2 - 3 beta_b), a^2 b (6 beta_q a^2 -
     3 beta_b)) (per unit rho A); every form of the right-hand side takes them from here."""
     a2 = a * a
-    return a * (b * b) * (12.0 * beta_q * a2 - 3.0 * beta_b), a2 * b * (6.0 * beta_q * a2 - 3.0 * beta_b)
+    return (a * (b * b) * (12.0 * beta_q * a2 - 3.0 * beta_b),
+            a2 * b * (6.0 * beta_q * a2 - 3.0 * beta_b))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")

@@ -909,3 +909,15 @@ def test_harness_clamps_runs_on_the_scalar_driver():
 def test_a_random_scene_counts_its_records_for_the_default_driver(overrides, expected):
     from sweep import load_scene
     assert load_scene("launch-random-gevs", overrides).get("solver.driver") == expected
+
+
+@pytest.mark.parametrize("overrides, expected", [
+    ({}, "scalar"),                                       # 3 lines a direction
+    ({"axes.length": [0.3, 0.4, 0.5, 0.6]}, "lanes"),     # 4 lines
+    ({"axes.length": [0.5]}, "scalar"),
+])
+def test_a_stepped_sweep_counts_its_lines_for_the_default_driver(overrides, expected):
+    """A stepped sweep's kernel call takes one dwell of every line: the dwells along the
+    continuation axis do not fill the lanes."""
+    from sweep import load_scene
+    assert load_scene("harness-stepped-sine", overrides).get("solver.driver") == expected

@@ -146,9 +146,11 @@ LANES_LEAST_POINTS = 4
 """Points that share one set of mode shapes, at least, for a scene of several modes to run on the
 lock-step lanes by default; with fewer (a single span; elastic clamps whose K = k_t l / EI
 differs at every point, each K its own basis and so its own kernel call) the scalar driver is
-the default. Measured (benchmarks/lanes_occupancy.py): 1 point a basis ran 3.6x faster on
-the scalar driver, 4 points 0.9x, 8 points 0.58x (the lanes' vector loops and per-step
-bookkeeping cost nearly as much for one running lane as for sixteen)."""
+the default. A stepped sweep counts its lines (a kernel call takes one dwell of every line of a
+direction). Measured (benchmarks/lanes_occupancy.py): the lanes took 3.6x the scalar driver's
+time with 1 point a basis, 0.9x with 4, 0.58x with 8 (their vector loops and per-step
+bookkeeping cost nearly as much for one running lane as for sixteen); harness-stepped-sine's 3
+lines a direction, one thread: 5.9 s on the lanes, 4.2 s on the scalar driver."""
 RANDOM_LANES_LEAST_POINTS = 8
 """The same for a random scene, counting each record (base.realisations) as a point: every
 accepted step of a record goes to the lanes' scalar path, so they need more company. Measured
@@ -977,11 +979,11 @@ def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
         values["cable.inertia"] = default_inertia(values["cable.area"])
 
 
-def points_per_basis(values: Mapping[str, Any], swept: Swept) -> int:
+def points_per_basis(values: Mapping[str, Any], swept: Swept, skip: str | None = None) -> int:
     """How many points of the grid share one set of mode shapes (at least): all of them, but
     with elastic clamps only the points along the axes (and [points]) that leave K = k_t l /
     EI as it is (`BASIS_KEYS_EXEMPT`, and every key outside [cable] and the clamps' rotational
-    stiffness)."""
+    stiffness); the axis `skip` not counted (a stepped sweep's: its lines share a call)."""
     elastic = values["clamps.rotation"] == "elastic"
 
     def moves_basis(name: str) -> bool:
@@ -991,7 +993,7 @@ def points_per_basis(values: Mapping[str, Any], swept: Swept) -> int:
 
     count = 1
     for name, axis in swept.items():
-        if name not in swept.zipped and not moves_basis(name):
+        if name not in swept.zipped and name != skip and not moves_basis(name):
             count *= len(axis)
     if swept.zipped and not any(moves_basis(name) for name in swept.zipped):
         count *= len(swept[next(iter(swept.zipped))])
@@ -1014,8 +1016,8 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
     elif values["model.modes"] > 1:
         if "solver.method" not in mentioned:
             values["solver.method"] = MULTI_MODE_METHOD
-        if ("solver.driver" not in mentioned
-                and points_per_basis(values, swept) < LANES_LEAST_POINTS):
+        together = points_per_basis(values, swept, skip=values["continuation.axis"])
+        if "solver.driver" not in mentioned and together < LANES_LEAST_POINTS:
             values["solver.driver"] = "scalar"
     swept = any(d in mentioned for d in SWEEP_KEYS)
     if "solver.t_end" not in mentioned and not swept and not random_scene.is_random(values):
