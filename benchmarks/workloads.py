@@ -162,9 +162,7 @@ def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -
     n = inputs.n_modes
     for row in rows:
         arrays = bases if isinstance(bases, tuple) else bases[int(row[-1])]
-        pp = np.zeros(md.prepared_size(n))
-        md.prepare(row, n, pp, arrays[md.RATIOS])
-        S = md.scratch(pp, n, arrays[md.TABLES], arrays[md.COUPLING])
+        S = md.row_scratch(row, arrays)
         T = arrays[md.TABLES]
         base = True if row[md.BASE_ACCEL] != 0.0 else None
 

@@ -434,7 +434,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
         states[point] = mt.INVALID_INPUT
         return False
     md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, T, basis[md.COUPLING])
+    S = md.scratch(pp, n, basis[md.COUPLING])
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
     p1 = drv.observer_row(row, n)

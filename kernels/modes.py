@@ -519,14 +519,11 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def scratch(pp, n_modes, T, CP):
-    """The one-state right-hand side's working arrays for prepared row pp (`derivative`), and
-    the basis' coupling CP (basis[COUPLING])."""
-    PP = np.empty((pp.shape[0], 1))
-    for c in range(pp.shape[0]):
-        PP[c, 0] = pp[c]
-    return (PP, np.empty((2 * n_modes, 1)), np.empty((1, 2 * n_modes, 1)), np.empty(1),
-            np.empty((4, T.shape[2], 1)), np.empty((4, 1)), CP)
+def scratch(pp, n_modes, CP):
+    """What the one-state right-hand side (`derivative`) reads and writes besides its state:
+    a copy of the prepared row pp, its projections' accumulator (N) and the basis' coupling
+    CP (basis[COUPLING])."""
+    return pp.copy(), np.empty(n_modes), CP
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -537,7 +534,7 @@ def row_scratch(row, basis):
     n = basis_modes(basis)
     pp = np.empty(prepared_size(n))
     prepare(row, n, pp, basis[RATIOS])
-    return scratch(pp, n, basis[TABLES], basis[COUPLING])
+    return scratch(pp, n, basis[COUPLING])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -548,16 +545,16 @@ def derivative(t, y, dy, S, n_modes, T, base):
     state's loop order: each node's fields summed over the modes in registers and its forces
     projected on every mode at once (with one lane, the lanes' loops cost more in overhead
     than in arithmetic: 2-3x this). It agrees with `lanes_derivative` to round-off. S:
-    `scratch`(prepared row, N, T, the basis' coupling); T: the basis' tables; y and dy
-    distinct."""
-    PP, X, K, tt, FLD, SC, CP = S
+    `scratch`(prepared row, N, the basis' coupling) or `row_scratch`; T: the basis' tables;
+    y and dy distinct."""
+    pp, F, CP = S                       # F: the projections, mode by mode
     n = n_modes
     sc = 3 * n
-    x = PP[sc + S_OMEGA, 0] * t + PP[sc + S_LOAD_PHASE, 0]
+    x = pp[sc + S_OMEGA] * t + pp[sc + S_LOAD_PHASE]
     cw = math.cos(x)
-    linear = PP[sc + S_LOAD_MEAN, 0] + PP[sc + S_LOAD_COS, 0] * cw
-    membrane = PP[sc + S_BETA_M0, 0] + PP[sc + S_BETA_M1, 0] * cw
-    tension = PP[sc + S_TENSION, 0]
+    linear = pp[sc + S_LOAD_MEAN] + pp[sc + S_LOAD_COS] * cw
+    membrane = pp[sc + S_BETA_M0] + pp[sc + S_BETA_M1] * cw
+    tension = pp[sc + S_TENSION]
     if tension != 0.0:                  # the uniform tension N = k_s e, e = int w_x^2 / 2
         e = 0.0
         for i in range(n):
@@ -566,10 +563,9 @@ def derivative(t, y, dy, S, n_modes, T, base):
                 if a_ik != 0.0:
                     e += a_ik * y[i] * y[k]
         linear -= tension * e
-    beta_b = PP[sc + S_BETA_B, 0]
-    beta_q = PP[sc + S_BETA_Q, 0]
-    energy = PP[sc + S_ENERGY, 0] != 0.0
-    F = X[:, 0]                         # the projections, mode by mode
+    beta_b = pp[sc + S_BETA_B]
+    beta_q = pp[sc + S_BETA_Q]
+    energy = pp[sc + S_ENERGY] != 0.0
     for i in range(n):
         F[i] = 0.0
     for j in range(T.shape[2]):
@@ -592,12 +588,10 @@ def derivative(t, y, dy, S, n_modes, T, base):
             g0 += _eq17_bending(a, b, c, d, beta_b, beta_q)
             for i in range(n):
                 F[i] += T[4, i, j] * g0
-    ab = 0.0
-    if base is not None:
-        ab = ex.signal(t, PP.reshape(PP.size), sc + S_EXCITATION, 1, base)
+    ab = base_acceleration(t, pp, n, base) if base is not None else 0.0
     for i in range(n):
-        acc = PP[P_STIFF * n + i, 0] * y[i] + PP[P_DAMPING * n + i, 0] * y[n + i] - F[i]
+        acc = pp[P_STIFF * n + i] * y[i] + pp[P_DAMPING * n + i] * y[n + i] - F[i]
         if base is not None:
-            acc += PP[P_FORCE * n + i, 0] * ab
+            acc += pp[P_FORCE * n + i] * ab
         dy[i] = y[n + i]
         dy[n + i] = acc

@@ -471,11 +471,15 @@ def test_the_one_state_right_hand_side_is_the_lanes_one(rotation, membrane):
         S = md.row_scratch(row, basis)
         dy = np.empty(2 * n)
         md.derivative(t, y, dy, S, n, T, base)
-        PP, X, K, tt, FLD, SC, CP = S
-        for c in range(2 * n):
-            X[c, 0] = y[c]
-        tt[0] = t
-        md.lanes_derivative(tt, X, K, 0, PP, n, T, FLD, SC, 1, None, base, CP)
+        pp, _, CP = S
+        PP = np.empty((pp.shape[0], 1))         # one lane of the lanes driver's arrays
+        PP[:, 0] = pp
+        X = np.empty((2 * n, 1))
+        X[:, 0] = y
+        K = np.empty((1, 2 * n, 1))
+        tt = np.full(1, t)
+        md.lanes_derivative(tt, X, K, 0, PP, n, T, np.empty((4, T.shape[2], 1)),
+                            np.empty((4, 1)), 1, None, base, CP)
         return dy, K[0, :, 0].copy()
 
     text = (f'[model]\nmodes = 4\ncoefficients = "consistent"\n'
