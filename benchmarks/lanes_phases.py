@@ -42,7 +42,7 @@ sys.path.insert(0, str(ROOT))
 
 HELPER = "#include <stdint.h>\n#include <x86intrin.h>\nuint64_t rdtsc(void) { return __rdtsc(); }\n"
 # each phase ends where the next begins; the first is the loop's own top (the interrupt test)
-PHASES = [("        _prepare(W, H, FLAG, settings, n_run)\n", "loop top"),
+PHASES = [("        tj.next_attempts(W, L, H, FLAG, settings, n_run)\n", "loop top"),
           ("        _attempt(W, Y, YN, K, ST, TT, H, ERR,", "next attempt, lanes loaded and ended"),
           ("        _control(W, H, ERR, SC, settings, n_run)\n", "attempt (stages, error)"),
           ("        if not record:                   # (a record's: no events to find, no ordinary "

@@ -5,7 +5,7 @@ RK45's or DOP853's sequence of attempts (or the PI controller's), the trajectory
 state machine.
 These loops run across the lanes with straight-line arithmetic, so LLVM vectorises them:
 
-- `_prepare`: the next step of every lane whose step needs no special care;
+- trajectory.next_attempts: the next step of every lane whose step needs no special care;
 - `_attempt`: one Dormand-Prince attempt (six right-hand sides, stage sums, error norm);
   `_attempt8` its DOP853 counterpart (twelve right-hand sides; solver.method = "dop853").
   Their stages are written out from each method's tableau by kernels.stages (straight-line
@@ -47,7 +47,7 @@ from . import trajectory as tj
 from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, MAX_FACTOR,
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
-from .layout import MAX_STEP, MAX_STEPS, MIN_STEP, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
+from .layout import RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
@@ -135,32 +135,6 @@ def _chains(A, B, C, sums, skip_zeros, name):
 _chain5, _chain5_p, _chain5_b, _chain5_pb = _chains(A, B, C, (E,), False, "rk45_chain")
 _chain8, _chain8_p, _chain8_b, _chain8_pb = _chains(dop853.A, dop853.B, dop853.C,
                                                     (dop853.E5, dop853.E3), True, "dop853_chain")
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _prepare(W, settings, n_run):
-    """trajectory.next_attempt across lanes, for the lanes whose step is ordinary: running,
-    before t_end, within max_steps, and far above the minimum step (10 ulps of t or
-    solver.min_step), so SciPy's clamp and failure cannot apply. Other lanes get W_FLAG = 1."""
-    L = LANES
-    max_step = settings[MAX_STEP]
-    max_steps = settings[MAX_STEPS]
-    min_user = settings[MIN_STEP]
-    for j in range(n_run):
-        t_end = W[tj.T_FINAL * L + j]         # the lane's own end (solver.stop_when_steady)
-        t = W[tj.T * L + j]
-        h_abs = W[tj.H_ABS * L + j]
-        fresh = W[tj.REJECTED_NOW * L + j] == 0.0
-        h_try = min(h_abs, max_step) if fresh else h_abs
-        ok = ((W[tj.STATUS * L + j] == mt.RUNNING) & (t < t_end)
-              & ((not fresh) | (W[tj.STEPS * L + j] < max_steps))
-              & (h_try > 1e-14 * t) & (h_try > min_user) & (h_try > 1e-300))
-        t_new = min(t + h_try, t_end)
-        h = t_new - t
-        W[W_H * L + j] = h if ok else 0.0
-        W[tj.H_ABS * L + j] = abs(h) if ok else h_abs
-        W[tj.T_NEW * L + j] = t_new if ok else W[tj.T_NEW * L + j]
-        W[W_FLAG * L + j] = ORDINARY if ok else NEEDS_SCALAR
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -536,11 +510,12 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     Qc = np.empty((2, QUARTIC_TERMS if eighth is None else DENSE_TERMS))   # RK45: its quartic
     next_point = lo
     n_run = min(L, hi - lo)   # lanes the vector loops cover: the active ones, rounded up to SIMD
-                              # width (min() keeps it a run-time int: one compiled _prepare)
+                              # width (min() keeps it a run-time int: one compiled next_attempts)
     while True:
         if halt[0] != 0:
             return                # an interrupt: the rows in flight are left unsolved
-        _prepare(W, settings, n_run)
+        tj.next_attempts(W, L, W[W_H * L:(W_H + 1) * L], W[W_FLAG * L:(W_FLAG + 1) * L],
+                         settings, n_run)
         top = 0
         for j in range(L):
             if j >= n_run or W[W_FLAG * L + j] != 0.0:

@@ -855,9 +855,7 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
         second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
                                  np.empty(0), modal, base, eighth, steady, weights,
                                  basis)
-        reals[i, SETTLING] = second[tj.LAST_ABOVE]
-        counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
-        states[i] = mt.STEADY
+        states[i] = tj.settle(second, reals[i], counts[i])
         done += 1
     return done
 

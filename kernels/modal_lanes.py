@@ -19,7 +19,7 @@ compile to packed AVX-512 FMAs on zmm registers):
   solution, f(t + h, y_new)) and SciPy's error norm;
 - `_control`: accept/reject and the step-size update, err^(-1/5) by vecmath.inv_fifth_root
   (kernels.lanes._step_factor);
-- `_prepare`: trajectory.next_attempt for the lanes whose step needs no special care;
+- trajectory.next_attempts: trajectory.next_attempt for the lanes whose step needs no special care;
 - `_midspan`, `_mode_events`, `_finish`, `_tail_modes`, `_advance`: the accepted step's
   stages projected on the midspan deflection (K_mid), the test for anything unusual, the
   Observer's step-end metrics of an ordinary step (trajectory.observe_step_end), each mode's
@@ -58,7 +58,7 @@ from . import modal_driver as drv
 from . import modes as md
 from . import trajectory as tj
 from .lanes import _step_factor
-from .layout import (CONTROLLER, LOADS, MAX_STEP, MAX_STEPS, METHOD, MIN_STEP, N_COUNTS,
+from .layout import (CONTROLLER, LOADS, METHOD, N_COUNTS,
                      N_REALS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING)
 from .oscillator import BOUND, N_PARAMS
 from .transverse import classify_metrics
@@ -198,33 +198,6 @@ def _control(W, H, ERR, SC, settings, n_run):
             1.0 if rejected_before else 0.0)
         W[tj.REJECTED * L + l] += 1.0 if active & (not accepted) else 0.0
         W[tj.STEPS * L + l] += 1.0 if active & accepted else 0.0
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _prepare(W, H, FLAG, settings, n_run):
-    """trajectory.next_attempt across the lanes whose step is ordinary: running, before t_end,
-    within max_steps and far above the minimum step (10 ulps of t or solver.min_step), so
-    SciPy's clamp and failure cannot apply (H: the step, FLAG 0). Other lanes get FLAG 1 (the
-    scalar next_attempt's turn) and are left as they are."""
-    L = LANES
-    max_step = settings[MAX_STEP]
-    max_steps = settings[MAX_STEPS]
-    min_user = settings[MIN_STEP]
-    for l in range(n_run):
-        t_end = W[tj.T_FINAL * L + l]         # the lane's own end (solver.stop_when_steady)
-        t = W[tj.T * L + l]
-        h_abs = W[tj.H_ABS * L + l]
-        fresh = W[tj.REJECTED_NOW * L + l] == 0.0
-        h_try = min(h_abs, max_step) if fresh else h_abs
-        ok = ((W[tj.STATUS * L + l] == mt.RUNNING) & (t < t_end)
-              & ((not fresh) | (W[tj.STEPS * L + l] < max_steps))
-              & (h_try > 1e-14 * t) & (h_try > min_user) & (h_try > 1e-300))
-        t_new = min(t + h_try, t_end)
-        h = t_new - t
-        H[l] = h if ok else 0.0
-        W[tj.H_ABS * L + l] = abs(h) if ok else h_abs
-        W[tj.T_NEW * L + l] = t_new if ok else W[tj.T_NEW * L + l]
-        FLAG[l] = 0.0 if ok else 1.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -593,7 +566,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     while True:
         if halt[0] != 0:
             return                # an interrupt: the rows in flight are left unsolved
-        _prepare(W, H, FLAG, settings, n_run)
+        tj.next_attempts(W, L, H, FLAG, settings, n_run)
         top = 0
         for j in range(L):
             if j < n_run and FLAG[j] == 0.0:

@@ -31,6 +31,7 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
                      STEADY_PERIODS, STEADY_TOL, TAIL, T_END)
+from .layout import RHS_EVALS as EVALS_COLUMN, SETTLING
 from .oscillator import (BOUND, EXCITATION, Q0, Q_SCALE, V0, V_SCALE, acceleration,
                          base_acceleration)
 from .stages import InlineWhereTrue
@@ -270,6 +271,49 @@ def next_attempt(settings, acc):
     acc[H_ABS] = abs(h)
     acc[T_NEW] = t_new
     return h
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def next_attempts(W, L, H, FLAG, settings, n_run):
+    """`next_attempt` across the lanes of a lock-step driver (W: the lanes' accumulators,
+    slot k of lane l at W[k * L + l]) whose step is ordinary: running, before their own end
+    (T_FINAL), within max_steps and far above the minimum step (10 ulps of t or
+    solver.min_step), so SciPy's clamp and failure cannot apply: H[l] the step (s), FLAG[l]
+    0. Other lanes get H[l] = 0 and FLAG[l] = 1 (the scalar `next_attempt`'s turn) and are
+    left as they are. One loop of straight-line arithmetic across the lanes, which LLVM
+    vectorises only where L is a compile-time constant: each driver's LANES (`literally`
+    compiles one version for each)."""
+    L = nb.literally(L)
+    max_step = settings[MAX_STEP]
+    max_steps = settings[MAX_STEPS]
+    min_user = settings[MIN_STEP]
+    for l in range(n_run):
+        t_end = W[T_FINAL * L + l]
+        t = W[T * L + l]
+        h_abs = W[H_ABS * L + l]
+        fresh = W[REJECTED_NOW * L + l] == 0.0
+        h_try = min(h_abs, max_step) if fresh else h_abs
+        ok = ((W[STATUS * L + l] == mt.RUNNING) & (t < t_end)
+              & ((not fresh) | (W[STEPS * L + l] < max_steps))
+              & (h_try > 1e-14 * t) & (h_try > min_user) & (h_try > 1e-300))
+        t_new = min(t + h_try, t_end)
+        h = t_new - t
+        H[l] = h if ok else 0.0
+        W[H_ABS * L + l] = abs(h) if ok else h_abs
+        W[T_NEW * L + l] = t_new if ok else W[T_NEW * L + l]
+        FLAG[l] = 0.0 if ok else 1.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def settle(second, reals, counts):
+    """A point's outputs (its rows of reals and counts) after its second pass, the run that
+    tracked |q - final| against the band tol * amplitude (`second`, its accumulator): the
+    settling time is the last time the trajectory was outside the band, and the pass's
+    evaluations add to the first run's (as if done in one go). Returns the point's state,
+    STEADY."""
+    reals[SETTLING] = second[LAST_ABOVE]
+    counts[EVALS_COLUMN] += int(second[RHS_EVALS])
+    return mt.STEADY
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

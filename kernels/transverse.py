@@ -218,9 +218,7 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), parametric,
                               base, eighth, steady)
-        reals[i, SETTLING] = second[tj.LAST_ABOVE]
-        counts[i, RHS_EVALS] += int(second[tj.RHS_EVALS])
-        states[i] = mt.STEADY
+        states[i] = tj.settle(second, reals[i], counts[i])
         done += 1
     return done
 

@@ -263,7 +263,9 @@ def test_sweep_run_refuses_a_negative_thread_count():
         sweep.run(scene, threads=-1)
 
 
-_VECTOR_LOOPS = [("_prepare", lambda W, s: (W, s, lanes.LANES)),
+_VECTOR_LOOPS = [("trajectory.next_attempts",
+                  lambda W, s: (W, lanes.LANES, np.zeros(lanes.LANES), np.zeros(lanes.LANES), s,
+                                lanes.LANES)),
                  ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, True, None)),
                  ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, None, True)),
                  ("_attempt", lambda W, s: (W, 1e-7, lanes.LANES, True, True)),
@@ -288,11 +290,17 @@ def test_lanes_loops_are_vectorised(name, args):
     packed-double instructions. Vectorised, these loops have 0.5-1 packed per scalar one (the
     scalar remainder loop keeps the rest); a loop LLVM left scalar has ~0.15."""
     import numba
-    kernel = getattr(lanes, name)
+    from sweep.kernels import trajectory
+    module, _, attribute = name.rpartition(".")
+    kernel = getattr(trajectory if module == "trajectory" else lanes, attribute)
     options = {k: v for k, v in kernel.targetoptions.items() if k not in ("cache", "nopython")}
     fresh = numba.njit(**options)(kernel.py_func)
     W = np.zeros(lanes.W_ROWS * lanes.LANES)
-    call(fresh, *args(W, settings()))         # the switches typed as the run types them
+    arguments = args(W, settings())
+    if any(a is True for a in arguments):
+        call(fresh, *arguments)               # the switches typed as the run types them
+    else:
+        fresh(*arguments)                     # (next_attempts: its lane count a literal)
     mnemonics = [line.split()[0] for text in fresh.inspect_asm().values()
                  for line in text.splitlines() if line.startswith("\t") and line.split()]
     packed = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+pd", m))
