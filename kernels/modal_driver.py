@@ -311,13 +311,34 @@ def _turns(r0, r1):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def _span_bound(y, h, QA, n_modes, shapes):
+    """An upper bound (m) of |w(x, t)| over the span and over the accepted step (every mode's
+    interpolant in QA, q_c = y_c + h sum_k QA[c, 0, k] x^(k+1), x in [0, 1]):
+    sum_c max |q_c| max |phi_c|, with max |q_c| <= |y_c| + |h| sum_k |QA[c, 0, k]| and
+    max |phi_c| <= sqrt(A^2 + B^2) + |C| + |D| for a shape A cos + B sin + C e^- + D e^+
+    (`modes.shape_at`; 1 for a pinned sine)."""
+    bound = 0.0
+    for c in range(n_modes):
+        reach = 0.0
+        for k in range(QA.shape[2]):
+            reach += abs(QA[c, 0, k])
+        size = (math.sqrt(shapes[c, 1] * shapes[c, 1] + shapes[c, 2] * shapes[c, 2])
+                + abs(shapes[c, 3]) + abs(shapes[c, 4]))
+        bound += (abs(y[c]) + abs(h) * reach) * size
+    return bound
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
     """The largest deflection over the span near the fraction x of the accepted step (every
     mode's interpolant in QA), into modal[2N] (m), and its place x* into modal's mode
     shapes: the span's maximum at x, at its place (modes.span_argmax), then at the instant
     inside the step where the deflection there turns (the root of its interpolated rate),
-    twice. qx (N), Qp (2, terms): scratch."""
+    twice. qx (N), Qp (2, terms): scratch. Skipped where no instant of the step can exceed the
+    largest so far (`_span_bound`)."""
     n = n_modes
+    if _span_bound(y, h, QA, n, basis[md.SHAPES]) <= modal[2 * n]:
+        return
     for c in range(n):
         qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
     top, where = md.span_argmax(qx, n, basis)

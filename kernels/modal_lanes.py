@@ -425,6 +425,32 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def _move_lane(k, i, W, Y, K, MOD, PP, P1, BOUNDS, H):
+    """Lane k's trajectory into the idle lane i: every array that carries a lane's state from
+    one attempt to the next (its accumulator, state, stages (K[0] = f(t, y)), modes'
+    accumulator, prepared and Observer rows, bound, step); lane k is left idle. A lane's
+    arithmetic does not depend on its place, so neither do its results."""
+    L = LANES
+    for c in range(W.shape[0] // L):
+        W[c * L + i] = W[c * L + k]
+    for c in range(Y.shape[0]):
+        Y[c, i] = Y[c, k]
+    for s in range(K.shape[0]):
+        for c in range(K.shape[1]):
+            K[s, c, i] = K[s, c, k]
+    for c in range(MOD.shape[0]):
+        MOD[c, i] = MOD[c, k]
+    for c in range(PP.shape[0]):
+        PP[c, i] = PP[c, k]
+    for c in range(P1.shape[0] // L):
+        P1[c * L + i] = P1[c * L + k]
+    BOUNDS[i] = BOUNDS[k]
+    H[i] = H[k]
+    H[k] = 0.0
+    W[tj.STATUS * L + k] = mt.DIVERGED           # idle, as before its first load
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, series, modal,
               final, buf, yl, ml, basis, base):
     """Classify lane j's finished trajectory (row `point`) as modal_driver.solve_point does."""
@@ -601,6 +627,21 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                 top = j + 1
         if top == 0:
             return
+        if next_point >= hi:      # draining: the running lanes packed into the lowest ones,
+            hole = 0              # so that the vector loops cover only them
+            while True:
+                while hole < top and H[hole] > 0.0:
+                    hole += 1
+                if hole >= top - 1:
+                    break
+                _move_lane(top - 1, hole, W, Y, K, MOD, PP, P1, BOUNDS, H)
+                bufs[hole] = bufs[top - 1]
+                capacity[hole] = capacity[top - 1]
+                point[hole] = point[top - 1]
+                point[top - 1] = -1
+                top -= 1
+                while top > 0 and H[top - 1] <= 0.0:
+                    top -= 1
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
                  n_run, base, basis[md.COUPLING])

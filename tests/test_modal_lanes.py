@@ -195,6 +195,27 @@ def test_a_block_inside_a_table_and_idle_lanes():
         assert np.all(y[:5] == 7) and np.all(y[12:] == 7)
 
 
+@pytest.mark.parametrize("name", ["n3-base-dop853", "n2-harmonic-load"])
+def test_packed_lanes_give_each_point_its_own_results(name):
+    """Once a block has no more points to load, its running lanes are packed into the lowest
+    ones as others end (modal_lanes._move_lane), so a trajectory changes lane mid-run: each
+    point's results, bit for bit, are those of the point solved alone in a block of its own.
+    The points' step counts differ several-fold, so lanes end out of their order and the
+    packing moves many of them."""
+    rows, n, s, n_samples = case_rows(name)
+    whole = solve(modal_lanes, rows, n, s, n_samples)
+    steps = whole[2][:, tk.STEPS]
+    assert steps.max() > 3 * steps[steps > 0].min()
+    arrays = pinned_sines(n).kernel_arrays()
+    for i in range(rows.shape[0]):
+        alone = tuple(np.full_like(x, 7) for x in whole)
+        call(modal_lanes.solve_block, rows, arrays, s, i, i + 1, *alone,
+             True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
+             np.zeros(1, np.int8))
+        for x, y in zip(whole, alone):
+            np.testing.assert_array_equal(y[i], x[i], err_msg=f"row {i}")
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(__import__("platform").machine().lower() not in ("x86_64", "amd64"),
                     reason="reads x86 assembly")
