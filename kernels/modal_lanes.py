@@ -587,6 +587,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     bufs = [tj.new_buffer() for _ in range(L)]
     capacity = np.full(L, bufs[0].shape[0], np.int64)
     point = np.full(L, -1, np.int64)
+    MOVES = np.empty((L, 2), np.int64)
     next_point = lo
     n_run = min(L, hi - lo)
     while True:
@@ -627,21 +628,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                 top = j + 1
         if top == 0:
             return
-        if next_point >= hi:      # draining: the running lanes packed into the lowest ones,
-            hole = 0              # so that the vector loops cover only them
-            while True:
-                while hole < top and H[hole] > 0.0:
-                    hole += 1
-                if hole >= top - 1:
-                    break
-                _move_lane(top - 1, hole, W, Y, K, MOD, PP, P1, BOUNDS, H)
-                bufs[hole] = bufs[top - 1]
-                capacity[hole] = capacity[top - 1]
-                point[hole] = point[top - 1]
-                point[top - 1] = -1
-                top -= 1
-                while top > 0 and H[top - 1] <= 0.0:
-                    top -= 1
+        if next_point >= hi:              # draining: pack the running lanes
+            n_moves, top = tj.lane_moves(H, top, MOVES)
+            for m in range(n_moves):
+                _move_lane(MOVES[m, 0], MOVES[m, 1], W, Y, K, MOD, PP, P1, BOUNDS, H)
+                tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
                  n_run, base, basis[md.COUPLING])

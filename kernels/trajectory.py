@@ -305,6 +305,39 @@ def next_attempts(W, L, H, FLAG, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def lane_moves(H, top, moves):
+    """How a lock-step driver packs its running lanes (H[l] > 0: a step to attempt) among
+    lanes 0..top-1 into the lowest ones, once its block has no more points to load (the
+    vector loops then cover only those): moves[m] = (from, to), the highest running lane into
+    the lowest idle one, for m < the count returned; and the lanes running, the new top."""
+    running = 0
+    for l in range(top):
+        running += 1 if H[l] > 0.0 else 0
+    m = 0
+    k = top - 1
+    for i in range(running):
+        if H[i] > 0.0:
+            continue
+        while H[k] <= 0.0:
+            k -= 1
+        moves[m, 0] = k
+        moves[m, 1] = i
+        m += 1
+        k -= 1
+    return m, running
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def move_books(k, i, bufs, capacity, point):
+    """A lane's books move with it (`lane_moves`): its extrema buffer, the buffer's rows and
+    its point from lane k to lane i, lane k left without a point."""
+    bufs[i] = bufs[k]
+    capacity[i] = capacity[k]
+    point[i] = point[k]
+    point[k] = -1
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def settle(second, reals, counts):
     """A point's outputs (its rows of reals and counts) after its second pass, the run that
     tracked |q - final| against the band tol * amplitude (`second`, its accumulator): the
