@@ -147,10 +147,11 @@ LANES_LEAST_POINTS = 4
 lock-step lanes by default; with fewer (a single span; elastic clamps whose K = k_t l / EI
 differs at every point, each K its own basis and so its own kernel call) the scalar driver is
 the default. A stepped sweep counts its lines (a kernel call takes one dwell of every line of a
-direction). Measured (benchmarks/lanes_occupancy.py): the lanes took 3.6x the scalar driver's
-time with 1 point a basis, 0.9x with 4, 0.58x with 8 (their vector loops and per-step
-bookkeeping cost nearly as much for one running lane as for sixteen); harness-stepped-sine's 3
-lines a direction, one thread: 5.9 s on the lanes, 4.2 s on the scalar driver."""
+direction). Measured (benchmarks/lanes_occupancy.py, 2026-12-04, with a draining block's
+lanes packed): the lanes took 3.4x the scalar driver's time with 1 point a basis, 1.0x with 4,
+0.70x with 8, 0.52x with 16 (their vector loops and per-step bookkeeping cost nearly as much
+for one running lane as for sixteen); harness-stepped-sine's 3 lines a direction, one thread:
+5.0 s on the lanes, 4.1 s on the scalar driver."""
 RANDOM_LANES_LEAST_POINTS = 8
 """The same for a random scene, counting each record (base.realisations) as a point: every
 accepted step of a record goes to the lanes' scalar path, so they need more company. Measured
