@@ -365,13 +365,24 @@ def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
             modal[2 * n + 1 + c] = md.shape_at(basis[md.SHAPES], c, best)[0]
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def negligible(peak, largest):
+    """Whether a mode whose peak so far is `peak` (m) is round-off beside the largest mode's
+    peak `largest` (m): at most HIDDEN_FLOOR times it. Such a mode's extrema are not located
+    inside a step (its tail amplitude is the largest at the steps' ends): an even mode seeded
+    by round-off under symmetric excitation (1e-25 to 1e-20 m on harness-base-sine) turns at
+    its own frequency, and each turn sent a step to the scalar path. A mode that grows above
+    the floor (a parametric resonance) is watched as any other from then on."""
+    return not (peak > HIDDEN_FLOOR * largest)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
                    basis, Qp):
     """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each
     mode's peak at the step's end; in the tail window each mode's tail amplitude max |q_i|
     (the step's end, the tail's start inside the step, and an extremum of q_i inside the
-    step, on its own interpolant) and the span's largest deflection at those instants (the
+    step, on its own interpolant, unless the mode is `negligible`) and the span's largest deflection at those instants (the
     tail's start and every mode's extremum: where the span's maximum in time lies, to second
     order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every mode's
     interpolant, scratch; qx (N), Qp (2, terms): scratch; basis: the span's (kernels.modes).
@@ -380,8 +391,10 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
     `_observe_loads`) over the tail window, or over the whole run where `start` marked it so
     (a sine sweep: their peak over the whole sweep)."""
     n = n_modes
+    largest = 0.0
     for i in range(n):
         modal[n + i] = max(modal[n + i], abs(y_new[i]))
+        largest = max(largest, modal[n + i])
         if t_new >= t_tail:
             modal[i] = max(modal[i], abs(y_new[i]))
     located = False
@@ -416,7 +429,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
             modal[c] = max(modal[c], abs(dopri5.dense_value(y[c], h, QA[c, 0], x)))
         _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
     for i in range(n):
-        if not _turns(y[n + i], y_new[n + i]):
+        if not _turns(y[n + i], y_new[n + i]) or negligible(modal[n + i], largest):
             continue
         if not located:
             for c in range(n):

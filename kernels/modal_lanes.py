@@ -228,8 +228,9 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP, LD):
-    """EV[l] = 1 where lane l's accepted attempt has, in some mode, an extremum of q_n or a
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD):
+    """EV[l] = 1 where lane l's accepted attempt has, in some mode not negligible beside the
+    largest (modal_driver.negligible; BIG: scratch, the largest mode's peak), an extremum of q_n or a
     divergence (|q_n| > bound, or q_n' not finite), or, ending in the tail window, a crest of
     the deflection at the place x* of the span's largest (its mode shapes in MOD, as
     modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV:
@@ -240,12 +241,17 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, CV, CP, LD):
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
+        BIG[l] = 0.0
     observe = MOD[drv.factor_slot(n) + 1, 0] != 0.0     # settings[LOADS], every lane's
+    for i in range(n):
+        for l in range(n_run):
+            BIG[l] = max(BIG[l], max(MOD[n + i, l], abs(YN[i, l])))
     for i in range(n):
         for l in range(n_run):
             v0 = Y[n + i, l]
             v1 = YN[n + i, l]
-            turns = ((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0))
+            turns = ((((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0)))
+                     & (not drv.negligible(max(MOD[n + i, l], abs(YN[i, l])), BIG[l])))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
             EV[l] = 1.0 if (turns & tail) | bad else EV[l]
@@ -571,6 +577,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     FLAG = np.zeros(L)
     MOVE = np.zeros(L)
     BOUNDS = np.zeros(L)
+    BIG = np.zeros(L)
     pp = np.empty(md.prepared_size(n))
     yl = np.empty(dim)
     ynl = np.empty(dim)
@@ -639,7 +646,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
         if not record:                   # (a record's: no events to find, no ordinary step)
-            _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, n, n_run, basis[md.CLAMPS],
+            _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
                          basis[md.COUPLING], LD)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)

@@ -335,7 +335,7 @@ amplitude = 0.0
 [base]
 acceleration_g = 1.0
 [solver]
-t_end = 4.0
+t_end = 12.0
 rtol = 1e-9
 [axes]
 length = {{start = 0.4, stop = 0.8, num = 8}}
@@ -346,7 +346,9 @@ base_frequency_ratio = {{start = 0.8, stop = 3.0, num = {n}}}
 @pytest.mark.parametrize("driver", fast_first(["lanes", "scalar"], "lanes"))
 def test_slow_blocks_report_rows_as_they_finish_and_an_interrupt_stops_inside_a_block(driver):
     """Five modes on one thread: the lanes' first block is 64 slow points (MIN_TIMED_BLOCK; a
-    block of these took 17 s on harness-base-sine; the scalar driver's are shorter,
+    block of these took 17 s on harness-base-sine; here about 2 s, long beside the watcher's
+    0.25 s: with t_end 4 s the block, 0.7 s, ended before the interrupt was heard once the
+    lanes got faster; the scalar driver's are shorter,
     SCALAR_BLOCK, then timed), so before, nothing was reported (stored) and an
     interrupt was not heard until the block ended. The watcher reports rows within the block,
     each once and in order, results equal to a run without it; with `stop` set at the first
