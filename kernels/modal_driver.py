@@ -370,7 +370,7 @@ def negligible(peak, largest):
     """Whether a mode whose peak so far is `peak` (m) is round-off beside the largest mode's
     peak `largest` (m): at most HIDDEN_FLOOR times it. Such a mode's extrema are not located
     inside a step (its tail amplitude is the largest at the steps' ends): an even mode seeded
-    by round-off under symmetric excitation (1e-25 to 1e-20 m on harness-base-sine) turns at
+    by round-off under symmetric excitation (1e-25 to 1e-11 m on harness-base-sine) turns at
     its own frequency, and each turn sent a step to the scalar path. A mode that grows above
     the floor (a parametric resonance) is watched as any other from then on."""
     return not (peak > HIDDEN_FLOOR * largest)
@@ -379,17 +379,17 @@ def negligible(peak, largest):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
                    basis, Qp):
-    """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each
-    mode's peak at the step's end; in the tail window each mode's tail amplitude max |q_i|
-    (the step's end, the tail's start inside the step, and an extremum of q_i inside the
-    step, on its own interpolant, unless the mode is `negligible`) and the span's largest deflection at those instants (the
-    tail's start and every mode's extremum: where the span's maximum in time lies, to second
-    order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every mode's
-    interpolant, scratch; qx (N), Qp (2, terms): scratch; basis: the span's (kernels.modes).
-    And where the deflection at the place x* of the largest so far turns inside the step (a
-    crest there that no mode's extremum marks), the span there too. The loads (`_observe_bends`,
-    `_observe_loads`) over the tail window, or over the whole run where `start` marked it so
-    (a sine sweep: their peak over the whole sweep)."""
+    """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each mode's
+    peak at the step's end; in the tail window each mode's tail amplitude max |q_i| (the step's
+    end, the tail's start inside the step, and an extremum of q_i inside the step, on its own
+    interpolant, unless the mode is `negligible`) and the span's largest deflection at those
+    instants (the tail's start and every mode's extremum: where the span's maximum in time lies,
+    to second order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every
+    mode's interpolant, scratch; qx (N), Qp (2, terms): scratch; basis: the span's
+    (kernels.modes). And where the deflection at the place x* of the largest so far turns inside
+    the step (a crest there that no mode's extremum marks), the span there too. The loads
+    (`_observe_bends`, `_observe_loads`) over the tail window, or over the whole run where
+    `start` marked it so (a sine sweep: their peak over the whole sweep)."""
     n = n_modes
     largest = 0.0
     for i in range(n):

@@ -229,14 +229,14 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD):
-    """EV[l] = 1 where lane l's accepted attempt has, in some mode not negligible beside the
-    largest (modal_driver.negligible; BIG: scratch, the largest mode's peak), an extremum of q_n or a
-    divergence (|q_n| > bound, or q_n' not finite), or, ending in the tail window, a crest of
-    the deflection at the place x* of the span's largest (its mode shapes in MOD, as
-    modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV:
-    the basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a
-    maximum of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis'
-    coupling; MOD's shear factor; LD (2, 6): scratch), where the scene observes the loads
+    """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
+    q_n' not finite), or, ending in the tail window, an extremum of q_n in a mode not negligible
+    beside the largest (modal_driver.negligible; BIG: scratch, the largest mode's peak) or a
+    crest of the deflection at the place x* of the span's largest (its mode shapes in MOD, as
+    modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV: the
+    basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a maximum
+    of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis' coupling;
+    MOD's shear factor; LD (2, 6): scratch), where the scene observes the loads
     (settings[LOADS], in MOD): the scalar path's turn; else 0."""
     L = LANES
     for l in range(n_run):

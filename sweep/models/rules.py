@@ -1017,8 +1017,9 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
     elif values["model.modes"] > 1:
         if "solver.method" not in mentioned:
             values["solver.method"] = MULTI_MODE_METHOD
-        together = points_per_basis(values, swept, skip=values["continuation.axis"])
-        if "solver.driver" not in mentioned and together < LANES_LEAST_POINTS:
+        if ("solver.driver" not in mentioned
+                and points_per_basis(values, swept, skip=values["continuation.axis"])
+                < LANES_LEAST_POINTS):
             values["solver.driver"] = "scalar"
     swept = any(d in mentioned for d in SWEEP_KEYS)
     if "solver.t_end" not in mentioned and not swept and not random_scene.is_random(values):
