@@ -5,7 +5,8 @@ What it measures
 In this process (run it with an empty NUMBA_CACHE_DIR: a cold start), `sweep compile`'s
 warm-up of the scene (sweep/warmup.py: the scene on a few of its points, one thread) under
 Numba's compile-event recorder: the wall time, and each compiled function's inclusive compile
-time (its own plus its callees' compiled for it), the longest first, with how many
+time (its own plus its callees' compiled for it) and its own (without them), the longest
+first, with how many
 specialisations of it were compiled.
 
 Command
@@ -43,23 +44,28 @@ def main() -> None:
         warm_up(scene, threads=1)
         total = time.perf_counter() - began
     inclusive: dict[str, float] = collections.defaultdict(float)
+    own: dict[str, float] = collections.defaultdict(float)
     count: collections.Counter = collections.Counter()
-    stack: list[tuple[str, float]] = []
+    stack: list[list] = []      # [name, start, callees' seconds]
     for stamp, ev in recorder.buffer:
         func = ev.data["dispatcher"].py_func
         name = f"{func.__module__.rsplit('.', 1)[-1]}.{func.__qualname__}"
         if ev.is_start:
-            stack.append((name, stamp))
+            stack.append([name, stamp, 0.0])
         else:
-            started_name, started = stack.pop()
-            inclusive[started_name] += stamp - started
+            started_name, started, callees = stack.pop()
+            spent = stamp - started
+            inclusive[started_name] += spent
+            own[started_name] += spent - callees
             count[started_name] += 1
-    rows = [[name, f"{seconds:.1f}", count[name]]
+            if stack:
+                stack[-1][2] += spent
+    rows = [[name, f"{seconds:.1f}", f"{own[name]:.1f}", count[name]]
             for name, seconds in sorted(inclusive.items(), key=lambda kv: -kv[1])[:args.top]]
     print(f"{args.scene}: the warm-up took {total:.1f} s on a cold cache")
     print()
     print(markdown_table(["function (module.name)", "inclusive compile (s)",
-                          "specialisations"], rows))
+                          "own compile (s)", "specialisations"], rows))
     print()
     print("command: NUMBA_CACHE_DIR=$(mktemp -d) PYTHONPATH=. python "
           f"benchmarks/compile_breakdown.py {args.scene} --top {args.top}")

@@ -746,7 +746,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     y = np.empty(dim)
     y_new = np.empty(dim)
     stage = np.empty(dim)
-    acc = np.zeros(tj.SCALAR_SLOTS)
+    acc = tj.new_accumulator(tj.SCALAR_SLOTS)
     buf = tj.new_buffer()
 
     start(row, n, settings, y, K[0], pp, S, T, p1, acc, series, modal, weights, basis, base)
@@ -883,10 +883,12 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
-        first, _, _ = integrate(params[i], n_modes, settings, True, 0.0, 0.0, settings[TOL],
+        # True, as a run-time bool (as solve_point's): integrate compiles once for both
+        track = states[i] == mt.SECOND_PASS
+        first, _, _ = integrate(params[i], n_modes, settings, track, 0.0, 0.0, settings[TOL],
                                 np.empty(0), modal, base, eighth, steady, weights, basis)
         band = settings[TOL] * first[tj.TAIL_AMP]
-        second, _, _ = integrate(params[i], n_modes, settings, True, first[tj.Q], band, 0.0,
+        second, _, _ = integrate(params[i], n_modes, settings, track, first[tj.Q], band, 0.0,
                                  np.empty(0), modal, base, eighth, steady, weights,
                                  basis)
         states[i] = tj.settle(second, reals[i], counts[i])

@@ -29,7 +29,8 @@ An accepted step with anything to locate on a dense output (an extremum of the m
 deflection or of any mode, the tail's start, a time-series sample, a threshold crossing) or a
 divergence goes to the scalar path for that lane alone (`_flagged_lane`): the scalar driver's
 own functions on copies of the lane's columns (the divergence test on every mode,
-modal_driver._observe_modes, trajectory.record_step on the lane's accumulator W[j::LANES]).
+modal_driver._observe_modes, trajectory.record_step on the lane's accumulator W[j::LANES]
+and its Observer row, with the scalar driver's types, so that they compile once for both).
 So do a lane's unusual steps to try (trajectory.next_attempt). A lane whose trajectory ends is
 classified as modal_driver.solve_point does and takes the next point of the block. Set-up
 (f(0), SciPy's initial step) is the scalar driver's arithmetic.
@@ -390,8 +391,8 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, reals, counts,
-               series, modal, final, T, pp, yl, fl, basis, base):
+def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states, reals,
+               counts, series, modal, final, T, pp, yl, fl, basis, base):
     """Give lane j the trajectory of row `point`, set up by the scalar driver's own
     modal_driver.start (f(0), SciPy's initial step, the midspan accumulator, each mode's tail
     amplitude and divergence at t = 0). An invalid row is answered at once
@@ -419,6 +420,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
     p1 = drv.observer_row(row, n)
     for c in range(N_PARAMS):
         P1[c * L + j] = p1[c]
+        P1L[j, c] = p1[c]
     mod = np.empty(MOD.shape[0])
     drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod,
               basis[md.MIDSPAN], basis, base)
@@ -431,7 +433,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, MOD, states, real
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _move_lane(k, i, W, Y, K, MOD, PP, P1, BOUNDS, H):
+def _move_lane(k, i, W, Y, K, MOD, PP, P1, P1L, BOUNDS, H):
     """Lane k's trajectory into the idle lane i: every array that carries a lane's state from
     one attempt to the next (its accumulator, state, stages (K[0] = f(t, y)), modes'
     accumulator, prepared and Observer rows, bound, step); lane k is left idle. A lane's
@@ -450,6 +452,7 @@ def _move_lane(k, i, W, Y, K, MOD, PP, P1, BOUNDS, H):
         PP[c, i] = PP[c, k]
     for c in range(P1.shape[0] // L):
         P1[c * L + i] = P1[c * L + k]
+        P1L[i, c] = P1L[k, c]
     BOUNDS[i] = BOUNDS[k]
     H[i] = H[k]
     H[k] = 0.0
@@ -481,16 +484,16 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, buf, series, i,
-                  track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis,
+def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, buf, series,
+                  i, track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis,
                   Kmid, Qc, base, steady):
     """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
     modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
     by modal_driver._observe_modes, the midspan Observer trajectory.record_step) on copies of
-    the lane's columns. Returns whether the lane moves on to the step's end (False: a mode
-    diverged)."""
-    L = LANES
-    acc = W[j::L]
+    the lane's state columns, its accumulator W[j::LANES] and its Observer row P1L[j] (the
+    scalar driver's types, trajectory.new_accumulator: these compile once for both drivers).
+    Returns whether the lane moves on to the step's end (False: a mode diverged)."""
+    acc = W[j::LANES]
     t = acc[tj.T]
     t_new = acc[tj.T_NEW]
     h = H[j]
@@ -517,8 +520,8 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, bound, weights, b
         Kmid[r, 1] = KM[r, 1, j]
     q_new = drv._project(ynl, weights, 0, n)
     v_new = drv._project(ynl, weights, n, n)
-    tj.record_step(P1, j, L, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
+    tj.record_step(P1L[j], 0, 1, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
+                   track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx,
                       basis, Qc)
     for c in range(MOD.shape[0]):
@@ -568,6 +571,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         MOD[drv.factor_slot(n) + 1, l] = settings[LOADS]     # as modal_driver.start sets it
     PP = np.zeros((md.prepared_size(n), L))
     P1 = np.zeros(N_PARAMS * L)
+    P1L = np.zeros((L, N_PARAMS))       # the same rows, a lane's contiguous (the scalar path)
     FLD = np.zeros((4, nodes, L))
     SC = np.zeros((4, L))
     TT = np.zeros(L)
@@ -622,9 +626,9 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                     point[j] = -1
                 if next_point >= hi:
                     break
-                if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, MOD,
-                              states, reals, counts, series, modal, final, T, pp, yl, fl,
-                              basis, base):
+                if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, P1L,
+                              MOD, states, reals, counts, series, modal, final, T, pp, yl,
+                              fl, basis, base):
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()
                     capacity[j] = bufs[j].shape[0]
@@ -638,7 +642,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         if next_point >= hi:              # draining: pack the running lanes
             n_moves, top = tj.lane_moves(H, top, MOVES)
             for m in range(n_moves):
-                _move_lane(MOVES[m, 0], MOVES[m, 1], W, Y, K, MOD, PP, P1, BOUNDS, H)
+                _move_lane(MOVES[m, 0], MOVES[m, 1], W, Y, K, MOD, PP, P1, P1L, BOUNDS,
+                           H)
                 tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
@@ -662,7 +667,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                 if W[tj.N_EXT * L + j] >= capacity[j]:
                     bufs[j] = tj.with_room(bufs[j], W[j::L])
                     capacity[j] = bufs[j].shape[0]
-                if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1, MOD, BOUNDS[j],
+                if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, BOUNDS[j],
                                  weights, bufs[j], series, point[j], track, thr_rel, eighth,
                                  n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis, Kmid,
                                  Qc, base, steady):

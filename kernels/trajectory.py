@@ -167,6 +167,14 @@ def start(p, o, s, settings, acc, series, parametric, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def new_accumulator(slots):
+    """A zeroed accumulator of `slots` for one trajectory, typed as a strided view (Numba's
+    layout 'A'), as a lanes driver's column W[j::LANES] is: every function that takes an
+    accumulator then compiles once for the scalar and the lanes drivers, not once each."""
+    return np.zeros((slots, 1))[:, 0]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def delay_window(acc, start):
     """A random record's own statistics window: the tail window starts no earlier than
     `start` (s, the row's start-up transient's end), so that a point's statistics depend on

@@ -48,7 +48,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
     """
     rtol = max(settings[RTOL], MIN_RTOL)
-    acc = np.zeros(tj.SCALAR_SLOTS)
+    acc = tj.new_accumulator(tj.SCALAR_SLOTS)
     buf = tj.new_buffer()
     K = np.empty((dop853.N_STAGES_EXTENDED if eighth else 7, 2))   # DOP853: room for the
     Qc = np.empty((2, DENSE_TERMS if eighth else QUARTIC_TERMS))     # dense output's stages
@@ -213,10 +213,12 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
             continue
         p = np.empty(N_PARAMS)
         prepare(params[i], p, 0, 1)
-        first, _ = integrate(p, settings, True, 0.0, 0.0, settings[TOL], np.empty(0), parametric,
-                             base, eighth, steady)
+        # True, as a run-time bool (as solve_point's): integrate compiles once for both
+        track = states[i] == mt.SECOND_PASS
+        first, _ = integrate(p, settings, track, 0.0, 0.0, settings[TOL], np.empty(0),
+                             parametric, base, eighth, steady)
         band = settings[TOL] * first[tj.TAIL_AMP]
-        second, _ = integrate(p, settings, True, first[tj.Q], band, 0.0, np.empty(0), parametric,
+        second, _ = integrate(p, settings, track, first[tj.Q], band, 0.0, np.empty(0), parametric,
                               base, eighth, steady)
         states[i] = tj.settle(second, reals[i], counts[i])
         done += 1
