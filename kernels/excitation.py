@@ -150,6 +150,28 @@ def _signal(t, p, o, s, base):
     return lambda t, p, o, s, base: acceleration(t, p, o, s)
 
 
+def by_kind(sine, record):
+    """One function for compiled code over the excitation kinds: it calls `sine` where the
+    `base` switch (its LAST argument) is True, or None, and `record` where it is an array of
+    records (both with the same arguments), chosen from base's type as the caller compiles.
+    Either may be None: that kind does nothing (the call returns None). So a scene compiles
+    its own kind's code only; a branch on `is_record(base)` would compile both, as Numba types
+    a dead branch's body before it drops it."""
+    def by_kind_call(*args):
+        raise TypeError("kernels.excitation.by_kind functions run only in compiled code")
+
+    @overload(by_kind_call)
+    def _choose(*args):
+        chosen = record if isinstance(args[-1], types.Array) else sine
+        if chosen is None:
+            return lambda *args: None
+        return lambda *args: chosen(*args)
+
+    by_kind_call.__doc__ = (f"{getattr(sine, '__name__', None)} for the sine kinds, "
+                            f"{getattr(record, '__name__', None)} for records (by_kind)")
+    return by_kind_call
+
+
 def is_record(base):
     """Whether the scene's `base` switch is an array of records (the record kind)."""
     return isinstance(base, np.ndarray)

@@ -264,14 +264,17 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def observe_random_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
+def _observe_record_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
     """The record kind's modal statistics of the accepted step [t, t + h] (K: its stages, the
     last f(t + h, y_new)), as trajectory.observe_random's for the midspan: the curvature
     squares at the clamp and midspan (`_observe_bend_squares`) once the step starts in the
-    statistics window, where the scene observes the loads. Nothing for the sine kinds."""
-    if ex.is_record(base):
-        if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
-            _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, basis, modal)
+    statistics window, where the scene observes the loads."""
+    if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
+        _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, basis, modal)
+
+
+# `_observe_record_modes` for a random record, nothing for the sine kinds (not compiled there)
+observe_random_modes = ex.by_kind(None, _observe_record_modes)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -403,6 +403,29 @@ def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _lanes_signal(tt, PP, sc, SC, n_run, base):
+    """SC[2, l] = a_b(tt[l]) (m/s^2) of each lane's excitation block (rows sc + S_EXCITATION..
+    of PP), any kind (kernels.excitation: libm's sine, or a record read lane by lane)."""
+    flat = PP.reshape(PP.size)
+    lanes = PP.shape[1]
+    for l in range(n_run):
+        SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _lanes_sine(tt, PP, sc, SC, n_run, base):
+    """`_lanes_signal` for the lanes' fixed-frequency, fixed-level sine, vectorised
+    (vecmath.fast_sin)."""
+    for l in range(n_run):
+        x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]
+        SC[2, l] = PP[sc + S_BASE_ACCEL, l] * fast_sin(x)
+
+
+# fast True: the vectorised sine, or a record (which has no fast form) lane by lane
+_lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
@@ -450,16 +473,10 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         for l in range(n_run):
             SC[0, l] -= PP[sc + S_TENSION, l] * SC[3, l]
     if base is not None:
-        if fast is None or ex.is_record(base):   # libm, and any excitation (kernels.excitation);
-            flat = PP.reshape(PP.size)           # a record's samples, lane by lane
-            lanes = PP.shape[1]
-            for l in range(n_run):
-                SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes,
-                                         base)
-        else:                           # the lanes: fixed frequency and level, vectorised
-            for l in range(n_run):
-                x = PP[sc + S_BASE_OMEGA, l] * tt[l] + PP[sc + S_BASE_PHASE, l]
-                SC[2, l] = PP[sc + S_BASE_ACCEL, l] * fast_sin(x)
+        if fast is None:
+            _lanes_signal(tt, PP, sc, SC, n_run, base)
+        else:
+            _lanes_fast_signal(tt, PP, sc, SC, n_run, base)
     energy = False                      # some lane's bending terms from the span's energy
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
     for l in range(n_run):

@@ -439,16 +439,35 @@ def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base
     p[o + column * s]: the point's prepared row."""
     if eighth is None:
         dense_coefficients(K, Qc)
-    elif (K.shape[0] == dop853.N_STAGES_EXTENDED and not ex.is_record(base)
-          and settings[RTOL] < dop853.SEVENTH_ORDER_BELOW_RTOL):
-        # fast None: the extra stages evaluate the row's own excitation (a sweep, a level
-        # table, the sweep's end), not the fixed sine the lanes' vector loop assumes.
-        dop853.dense_output(acc[T], acc[Q], acc[V], q_new, v_new, h, p, o, s, K, Qc, None,
-                            parametric, base)
-        acc[RHS_EVALS] += dop853.RHS_DENSE
-    else:
+    elif not _seventh_order(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
         dop853.hermite_coefficients(acc[Q], acc[V], acc[FV], q_new, v_new,
                                     K[fsal_row(K), 1], h, Qc)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _seventh_order_sine(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
+    """DOP853's own seventh-order interpolant into Qc where `interpolant` takes it (the
+    extended K, rtol below dop853.SEVENTH_ORDER_BELOW_RTOL), its three extra right-hand sides
+    counted: returns whether it did. (fast None: the extra stages evaluate the row's own
+    excitation (a sweep, a level table, the sweep's end), not the fixed sine the lanes'
+    vector loop assumes.)"""
+    if not (K.shape[0] == dop853.N_STAGES_EXTENDED
+            and settings[RTOL] < dop853.SEVENTH_ORDER_BELOW_RTOL):
+        return False
+    dop853.dense_output(acc[T], acc[Q], acc[V], q_new, v_new, h, p, o, s, K, Qc, None,
+                        parametric, base)
+    acc[RHS_EVALS] += dop853.RHS_DENSE
+    return True
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _hermite_only(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
+    """A random record's interpolant is always the quintic Hermite (`interpolant`)."""
+    return False
+
+
+# the seventh order for the sine kinds or none; a record never compiles it (excitation.by_kind)
+_seventh_order = ex.by_kind(_seventh_order_sine, _hermite_only)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -822,18 +841,12 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
                                   K[fsal_row(K), 1], t_tail, track, centre, thr_fixed,
                                   thr_rel, True, None, base)
     if base is not None:
-        if acc[ACC_TURN] != 0.0 and not ex.is_record(base):
-            refine_acceleration_peak(acc, 0, 1, p, o, s, base)
+        if acc[ACC_TURN] != 0.0:
+            _refine_sine_peak(acc, 0, 1, p, o, s, base)
         if t < t_tail <= t_new:
             observe_tail_start(acc, p, o, s, t_tail, t, q_old, v_old, fv_old, base)
-        if ex.is_record(base):
-            newest = ACC_SAMPLES + S_A
-            a_new = acc[newest]
-            a_old = acc[ACC_SAMPLES + SAMPLE_SIZE + S_A]     # at t: the step before's end
-            if math.isnan(a_old):
-                a_old = fv_old + base_acceleration(t, p, o, s, None, base)
-            observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new,
-                           K[fsal_row(K), 1], a_old, a_new, has_ext, qe)
+        _observe_record_step(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
+                             v_new, K[fsal_row(K), 1], has_ext, qe, base)
 
     if track and not above:
         xa, xb, side = _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr)
@@ -936,6 +949,26 @@ def _count_crossings(settings, acc, a, b):
         u = settings[LEVEL_0 + k]
         if (a < u <= b) or (a > -u >= b):
             acc[UP_LEVEL + k] += 1.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _record_step_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
+                            v_new, fv_new, has_ext, qe, base):
+    """`observe_random` for record_step's accepted step, with the absolute acceleration at
+    both ends: the newest sample's at t_new, the step before's end at t (evaluated here where
+    there is none)."""
+    a_new = acc[ACC_SAMPLES + S_A]
+    a_old = acc[ACC_SAMPLES + SAMPLE_SIZE + S_A]     # at t: the step before's end
+    if math.isnan(a_old):
+        a_old = fv_old + base_acceleration(t, p, o, s, None, base)
+    observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
+                   a_old, a_new, has_ext, qe)
+
+
+# record_step's kind-specific parts, each compiled only for its own kind (excitation.by_kind):
+# a sine's acceleration peak refined, a record's statistics.
+_refine_sine_peak = ex.by_kind(refine_acceleration_peak, None)
+_observe_record_step = ex.by_kind(None, _record_step_statistics)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
