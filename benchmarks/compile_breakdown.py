@@ -6,8 +6,7 @@ In this process (run it with an empty NUMBA_CACHE_DIR: a cold start), `sweep com
 warm-up of the scene (sweep/warmup.py: the scene on a few of its points, one thread) under
 Numba's compile-event recorder: the wall time, and each compiled function's inclusive compile
 time (its own plus its callees' compiled for it) and its own (without them), the longest
-first, with how many
-specialisations of it were compiled.
+first, with how many specialisations of it were compiled.
 
 Command
 -------

@@ -160,7 +160,9 @@ def by_kind(sine, record):
     def by_kind_call(*args):
         raise TypeError("kernels.excitation.by_kind functions run only in compiled code")
 
-    @overload(by_kind_call)
+    # prefer_literal: the arguments keep their literal types (the switches' True, o, s = 0,
+    # 1), so the call compiles the same specialisation a direct call would
+    @overload(by_kind_call, prefer_literal=True)
     def _choose(*args):
         chosen = record if isinstance(args[-1], types.Array) else sine
         if chosen is None:

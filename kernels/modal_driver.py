@@ -400,7 +400,8 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         largest = max(largest, modal[n + i])
         if t_new >= t_tail:
             modal[i] = max(modal[i], abs(y_new[i]))
-    located = False
+    # a run-time bool, not the literal False: the observers below compile once for both calls
+    located = bool(False)
     if modal[factor_slot(n) + 1] == WHOLE_RUN:
         located = _observe_bends(t, t_new, 0.0, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
                                  Qp, located)

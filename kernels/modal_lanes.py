@@ -530,6 +530,16 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def _refine_marked(W, P1L, n_run, base):
+    """trajectory.refine_marked_lanes on the scalar path's types (a lane's accumulator
+    W[j::LANES], its Observer row P1L[j]), so that the refinement compiles once for both
+    drivers: `refine_acceleration_peak` for each lane that `observe_acceleration` marked."""
+    for j in range(n_run):
+        if W[tj.ACC_TURN * LANES + j] != 0.0:
+            tj.refine_acceleration_peak(W[j::LANES], 0, 1, P1L[j], 0, 1, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, modal, final,
                 base, eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
@@ -659,7 +669,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
             _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
                         basis[md.COUPLING], LD)
         if base is not None and not record:
-            tj.refine_marked_lanes(W, L, P1, 0, n_run)   # ordinary steps' extrema
+            _refine_marked(W, P1L, n_run, base)          # ordinary steps' extrema
         if n_flagged > 0:
             for j in range(n_run):
                 if FLAG[j] != 2.0:
