@@ -240,32 +240,43 @@ def test_sweep_modes_compares_the_bending_at_the_clamp(tmp_path, capsys):
 
 def test_a_sine_sweep_reports_the_loads_peak_over_the_whole_sweep():
     """A logarithmic sweep 40 -> 80 Hz at 60 octaves/min (1 s; the level rising over 10 cycles
-    of 40 Hz, as kernels/excitation.py defines it) on the clamped span at 2 g, three modes:
-    each load's peak over the whole sweep (not a tail window) against SciPy on the textbook
-    modes, the chirp written here from its definition, to 1e-6."""
+    of its start frequency, as kernels/excitation.py defines it) on the clamped span at 2 g,
+    three modes, up and down (direction = "both") in a scene that asks for nothing but the
+    sweep (no [metrics]: the default outputs of a sweep): each load's peak over the whole
+    sweep (not a tail window), for each direction on the `direction` dimension, against SciPy
+    on the textbook modes, the chirp written here from its definition, to 1e-6."""
     from scipy.integrate import solve_ivp
     text = scene_text(modes=3, ratio=1.0, level_g=2.0, t_end=1.0)
     text = text.replace("frequency_ratio = 1.0", "sweep = { start = 40.0, stop = 80.0, "
-                        "rate = 60.0 }").replace("t_end = 1.0\n", "")
-    ds = sweep.run(sweep.load_scene_text(text), progress=False)
+                        "rate = 60.0, direction = \"both\" }").replace("t_end = 1.0\n", "")
+    text = text.replace("[metrics]\ntail = 0.25\n", "")
+    assert "[metrics]" not in text
+    both = sweep.run(sweep.load_scene_text(text), progress=False)
     cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
     omega_n, gamma, mid = _textbook(3, cable)
     shapes = g.clamped_shapes(3, LENGTH)
     free = g.shapes_rhs(cable, shapes, omega_n, tension_stiffness=EA / LENGTH)
-    lam, rise = 60.0 * math.log(2.0) / 60.0, 10.0 / 40.0
+    for direction, start, sign in (("up", 40.0, 1.0), ("down", 80.0, -1.0)):
+        ds = both.sel(direction=direction)
+        lam, rise = sign * 60.0 * math.log(2.0) / 60.0, 10.0 / start
 
-    def chirp(t: float) -> float:
-        ramp = 0.5 - 0.5 * math.cos(math.pi * t / rise) if t < rise else 1.0
-        return 2.0 * 9.80665 * ramp * math.sin(2.0 * math.pi * 40.0 * math.expm1(lam * t) / lam)
+        def chirp(t: float) -> float:
+            ramp = 0.5 - 0.5 * math.cos(math.pi * t / rise) if t < rise else 1.0
+            return (2.0 * 9.80665 * ramp
+                    * math.sin(2.0 * math.pi * start * math.expm1(lam * t) / lam))
 
-    def rhs(t, y):
-        f = free(t, y)
-        f[3:] -= gamma * chirp(t)
-        return f
-    sol = solve_ivp(rhs, (0.0, 1.0), np.zeros(6), method="DOP853", rtol=1e-10, atol=1e-15,
-                    dense_output=True).sol
-    peaks = _peaks_of(sol, 3, shapes, np.linspace(0.0, 1.0, 40001), EA / LENGTH)
-    assert _one(ds, "peak_amplitude") == pytest.approx(peaks["midspan"], rel=1e-6)
-    assert _one(ds, "clamp_moment") / EI == pytest.approx(peaks["clamp_curvature"], rel=1e-6)
-    _check_loads(ds, peaks)
+        def rhs(t, y):
+            f = free(t, y)
+            f[3:] -= gamma * chirp(t)
+            return f
+        sol = solve_ivp(rhs, (0.0, 1.0), np.zeros(6), method="DOP853", rtol=1e-10, atol=1e-15,
+                        dense_output=True).sol
+        peaks = _peaks_of(sol, 3, shapes, np.linspace(0.0, 1.0, 40001), EA / LENGTH)
+        assert _one(ds, "peak_amplitude") == pytest.approx(peaks["midspan"], rel=1e-6)
+        assert _one(ds, "clamp_moment") / EI == pytest.approx(peaks["clamp_curvature"],
+                                                              rel=1e-6)
+        _check_loads(ds, peaks)
+    for name in ("clamp_bending_strain", "clamp_moment", "clamp_force", "axial_tension",
+                 "max_strain"):
+        assert both[name].dims[0] == "direction"
     assert "over the whole sweep" in ds["clamp_force"].attrs["long_name"]

@@ -402,3 +402,12 @@ def test_wide_band_light_damping_against_scipy_quad_with_margin():
             expected = _quad(f, W, omega, c, weights, what)
             got = rnd.linear_mean_square(f, W, omega, c, weights, what=what)
             assert got == pytest.approx(expected, rel=1e-9), (fn, what)
+
+
+def test_an_undamped_random_span_is_refused_by_its_damping():
+    """Without damping the start-up never decays: one line naming cable.damping_ratio (it
+    used to ask for a duration of 'at least inf s')."""
+    import sweep
+    scene = sweep.load_scene("launch-random-gevs", overrides={"cable.damping_ratio": 0.0})
+    text = _user_error("cable.damping_ratio", sweep.run, scene, progress=False)
+    assert "inf" not in text

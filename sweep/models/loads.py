@@ -121,11 +121,14 @@ WHOLE_RUN = 2.0
 
 def observation(scene: Any, swept: bool) -> float:
     """kernels/layout.py's LOADS setting for `scene`: where it gets these outputs (`wanted`)
-    and its amplitude, their peaks over the tail window (TAIL_WINDOW) or, swept, over the
-    whole sweep (WHOLE_RUN); else 0.0, and the kernels skip that work."""
+    and the deflection's peak they go with, their peaks over the tail window (TAIL_WINDOW:
+    with outputs.amplitude) or, swept, over the whole sweep (WHOLE_RUN: with
+    outputs.peak_amplitude, the peak a sweep reports); else 0.0, and the kernels skip that
+    work."""
     membrane = (scene.get("model.membrane") is not None or "membrane" in scene.axes
                 or "membrane" in (scene.points or {}))
-    if not (scene.get("outputs.amplitude") and _wanted(scene.get("clamps.rotation"), membrane)):
+    deflection = "outputs.peak_amplitude" if swept else "outputs.amplitude"
+    if not (scene.get(deflection) and _wanted(scene.get("clamps.rotation"), membrane)):
         return 0.0
     return WHOLE_RUN if swept else TAIL_WINDOW
 

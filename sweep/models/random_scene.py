@@ -313,6 +313,10 @@ def check_duration(t_end: float, startup: float) -> None:
     """Refuse (one line) a run that leaves less than a tenth of itself after the start-up
     transient of its least-damped point (`startup_time`, s): each point's statistics start
     after its own transient (kernels.trajectory.delay_window)."""
+    if not math.isfinite(startup):
+        _fail("scene key 'cable.damping_ratio'", "a random response needs damping: without it "
+              "the start-up transient never decays and the response has no stationary "
+              "statistics", "give a damping ratio above 0, e.g. 0.02")
     if not startup < 0.9 * t_end:
         _fail("scene key 'base.duration'", f"the run ({t_end:g} s) leaves less than a tenth "
               f"of it after the start-up transient has decayed ({startup:.3g} s = "

@@ -79,11 +79,12 @@ _BASE_DERIVED = {
     **{axis: (BY_AXIS[axis].units, BY_AXIS[axis].long_name)
        for axis in ("base_acceleration", "base_acceleration_g", "base_frequency",
                     "base_frequency_ratio")},
-    "linear_amplitude": ("m", "steady midspan amplitude of the linearised span (no load, "
-                              "K3 = K5 = 0), (4/pi) A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2); "
-                              "NaN: unbounded (undamped at resonance)"),
+    "linear_amplitude": ("m", "steady midspan amplitude of the linearised span's first mode "
+                              "(no load, K3 = K5 = 0), Gamma A / sqrt((w1^2 - w^2)^2 + (2 zeta "
+                              "w1 w)^2), Gamma the mode's participation times its midspan value "
+                              "(4/pi for pinned ends); NaN: unbounded (undamped at resonance)"),
     "resonance_amplification": ("1", "linear resonance amplification Q = 1/(2 zeta): peak "
-                                     "amplitude over the quasi-static (4/pi) A / w1^2; NaN: "
+                                     "amplitude over the quasi-static Gamma A / w1^2; NaN: "
                                      "undamped"),
 }
 
@@ -655,7 +656,7 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...], direction
     from . import continuation as ct
     first = results[0]
     solved = {"state", "jump", "modal_amplitude", "max_deflection", "peak_frequency", "envelope",
-              *_REALS, *_COUNTS, *BASE_OUTPUTS}
+              *_REALS, *_COUNTS, *BASE_OUTPUTS, *loads.NAMES}
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
     ds = first.drop_vars(per_point).merge(stacked)
