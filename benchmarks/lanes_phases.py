@@ -45,10 +45,9 @@ HELPER = "#include <stdint.h>\n#include <x86intrin.h>\nuint64_t rdtsc(void) { re
 PHASES = [("        tj.next_attempts(W, L, H, FLAG, settings, n_run)\n", "loop top"),
           ("        _attempt(W, Y, YN, K, ST, TT, H, ERR,", "next attempt, lanes loaded and ended"),
           ("        _control(W, H, ERR, SC, settings, n_run)\n", "attempt (stages, error)"),
-          ("        if not record:                   # (a record's: no events to find, no ordinary "
-           "step)\n", "controller, midspan projection"),
+          ("        _sine_mode_events(", "controller, midspan projection"),
           ("        n_flagged = _finish(", "modes' event test"),
-          ("        if not record:\n            _tail_modes", "_finish"),
+          ("        _sine_tail_modes(", "_finish"),
           ("        if n_flagged > 0:\n", "modes' step-end update, refinement"),
           ("        _advance(Y, YN, K, MOVE, dim, n_stages, n_run)\n",
            "steps handed to the scalar path")]

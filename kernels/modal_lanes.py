@@ -229,7 +229,7 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, an extremum of q_n in a mode not negligible
     beside the largest (modal_driver.negligible; BIG: scratch, the largest mode's peak) or a
@@ -340,7 +340,7 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
@@ -539,6 +539,13 @@ def _refine_marked(W, P1L, n_run, base):
             tj.refine_acceleration_peak(W[j::LANES], 0, 1, P1L[j], 0, 1, base)
 
 
+# The ordinary steps' work, which a random record's steps never do (each goes to the scalar
+# path): compiled for the sine kinds or none only (excitation.by_kind)
+_sine_mode_events = ex.by_kind(_mode_events, None)
+_sine_tail_modes = ex.by_kind(_tail_modes, None)
+_sine_refine_marked = ex.by_kind(_refine_marked, None)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, modal, final,
                 base, eighth, steady, halt):
@@ -660,16 +667,15 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        if not record:                   # (a record's: no events to find, no ordinary step)
-            _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
-                         basis[md.COUPLING], LD)
+        # (a record's steps: no events to find, no ordinary step: the _sine_ functions)
+        _sine_mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
+                          basis[md.COUPLING], LD, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        if not record:
-            _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
-                        basis[md.COUPLING], LD)
-        if base is not None and not record:
-            _refine_marked(W, P1L, n_run, base)          # ordinary steps' extrema
+        _sine_tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
+                         basis[md.COUPLING], LD, base)
+        if base is not None:
+            _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema
         if n_flagged > 0:
             for j in range(n_run):
                 if FLAG[j] != 2.0:
