@@ -298,6 +298,11 @@ def _design(args: argparse.Namespace) -> int:
     if args.refine:
         print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
               f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
+    elif any(v is not None for k, v in criteria.items() if k not in ("min_frequency",
+                                                                    "quantity")):
+        print("interpolated between the grid's lengths, not run there: a response that peaks "
+              "between two of them (a resonance) can put the true limit shorter; --refine "
+              "runs the engine to bracket it")
     if args.output is not None:
         write_netcdf(result, args.output, overwrite=args.overwrite)
         print(f"-> {args.output}")

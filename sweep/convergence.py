@@ -202,6 +202,10 @@ def mode_convergence(source: str, overrides: Mapping[str, Any] | None = None,
     if scene.get("model.kind") != "transverse":
         raise UserError(f"scene '{source}': model.kind = '{scene.get('model.kind')}' has no "
                         "modes to compare (the mode check is for transverse scenes)")
+    if scene.get("model.coefficients") == "paper":
+        raise UserError(f"scene '{source}': model.coefficients = 'paper' is the paper's one-mode "
+                        "Eq.32, so there are no more modes to compare (use model.coefficients "
+                        "= 'consistent' to check the modes)")
     n = n_modes if n_modes is not None else scene.get("model.modes")
     most = int(BY_DOTTED["model.modes"].maximum)
     if not 1 <= n <= most - 2:

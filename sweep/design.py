@@ -385,7 +385,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     title = str(ds.attrs.get("title", ""))
     criteria = "; ".join(
         ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
-        + [f"{name} <= {limit:g} {ds[name].attrs.get('units', '')}".rstrip()
+        + [f"{name} <= {limit:g} {_shown_units(ds[name])}".rstrip()
            if level is None else f"{name} at clearance {level:g} m, mean over the "
            f"realisations, <= {limit:g}" for name, limit, level in limits.values()]
         + (["state not in (" + ", ".join(STATE_FAILURES) + ")"] if "state" in ds else [])
@@ -491,6 +491,12 @@ def _frequency_span(f1: Callable[[float], float], lo: float, hi: float, fmin: fl
         else:
             hi = mid
     return lo
+
+
+def _shown_units(values: xr.DataArray) -> str:
+    """A variable's units as a criterion line shows them: none for a pure number ("1")."""
+    units = values.attrs.get("units", "")
+    return "" if units == "1" else units
 
 
 def _interpolate(la: float, lb: float, va: float, vb: float, limit: float, how: str) -> float:

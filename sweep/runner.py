@@ -201,9 +201,17 @@ def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
                        done=done, partial=partial, unit=unit)
     if options.resume:
         from .execute import DWELLS_DONE
-        partway = sum(int(np.count_nonzero(a[DWELLS_DONE] > 0)) for a in partial.values())
-        sys.stderr.write(f"resumed: {n - computed:,} of {n:,} {unit} were already done, "
-                         f"{computed:,} computed"
+        # a stepped chunk left unfinished kept its lines' progress: whole lines (every dwell
+        # done, as the interrupt's message counted them) and part-way ones
+        whole = partway = 0
+        for a in partial.values():
+            dwells = a["states"].shape[1] if "states" in a else None
+            finished = a[DWELLS_DONE] == dwells if dwells is not None else a[DWELLS_DONE] < 0
+            whole += int(np.count_nonzero(finished))
+            partway += int(np.count_nonzero((a[DWELLS_DONE] > 0) & ~finished))
+        kept = n - computed + whole
+        sys.stderr.write(f"resumed: {kept:,} of {n:,} {unit} were already done, "
+                         f"{n - kept:,} computed"
                          + (f" ({partway:,} of them from where they stopped)" if partway
                             else "") + "\n")
     return outputs

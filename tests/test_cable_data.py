@@ -73,6 +73,38 @@ def test_linear_mass_strings_in_a_scene(text, expected):
     assert scene.get("cable.linear_mass") == pytest.approx(expected, rel=1e-14)
 
 
+@pytest.mark.parametrize("text, expected", [
+    ("0.31515 N m2", 0.31515), ("315150 N mm2", 0.31515), ("315150 N mm**2", 0.31515),
+    ("0.31515 N*m^2", 0.31515), ("45.66 lbf in2", 45.66 * 4.4482216152605 * INCH ** 2)])
+def test_udunits_exponents_read_as_powers(text, expected):
+    """'N m2' as the messages spell the key's unit: a power, not an unknown unit 'm2'."""
+    key = schema.BY_DOTTED["cable.bending_rigidity"]
+    assert to_si("scene key 'cable.bending_rigidity'", key, text) == pytest.approx(expected,
+                                                                                  rel=1e-12)
+
+
+def test_mil_is_a_thousandth_of_an_inch():
+    key = schema.BY_DOTTED["cable.diameter"]
+    assert to_si("scene key 'cable.diameter'", key, "109 mil") == pytest.approx(109e-3 * INCH,
+                                                                               rel=1e-14)
+    assert to_si("scene key 'cable.diameter'", key, "109 mils") == pytest.approx(109e-3 * INCH,
+                                                                                rel=1e-14)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("53,4 g/m", "comma"), ("1,000 g/m", "comma"), ("53.4 g/m 2", "inside its unit"),
+    ("53.4 g/m + 1 g/m", "inside its unit"), ("53.4 g/m - 1 g/m", "inside its unit"),
+    ("2 53.4 g/m", "inside its unit")])
+def test_a_unit_string_is_one_number_and_its_unit_not_arithmetic(text, words):
+    """pint would compute these ('53,4 g/m' as 534 g/m: a European data sheet's decimal comma
+    made the mass 10x): each is refused in one line naming the key."""
+    with pytest.raises(sweep.SceneError) as info:
+        load(f'[cable]\nlinear_mass = "{text}"\nbending_rigidity = 2e-3\n'
+             'axial_rigidity = 1.6e6\n')
+    message = str(info.value)
+    assert "'cable.linear_mass'" in message and words in message and "\n" not in message
+
+
 def test_g_is_standard_gravity_on_acceleration_keys_and_the_gram_elsewhere():
     scene = load('[base]\nacceleration = "0.5 g"\nfrequency = "20 Hz"\n'
                  '[cable]\nlinear_mass = "33.3 g/m"\nbending_rigidity = 2e-3\n'

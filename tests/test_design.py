@@ -168,7 +168,8 @@ def test_strain_and_deflection_criteria_on_a_linear_span_are_the_closed_forms(re
     out = max_span(ds, max_strain=limit)
     assert float(out["max_span"]) == pytest.approx(_strain_reference(limit), rel=2e-3)
     assert str(out["limited_by"].values) == "max_strain"
-    assert f"max_strain <= {limit:g} 1" in out.attrs["criteria"]
+    criteria = out.attrs["criteria"]      # a pure number shows no unit (not "... 1")
+    assert f"max_strain <= {limit:g}" in criteria and f"{limit:g} 1" not in criteria
     deflection = max_span(ds, max_deflection=limit * 10)
     assert float(deflection["max_span"]) == pytest.approx(_amplitude_reference(limit * 10),
                                                           rel=2e-3)
@@ -252,6 +253,17 @@ def test_cli_design_writes_a_cf_clean_file(results, tmp_path, capsys):
     assert float(back["max_span"]) == pytest.approx(l_max_frequency(100.0), rel=1e-6)
     assert str(back["limited_by"].values) == "min_frequency"
     back.close()
+
+
+def test_cli_design_says_when_its_span_is_interpolated(results, capsys):
+    """A response criterion's span is interpolated between grid lengths (a resonance between
+    them can make it unsafe): the command says so and points at --refine; a frequency
+    criterion's log-log interpolation is exact for f1 ~ l^-2 and gets no such line."""
+    _, path = results["coarse"]
+    assert main(["design", str(path), "--max-amplitude", "1e-3"]) == 0
+    assert "--refine" in capsys.readouterr().out
+    assert main(["design", str(path), "--min-frequency", "100"]) == 0
+    assert "--refine" not in capsys.readouterr().out
 
 
 def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, capsys):

@@ -230,7 +230,8 @@ def test_sweep_modes_refuses_what_it_cannot_compare(tmp_path, capsys):
     assert err.count("\n") == 1 and "--tolerance" in err
     assert main(["modes", "paper-fig5"]) == 2          # refused before anything runs
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "model.modes" in err and "paper" in err
+    assert err.count("\n") == 1 and "model.coefficients" in err and "paper" in err
+    assert "model.modes" not in err              # a key the user never set
     assert main(["modes", str(path), "--modes", "11"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--modes 11" in err and "1 to 10" in err

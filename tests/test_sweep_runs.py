@@ -101,6 +101,39 @@ def test_an_interrupted_run_keeps_its_chunks_and_resumes_to_the_same_result(case
         _same(written, whole)
 
 
+def test_a_stepped_resume_counts_the_lines_the_interrupt_kept_whole(tmp_path, monkeypatch,
+                                                                     capsys):
+    """Stopped after the up lines finished and the down lines began (one chunk of 6 lines:
+    3 whole, 3 part-way), the interrupt's count and the resume's agree: 3 of 6 lines were
+    already done (it said 0 of 6 done and 6 computed, the whole ones among those 'from where
+    they stopped'), and the result is the same to the bit as a run never stopped."""
+    import signal
+    scene = sweep.load_scene_text(STEPPED, overrides={"run.threads": 1})
+    whole = sweep.run(scene)
+    real = ex.transverse_chunk
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(args[0].shape[0])
+        out = real(*args, **kwargs)
+        if interrupt and len(calls) == 8:
+            signal.raise_signal(signal.SIGINT)
+        return out
+
+    monkeypatch.setattr(ex, "transverse_chunk", counted)
+    out = tmp_path / "out.nc"
+    interrupt = True
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        sweep.run(scene, output=out)
+    assert "3 of 6 lines are kept whole and 3 part-way" in str(stopped.value)
+    interrupt = False
+    capsys.readouterr()
+    ds = sweep.run(scene, output=out, resume=True)
+    assert ("3 of 6 lines were already done, 3 computed (3 of them from where they stopped)"
+            in capsys.readouterr().err)
+    _same(ds, whole)
+
+
 def test_a_stepped_run_stopped_mid_line_resumes_each_line_from_its_last_dwell(tmp_path,
                                                                              monkeypatch,
                                                                              capsys):

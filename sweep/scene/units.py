@@ -1,6 +1,10 @@
 """Values with units: a scene may write any dimensional number as a string, "33.3 g/m",
 "1.27 mm", "0.5 g", "3.2 lb/kft", "100 Hz", and it is converted here, once, to the key's SI
-unit (the schema's ``units``), before any other check sees it. Plain numbers stay SI.
+unit (the schema's ``units``), before any other check sees it. Plain numbers stay SI. A string
+is one number (a point for decimals) and its unit: a comma, or a number or sign in the unit
+other than an exponent, is refused, not computed ("53,4 g/m" would be 534 g/m to pint).
+UDUNITS' exponents ("N m2", "m s-2") are read as powers, and "mil" is a data sheet's 1/1000
+inch (pint's is an angle).
 
 Where: every float key, the items of "floats" and "pairs" keys (a pair's first item is a
 frequency, Hz), the values of [axes] lists and ranges (start, stop) and of [points] lists.
@@ -128,6 +132,33 @@ def _has_unit(value: Any) -> bool:
     return False
 
 
+_LEADING_NUMBER = re.compile(r"\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?=\s|[^\d.eE]|$)")
+_MIL = re.compile(r"(?<![A-Za-z_])mils?(?![A-Za-z_])")
+_EXPONENT = re.compile(r"(?:\^|\*\*)\s*\(?\s*[+-]?\d+(?:\.\d+)?\s*\)?")
+
+
+def _unit_text(where: str, key: schema.Key, text: str, example: str) -> str:
+    """`text` as pint should read it: one number, then its unit, UDUNITS' exponents ("N m2",
+    "m s-2") written as powers. Refused in one line: a comma (a decimal comma or a thousands
+    separator, which pint would drop: '53,4 g/m' read as 534 g/m), and any number or sign in
+    the unit other than an exponent ('g/m 2', 'g/m + 1 g/m': pint would compute them)."""
+    fix = f"give one number with a point for decimals, then the unit, e.g. {example}"
+    if "," in text:
+        _fail(where, f"{_show(text)} has a comma (a decimal comma or a thousands separator "
+              "reads as another number)", fix)
+    number = _LEADING_NUMBER.match(text)
+    if number is None:
+        return text                      # not a number first: pint's message, below
+    unit = " ".join(f"{m.group(1)} ** {m.group(2)}"
+                    if (m := _UDUNITS_TERM.fullmatch(term)) and m.group(2) else term
+                    for term in text[number.end():].split())
+    unit = _MIL.sub("thou", unit)        # a data sheet's mil, 1/1000 inch (pint's is an angle)
+    if re.search(r"[\d+-]", _EXPONENT.sub("", unit)):
+        _fail(where, f"{_show(text)} has a number or a sign inside its unit (only exponents "
+              "such as m^2, m**2 or m2 may follow the unit)", fix)
+    return f"{number.group(0).strip()} {unit}"
+
+
 def to_si(where: str, key: schema.Key, text: str) -> float:
     """The number a unit string means, in the key's SI unit (schema units); refused in one
     line for a dimensionless key, an unknown unit, or a quantity of another dimension."""
@@ -137,9 +168,10 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     import pint
     registry = _registry()
     acceleration = key.units in ACCELERATION_UNITS
-    parsed_text = _LONE_G.sub("g_0", text) if acceleration else text
     target = _pint_units(key.units)
     example = _EXAMPLES.get(key.units, f"a number with a unit of {key.units}")
+    parsed_text = _unit_text(where, key, text, example)
+    parsed_text = _LONE_G.sub("g_0", parsed_text) if acceleration else parsed_text
     gravity = " ('g' is standard gravity on this key)" if acceleration else ""
     try:
         quantity = registry.Quantity(parsed_text.strip())
