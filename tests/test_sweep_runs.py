@@ -101,32 +101,40 @@ def test_an_interrupted_run_keeps_its_chunks_and_resumes_to_the_same_result(case
         _same(written, whole)
 
 
+class _Dwells:
+    """Counts the stepped chunks' kernel calls (one dwell of the lines in hand each: `calls`
+    holds their line counts) and, while `stop_at` is set, raises SIGINT as Ctrl-C does after
+    that call (the dwell in hand finishes)."""
+
+    def __init__(self, monkeypatch, stop_at: int | None) -> None:
+        import signal
+        self.calls: list[int] = []
+        self.stop_at = stop_at
+        real = ex.transverse_chunk
+
+        def counted(*args, **kwargs):
+            self.calls.append(args[0].shape[0])
+            out = real(*args, **kwargs)
+            if self.stop_at is not None and len(self.calls) == self.stop_at:
+                signal.raise_signal(signal.SIGINT)
+            return out
+        monkeypatch.setattr(ex, "transverse_chunk", counted)
+
+
 def test_a_stepped_resume_counts_the_lines_the_interrupt_kept_whole(tmp_path, monkeypatch,
                                                                      capsys):
     """Stopped after the up lines finished and the down lines began (one chunk of 6 lines:
     3 whole, 3 part-way), the interrupt's count and the resume's agree: 3 of 6 lines were
     already done (it said 0 of 6 done and 6 computed, the whole ones among those 'from where
     they stopped'), and the result is the same to the bit as a run never stopped."""
-    import signal
     scene = sweep.load_scene_text(STEPPED, overrides={"run.threads": 1})
     whole = sweep.run(scene)
-    real = ex.transverse_chunk
-    calls = []
-
-    def counted(*args, **kwargs):
-        calls.append(args[0].shape[0])
-        out = real(*args, **kwargs)
-        if interrupt and len(calls) == 8:
-            signal.raise_signal(signal.SIGINT)
-        return out
-
-    monkeypatch.setattr(ex, "transverse_chunk", counted)
+    dwells = _Dwells(monkeypatch, stop_at=8)
     out = tmp_path / "out.nc"
-    interrupt = True
     with pytest.raises(KeyboardInterrupt) as stopped:
         sweep.run(scene, output=out)
     assert "3 of 6 lines are kept whole and 3 part-way" in str(stopped.value)
-    interrupt = False
+    dwells.stop_at = None
     capsys.readouterr()
     ds = sweep.run(scene, output=out, resume=True)
     assert ("3 of 6 lines were already done, 3 computed (3 of them from where they stopped)"
@@ -141,22 +149,11 @@ def test_a_stepped_run_stopped_mid_line_resumes_each_line_from_its_last_dwell(tm
     outputs, dwells done, the carried state and phases), and --resume goes on from there: it
     solves only the dwells left, and the result is the same to the bit as a run never
     stopped."""
-    import signal
     scene = sweep.load_scene_text(STEPPED, overrides={"run.threads": 1})
     whole = sweep.run(scene)
-    real = ex.transverse_chunk
-    calls = []
-
-    def counted(*args, **kwargs):
-        calls.append(args[0].shape[0])
-        out = real(*args, **kwargs)
-        if interrupt and len(calls) == 4:
-            signal.raise_signal(signal.SIGINT)   # as Ctrl-C: the dwell in hand finishes
-        return out
-
-    monkeypatch.setattr(ex, "transverse_chunk", counted)
+    dwells = _Dwells(monkeypatch, stop_at=4)
+    calls = dwells.calls
     out = tmp_path / "out.nc"
-    interrupt = True
     with pytest.raises(KeyboardInterrupt) as stopped:
         sweep.run(scene, output=out)
     assert not out.exists()
@@ -168,7 +165,7 @@ def test_a_stepped_run_stopped_mid_line_resumes_each_line_from_its_last_dwell(tm
     import shutil
     shutil.copytree(tmp_path / "out.nc.chunks", tmp_path / "kept")
     calls.clear()
-    interrupt = False
+    dwells.stop_at = None
     ds = sweep.run(scene, output=out, resume=True)
     assert calls == [3, 3] + [3] * 6           # the up lines' last 2 dwells, then the down lines
     _same(ds, whole)
