@@ -332,8 +332,10 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
             f"confidence interval (Student's t) of {name}_mean")
     escaped = xr.DataArray((states == km.DIVERGED).reshape(shape), dims=dims)
     data["escape_probability"] = escaped.mean(REALISATION_DIM).assign_attrs(
-        units="1", long_name="fraction of the realisations in which the span escaped "
-        "(diverged) within the run: a softening span's measure, where an RMS means nothing")
+        units="1", long_name="fraction of the realisations in which the span escaped within "
+        "the run: |q| reached the divergence bound (the span length unless "
+        "metrics.divergence_bound says otherwise; a crossing of escape_barrier that comes "
+        "back does not count): a softening span's measure, where an RMS means nothing")
     failed_at = xr.DataArray(reals[:, tk.FAILURE_TIME].reshape(shape), dims=dims)
     data["escape_time_mean"] = failed_at.where(escaped).mean(REALISATION_DIM).assign_attrs(
         units="s", long_name="mean time of escape (divergence) over the realisations that "
