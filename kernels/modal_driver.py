@@ -887,8 +887,7 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
     for i in range(params.shape[0]):
         if states[i] != mt.SECOND_PASS:
             continue
-        # True, as a run-time bool (as solve_point's): integrate compiles once for both
-        track = states[i] == mt.SECOND_PASS
+        track = bool(True)    # a run-time bool, as solve_point's: integrate compiles once
         first, _, _ = integrate(params[i], n_modes, settings, track, 0.0, 0.0, settings[TOL],
                                 np.empty(0), modal, base, eighth, steady, weights, basis)
         band = settings[TOL] * first[tj.TAIL_AMP]

@@ -238,7 +238,8 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, b
     basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a maximum
     of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis' coupling;
     MOD's shear factor; LD (2, 6): scratch), where the scene observes the loads
-    (settings[LOADS], in MOD): the scalar path's turn; else 0."""
+    (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch,
+    read only by excitation.by_kind (`_sine_mode_events`: a record's steps never call this)."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
@@ -346,7 +347,8 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, base):
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
     same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
     their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
-    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch)."""
+    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch). base:
+    read only by excitation.by_kind (`_sine_tail_modes`)."""
     L = LANES
     for i in range(n):
         for l in range(n_run):

@@ -213,8 +213,7 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
             continue
         p = np.empty(N_PARAMS)
         prepare(params[i], p, 0, 1)
-        # True, as a run-time bool (as solve_point's): integrate compiles once for both
-        track = states[i] == mt.SECOND_PASS
+        track = bool(True)    # a run-time bool, as solve_point's: integrate compiles once
         first, _ = integrate(p, settings, track, 0.0, 0.0, settings[TOL], np.empty(0),
                              parametric, base, eighth, steady)
         band = settings[TOL] * first[tj.TAIL_AMP]

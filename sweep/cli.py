@@ -22,7 +22,7 @@ import signal
 import sys
 import time
 import warnings
-from typing import Any, Sequence
+from typing import Sequence
 
 from .errors import CableSweepWarning, UserError, one_line
 from .version import VERSION, package_version  # noqa: F401  (VERSION: re-exported)
@@ -270,7 +270,7 @@ def _modes(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from .design import NO_CRITERION, max_span, refine_span, table
+    from .design import NO_CRITERION, interpolated, max_span, refine_span, table
     from .io import check_output_path, write_netcdf
     from .plot import load_result
     if all(v is None for v in (args.min_frequency, args.max_amplitude, args.max_deflection,
@@ -298,7 +298,7 @@ def _design(args: argparse.Namespace) -> int:
     if args.refine:
         print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
               f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
-    elif _interpolated(result, criteria):
+    elif interpolated(result, criteria):
         print("interpolated between the grid's lengths, not run there: a response that peaks "
               "between two of them (a resonance) can put the true limit shorter; --refine "
               "runs the engine to bracket it")
@@ -306,19 +306,6 @@ def _design(args: argparse.Namespace) -> int:
         write_netcdf(result, args.output, overwrite=args.overwrite)
         print(f"-> {args.output}")
     return 0
-
-
-def _interpolated(result: Any, criteria: dict[str, Any]) -> bool:
-    """Whether some span of a design result lies between two grid lengths, interpolated on a
-    response criterion (a frequency's log-log interpolation is exact; the grid's longest
-    length and a failing shortest one are not interpolated)."""
-    import numpy as np
-    response = any(v is not None for k, v in criteria.items()
-                   if k not in ("min_frequency", "quantity"))
-    limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
-    spans = np.asarray(result["max_span"].values, dtype=float).ravel()
-    return response and bool(np.any((limited != "grid") & (limited != "min_frequency")
-                                    & np.isfinite(spans)))
 
 
 def _compile(args: argparse.Namespace) -> int:

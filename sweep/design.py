@@ -493,6 +493,20 @@ def _frequency_span(f1: Callable[[float], float], lo: float, hi: float, fmin: fl
     return lo
 
 
+def interpolated(result: xr.Dataset, criteria: dict[str, Any]) -> bool:
+    """Whether some span of `max_span`'s result (criteria: its keyword arguments) lies between
+    two grid lengths, interpolated on a response criterion: a resonance between them can put
+    the true limit shorter (`refine_span` runs the engine there). A frequency's log-log
+    interpolation is exact; the grid's longest length and a failing shortest one are not
+    interpolated."""
+    response = any(v is not None for k, v in criteria.items()
+                   if k not in ("min_frequency", "quantity"))
+    limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
+    spans = np.asarray(result["max_span"].values, dtype=float).ravel()
+    return response and bool(np.any((limited != "grid") & (limited != "min_frequency")
+                                    & np.isfinite(spans)))
+
+
 def _shown_units(values: xr.DataArray) -> str:
     """A variable's units as a criterion line shows them: none for a pure number ("1")."""
     units = values.attrs.get("units", "")

@@ -205,8 +205,7 @@ def solve_chunked(options: RunOptions, chunk_fn: Callable[..., dict],
         # done, as the interrupt's message counted them) and part-way ones
         whole = partway = 0
         for a in partial.values():
-            dwells = a["states"].shape[1] if "states" in a else None
-            finished = a[DWELLS_DONE] == dwells if dwells is not None else a[DWELLS_DONE] < 0
+            finished = a[DWELLS_DONE] == a["states"].shape[1]      # (lines, dwells)
             whole += int(np.count_nonzero(finished))
             partway += int(np.count_nonzero((a[DWELLS_DONE] > 0) & ~finished))
         kept = n - computed + whole

@@ -83,6 +83,12 @@ def test_udunits_exponents_read_as_powers(text, expected):
                                                                                   rel=1e-12)
 
 
+def test_udunits_exponents_after_a_slash():
+    key = schema.BY_DOTTED["cable.density"]
+    assert to_si("scene key 'cable.density'", key, "8.9 g/cm3") == pytest.approx(8900.0,
+                                                                                rel=1e-14)
+
+
 def test_mil_is_a_thousandth_of_an_inch():
     key = schema.BY_DOTTED["cable.diameter"]
     assert to_si("scene key 'cable.diameter'", key, "109 mil") == pytest.approx(109e-3 * INCH,

@@ -28,8 +28,8 @@ from .messages import _fail, _show
 
 ACCELERATION_UNITS = ("m s-2", schema.G_UNITS, "m2 s-4 Hz-1", schema.G2_UNITS)
 """Schema units of the keys on which "g" means standard gravity."""
+_UNIT_POWER = re.compile(r"(?<![\w.])([A-Za-z]+)(-?\d+)(?![\w.])")   # m2, s-2 (UDUNITS)
 _LONE_G = re.compile(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])")
-_UDUNITS_TERM = re.compile(r"([A-Za-z]+)(-?\d+)?")
 
 _DIMENSION_NAMES: dict[str, str] = {
     "[length]": "a length", "[mass]": "a mass", "[time]": "a time",
@@ -137,7 +137,7 @@ _MIL = re.compile(r"(?<![A-Za-z_])mils?(?![A-Za-z_])")
 _EXPONENT = re.compile(r"(?:\^|\*\*)\s*\(?\s*[+-]?\d+(?:\.\d+)?\s*\)?")
 
 
-def _unit_text(where: str, key: schema.Key, text: str, example: str) -> str:
+def _unit_text(where: str, text: str, example: str) -> str:
     """`text` as pint should read it: one number, then its unit, UDUNITS' exponents ("N m2",
     "m s-2") written as powers. Refused in one line: a comma (a decimal comma or a thousands
     separator, which pint would drop: '53,4 g/m' read as 534 g/m), and any number or sign in
@@ -149,9 +149,7 @@ def _unit_text(where: str, key: schema.Key, text: str, example: str) -> str:
     number = _LEADING_NUMBER.match(text)
     if number is None:
         return text                      # not a number first: pint's message, below
-    unit = " ".join(f"{m.group(1)} ** {m.group(2)}"
-                    if (m := _UDUNITS_TERM.fullmatch(term)) and m.group(2) else term
-                    for term in text[number.end():].split())
+    unit = _powers(" ".join(text[number.end():].split()))
     unit = _MIL.sub("thou", unit)        # a data sheet's mil, 1/1000 inch (pint's is an angle)
     if re.search(r"[\d+-]", _EXPONENT.sub("", unit)):
         _fail(where, f"{_show(text)} has a number or a sign inside its unit (only exponents "
@@ -170,7 +168,7 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     acceleration = key.units in ACCELERATION_UNITS
     target = _pint_units(key.units)
     example = _EXAMPLES.get(key.units, f"a number with a unit of {key.units}")
-    parsed_text = _unit_text(where, key, text, example)
+    parsed_text = _unit_text(where, text, example)
     parsed_text = _LONE_G.sub("g_0", parsed_text) if acceleration else parsed_text
     gravity = " ('g' is standard gravity on this key)" if acceleration else ""
     try:
@@ -206,21 +204,18 @@ def _dimension_name(dimensionality: Any) -> str:
 
 
 def _pint_units(units: str) -> str:
-    """A schema (UDUNITS) unit string in pint's syntax: "kg m-3" -> "kg * m ** -3"; the keys
+    """A schema (UDUNITS) unit string in pint's syntax: "kg m-3" -> "kg m ** -3"; the keys
     in g -> "g_0" (standard gravity)."""
     if units == schema.G_UNITS:
         return "g_0"
     if units == schema.G2_UNITS:
         return "g_0 ** 2 / Hz"
-    terms = []
-    for term in units.split():
-        match = _UDUNITS_TERM.fullmatch(term)
-        if match is None:
-            terms.append(term)
-        else:
-            name, power = match.groups()
-            terms.append(f"{name} ** {power}" if power else name)
-    return " * ".join(terms)
+    return _powers(units)
+
+
+def _powers(units: str) -> str:
+    """UDUNITS' exponents as pint's powers: "m s-2" -> "m s ** -2", "kg/m3" -> "kg/m ** 3"."""
+    return _UNIT_POWER.sub(r"\1 ** \2", units)
 
 
 @lru_cache(maxsize=1)
