@@ -1,11 +1,12 @@
-"""Random records of several modes on the lock-step lanes against the scalar driver.
+"""Random records on the lock-step lanes against the scalar driver, one mode and several.
 
 What it measures
 ----------------
 The built-in scene launch-random-gevs, one span at one level (--length, --level), --records
 records of the scene's 8 s, model.modes = N for each N in --modes, run.threads = 1, through
 the public API (`sweep.run`), once with solver.driver = "scalar" and once with "lanes" (the
-default with several modes), side by side in one run: the solve's own time (the dataset's
+default where enough points and records fill them, sweep/models/rules.py), side by side in
+one run: the solve's own time (the dataset's
 run_seconds: the kernels, after the records are made) per realisation-second, best of
 --repeats after a first run (compile or cache), and the ratio. Beside it, how far each
 driver's RMS deflection and acceleration lie from the scalar driver's at rtol 1e-9 on the
@@ -17,14 +18,22 @@ moves with the tolerance by ~10 %; only the statistics over records converge, so
 error is the one to read there; on a mildly nonlinear one (--length 0.1 --level -10) each
 record's converges.
 
+With --occupancy: how many trajectories the lanes need to beat the scalar driver (the rules'
+RANDOM_LANES_LEAST_POINTS and RANDOM_ONE_MODE_LANES_LEAST_POINTS): one span at --length and
+--level, 1, 2, 4, 8 and 16 records of --duration s, each N of --modes, both drivers, the
+solve's time (run_seconds, best of --repeats after a first run) and the lanes' share of the
+scalar driver's.
+
 Then the whole built-in scene (9 spans x 2 levels x 8 records of 8 s, its spectra on) on 2
-threads, warm, best of --repeats wall times of `sweep.run`: one mode (the scalar driver, the
-scene as shipped), and --scene-modes modes on each driver.
+threads, warm, best of --repeats wall times of `sweep.run`: one mode (the scene as shipped)
+and --scene-modes modes, each on both drivers.
 
 Command
 -------
-    PYTHONPATH=. python benchmarks/random_lanes.py [--modes 2 3 5] [--records 32]
+    PYTHONPATH=. python benchmarks/random_lanes.py [--modes 1 2 3 5] [--records 32]
         [--repeats 2] [--length 0.15] [--level 0.0] [--scene-modes 3] [--no-scene]
+    PYTHONPATH=. python benchmarks/random_lanes.py --occupancy --modes 1 3 --length 0.1
+        --level -10 [--duration 2.0] [--repeats 3]
 
 Prints a Markdown table to stdout.
 """
@@ -50,11 +59,14 @@ WATCHED = ("rms_deflection", "rms_acceleration_g")
 
 
 def scene(length: float, level: float, records: int, modes: int, driver: str,
-          rtol: float | None = None) -> sweep.Scene:
-    """The built-in scene at one span and level, `records` records, N modes, one thread."""
+          rtol: float | None = None, duration: float | None = None) -> sweep.Scene:
+    """The built-in scene at one span and level, `records` records (of `duration` s, the
+    scene's 8 s by default), N modes, one thread."""
     over = {"axes.length": [length], "axes.base_asd_scale": [level],
             "base.realisations": records, "run.threads": 1, "model.modes": modes,
             "solver.driver": driver, "outputs.response_asd": False}
+    if duration is not None:
+        over["base.duration"] = duration
     if rtol is not None:
         over["solver.rtol"] = rtol
     return sweep.load_scene(SCENE, over)
@@ -70,16 +82,41 @@ def solve(sc: sweep.Scene, repeats: int) -> tuple[float, dict]:
     return best, {k: ds[k].values.ravel() for k in WATCHED}
 
 
+def occupancy(args: argparse.Namespace) -> None:
+    """The lanes' time over the scalar driver's against the number of records (one span)."""
+    rows = []
+    for n in args.modes:
+        for records in (1, 2, 4, 8, 16):
+            t = {driver: solve(scene(args.length, args.level, records, n, driver,
+                                     duration=args.duration), args.repeats)[0]
+                 for driver in ("scalar", "lanes")}
+            rows.append([f"{n}", f"{records}", f"{t['scalar'] * 1e3:.1f}",
+                         f"{t['lanes'] * 1e3:.1f}", f"{t['lanes'] / t['scalar']:.2f}"])
+    print(f"machine: {machine()}\n")
+    print(f"{SCENE}, {args.length * 1e3:g} mm at {args.level:g} dB, records of "
+          f"{args.duration:g} s, one thread, DOP853 at the scene's rtol; the solve's time "
+          f"(run_seconds, best of {args.repeats} after a first run):\n")
+    print(markdown_table(["modes", "records", "scalar ms", "lanes ms", "lanes / scalar"],
+                         rows))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--modes", type=int, nargs="+", default=[2, 3, 5])
+    parser.add_argument("--modes", type=int, nargs="+", default=[1, 2, 3, 5])
     parser.add_argument("--records", type=int, default=32)
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--length", type=float, default=0.15, help="m")
     parser.add_argument("--level", type=float, default=0.0, help="dB")
     parser.add_argument("--scene-modes", type=int, default=3)
     parser.add_argument("--no-scene", action="store_true", help="skip the whole scene's runs")
+    parser.add_argument("--occupancy", action="store_true",
+                        help="the lanes against the scalar driver over 1-16 records, only")
+    parser.add_argument("--duration", type=float, default=2.0,
+                        help="s, each record, with --occupancy")
     args = parser.parse_args()
+    if args.occupancy:
+        occupancy(args)
+        return
     rows = []
     for n in args.modes:
         ref = sweep.run(scene(args.length, args.level, args.records, n, "scalar", 1e-9),
@@ -109,7 +146,8 @@ def main() -> None:
     if args.no_scene:
         return
     rows = []
-    for n, driver in ((1, "scalar"), (args.scene_modes, "scalar"), (args.scene_modes, "lanes")):
+    for n, driver in ((1, "scalar"), (1, "lanes"), (args.scene_modes, "scalar"),
+                      (args.scene_modes, "lanes")):
         sc = sweep.load_scene(SCENE, {"model.modes": n, "solver.driver": driver,
                                       "run.threads": 2})
         sweep.run(sc, progress=False)

@@ -184,3 +184,15 @@ def _is_record(base):
     if isinstance(base, types.Array):
         return lambda base: True
     return lambda base: False
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _true(base):
+    return True
+
+
+record_switch = by_kind(None, _true)
+record_switch.__doc__ = """None for the sine kinds, True for the record kind (an array of
+records as the `base` switch): a switch whose `is None` branches Numba prunes before it
+inlines (a branch on `is_record(base)` is pruned only after, so both sides' inlined code is
+copied and typed)."""

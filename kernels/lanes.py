@@ -41,6 +41,7 @@ import numba as nb
 import numpy as np
 
 from . import dop853
+from . import excitation as ex
 from . import metrics as mt
 from . import stages
 from . import trajectory as tj
@@ -65,7 +66,7 @@ SIMD = 4                # doubles per vector register the loops are rounded to (
 # vectorises across lanes with no run-time alias checks. Rows 0 .. tj.N_SLOTS - 1 are the
 # trajectory's accumulator slots (so W[j::LANES] is lane j's accumulator for the scalar
 # state machine), then the parameter row (oscillator columns), then the attempt's work rows.
-W_P = tj.N_SLOTS                  # parameter column c at row W_P + c (the oscillator's
+W_P = tj.SCALAR_SLOTS             # parameter column c at row W_P + c (the oscillator's
                                   # coefficients divided by -m: see `_load_lane`)
 W_H = W_P + N_PARAMS              # signed step of the attempt (s); 0 for an idle lane
 W_K = W_H + 1                     # stage s, component c at row W_K + 2 s + c (s >= 1)
@@ -121,24 +122,29 @@ def _accel(W, j, t, q, v, parametric, base):
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in
 # the tableau's order, so the loops across the lanes stay vectorised. RK45 sums every entry
 # of its tableau; DOP853 leaves out the zeros of its sparse one. One chain per combination of
-# the System's optional terms (suffix p: parametric, b: base), its right-hand side written
+# the System's optional terms (suffix p: parametric, b: a sine base excitation, r: a random
+# record, the base switch then left an argument: the records), its right-hand side written
 # out for those terms alone: `_attempt` picks one by its switches, in branches on its own
 # arguments, which Numba prunes before it inlines, so it copies only the chain it uses, and
 # only the code of those terms (each copy costs compile time).
+_KINDS = (({"parametric": None, "base": None}, ""), ({"parametric": True, "base": None}, "_p"),
+          ({"parametric": None, "base": True}, "_b"), ({"parametric": True, "base": True}, "_pb"),
+          ({"parametric": None}, "_r"), ({"parametric": True}, "_pr"))
+
+
 def _chains(A, B, C, sums, skip_zeros, name):
     return tuple(stages.make_chain(A, B, C, _accel, sums, skip_zeros, f"{name}{suffix}",
-                                   {"parametric": parametric, "base": base})
-                 for parametric, base, suffix in ((None, None, ""), (True, None, "_p"),
-                                                  (None, True, "_b"), (True, True, "_pb")))
+                                   switches) for switches, suffix in _KINDS)
 
 
-_chain5, _chain5_p, _chain5_b, _chain5_pb = _chains(A, B, C, (E,), False, "rk45_chain")
-_chain8, _chain8_p, _chain8_b, _chain8_pb = _chains(dop853.A, dop853.B, dop853.C,
-                                                    (dop853.E5, dop853.E3), True, "dop853_chain")
+_chain5, _chain5_p, _chain5_b, _chain5_pb, _chain5_r, _chain5_pr = _chains(
+    A, B, C, (E,), False, "rk45_chain")
+_chain8, _chain8_p, _chain8_b, _chain8_pb, _chain8_r, _chain8_pr = _chains(
+    dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "dop853_chain")
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt(W, rtol, n_run, parametric, base):
+def _attempt(W, rtol, n_run, parametric, base, record):
     """One Dormand-Prince attempt in every lane of W: the stages (`_chain5`, from dopri5.A,
     B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
     y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
@@ -154,7 +160,12 @@ def _attempt(W, rtol, n_run, parametric, base):
         h = W[W_H * L + j]
         fq = W[tj.FQ * L + j]
         fv = W[tj.FV * L + j]
-        if parametric is None:
+        if record is not None:
+            if parametric is None:
+                stages_ = _chain5_r(W, j, t, q, v, h, fq, fv, parametric, base)
+            else:
+                stages_ = _chain5_pr(W, j, t, q, v, h, fq, fv, parametric, base)
+        elif parametric is None:
             if base is None:
                 stages_ = _chain5(W, j, t, q, v, h, fq, fv, parametric, base)
             else:
@@ -186,7 +197,7 @@ def _attempt(W, rtol, n_run, parametric, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _attempt8(W, rtol, n_run, parametric, base):
+def _attempt8(W, rtol, n_run, parametric, base, record):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
     (W_K + 12, W_K + 13), stages 1 .. 11 in W_K8 (the seventh-order dense output of a step
@@ -201,7 +212,12 @@ def _attempt8(W, rtol, n_run, parametric, base):
         h = W[W_H * L + j]
         fq = W[tj.FQ * L + j]
         fv = W[tj.FV * L + j]
-        if parametric is None:
+        if record is not None:
+            if parametric is None:
+                stages_ = _chain8_r(W, j, t, q, v, h, fq, fv, parametric, base)
+            else:
+                stages_ = _chain8_pr(W, j, t, q, v, h, fq, fv, parametric, base)
+        elif parametric is None:
             if base is None:
                 stages_ = _chain8(W, j, t, q, v, h, fq, fv, parametric, base)
             else:
@@ -286,6 +302,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     n_flagged = 0
     n_extrema = 0
     n_near = 0
+    record = ex.is_record(base)     # a random record's statistics: every step's (record_step)
     for j in range(n_run):
         t_tail = W[tj.T_TAIL * L + j]         # the lane's own tail window start
         h = W[W_H * L + j]
@@ -307,7 +324,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
         sample = W[tj.SAMPLE * L + j]
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
-        event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
+        event = active & accepted & (extremum | (not bounded) | straddles | due | crosses
+                                     | record)
         done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
         if pi is None:
@@ -485,8 +503,10 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     True for DOP853 (SciPy's controller only). None is a type of its own to Numba, which
     prunes the branches on `pi is None` at compile time: each combination is its own
     specialisation, compiled without the others' code. `base` likewise: None, or True when
-    settings[BASE] is 1 (oscillator's base-excitation switch); `steady` True when
-    settings[STOP_STEADY] is 1 (the early stop, trajectory.record_step).
+    settings[BASE] is 1 (oscillator's base-excitation switch), or the records of a random base
+    acceleration (kernels.excitation's record kind: each lane reads its row's record in its
+    stage chain, and every accepted step goes to record_step for the record's statistics);
+    `steady` True when settings[STOP_STEADY] is 1 (the early stop, trajectory.record_step).
 
     halt (1,): once another thread sets halt[0] != 0 (an interrupt), the call returns after
     the attempt in hand, the rows in flight left unsolved (their `states` untouched; a lane's
@@ -498,6 +518,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     rtol = max(settings[RTOL], MIN_RTOL)
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
+    record = ex.record_switch(base)     # None, or True for records: the attempts' chain
     n_samples = series.shape[1]
     W = np.zeros(W_ROWS * L)
     for j in range(L):
@@ -546,9 +567,9 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         if eighth is None:
-            _attempt(W, rtol, n_run, parametric, base)
+            _attempt(W, rtol, n_run, parametric, base, record)
         else:
-            _attempt8(W, rtol, n_run, parametric, base)
+            _attempt8(W, rtol, n_run, parametric, base, record)
         if pi is not None:
             _pi_factors(W, n_run)
         n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth,

@@ -113,7 +113,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
     for its response envelope and durations (n,), each point's end time (s; `swept_settings`).
     records: a random base acceleration's (R, 2, N) records, which the kernels take as their
-    `base` switch (kernels.excitation's record kind; the scalar driver only).
+    `base` switch (kernels.excitation's record kind), on either driver.
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
@@ -134,7 +134,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     if constant and (np.any(params[:, osc.K1] != 0.0) or np.any(params[:, osc.G1] != 0.0)):
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
     parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
-    base = _random_base(records, driver, base, lanes_take_records=False)
+    base = _random_base(records, base)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept:
@@ -198,8 +198,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         from sweep.kernels import modal_lanes as kernel
     else:
         kernel = modal_driver
-    base = _random_base(records, driver, True if settings[tk.BASE] != 0.0 else None,
-                        lanes_take_records=True)
+    base = _random_base(records, True if settings[tk.BASE] != 0.0 else None)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept and driver != "scalar":
@@ -233,15 +232,11 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
                tick=watch.ticker(), lanes=driver == "lanes")
 
 
-def _random_base(records: np.ndarray | None, driver: str, base: bool | None,
-                 lanes_take_records: bool) -> Any:
-    """The kernels' `base` switch: the records of a random base acceleration (the scalar
-    driver, or the lanes where they take records: the multi-mode System's), else `base` as
-    it is (None or True: a sine kind)."""
+def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
+    """The kernels' `base` switch: the records of a random base acceleration (every driver
+    takes them), else `base` as it is (None or True: a sine kind)."""
     if records is None:
         return base
-    if driver != "scalar" and not lanes_take_records:
-        raise ValueError("a random base acceleration of one mode takes driver 'scalar'")
     return np.ascontiguousarray(records, dtype=np.float64)
 
 

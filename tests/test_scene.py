@@ -897,7 +897,14 @@ def test_harness_clamps_runs_on_the_scalar_driver():
 
 @pytest.mark.parametrize("overrides, expected", [
     ({"model.modes": 3}, "lanes"),                       # 9 spans x 2 levels x 8 records a basis
-    ({"model.modes": 1}, "scalar"),                      # one mode: always the scalar driver
+    ({"model.modes": 1}, "lanes"),                       # one mode: 9 x 2 x 8 in one call
+    ({"model.modes": 1, "base.realisations": 1, "axes.length": [0.1],
+      "axes.base_asd_scale": [0.0]}, "scalar"),          # one trajectory
+    ({"model.modes": 1, "base.realisations": 2, "axes.length": [0.1],
+      "axes.base_asd_scale": [0.0]}, "lanes"),           # two
+    ({"model.modes": 1, "base.realisations": 1, "axes.length": [0.1],
+      "axes.base_asd_scale": [0.0], "clamps.rotation": "elastic", "cable.diameter": "3 mm",
+      "axes.clamp_rotational_stiffness": [1.0, 2.0]}, "lanes"),  # elastic: still one call
     ({"model.modes": 3, "base.realisations": 1, "axes.length": [0.1]}, "scalar"),   # 2 records
     ({"model.modes": 3, "base.realisations": 4}, "lanes"),                          # 9 x 2 x 4
     ({"model.modes": 3, "base.realisations": 1, "clamps.rotation": "elastic",

@@ -104,10 +104,6 @@ def check(given: dict[str, Any], axes: Mapping[str, Any]) -> None:
     for dotted, why, fix in refused:
         if given.get(dotted) not in (None, False):
             _fail(f"scene key '{dotted}'", f"{why} ({key} is a random base acceleration)", fix)
-    if given.get("solver.driver") == "lanes" and given.get("model.modes", 1) == 1:
-        _fail("scene key 'solver.driver'", "a random base acceleration of one mode is solved "
-              "by the 'scalar' driver only (the one-mode lanes take a fixed sine)",
-              "remove solver.driver, or give model.modes >= 2 (their lanes take records)")
     duration = given["base.duration"]
     t_end = given.get("solver.t_end")
     if t_end is not None and t_end > duration:
@@ -151,15 +147,15 @@ def _check_sampling(given: Mapping[str, Any], key: str) -> None:
 
 
 def defaults(values: dict[str, Any], mentioned: set[str]) -> None:
-    """A random scene's defaults: its level 0 dB, one record, seed 0, the lanes driver with
-    several modes (their lanes take records: 1.9-2.6x the scalar driver's speed, measured in
-    benchmarks/RESULTS.md) and the scalar driver with one, DOP853 at rtol DEFAULT_RTOL, t_end
+    """A random scene's defaults: its level 0 dB, one record, seed 0, the lanes driver (they
+    take records: 1.9-2.6x the scalar driver's speed with several modes, about 1.8x with one,
+    measured in benchmarks/RESULTS.md; rules.py keeps the scalar driver where too few points
+    and records would fill them), DOP853 at rtol DEFAULT_RTOL, t_end
     the record's length, the statistics over the whole record after its start-up transient
     (metrics.tail 1), and no settling time or response period (they mean nothing for a random
     response)."""
-    driver = "lanes" if values.get("model.modes", 1) >= 2 else "scalar"
     for dotted, value in (("base.asd_scale", 0.0), ("base.realisations", 1), ("base.seed", 0),
-                          ("solver.driver", driver), ("solver.method", "dop853"),
+                          ("solver.driver", "lanes"), ("solver.method", "dop853"),
                           ("solver.rtol", DEFAULT_RTOL),
                           ("solver.t_end", values["base.duration"]), ("metrics.tail", 1.0),
                           ("outputs.settling_time", False),

@@ -157,6 +157,11 @@ RANDOM_LANES_LEAST_POINTS = 8
 accepted step of a record goes to the lanes' scalar path, so they need more company. Measured
 (elastic clamps, 3 modes, one basis a span, 2 s GEVS records, one thread): the lanes took 2.79x
 the scalar driver's time with 1 record a basis, 1.23x with 4, 0.77x with 8."""
+RANDOM_ONE_MODE_LANES_LEAST_POINTS = 2
+"""The same for a random scene of one mode (no basis: one kernel call takes every point),
+counting each record as a point. Measured (benchmarks/random_lanes.py --one-mode, GEVS at
+-10 dB on a 100 mm span, 2 s records, one thread): the lanes took 1.34x the scalar driver's
+time with 1 record, 0.99x with 2, 0.63x with 4, 0.55x with 8."""
 BASIS_KEYS_EXEMPT = frozenset({"cable.damping_ratio", "cable.density", "cable.linear_mass"})
 """cable.* keys that do not move K = k_t l / EI (every other cable key may: the length and
 the cable's bending rigidity, however it is given)."""
@@ -1005,14 +1010,18 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
                          mentioned: set[str], swept: Swept) -> None:
     """solver.t_end 5 s, DOP853 for several modes (MULTI_MODE_METHOD) and the scalar driver
     where fewer than LANES_LEAST_POINTS points share a basis (RANDOM_LANES_LEAST_POINTS
-    records for a random scene), and the paper preset's initial.velocity without an initial
-    condition."""
+    points x records for a random scene, RANDOM_ONE_MODE_LANES_LEAST_POINTS with one mode),
+    and the paper preset's initial.velocity without an initial condition."""
     _shared_defaults(values, mentioned)
     if random_scene.is_random(values):
         random_scene.defaults(values, mentioned)
-        if (values["model.modes"] > 1 and "solver.driver" not in mentioned
-                and points_per_basis(values, swept) * values["base.realisations"]
-                < RANDOM_LANES_LEAST_POINTS):
+        if values["model.modes"] > 1:
+            least, points = RANDOM_LANES_LEAST_POINTS, points_per_basis(values, swept)
+        else:       # one mode: every point in one call, whatever the clamps
+            least = RANDOM_ONE_MODE_LANES_LEAST_POINTS
+            points = points_per_basis({**values, "clamps.rotation": "pinned"}, swept)
+        if ("solver.driver" not in mentioned
+                and points * values["base.realisations"] < least):
             values["solver.driver"] = "scalar"
     elif values["model.modes"] > 1:
         if "solver.method" not in mentioned:
