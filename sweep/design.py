@@ -21,7 +21,8 @@ margin of the criterion that binds. A length fails when
   deflection| (`peak_deflection_mean`, m) is above the limit;
 * ``clearance`` (a random result with outputs.clearance): the probability that |midspan
   deflection| exceeds the clearance level at least once in the test (`exceedance_probability`
-  at that `clearance` level, mean over the realisations, 1) is above ``max_probability``
+  at that `clearance` level, from the crossing rate pooled over the realisations, 1) is above
+  ``max_probability``
   (0.01 by default);
 * ``state``: its `state` is a failure (invalid_input, diverged, step_size_too_small,
   max_steps_reached);
@@ -313,7 +314,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         the realisations of the largest |midspan deflection|, is at most this.
     clearance : m, one of a random result's `clearance` levels (outputs.clearance); a length
         passes when `exceedance_probability` there (that |midspan deflection| exceeds it at
-        least once in the test), mean over the realisations, is at most `max_probability`.
+        least once in the test, from the crossing rate pooled over the realisations) is at
+        most `max_probability`.
     max_probability : 1, below 1; the clearance criterion's limit (needs clearance; default
         0.01, i.e. 1 %).
 
@@ -386,8 +388,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     criteria = "; ".join(
         ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
         + [f"{name} <= {limit:g} {_shown_units(ds[name])}".rstrip()
-           if level is None else f"{name} at clearance {level:g} m, mean over the "
-           f"realisations, <= {limit:g}" for name, limit, level in limits.values()]
+           if level is None else f"{name} at clearance {level:g} m (pooled over the "
+           f"realisations) <= {limit:g}" for name, limit, level in limits.values()]
         + (["state not in (" + ", ".join(STATE_FAILURES) + ")"] if "state" in ds else [])
         + (["growth_rate <= 0 (stable)"] if "stability" in ds else []))
     from .version import package_version
@@ -429,8 +431,9 @@ def _worst(var: xr.DataArray, how: str) -> xr.DataArray:
 
 def _limited(ds: xr.Dataset, name: str, level: float | None) -> xr.DataArray:
     """The value an upper-limit criterion compares with its limit: `name` at its worst over
-    direction and realisation, or at the `clearance` level (m) the mean over the realisations
-    of the finite values (a realisation that escaped has none, and fails `state`)."""
+    direction and realisation, or at the `clearance` level (m): the pooled probability (a
+    result written before it was pooled holds one per realisation: their mean over the finite
+    values; a realisation that escaped has none, and fails `state`)."""
     var = ds[name]
     if level is None:
         return _worst(var, "max")

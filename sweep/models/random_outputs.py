@@ -6,9 +6,10 @@ name) plus what is made from them over the realisations.
 Per grid point and realisation, over the statistics window (the record after the start-up
 transient, sweep/models/random_scene.py): the RMS midspan deflection, velocity and absolute
 acceleration, the up-crossing rate of zero, the peak |deflection| (`peak_deflection`), the peak
-factor, and with outputs.clearance each level's up-crossing rate by |q|, the expected number of
-exceedances in the test and the probability of at least one (Poisson: 1 - exp(-nu T)). Over
-the realisations: the mean of each statistic with a 95 % confidence half-width (Student's t),
+factor, and with outputs.clearance each level's up-crossing rate by |q|. Over the
+realisations: each level's crossings pooled (`pooled_crossings`), the expected number of
+exceedances in the test and the probability of at least one (Poisson: 1 - exp(-nu T)) from
+the pooled rate nu; the mean of each statistic with a 95 % confidence half-width (Student's t),
 the escape probability (the fraction of realisations that diverged: a softening span has no
 stationary RMS), and beside them the exact linear RMS of the same span (stretching and end
 load off) and the realised and specified grms of the input.
@@ -295,6 +296,20 @@ def realised_grms(records: np.ndarray, random: RandomInputs) -> np.ndarray:
     return np.sqrt(np.mean(run * run, axis=1)) / STANDARD_GRAVITY
 
 
+def pooled_crossings(rate: xr.DataArray, window: xr.DataArray, kept: xr.DataArray
+                     ) -> tuple[xr.DataArray, xr.DataArray]:
+    """(crossings counted, s of window observed): each realisation's up-crossing `rate` (1/s)
+    times its statistics `window` (s), summed over the realisations where `kept`, and those
+    windows' total. Their ratio is the rate of the stationary response over every record
+    at once: a level that few records cross is estimated from all of them, where each
+    record's own 1 - exp(-rate T) (0 where its window saw no crossing) averaged over the
+    records underestimates the probability of a rare exceedance (Jensen's inequality)."""
+    usable = kept & np.isfinite(rate) & np.isfinite(window)
+    counted = np.rint(rate * window).where(usable, 0.0).sum(REALISATION_DIM)
+    observed = window.where(usable, 0.0).sum(REALISATION_DIM)
+    return counted, observed
+
+
 def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
             shape: tuple[int, ...], coords: dict[str, xr.DataArray], random: RandomInputs,
             coeffs: dict[str, Any], params: dict[str, Any], records: np.ndarray, basis: Any,
@@ -352,14 +367,23 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
         data["clearance_upcrossing_rate"] = rate.assign_attrs(
             units="s-1", long_name="up-crossings of the clearance level by |midspan "
             "deflection| per second over the statistics window")
-        expected = rate * random.test_duration
+        counted, observed = pooled_crossings(rate, data["statistics_window"], ~escaped)
+        data["clearance_upcrossings"] = counted.assign_attrs(
+            units="1", long_name="up-crossings of the clearance level by |midspan deflection| "
+            "counted over the statistics windows of the realisations that did not escape (the "
+            "count behind expected_exceedances: its relative standard error is about "
+            "1 / sqrt(count))")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            expected = counted / observed * random.test_duration
         data["expected_exceedances"] = expected.assign_attrs(
             units="1", long_name=f"expected number of exceedances of the clearance level in "
-            f"the test ({random.test_duration:g} s): the measured rate times its duration")
+            f"the test ({random.test_duration:g} s): the up-crossing rate pooled over the "
+            "realisations that did not escape (clearance_upcrossings over their windows' "
+            "total length) times the test's duration")
         data["exceedance_probability"] = (1.0 - np.exp(-expected)).assign_attrs(
             units="1", long_name="probability that |midspan deflection| exceeds the "
             "clearance level at least once in the test, 1 - exp(-expected_exceedances) "
-            "(Poisson crossings, Rice)")
+            "(Poisson crossings, Rice), from the pooled rate")
     curvatures = None
     if n_modes != 1 and loads:
         from .loads import strain_per_curvature

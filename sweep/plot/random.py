@@ -167,8 +167,8 @@ def plot_peak(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
 def plot_exceedance(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
                     ax: Axes | None = None) -> Figure:
     """The probability that |midspan deflection| exceeds each clearance level at least once
-    in the test (`exceedance_probability`, 1: the mean over the realisations that did not
-    escape) against the swept axis: one colour per clearance level (m, shown in mm), one line
+    in the test (`exceedance_probability`, 1: from the crossing rate pooled over the
+    realisations that did not escape) against the swept axis: one colour per clearance level (m, shown in mm), one line
     style per value of at most one other swept axis. Returns the Figure."""
     if CLEARANCE_DIM not in ds.dims:
         raise UserError("the result has no clearance levels (give outputs.clearance)")
@@ -196,7 +196,7 @@ def plot_exceedance(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     ax.set_ylim(-0.02, 1.02)
     return _finish(ax, ds, x, "exceedance_probability",
                    "probability of exceeding the clearance in the test",
-                   f"clearance exceedance, mean of {_records(ds)}", handles)
+                   f"clearance exceedance, pooled over {_records(ds)}", handles)
 
 
 def peak_factors(ds: xr.Dataset) -> np.ndarray:

@@ -59,9 +59,10 @@ _OVER_AXES = ("amplitude", "settling_time", "peak_end_displacement", "dynamic_am
               "rms_deflection_mean", "rms_deflection_ci", "peak_deflection_mean",
               "peak_deflection_ci", "rms_acceleration_g_mean", "rms_acceleration_g_ci",
               "peak_factor_mean", "peak_factor_ci", "escape_probability", "linear_rms")
-# A random result's clearance statistics: over the swept axes, the realisations and CLEARANCE_DIM.
-_OVER_CLEARANCE = ("clearance_upcrossing_rate", "expected_exceedances",
-                   "exceedance_probability")
+# A random result's clearance statistics: over the swept axes, the realisations and CLEARANCE_DIM
+# (those of _POOLED without the realisations: each made from every record's crossings at once).
+_POOLED = ("clearance_upcrossings", "expected_exceedances", "exceedance_probability")
+_OVER_CLEARANCE = ("clearance_upcrossing_rate", *_POOLED)
 # A stability result's flags (outputs.stability): CF flags like `state`'s, over the swept axes.
 # With the time-domain outputs off a result has no `state`: `stability` stands in for it.
 STABILITY = "stability"
@@ -357,7 +358,8 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
         da = ds[name]
         if da.dtype.kind not in "iuf":
             raise _refuse(where, f"variable '{name}' holds {da.dtype}, not numbers")
-        extra = [d for d in da.dims if d not in axes and d != DIRECTION_DIM]
+        own = [d for d in axes if d != REALISATION_DIM] if name in _POOLED else axes
+        extra = [d for d in da.dims if d not in own and d != DIRECTION_DIM]
         if name in _HISTORIES:
             expected = [d for d in _TIME_DIMS if d in da.dims][:1]
         elif name in _SNAPSHOTS:
@@ -366,10 +368,10 @@ def check_result(ds: xr.Dataset, where: str = "the result") -> None:
             expected = [CLEARANCE_DIM]
         else:
             expected = []
-        if sorted(extra) != sorted(expected) or (expected and len(da.dims) != len(axes) + len(
+        if sorted(extra) != sorted(expected) or (expected and len(da.dims) != len(own) + len(
                 expected)):
-            want = ", ".join(axes + (expected or ([_TIME_DIMS[0]] if name in _HISTORIES
-                                                  else [])))
+            want = ", ".join(own + (expected or ([_TIME_DIMS[0]] if name in _HISTORIES
+                                                 else [])))
             raise _refuse(where, f"variable '{name}' lies over ({', '.join(map(str, da.dims))})"
                                  f", not over ({want})")
         for dim in expected:
