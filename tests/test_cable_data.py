@@ -97,6 +97,34 @@ def test_mil_is_a_thousandth_of_an_inch():
                                                                                 rel=1e-14)
 
 
+@pytest.mark.parametrize("text, hertz", [
+    ("20 rad/s", 20.0 / (2.0 * math.pi)), ("1200 rpm", 20.0), ("20 cycles/s", 20.0),
+    ("360 deg/s", 1.0), ("20 Hz", 20.0), ("0.02 kHz", 20.0), ("1200 /min", 20.0)])
+def test_an_angle_per_time_on_a_frequency_key_is_read_in_cycles(text, hertz):
+    """pint takes the radian for a pure number: "20 rad/s" was 20 Hz and "1200 rpm" 125.7 Hz,
+    2 pi off without a word. A frequency key reads an angle per time in cycles; a plain 1/s
+    stays as it is."""
+    key = schema.BY_DOTTED["base.frequency"]
+    assert to_si("scene key 'base.frequency'", key, text) == pytest.approx(hertz, rel=1e-14)
+
+
+def test_an_angle_where_the_key_has_none_is_refused_and_data_sheet_spellings_read():
+    """An octave rate given in rpm is refused in one line; "oct/min" (a sweep rate as a test
+    specification writes it) and "Nm" (pint's "number metre") read as meant."""
+    rate = schema.BY_DOTTED["base.sweep.rate"]
+    with pytest.raises(sweep.SceneError) as info:
+        to_si("scene key 'base.sweep.rate'", rate, "2 rpm")
+    assert "holds an angle" in str(info.value) and "\n" not in str(info.value)
+    assert to_si("scene key 'base.sweep.rate'", rate, "2 oct/min") == 2.0
+    assert to_si("scene key 'base.sweep.rate'", rate, "3 octaves/min") == 3.0
+    spring = schema.BY_DOTTED["clamps.rotational_stiffness"]
+    assert to_si("k", spring, "0.5 Nm/rad") == pytest.approx(0.5, rel=1e-14)
+    assert to_si("k", spring, "0.5 N m/deg") == pytest.approx(0.5 * 180.0 / math.pi,
+                                                              rel=1e-14)
+    bending = schema.BY_DOTTED["cable.bending_rigidity"]
+    assert to_si("k", bending, "0.31515 Nm^2") == pytest.approx(0.31515, rel=1e-14)
+
+
 @pytest.mark.parametrize("text, words", [
     ("53,4 g/m", "comma"), ("1,000 g/m", "comma"), ("53.4 g/m 2", "inside its unit"),
     ("53.4 g/m + 1 g/m", "inside its unit"), ("53.4 g/m - 1 g/m", "inside its unit"),

@@ -4,7 +4,9 @@ unit (the schema's ``units``), before any other check sees it. Plain numbers sta
 is one number (a point for decimals) and its unit: a comma, or a number or sign in the unit
 other than an exponent, is refused, not computed ("53,4 g/m" would be 534 g/m to pint).
 UDUNITS' exponents ("N m2", "m s-2") are read as powers, and "mil" is a data sheet's 1/1000
-inch (pint's is an angle).
+inch (pint's is an angle), "Nm" a newton metre (pint's is a "number metre"), and a sweep rate
+may say "oct/min" (pint's octave is a level ratio). An angle per time on a frequency key is read in cycles ("20 rad/s"
+is 20 / 2 pi Hz, "1200 rpm" 20 Hz), where pint would take the radian for a pure number.
 
 Where: every float key, the items of "floats" and "pairs" keys (a pair's first item is a
 frequency, Hz), the values of [axes] lists and ranges (start, stop) and of [points] lists.
@@ -134,6 +136,8 @@ def _has_unit(value: Any) -> bool:
 
 _LEADING_NUMBER = re.compile(r"\s*[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?=\s|[^\d.eE]|$)")
 _MIL = re.compile(r"(?<![A-Za-z_])mils?(?![A-Za-z_])")
+_NEWTON_METRE = re.compile(r"(?<![A-Za-z_])Nm(?![A-Za-z_])")   # a data sheet's "Nm", "Nm^2"
+_OCTAVES = re.compile(r"(?<![A-Za-z_])oct(?:ave)?s?(?![A-Za-z_])")
 _EXPONENT = re.compile(r"(?:\^|\*\*)\s*\(?\s*[+-]?\d+(?:\.\d+)?\s*\)?")
 
 
@@ -151,6 +155,7 @@ def _unit_text(where: str, text: str, example: str) -> str:
         return text                      # not a number first: pint's message, below
     unit = _powers(" ".join(text[number.end():].split()))
     unit = _MIL.sub("thou", unit)        # a data sheet's mil, 1/1000 inch (pint's is an angle)
+    unit = _NEWTON_METRE.sub("N m", unit)    # pint's Nm is a "number metre"
     if re.search(r"[\d+-]", _EXPONENT.sub("", unit)):
         _fail(where, f"{_show(text)} has a number or a sign inside its unit (only exponents "
               "such as m^2, m**2 or m2 may follow the unit)", fix)
@@ -170,6 +175,8 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     example = _EXAMPLES.get(key.units, f"a number with a unit of {key.units}")
     parsed_text = _unit_text(where, text, example)
     parsed_text = _LONE_G.sub("g_0", parsed_text) if acceleration else parsed_text
+    if key.units == "min-1":             # a sweep rate in octaves per minute: "2 oct/min"
+        parsed_text = _OCTAVES.sub("", parsed_text)
     gravity = " ('g' is standard gravity on this key)" if acceleration else ""
     try:
         quantity = registry.Quantity(parsed_text.strip())
@@ -184,6 +191,7 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
               f"give a number and a unit of {key.units}, e.g. {example}{gravity}")
     if not isinstance(quantity, registry.Quantity):    # a bare number parses as a float
         quantity = registry.Quantity(quantity)
+    quantity = _cycles(where, key, text, quantity, target, registry)
     try:
         value = float(quantity.to(target).magnitude)
     except pint.errors.DimensionalityError:
@@ -196,6 +204,28 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
               f"give e.g. {example}")
     # 15 significant digits: '33.3 g/m' is 0.0333, not 33.3 x 0.001 = 0.033299999999999996
     return float(f"{value:.15g}")
+
+
+def _cycles(where: str, key: schema.Key, text: str, quantity: Any, target: str,
+            registry: Any) -> Any:
+    """`quantity` with its angle read as pint cannot: pint takes the radian for a pure number,
+    so "20 rad/s" would be 20 Hz and "20 rpm" 2.09 Hz (2 pi off, silently). A frequency key
+    (Hz) given an angle per time is read as cycles: "20 rad/s" is 20 / (2 pi) Hz, "1200 rpm"
+    20 Hz, "20 cycles/s" 20 Hz. Any other key given an angle its unit does not hold ("2 rpm"
+    as an octave rate) is refused; one written without the angle its unit holds ("0.5 N m"
+    for N m/rad) is read with it, as pint does."""
+    def radians(q: Any) -> float:
+        return dict(q.to_root_units().unit_items()).get("radian", 0)
+
+    have = radians(quantity)
+    want = radians(registry.Quantity(1.0, target))
+    if have == 0 or have == want:
+        return quantity
+    if key.units == "Hz" and have == 1:
+        return (quantity.to("radian / second") / (2.0 * 3.141592653589793)
+                / registry.radian)
+    _fail(where, f"{_show(text)} holds an angle, the key takes {key.units}",
+          f"give e.g. {_EXAMPLES.get(key.units, f'a number with a unit of {key.units}')}")
 
 
 def _dimension_name(dimensionality: Any) -> str:
