@@ -18,7 +18,7 @@ import pytest
 
 import sweep
 from sweep.errors import SceneError
-from sweep.models import modal
+from sweep.models import loads, modal
 
 import galerkin as g
 from test_clamps import EI, LENGTH, ZETA, _linear_midspan, _one, _textbook, scene, scene_text
@@ -203,6 +203,23 @@ def test_pinned_clamps_bend_nothing_and_the_paper_membrane_takes_no_diameter():
         sweep.load_scene_text(text.replace("[cable]", "[cable]\ndiameter = 0.004"),
                               overrides={"model.membrane": 0.375})
     assert "cable.diameter" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_the_paper_preset_reports_no_loads_of_a_tension_it_does_not_integrate():
+    """model.coefficients = 'paper' is Eq.32 as printed, whose numbers hold the paper's local
+    membrane term (alpha = 3/8), not the uniform tension the loads are made from: paper-fig5
+    reported axial_tension, clamp_force and strains of a model it did not run (a reviewer's
+    finding); the same span with the consistent coefficients reports them."""
+    paper = sweep.run(sweep.load_scene("paper-fig5", {"axes.length": [0.5]}), progress=False)
+    assert not set(loads.NAMES) & set(paper.data_vars)
+    assert "Eq.32" in paper.attrs["stretching"]
+    consistent = sweep.run(sweep.load_scene("paper-fig5", {"axes.length": [0.5],
+                                                           "model.coefficients": "consistent"}),
+                           progress=False)
+    assert {"axial_tension", "clamp_force", "midspan_bending_strain"} <= set(consistent)
+    with pytest.raises(SceneError) as info:
+        sweep.load_scene("paper-fig5", {"axes.length": [0.5], "cable.diameter": 0.003})
+    assert "cable.diameter" in str(info.value) and "'paper'" in str(info.value)
 
 
 @pytest.mark.parametrize("method, driver", [("dop853", "lanes"), ("rk45", "scalar")])

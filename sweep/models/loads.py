@@ -104,8 +104,10 @@ NAMES = tuple(o.name for o in OUTPUTS)
 
 def wanted(params: dict[str, Any]) -> bool:
     """Whether a scene gets these outputs: clamps that hold rotation, or the uniform tension
-    (pinned clamps under the paper's local membrane term report none: the paper's scenes)."""
-    return _wanted(params.get("clamps_rotation"), params.get("membrane") is not None)
+    (pinned clamps under the paper's local membrane term report none: model.membrane, or the
+    paper's Eq.32 as printed, model.coefficients = 'paper', whose numbers hold that term)."""
+    local = params.get("membrane") is not None or params.get("coefficients") == "paper"
+    return _wanted(params.get("clamps_rotation"), local)
 
 
 def _wanted(rotation: str | None, membrane: bool) -> bool:
@@ -126,7 +128,8 @@ def observation(scene: Any, swept: bool) -> float:
     outputs.peak_amplitude, the peak a sweep reports); else 0.0, and the kernels skip that
     work."""
     membrane = (scene.get("model.membrane") is not None or "membrane" in scene.axes
-                or "membrane" in (scene.points or {}))
+                or "membrane" in (scene.points or {})
+                or scene.get("model.coefficients") == "paper")
     deflection = "outputs.peak_amplitude" if swept else "outputs.amplitude"
     if not (scene.get(deflection) and _wanted(scene.get("clamps.rotation"), membrane)):
         return 0.0

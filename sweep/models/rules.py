@@ -487,12 +487,17 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "clamp_rotational_stiffness")
     if rotation == "pinned":
         # a data sheet's outer diameter describes the cable, used or not
-        if (_present("cable.diameter", given, axes) and given.get("model.membrane") is not None
+        paper = given.get("model.coefficients") == "paper"
+        if (_present("cable.diameter", given, axes)
+                and (given.get("model.membrane") is not None or paper)
                 and not cable.is_sheet(given, axes)):
+            term = ("model.coefficients = 'paper', Eq.32 as printed" if paper
+                    else "model.membrane")
+            fix = ("use model.coefficients = 'consistent'" if paper
+                   else "remove model.membrane (the uniform stretching tension)")
             _fail(_where("cable.diameter", axes), "is used for the bending strains, which a "
-                  "pinned span under the paper's local membrane term (model.membrane) does not "
-                  "report", "remove model.membrane (the uniform stretching tension), or the "
-                  "diameter")
+                  f"pinned span under the paper's local membrane term ({term}) does not "
+                  "report", f"{fix}, or remove the diameter")
         return
     if given.get("model.coefficients") == "paper":
         _fail("scene key 'clamps.rotation'", f"model.coefficients = 'paper' is the pinned span's "
