@@ -530,3 +530,16 @@ load_amplitude = [1.0, 2.0]
     labels = [t.get_text() for t in state.legends[0].get_texts()] if state.legends else [
         t.get_text() for ax in state.axes for lg in [ax.get_legend()] if lg for t in lg.get_texts()]
     assert any("max_steps_reached" in t for t in labels) and any("completed" in t for t in labels)
+
+
+def test_a_level_in_db_is_labelled_db_though_its_cf_units_are_one():
+    """UDUNITS (so CF) has no decibel: base_asd_scale's units are '1' and its long name says
+    dB; the axis label shows [dB], and a plain ratio stays without brackets."""
+    from sweep import schema
+    from sweep.plot.labels import label
+    key = schema.BY_DOTTED["base.asd_scale"]
+    level = xr.DataArray([0.0], dims="base_asd_scale", name="base_asd_scale",
+                         attrs={"units": key.units, "long_name": key.long_name})
+    assert key.units == "1" and label(level).endswith("[dB]")
+    ratio = xr.DataArray([1.0], dims="x", name="x", attrs={"units": "1", "long_name": "ratio"})
+    assert label(ratio) == "ratio"

@@ -20,8 +20,11 @@ _FOOTER_PT = 7.0
 
 def label(da: xr.DataArray, units: str | None = None) -> str:
     """'long_name [units]' from the attributes (shortened: the text before ' (' when that is
-    long, the variable name when still too long; no brackets for dimensionless '1')."""
+    long, the variable name when still too long; no brackets for dimensionless '1', but [dB]
+    for a level the long name gives in dB, which UDUNITS and so CF have no unit for)."""
     name = str(da.attrs.get("long_name") or da.name or "")
+    if units is None and da.attrs.get("units") == "1" and " in dB" in name:
+        units = "dB"
     if len(name) > 40 and " (" in name and name.index(" (") >= 10:
         name = name[:name.index(" (")]
     if len(name) > _MAX_LABEL:
