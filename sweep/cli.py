@@ -299,9 +299,10 @@ def _design(args: argparse.Namespace) -> int:
         print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
               f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
     elif interpolated(result, criteria):
+        fix = ("refine the scene's length axis (and add base.realisations) to narrow it"
+               if "realisation" in ds.dims else "--refine runs the engine to bracket it")
         print("interpolated between the grid's lengths, not run there: a response that peaks "
-              "between two of them (a resonance) can put the true limit shorter; --refine "
-              "runs the engine to bracket it")
+              f"between two of them (a resonance) can put the true limit shorter; {fix}")
     if args.output is not None:
         write_netcdf(result, args.output, overwrite=args.overwrite)
         print(f"-> {args.output}")

@@ -154,8 +154,9 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
         if "max_strain" not in ds:
             raise UserError("design: --max-strain needs the variable 'max_strain' (bending "
                             "plus stretching strain), which this result lacks: it comes with "
-                            "the uniform stretching tension (no model.membrane) and is not "
-                            "made by a sine sweep")
+                            "the uniform stretching tension (not with model.membrane or "
+                            "model.coefficients = 'paper': the paper's local term) and the "
+                            "cable's diameter (a data-sheet cable needs cable.diameter)")
         limits["max_strain"] = ("max_strain", max_strain, None)
     for criterion, flag, name, limit, what in (
             ("max_rms", "--max-rms", "rms_deflection_mean", max_rms,

@@ -201,6 +201,7 @@ def test_cli_design_of_a_random_result_end_to_end(random_file, tmp_path, capsys)
     assert main(["design", str(path), "--max-rms", f"{limit!r}", "-o", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "max_rms" in printed
+    assert "interpolated" in printed and "--refine" not in printed   # refused for random
     got = xr.open_dataset(out)
     assert got["max_span"].dims == ("base_asd_scale",)
     expected = 0.14 + 0.04 * (limit - rms[1]) / (rms[2] - rms[1])

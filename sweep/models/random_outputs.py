@@ -200,8 +200,9 @@ def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, A
     ms = linear_mean_square(f, w, omega, damping, weights)
     out = template.copy(data=np.sqrt(ms) * level.values)
     out.attrs = {"units": "m", "long_name": "exact RMS midspan deflection of the same span "
-                 "made linear (no stretching, no end load) under the same spectrum: beside "
-                 "rms_deflection, the nonlinearity's effect"}
+                 "made linear (no stretching, no end load) under the same spectrum, over the "
+                 "modes the scene keeps (model.modes): beside rms_deflection, the "
+                 "nonlinearity's effect"}
     return out
 
 

@@ -114,7 +114,7 @@ def check(given: dict[str, Any], axes: Mapping[str, Any]) -> None:
     levels = given.get("outputs.clearance")
     if levels is not None:
         if not 1 <= len(levels) <= MAX_LEVELS or not all(u > 0.0 for u in levels):
-            _fail("scene key 'outputs.clearance'", f"{_show(levels)}: give 1 to "
+            _fail("scene key 'outputs.clearance'", f"{_show(list(levels))}: give 1 to "
                   f"{MAX_LEVELS} levels of |deflection|, each > 0 (m)",
                   "e.g. clearance = [0.001, 0.002]")
     _check_sampling(given, key)
