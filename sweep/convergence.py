@@ -26,20 +26,21 @@ import numpy as np
 import xarray as xr
 
 from .errors import UserError
+from .models.loads import NAMES
 from .schema import BY_DOTTED
 
 METRICS = ("amplitude", "peak_amplitude", "settling_time", "response_period",
            "absolute_acceleration", "transmissibility", "peak_frequency", "envelope",
-           "growth_rate", "floquet_multiplier", "modal_amplitude", "max_deflection",
-           "clamp_bending_strain", "clamp_moment")
+           "growth_rate", "floquet_multiplier", "modal_amplitude", "max_deflection") + NAMES
 """The result variables compared, where both runs have them: the time-domain metrics of
 every kind of run (fixed frequency, stepped, swept: its peak, peak frequency and envelope)
-and a stability chart's Floquet results; the bending at the clamps where they hold rotation
-(it converges more slowly with the modes than the midspan: the shape sharpens there)."""
+and a stability chart's Floquet results; every load output of the span (sweep.models.loads:
+the bending at the clamps converges more slowly with the modes than the midspan, the shape
+sharpens there, and the clamp's shear, clamp_force, more slowly still: like 1/N)."""
 SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled", "completed")
 """States whose metrics mean something (the failure states have NaN metrics)."""
 TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude",
-                "max_deflection", "clamp_bending_strain", "clamp_moment")
+                "max_deflection") + NAMES
 """Metrics of the tail window, not compared where either run decayed: a decayed point's tail
 is below metrics.tolerance x its peak by definition, and what is left of it there (its rate
 of decay, round-off near the absolute tolerance) is no answer to compare."""

@@ -220,6 +220,10 @@ def test_the_paper_preset_reports_no_loads_of_a_tension_it_does_not_integrate():
     with pytest.raises(SceneError) as info:
         sweep.load_scene("paper-fig5", {"axes.length": [0.5], "cable.diameter": 0.003})
     assert "cable.diameter" in str(info.value) and "'paper'" in str(info.value)
+    for axial in ({"clamps.axial_stiffness": 0.0}, {"axes.clamp_axial_stiffness": [0.0, 1e5]}):
+        with pytest.raises(SceneError) as info:       # it was ignored: identical columns
+            sweep.load_scene("paper-fig5", {"axes.length": [0.5], **axial})
+        assert "axial_stiffness" in str(info.value) and "'paper'" in str(info.value)
 
 
 @pytest.mark.parametrize("method, driver", [("dop853", "lanes"), ("rk45", "scalar")])
@@ -238,9 +242,11 @@ def test_each_method_and_driver_gives_the_clamped_span_and_its_bending(method, d
 
 
 def test_sweep_modes_compares_the_bending_at_the_clamp(tmp_path, capsys):
-    """`sweep modes` on clamped ends reports the clamp's bending beside the midspan: its line
-    gives the largest relative change of clamp_bending_strain between the two runs, recomputed
-    here from two plain runs (the curvature at a clamp converges more slowly with the modes)."""
+    """`sweep modes` on clamped ends reports every load beside the midspan (it left out all but
+    the clamp's bending: a reviewer's clamp_force moved 6.5 % from 3 to 5 modes unreported):
+    each line gives the largest relative change between the two runs, recomputed here from two
+    plain runs (the curvature at a clamp converges more slowly with the modes, its shear more
+    slowly still)."""
     from sweep.cli import main
     path = tmp_path / "clamped.toml"
     path.write_text(scene_text(modes=1, ratio=1.0, level_g=2.0, t_end=1.5))
@@ -248,11 +254,13 @@ def test_sweep_modes_compares_the_bending_at_the_clamp(tmp_path, capsys):
     out = capsys.readouterr().out
     coarse, fine = (sweep.run(sweep.load_scene(str(path), overrides={"model.modes": n}),
                               progress=False) for n in (1, 3))
-    f, c = (_one(ds, "clamp_bending_strain") for ds in (fine, coarse))
-    change = abs(f - c) / abs(f)
-    line = next(line for line in out.splitlines()
-                if line.strip().startswith("clamp_bending_strain "))
-    assert float(line.split()[1]) == pytest.approx(change, rel=1e-2)
+    names = [name for name in loads.NAMES if name in fine]
+    assert {"clamp_bending_strain", "clamp_force", "axial_tension", "max_strain"} <= set(names)
+    for name in names:
+        f, c = (_one(ds, name) for ds in (fine, coarse))
+        change = abs(f - c) / abs(f)
+        line = next(line for line in out.splitlines() if line.strip().startswith(f"{name} "))
+        assert float(line.split()[1]) == pytest.approx(change, rel=1e-2), name
 
 
 def test_a_sine_sweep_reports_the_loads_peak_over_the_whole_sweep():

@@ -88,7 +88,8 @@ OUTPUTS = (
            "(d / 2) max |w_xx(l/2)| over the tail window", _strain("midspan"), diameter=True),
     Output("clamp_force", "N", "transverse reaction at the clamp: max |V| at either clamp over "
            "the tail window, V = -EI w_xxx + N w_x (the shear plus the stretching tension's "
-           "transverse part; without model.membrane's local term)",
+           "transverse part; without model.membrane's local term and without an end load's "
+           "part -P w_x; converges like 1/N with the modes kept: check with sweep modes)",
            lambda p, s: s.bending * p.shear / s.length ** 3),
     Output("axial_tension", "N", "stretching tension of the span: its largest N = k_s e over "
            "the tail window (e = (1/2) int w_x^2 dx the elongation, k_s the span and its clamps "
@@ -97,7 +98,8 @@ OUTPUTS = (
            lambda p, s: _tension(p, s) / s.axial, tension=True),
     Output("max_strain", "1", "largest outer-fibre strain reported: max(clamp_bending_strain, "
            "midspan_bending_strain) + axial_strain (their peaks added: an upper bound where "
-           "they do not coincide)", _largest_strain, tension=True, diameter=True),
+           "they do not coincide; an end load's own axial strain -P / EA not included)",
+           _largest_strain, tension=True, diameter=True),
 )
 NAMES = tuple(o.name for o in OUTPUTS)
 

@@ -463,7 +463,7 @@ ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
 
 def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
-    or model.membrane, not both); a rotational stiffness with elastic clamps only, and always
+    or model.membrane, not both; none with the paper's Eq.32, whose is its own); a rotational stiffness with elastic clamps only, and always
     with them; a diameter (the bending strains) not where a pinned span under model.membrane
     reports none (sweep.models.loads.wanted), unless it is part of a data-sheet cable
     (sweep.models.cable); ends other than pins need the consistent coefficients (Eq.32 is the
@@ -475,6 +475,13 @@ def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "sets the uniform tension between them, model.membrane the paper's local term",
               "remove model.membrane (the span then stretches as a whole between the clamps) or "
               "the axial stiffness")
+    if (_present("clamps.axial_stiffness", given, axes)
+            and given.get("model.coefficients") == "paper"):
+        _fail(_where("clamps.axial_stiffness", axes), "model.coefficients = 'paper' is Eq.32 "
+              "as printed, whose stretching is the paper's local term (alpha = 3/8): the "
+              "clamps' axial stiffness would change nothing",
+              "use model.coefficients = 'consistent' (the uniform tension between the "
+              "clamps), or remove the axial stiffness")
     rotation = given.get("clamps.rotation", "pinned")
     stiffness = _present(ROTATIONAL_STIFFNESS, given, axes)
     if rotation != "elastic" and stiffness:
