@@ -505,31 +505,19 @@ area = [1e-6, 6e-6]
     assert scene.get("load.type") == "constant"
 
 
-def test_longitudinal_accepts_transverse_only_keys():
-    scene = load_scene_text("""
-[model]
-kind = "longitudinal"
-coefficients = "paper"
-[load]
-frequency = 10.0
-[initial]
-velocity = 0.1
-[solver]
-rtol = 1e-6
-[metrics]
-tail = 0.25
-[outputs]
-time_series = true
-sample_interval = 100.0
-""")
-    assert scene.get("model.coefficients") == "paper"
-    assert scene.get("initial.velocity") == 0.1
-    assert scene.get("outputs.sample_interval") == 100.0  # not compared with an end time
+def test_longitudinal_refuses_transverse_only_keys_and_keeps_its_own():
+    """A transverse run's keys were accepted here and ignored (tests/test_silent_answers.py has
+    each); the wave's own sample interval is not compared with a transverse end time."""
+    for text in ('coefficients = "paper"', "[load]\nfrequency = 10.0",
+                 "[initial]\nvelocity = 0.1", "[solver]\nrtol = 1e-6", "[metrics]\ntail = 0.25",
+                 "[outputs]\ntime_series = true"):
+        assert "would ignore it" in scene_error(LONG + text)
+    scene = load_scene_text(LONG + "[outputs]\nhistories = true\nsample_interval = 1e-6")
+    assert scene.get("outputs.sample_interval") == 1e-6
 
 
-def test_longitudinal_paper_rules_do_not_apply():
-    scene = load_scene_text('[model]\nkind = "longitudinal"\ncoefficients = "paper"\n'
-                            "[axes]\ndensity = [2700, 8900]")
+def test_longitudinal_sweeps_the_density_without_the_paper_rules():
+    scene = load_scene_text('[model]\nkind = "longitudinal"\n[axes]\ndensity = [2700, 8900]')
     assert scene.get("initial.velocity") == 0.0
     assert list(scene.axes) == ["density"]
 

@@ -423,7 +423,8 @@ def check_pairs(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
 
 def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of a transverse scene: no longitudinal-only keys, a controller for the method,
-    a load frequency to sweep, and model.coefficients = 'paper' with Table 1's cable only."""
+    a load frequency to sweep (none for a constant load), and model.coefficients = 'paper' with
+    Table 1's cable only."""
     if given.get("solver.transits") is not None:
         _fail("scene key 'solver.transits'", "only for model.kind = 'longitudinal'",
               "use solver.t_end in seconds")
@@ -438,11 +439,16 @@ def _check_transverse(given: dict[str, Any], axes: dict[str, np.ndarray]) -> Non
         _fail("scene keys 'solver.method' and 'solver.controller'",
               "the PI controller is tuned for method 'rk45' only",
               "use solver.controller = 'scipy' with method 'dop853'")
+    _refuse_without(given, ("solver.intervals", "solver.courant"),
+                    "only for model.kind = 'longitudinal' (its central-difference grid); a "
+                    "transverse scene would ignore it", "remove the key")
     if given.get("load.type") == "constant":
         for axis in ("frequency_ratio", "frequency"):
             if axis in axes:
                 _fail(f"axis '{axis}'", "load.type = 'constant' has no load frequency to sweep",
                       f"remove the {axis} axis, or use load.type = 'harmonic'")
+        _refuse_frequency(given, "load.type = 'constant' has no load frequency; it would be "
+                          "ignored", "remove the key, or use load.type = 'harmonic'")
     _check_load_frequency_axis(given, axes)
     _check_clamps(given, axes)
     _check_modes(given, axes)
@@ -540,6 +546,15 @@ def _has_end_load(given: dict[str, Any], axes: dict[str, np.ndarray]) -> bool:
     amplitude = axes["load_amplitude"] if "load_amplitude" in axes \
         else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
     return bool(np.any(np.asarray(amplitude, dtype=float) != 0.0))
+
+
+def _refuse_frequency(given: dict[str, Any], problem: str, fix: str) -> None:
+    """Refuse an end-load frequency where there is none to have: load.frequency, or a
+    frequency_ratio other than the DEFAULT_FREQUENCY_RATIO every resolved scene writes out."""
+    if given.get("load.frequency") is not None:
+        _fail("scene key 'load.frequency'", problem, fix)
+    if given.get("load.frequency_ratio") not in (None, DEFAULT_FREQUENCY_RATIO):
+        _fail("scene key 'load.frequency_ratio'", problem, fix)
 
 
 def _refuse_without(given: dict[str, Any], dependents: tuple[str, ...], problem: str,
@@ -650,6 +665,18 @@ def _check_paper_cable(given: dict[str, Any]) -> None:
               "remove the key, or use model.coefficients = 'consistent' for another cable")
 
 
+TRANSVERSE_ONLY = ("cable.damping_ratio", "initial.displacement", "initial.velocity", "initial.modal_displacement",
+                   "initial.modal_velocity", "model.coefficients", "model.membrane",
+                   "model.paper_parametric", "solver.rtol", "solver.atol", "solver.method",
+                   "solver.controller", "solver.driver", "solver.max_step", "solver.min_step",
+                   "solver.first_step", "solver.steady_periods", "solver.steady_tolerance",
+                   "metrics.tail", "metrics.tolerance", "outputs.amplitude",
+                   "outputs.peak_amplitude", "outputs.settling_time", "outputs.response_period",
+                   "outputs.absolute_acceleration", "outputs.time_series")
+"""Keys of a transverse run that the longitudinal model (sweep/models/longitudinal.py, wave.py)
+never reads: refused in a longitudinal scene with any value but their default."""
+
+
 def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of a longitudinal scene: a constant load, its parameters only, one end time."""
     if given.get("outputs.stability"):
@@ -669,6 +696,10 @@ def _check_longitudinal(given: dict[str, Any], axes: dict[str, np.ndarray]) -> N
     _refuse_without(given, ("model.modes", "solver.stop_when_steady"),
                     "only for model.kind = 'transverse' (Galerkin modes, the steady early "
                     "stop); a longitudinal scene would ignore it", "remove the key")
+    why = ("only for model.kind = 'transverse'; the longitudinal wave (undamped, from rest, a "
+           "constant end load, central differences) would ignore it")
+    _refuse_without(given, TRANSVERSE_ONLY, why, "remove the key")
+    _refuse_frequency(given, why, "remove the key")
     load_type = given.get("load.type", LONGITUDINAL_LOAD)
     if load_type != LONGITUDINAL_LOAD:
         _fail("scene key 'load.type'",
