@@ -41,6 +41,33 @@ def _one_line(text: object) -> str:
     return one_line(text)
 
 
+
+def _with_unit(text: str, units: str, example: str) -> float:
+    """An argparse value: a plain number (SI) or a number with a unit, converted to `units`
+    (sweep.scene.units, the scene keys' rules); ArgumentTypeError, one line, otherwise."""
+    import argparse
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    from .errors import SceneError
+    from .scene.units import to_si
+    from .schema import Key
+    try:
+        return to_si("value", Key("design", "limit", "float", None, units=units), text)
+    except SceneError as exc:
+        said = str(exc).removeprefix("value: ").replace("the key takes", "it takes")
+        raise argparse.ArgumentTypeError(f"{said}; a plain number is in {units}, or write "
+                                         f"e.g. {example}") from None
+
+
+def _metres(text: str) -> float:
+    return _with_unit(text, "m", "'2 mm'")
+
+
+def _hertz(text: str) -> float:
+    return _with_unit(text, "Hz", "'100 Hz'")
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sweep", description="Parameter sweeps of nonlinear cable vibration.")
     parser.add_argument("--version", action="version",
@@ -97,33 +124,34 @@ def _parser() -> argparse.ArgumentParser:
                        help="worker threads (default: all)")
     modes.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     design = sub.add_parser("design", help="the largest span between clamps meeting the "
-                                           "criteria, from a result with a length axis")
+                                           "criteria, from a result with a length axis (limits "
+                                           "in SI, or with a unit: --max-amplitude '2 mm')")
     design.add_argument("result", metavar="RESULT.nc",
                         help="a netCDF file written by 'sweep run' with a length axis")
-    design.add_argument("--min-frequency", type=float, default=None, metavar="HZ",
+    design.add_argument("--min-frequency", type=_hertz, default=None, metavar="HZ",
                         help="first natural frequency at least this (Hz)")
-    design.add_argument("--max-amplitude", type=float, default=None, metavar="M",
+    design.add_argument("--max-amplitude", type=_metres, default=None, metavar="M",
                         help="response at most this (m): peak_amplitude of a swept result, "
                              "else amplitude, or --quantity")
     design.add_argument("--quantity", default=None, metavar="NAME",
                         help="the variable (in m) --max-amplitude limits")
-    design.add_argument("--max-deflection", type=float, default=None, metavar="M",
+    design.add_argument("--max-deflection", type=_metres, default=None, metavar="M",
                         help="largest deflection anywhere on the span at most this (m): "
                              "max_deflection (one mode: its midspan amplitude)")
     design.add_argument("--max-strain", type=float, default=None, metavar="S",
                         help="largest outer-fibre strain at most this (1, e.g. 0.001): "
                              "max_strain, bending at the clamp or midspan plus stretching")
-    design.add_argument("--max-rms", type=float, default=None, metavar="M",
+    design.add_argument("--max-rms", type=_metres, default=None, metavar="M",
                         help="random result: RMS midspan deflection, the mean over the "
                              "realisations (rms_deflection_mean), at most this (m)")
-    design.add_argument("--max-peak", type=float, default=None, metavar="M",
+    design.add_argument("--max-peak", type=_metres, default=None, metavar="M",
                         help="random result: largest |midspan deflection|, the mean over the "
                              "realisations (peak_deflection_mean), at most this (m)")
-    design.add_argument("--clearance", type=float, default=None, metavar="M",
+    design.add_argument("--clearance", type=_metres, default=None, metavar="M",
                         help="random result: the probability that |midspan deflection| exceeds "
                              "this clearance level (m, one of the result's outputs.clearance) "
-                             "at least once in the test, mean over the realisations, at most "
-                             "--max-probability")
+                             "at least once in the test, from the crossing rate pooled over the "
+                             "realisations, at most --max-probability")
     design.add_argument("--max-probability", type=float, default=None, metavar="P",
                         help="--clearance: the largest exceedance probability (default 0.01, "
                              "i.e. 1 %%)")

@@ -269,6 +269,27 @@ def test_cli_design_says_when_its_span_is_interpolated(results, capsys):
     assert "--refine" not in capsys.readouterr().out
 
 
+def test_cli_design_limits_take_units(results, tmp_path, capsys):
+    """A limit may carry its unit, as a scene key does: '--max-amplitude "2 mm"' is 0.002 m (it
+    was refused as an invalid float, and a bare 2 meant 2 m), '--min-frequency "0.1 kHz"' is
+    100 Hz; a unit of the wrong kind is one line, exit 2."""
+    _, path = results["coarse"]
+    spans = []
+    for flags in (["--max-amplitude", "0.002", "--min-frequency", "100"],
+                  ["--max-amplitude", "2 mm", "--min-frequency", "0.1 kHz"]):
+        out = tmp_path / f"span{len(spans)}.nc"
+        assert main(["design", str(path), *flags, "-o", str(out)]) == 0
+        with xr.open_dataset(out) as got:
+            spans.append(got["max_span"].values.copy())
+    capsys.readouterr()
+    np.testing.assert_array_equal(spans[0], spans[1])
+    with pytest.raises(SystemExit) as info:
+        main(["design", str(path), "--max-amplitude", "2 Hz"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--max-amplitude" in err and "a frequency" in err
+
+
 def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, capsys):
     from test_cf import cf_problems
     ds, _ = results["coarse"]
@@ -287,7 +308,7 @@ def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, caps
     ("coarse", [], "no criterion"),
     ("no_length", ["--min-frequency", "100"], "length"),
     ("coarse", ["--max-amplitude", "1e-3", "--quantity", "nonesuch"], "nonesuch"),
-    ("coarse", ["--min-frequency", "abc"], "invalid float"),
+    ("coarse", ["--min-frequency", "abc"], "unknown unit"),
     ("coarse", ["--max-strain", "1e-3"], "max_strain"),
     ("swept", ["--max-strain", "-1"], "positive"),
 ])
