@@ -155,17 +155,6 @@ def test_override_scalar_replaces_axis():
     assert scene.get("cable.length") == 0.8
 
 
-@pytest.mark.parametrize("overrides", [
-    {"cable.length": 0.8, "axes.length": [0.5, 0.6]},
-    {"axes.length": [0.5, 0.6], "cable.length": 0.8},
-    {"axes.length": [0.5], "points.length": [0.6]}])
-def test_overrides_that_set_one_key_twice_are_refused(overrides):
-    """A key and its axis (or [points] entry) in one command: the last one won, silently (a
-    reviewer's --set base.frequency=33 --set axes.base_frequency=[20] ran at 20 Hz)."""
-    message = scene_error(BASE, overrides)
-    assert "cable.length" in message and "only the last would count" in message
-
-
 def test_override_frequency_replaces_frequency_ratio():
     scene = load_scene("harness-parametric", overrides={"load.frequency": 10.0})
     assert list(scene.axes) == ["length"]

@@ -86,14 +86,6 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
                   "write KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
         key = key.strip()
         parsed[key] = _override_value(key, value)
-    named: dict[str, str] = {}
-    for key in parsed:
-        target = _key_target(key)
-        if target in named:
-            _fail(f"overrides '{named[target]}' and '{key}'", f"both set {target} (as a key, "
-                  "an axis or a [points] entry), and only the last would count",
-                  "give one of them")
-        named[target] = key
     for pair in PAIRS:
         if len({_pair_target(k, pair) for k in parsed} - {None}) == 2:
             _fail(f"overrides '{pair[0]}' and '{pair[1]}'", "give one, not both",
@@ -102,17 +94,6 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
         _fail("overrides 'solver.t_end' and 'solver.transits'", "give one, not both",
               "remove one of the two overrides")
     return parsed
-
-
-def _key_target(dotted: str) -> str:
-    """The scene key an override sets: an axis's or a [points] entry's dotted key, else its
-    own."""
-    section, _, name = dotted.partition(".")
-    if section in schema.SWEPT_SECTIONS:
-        axis = _axis_or_none(name)
-        if axis is not None:
-            return schema.BY_AXIS[axis].dotted
-    return dotted
 
 
 def _pair_target(dotted: str, pair: tuple[str, str]) -> str | None:
