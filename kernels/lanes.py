@@ -374,6 +374,20 @@ def _observe_acceleration(W, settings, n_run):
     return n_turns
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _sine_acceleration(W, settings, n_run, n_near, base):
+    """With a sine base excitation (`base` True), and ordinary steps near or in the tail
+    window (n_near of them, `_finish`): `_observe_acceleration`, and the acceleration's peaks
+    refined where it marked some (trajectory.refine_marked_lanes)."""
+    if base is not None and n_near > 0:
+        if _observe_acceleration(W, settings, n_run) > 0:
+            tj.refine_marked_lanes(W, LANES, W, W_P * LANES, n_run)
+
+
+# A record's steps are all the scalar path's (`_finish`): this compiles for the sine kinds only.
+_ordinary_acceleration = ex.by_kind(_sine_acceleration, None)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _dense_row(k0, k1, k2, k3, k4, k5, k6, p):
     """Column c of K^T P for one component, p = _P_COLUMNS[c] (dopri5.dense_coefficients, same
@@ -574,9 +588,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             _pi_factors(W, n_run)
         n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth,
                                                parametric, base)
-        if base is not None and n_near > 0:
-            if _observe_acceleration(W, settings, n_run) > 0:
-                tj.refine_marked_lanes(W, L, W, W_P * L, n_run)
+        _ordinary_acceleration(W, settings, n_run, n_near, base)
         if n_flagged == 0:
             continue
         if n_extrema > 0 and eighth is None:

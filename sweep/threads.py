@@ -20,7 +20,7 @@ flag, which the watcher sets: they return at once (the lanes drivers) or before 
 
 Points a driver leaves SECOND_PASS (at rest away from zero, settling wanted) are finished by
 `kernels.transverse.settle_second_pass` block by block, compiled only when a sweep has one (or
-ahead of a run: COMPILE_AHEAD).
+ahead of a run: COMPILE_AHEAD), never for random records (their state is final).
 """
 
 from __future__ import annotations
@@ -163,9 +163,10 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         if watch.halted():
             watch.end(lo)                # the follow-up pass is left to a resume
             return
-        _follow_up(tk.settle_second_pass, bool(np.any(states[lo:hi] == mt.SECOND_PASS)),
-                   params[lo:hi], settings, states[lo:hi], reals[lo:hi], counts[lo:hi],
-                   parametric, base, eighth, steady)
+        if records is None:              # a record's state is final (COMPLETED or failed)
+            _follow_up(tk.settle_second_pass, bool(np.any(states[lo:hi] == mt.SECOND_PASS)),
+                       params[lo:hi], settings, states[lo:hi], reals[lo:hi], counts[lo:hi],
+                       parametric, base, eighth, steady)
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
@@ -216,6 +217,9 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
                  counts, series, modal, final, base, eighth, steady, watch.halt)
         if watch.halted():
             watch.end(lo)                # the follow-up passes are left to a resume
+            return
+        if records is not None:          # a record's state is final (COMPLETED or failed)
+            watch.end(lo)
             return
         off = bool(np.any((states[lo:hi] == mt.OFF_MIDSPAN)
                           | (states[lo:hi] == mt.HIDDEN_MODE)))
