@@ -312,3 +312,19 @@ def test_a_data_sheet_without_a_diameter_reports_no_bending_strain():
                                         'axial_rigidity = "660 kN"\ndiameter = "2 mm"\n')))
     expected = 0.5 * 2e-3 * (np.pi / given.length) ** 2 * given.amplitude
     np.testing.assert_allclose(given.midspan_bending_strain, expected, rtol=1e-12)
+
+
+@pytest.mark.parametrize("overrides, key", [
+    ({"cable.linear_mass": 53.4}, "cable.linear_mass"), ({"cable.diameter": 2.76}, "cable.diameter"),
+    ({"cable.damping_ratio": 1.5}, "cable.damping_ratio"),
+    ({"axes.length": [0.2, 150.0]}, "cable.length")])
+def test_a_data_sheet_number_without_its_unit_is_warned_of(overrides, key):
+    """Plain numbers are SI: a data sheet's 53.4 (g/m) typed bare is 53.4 kg/m, and the span's
+    f1 half a hertz (a reviewer's slip). One warning naming the key and the unit string to
+    write; the built-in scene alone warns of nothing."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sweep.load_scene("harness-base-sine", overrides)
+        sweep.load_scene("harness-base-sine")
+    messages = [str(w.message) for w in caught if issubclass(w.category, sweep.CableSweepWarning)]
+    assert len(messages) == 1 and messages[0].startswith(key) and "SI" in messages[0]

@@ -1101,12 +1101,41 @@ def _longitudinal_defaults(values: dict[str, Any], given: dict[str, Any],
         values["solver.transits"] = DEFAULT_TRANSITS
 
 
+PLAUSIBLE = (
+    ("cable.length", 5.0, "m", "a clamp spacing is a few cm to a metre: was it in mm? write "
+     "e.g. '150 mm'"),
+    ("cable.linear_mass", 5.0, "kg/m", "a harness cable or bundle weighs grams to a kilogram or "
+     "two a metre: was it the data sheet's g/m? write e.g. '53.4 g/m'"),
+    ("cable.diameter", 0.1, "m", "was it in mm? write e.g. '2.76 mm'"),
+    ("cable.damping_ratio", 0.5, "of critical", "a cable's is about 0.005-0.1: was it a "
+     "percentage? 2 % is 0.02"),
+)
+"""(key, largest plausible value, its unit as shown, the hint): a plain number is SI, and a
+data sheet's number typed without its unit lands far above these (a warning, not a refusal:
+the physics allows them)."""
+
+
+def _warn_implausible(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
+    """Warn, one line a key, where a key of PLAUSIBLE is above its largest plausible value at
+    some point of the grid."""
+    for dotted, largest, units, hint in PLAUSIBLE:
+        axis = schema.BY_DOTTED[dotted].axis
+        if axis not in axes and values.get(dotted) is None:
+            continue
+        value = _extreme(values, axes, dotted, np.max)
+        if value > largest:
+            warnings.warn(f"{dotted} = {value:g} {units} (plain numbers are SI) is more than "
+                          f"{largest:g} {units}: {hint}", CableSweepWarning, stacklevel=5)
+
+
 def _check_transverse_resolved(values: dict[str, Any], axes: dict[str, np.ndarray],
                                given: dict[str, Any]) -> None:
-    """Finite coefficients, steps and samples within t_end, and the zero-solution warning."""
+    """Finite coefficients, steps and samples within t_end, the zero-solution warning and a
+    warning for a cable far from a harness's (PLAUSIBLE)."""
     _check_coefficients(values, axes)
     _check_times(values, axes)
     _warn_zero_solution(values, axes, given)
+    _warn_implausible(values, axes)
 
 
 def _check_longitudinal_resolved(values: dict[str, Any], axes: dict[str, np.ndarray],
