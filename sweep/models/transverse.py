@@ -810,6 +810,10 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     if result.modal is not None:
         data.update(modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis,
                                   inputs.params))
+        if inputs.swept:                 # a sweep's tail window is the whole sweep
+            attrs = data["modal_amplitude"].attrs
+            attrs["long_name"] = attrs["long_name"].replace("over the tail window",
+                                                            "over the whole sweep")
         if not inputs.swept and "outputs.amplitude" in inputs.wanted:
             data["max_deflection"] = xr.DataArray(
                 result.reals[:, tk.SPAN_MAX].reshape(shape), dims=dims,
@@ -849,8 +853,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
     if result.modal is not None:
         all_coords[MODE_DIM] = xr.DataArray(
             np.arange(1, result.modal.shape[1] + 1, dtype=np.int32), dims=MODE_DIM,
-            attrs={"units": "1", "long_name": "Galerkin mode number n of "
-                                              f"{inputs.basis.mode_text}"})
+            attrs={"units": "1", "long_name": "Galerkin mode number n (the modes: "
+                                              f"{inputs.basis.mode_text})"})
     if result.series.shape[1] > 0:
         all_coords[TIME_DIM] = elapsed_time(result.sample_times)
         data["displacement"] = xr.DataArray(
