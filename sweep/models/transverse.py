@@ -330,7 +330,7 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
         _check_time_domain_memory(inputs)      # before anything is computed over the grid
     coeffs = modal.oscillator(inputs.params)   # derived quantities, on the axes they need
     if "outputs.stability" not in inputs.wanted:
-        return _run_time_domain(inputs, coeffs, options)
+        return _warn_steep(_run_time_domain(inputs, coeffs, options), inputs)
     from .stability import stability_outputs
     started = time.perf_counter()
     stable = stability_outputs(coeffs, inputs.dims, inputs.shape, inputs.n_modes,
@@ -343,7 +343,37 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
                             "outputs.stability; remove [continuation] or turn an output on")
         return stability_dataset(inputs, coeffs, stable, time.perf_counter() - started)
     ds = _run_time_domain(inputs, coeffs, options)
-    return ds.assign(stable)
+    return _warn_steep(ds.assign(stable), inputs)
+
+
+STEEP_SLOPE = 0.5
+"""The largest slope pi w / l (w the largest deflection reported, l the span) past which a
+run warns: the cubic and quintic terms are the first of a series in the squared slope (docs/
+model.md sec. 2), whose next term is about slope^6 of the curvature there (1.6 % at 0.5) and
+which diverges at 1 (modal.MAX_SLOPE)."""
+_DEFLECTIONS = ("max_deflection", "amplitude", "peak_amplitude", "peak_deflection")
+
+
+def _warn_steep(ds: xr.Dataset, inputs: Inputs) -> xr.Dataset:
+    """Warn (one line) where some point's largest deflection reported puts its slope, about
+    pi w / l, above STEEP_SLOPE: its answers are then qualitative. Returns ds."""
+    import warnings
+
+    from ..errors import CableSweepWarning
+    length = derived(inputs.params["length"], inputs.coords)
+    steep = None
+    for name in _DEFLECTIONS:
+        if name in ds:
+            slope = (math.pi * ds[name] / length).where(np.isfinite(ds[name]))
+            steep = slope if steep is None else np.fmax(steep, slope.broadcast_like(steep))
+    if steep is None or not bool((steep > STEEP_SLOPE).any()):
+        return ds
+    count = int((steep > STEEP_SLOPE).sum())
+    warnings.warn(f"{count} of {steep.size} points deflect to a slope of about "
+                  f"{float(steep.max()):.2g} (pi w / l > {STEEP_SLOPE:g}): beyond the moderate "
+                  "slopes the model's cubic and quintic terms describe (docs/model.md sec. 2), "
+                  "so their answers are qualitative", CableSweepWarning, stacklevel=4)
+    return ds
 
 
 def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
