@@ -543,3 +543,23 @@ def test_a_level_in_db_is_labelled_db_though_its_cf_units_are_one():
     assert key.units == "1" and label(level).endswith("[dB]")
     ratio = xr.DataArray([1.0], dims="x", name="x", attrs={"units": "1", "long_name": "ratio"})
     assert label(ratio) == "ratio"
+
+
+def test_the_span_loads_get_a_strain_figure_and_two_stiffnesses_decades_apart_a_log_axis():
+    """A span that reports its loads gets 'max_strain' (the quantity `sweep design
+    --max-strain` limits; harness-clamps had no strain figure), and an axis of two clamp
+    stiffnesses four decades apart is drawn on a log scale (a linear one put the cells' edges
+    below zero: negative stiffness labels)."""
+    text = ('[cable]\ndiameter = "2.76 mm"\ndamping_ratio = 0.02\n'
+            '[clamps]\nrotation = "elastic"\n[base]\nacceleration_g = 1.0\n'
+            'frequency_ratio = 0.8\n[solver]\nt_end = 1.0\n[axes]\nlength = [0.2, 0.3, 0.4]\n'
+            'clamp_rotational_stiffness = [0.01, 100.0]\n')
+    ds = sweep.run(sweep.load_scene_text(text), progress=False)
+    figures = splot.plot(ds)
+    assert "max_strain" in figures
+    ax = figures["max_strain"].axes[0]
+    scales = {ax.get_xscale(), ax.get_yscale()}
+    labels = ax.get_xlabel() + ax.get_ylabel()
+    assert "log" in scales and "rotational stiffness" in labels
+    for fig in figures.values():
+        fig.clf()

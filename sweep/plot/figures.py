@@ -73,7 +73,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     """Every figure that fits the result, keyed by name (the file name `save` gives it).
 
     Transverse: 'amplitude' and 'settling_time' (lines over one swept axis, maps over two),
-    and 'absolute_acceleration_g' under base excitation; a continuous sine sweep also
+    'max_strain' where clamps that hold rotation bend the span (the strain a design limits), and
+    'absolute_acceleration_g' under base excitation; a continuous sine sweep also
     'peak_amplitude' and 'peak_frequency' over the axes, and with its envelope stored
     'envelope' (against the excitation frequency, zero or one swept axis) and 'envelope_map'
     (one swept axis x the bands);
@@ -117,6 +118,8 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
         scalars = ["amplitude", "settling_time"]
         if "absolute_acceleration_g" in ds:        # base excitation (docs/model.md sec. 5)
             scalars.insert(1, "absolute_acceleration_g")
+        if "max_strain" in ds and "clamp_bending_strain" in ds:   # clamps that hold rotation:
+            scalars.insert(1, "max_strain")        # the strain where wires break (loads.py)
         if _is_swept(ds):                          # a continuous sine sweep: its peak first
             scalars[:0] = ["peak_amplitude", "peak_frequency"]
     if len(axes) == 2 and not random:

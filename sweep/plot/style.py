@@ -171,7 +171,12 @@ def _new_axes(figsize: tuple[float, float] = (6.4, 4.8)) -> Axes:
 
 
 def _is_log_spaced(values: np.ndarray) -> bool:
+    """Whether a coordinate is drawn on a log axis: three or more positive values in a
+    geometric (not an arithmetic) progression, or two positive values a decade or more apart
+    (a linear axis put their cells' edges below zero: k_t = 0.01 and 100 N m/rad)."""
     v = np.asarray(values, dtype=float)
+    if v.size == 2 and np.all(v > 0):
+        return bool(max(v) >= 10.0 * min(v))
     if v.size < 3 or np.any(v <= 0):
         return False
     d = np.diff(v)
