@@ -93,7 +93,7 @@ W_START = IN_WINDOW + 1  # when it started (s)
 W_END = W_START + 1      # the last step end in it (s)
 SUM_Q2 = W_END + 1       # integral of q^2 dt (m^2 s), on the step's quintic Hermite
 SUM_V2 = SUM_Q2 + 1      # integral of q'^2 dt (m^2/s), on the same quintic's slope
-SUM_A2 = SUM_V2 + 1      # integral of (q'' + a_b)^2 dt (m^2/s^3), trapezoidal on step ends
+SUM_A2 = SUM_V2 + 1      # integral of (q'' + a_b)^2 dt (m^2/s^3), Simpson's rule on each step
 SUM_F2 = SUM_A2 + 1      # integral of q''^2 dt (m^2/s^3), on the quintic's second derivative
 UP_ZERO = SUM_F2 + 1     # up-crossings of q = 0
 UP_LEVEL = UP_ZERO + 1   # level k's crossings of |q| upwards through settings[LEVEL_0 + k]
@@ -906,6 +906,33 @@ def _quintic_gram() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 _GRAM, _SLOPE_GRAM, _CURVE_GRAM = _quintic_gram()
 
 
+def _quintic_midpoint_row() -> tuple[float, ...]:
+    """The second derivatives at s = 1/2 of the quintic Hermite basis (`_quintic_gram`'s
+    order): q''(t + h/2) = sum_i row_i c_i / h^2, c = (q0, h v0, h^2 a0, q1, h v1, h^2 a1)."""
+    conditions = np.zeros((6, 6))
+    for k in range(6):
+        conditions[0, k] = 1.0 if k == 0 else 0.0
+        conditions[1, k] = 1.0 if k == 1 else 0.0
+        conditions[2, k] = 2.0 if k == 2 else 0.0
+        conditions[3, k] = 1.0
+        conditions[4, k] = float(k)
+        conditions[5, k] = float(k * (k - 1))
+    basis = np.linalg.inv(conditions)
+    second = np.array([k * (k - 1) * 0.5 ** (k - 2) if k >= 2 else 0.0 for k in range(6)])
+    return tuple(float(x) for x in second @ basis)
+
+
+_MID = _quintic_midpoint_row()
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _quintic_midpoint_curvature(h, q0, v0, a0, q1, v1, a1):
+    """q'' (m/s^2) at the middle of a step of h (s) on the quintic Hermite through q, q' = v
+    and q'' = a at both ends (`_MID`)."""
+    return (_MID[0] * q0 + _MID[1] * h * v0 + _MID[2] * h * h * a0 + _MID[3] * q1
+            + _MID[4] * h * v1 + _MID[5] * h * h * a1) / (h * h)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _form(M, c0, c1, c2, c3, c4, c5):
     """c^T M c for the 6 x 6 matrix M, written out: a loop over a tuple's items indexes it at
@@ -955,14 +982,19 @@ def _count_crossings(settings, acc, a, b):
 def _record_step_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
                             v_new, fv_new, has_ext, qe, base):
     """`observe_random` for record_step's accepted step, with the absolute acceleration at
-    both ends: the newest sample's at t_new, the step before's end at t (evaluated here where
-    there is none)."""
+    both ends (the newest sample's at t_new, the step before's end at t, evaluated here where
+    there is none) and at its middle (q'' on the quintic Hermite, plus a_b there)."""
+    if t < acc[T_TAIL]:
+        return
     a_new = acc[ACC_SAMPLES + S_A]
     a_old = acc[ACC_SAMPLES + SAMPLE_SIZE + S_A]     # at t: the step before's end
     if math.isnan(a_old):
         a_old = fv_old + base_acceleration(t, p, o, s, None, base)
+    h = t_new - t
+    a_mid = (_quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+             + base_acceleration(t + 0.5 * h, p, o, s, None, base))
     observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
-                   a_old, a_new, has_ext, qe)
+                   a_old, a_mid, a_new, has_ext, qe)
 
 
 # record_step's kind-specific parts, each compiled only for its own kind (excitation.by_kind):
@@ -973,13 +1005,14 @@ _observe_record_step = ex.by_kind(None, _record_step_statistics)
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
-                   a_old, a_new, has_ext, qe):
+                   a_old, a_mid, a_new, has_ext, qe):
     """The record kind's statistics of the accepted step [t, t_new] (s) of the watched
     deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
-    m/s^2; qe its extremum inside the step where has_ext), once the step starts at or after
-    the tail window's start: the integrals of q^2, q'^2 and q''^2 on the quintic Hermite
-    through q, q', q'' at both ends (`_quintic_squares`) and of (q'' + a_b)^2 by the
-    trapezoidal rule (SCALAR_SLOTS), and the crossings of zero and of settings' levels on the
+    m/s^2, at both ends and a_mid at the middle; qe its extremum inside the step where has_ext),
+    once the step starts at or after the tail window's start: the integrals of q^2, q'^2 and
+    q''^2 on the quintic Hermite through q, q', q'' at both ends (`_quintic_squares`) and of
+    (q'' + a_b)^2 by Simpson's rule (SCALAR_SLOTS; the trapezoidal rule on the ends read a
+    reviewer's clamped span's RMS 0.24-0.29 % high where the steps are long), and the crossings of zero and of settings' levels on the
     step's monotone pieces, q_old to qe to q_new (a level grazed inside a step counts)."""
     if t < acc[T_TAIL]:
         return
@@ -992,7 +1025,7 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
     acc[SUM_Q2] += square
     acc[SUM_V2] += slope
     acc[SUM_F2] += curve
-    acc[SUM_A2] += 0.5 * h * (a_old * a_old + a_new * a_new)
+    acc[SUM_A2] += h / 6.0 * (a_old * a_old + 4.0 * a_mid * a_mid + a_new * a_new)
     if has_ext:
         _count_crossings(settings, acc, q_old, qe)
         _count_crossings(settings, acc, qe, q_new)
