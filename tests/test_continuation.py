@@ -199,6 +199,28 @@ def test_jumps_bracket_the_harmonic_balance_folds_and_the_branches_differ(both_w
     assert 0.3 < c["k3"] * a_fold ** 2 / c["w1"] ** 2 < 0.7
 
 
+def test_a_jump_after_a_steep_dwell_keeps_its_flag_both_ways():
+    """A reviewer's coarse down sweep (0.05 f1 steps on a hardening 0.4 m span, SciPy's stepped
+    run written by them gave the same amplitudes) climbed the low branch's steep side by 1.57x
+    into the dwell before its jump (3.6x up): the two flags of one sense were reduced to the
+    first, the slope's, which the both-ways check then dropped (up and down agree before it),
+    so the real jump lost its flag. Their amplitudes (mm) along 1.00, 1.05, ... 1.20 f1: the
+    jump is flagged at 1.05 going down and at 1.15 going up, and nothing else."""
+    from sweep.models import continuation as ct
+    up = np.array([0.40, 0.50, 0.620, 0.087, 0.070])
+    down = np.array([0.40, 0.493, 0.1366, 0.087, 0.070])
+    from sweep.kernels import states as km
+    states = np.full(5, km.STEADY, np.int8)
+    orders = (np.arange(5), np.arange(5)[::-1])
+    flags = [ct.jumps(a, states, 0, order, 1.5) for a, order in zip((up, down), orders)]
+    flags = ct.branches_differ(flags, [up, down], 0, orders, 1.5)
+    flags = [ct.first_only(f, 0, order) for f, order in zip(flags, orders)]
+    assert list(flags[0]) == [0, 0, 0, ct.JUMP_DOWN, 0]
+    assert list(flags[1]) == [0, ct.JUMP_UP, 0, 0, 0]
+    one_way = ct.first_only(ct.jumps(down, states, 0, orders[1], 1.5), 0, orders[1])
+    assert list(one_way) == [0, 0, ct.JUMP_UP, 0, 0]     # one way: the run's first (documented)
+
+
 LINEAR_FREQS = F1 * np.linspace(0.8, 1.2, 9)      # coarse steps of 0.05 f1 over resonance
 LINEAR_LEVEL_G = 1e-4                             # K3 a^2 / w1^2 ~ 1e-5: no hysteresis
 

@@ -190,8 +190,8 @@ def jumps(amplitude: np.ndarray, states: np.ndarray, axis: int, order: np.ndarra
     """The jump flag of every point (grid shape, int8): JUMP_UP at the dwell whose tail
     amplitude is more than `ratio` times the previous dwell's in the sweep's `order` along
     `axis`, JUMP_DOWN where it is less than 1/ratio of it, NO_JUMP elsewhere (and where either
-    dwell failed or has no amplitude). A jump that takes more than one dwell (the first one
-    still ringing down from the old branch) is flagged once, at its first dwell."""
+    dwell failed or has no amplitude). Consecutive flags of one sense all stand (`first_only`
+    keeps the first of each run)."""
     a = np.moveaxis(amplitude, axis, -1)[..., order]
     ok = ~np.isin(np.moveaxis(states, axis, -1)[..., order], FAILED) & np.isfinite(a)
     flags = np.zeros(a.shape, np.int8)
@@ -200,11 +200,24 @@ def jumps(amplitude: np.ndarray, states: np.ndarray, axis: int, order: np.ndarra
     with np.errstate(divide="ignore", invalid="ignore"):
         flags[..., 1:] = np.where(both & (cur > ratio * prev), JUMP_UP,
                                   np.where(both & (cur * ratio < prev), JUMP_DOWN, NO_JUMP))
-    repeated = np.zeros(flags.shape, bool)
-    repeated[..., 1:] = (flags[..., 1:] != NO_JUMP) & (flags[..., 1:] == flags[..., :-1])
-    flags[repeated] = NO_JUMP
     back = np.empty_like(flags)
     back[..., order] = flags
+    return np.moveaxis(back, -1, axis)
+
+
+def first_only(flags: np.ndarray, axis: int, order: np.ndarray) -> np.ndarray:
+    """`flags` with each run of consecutive flags of one sense (in the sweep's `order` along
+    `axis`) reduced to its first: a jump that takes more than one dwell (the first one still
+    ringing down from the old branch) is flagged once. A sweep run both ways applies this
+    after `branches_differ`: a steep slope flagged just before a jump is dropped there first,
+    and the jump keeps its own flag (collapsed before, the slope took the jump's flag with
+    it)."""
+    f = np.moveaxis(flags, axis, -1)[..., order].copy()
+    repeated = np.zeros(f.shape, bool)
+    repeated[..., 1:] = (f[..., 1:] != NO_JUMP) & (f[..., 1:] == f[..., :-1])
+    f[repeated] = NO_JUMP
+    back = np.empty_like(f)
+    back[..., order] = f
     return np.moveaxis(back, -1, axis)
 
 

@@ -662,6 +662,7 @@ def _run_stepped(inputs: Inputs, options: RunOptions, coeffs: dict[str, Any], sy
     both = len(directions) == 2
     if both:
         flags = ct.branches_differ(flags, amplitudes, axis, orders, inputs.jump_ratio)
+    flags = [ct.first_only(f, axis, order) for f, order in zip(flags, orders)]
     results = []
     for out, flag in zip(outs, flags):
         ds = assemble(inputs, coeffs, _result(out, inputs), time.perf_counter() - started)
