@@ -328,3 +328,16 @@ def test_a_data_sheet_number_without_its_unit_is_warned_of(overrides, key):
         sweep.load_scene("harness-base-sine")
     messages = [str(w.message) for w in caught if issubclass(w.category, sweep.CableSweepWarning)]
     assert len(messages) == 1 and messages[0].startswith(key) and "SI" in messages[0]
+
+
+@pytest.mark.parametrize("extra", ["wires = 7", 'bending = "lower"'])
+def test_bundle_keys_beside_a_data_sheet_without_a_wire_are_refused(extra):
+    """A data sheet's mass, EI and EA with `wires = 7` ran one wire's cable: 7x too light and
+    7x too little EA, and the stored scene said 7 (a reviewer's finding). The bundle keys need
+    cable.wire: one line naming the key."""
+    text = ('[cable]\nlinear_mass = "53.4 g/m"\naxial_rigidity = "660 kN"\n'
+            f'bending_rigidity = 0.1\n{extra}\n')
+    with pytest.raises(sweep.SceneError) as info:
+        load(text)
+    message = str(info.value)
+    assert "cable.wire" in message and extra.split()[0] in message and "\n" not in message

@@ -69,8 +69,10 @@ def check(given: dict[str, Any], swept: Mapping[str, Any]) -> None:
     apart (longitudinal) or the paper's Eq.32 (its cable is baked in)."""
     sheet = [d for d in SHEET_KEYS if _present(d, given, swept)]
     for dotted in ("cable.f1_span", *WIRE_KEYS):
-        if dotted in given and not sheet:
-            partner = "cable.f1_measured" if dotted == "cable.f1_span" else "cable.wire"
+        partner = "cable.f1_measured" if dotted == "cable.f1_span" else "cable.wire"
+        if dotted in given and not _present(partner, given, swept):
+            # not only without a data sheet: beside a sheet's mass and EI they were ignored
+            # (wires = 7 ran one wire's cable)
             _fail(f"scene key '{dotted}'", f"is for a cable given by {partner}",
                   f"add {partner}, or remove {dotted}")
     if not sheet:
