@@ -33,6 +33,12 @@ rather than dividing by m. Results therefore equal the scalar driver's to round-
 for bit: to what a trajectory makes of round-off, which on strongly nonlinear points reaches
 ~1e-9 relative (tests/test_lanes.py measures it with a one-ulp change of q(0) in the scalar
 driver).
+
+A random base acceleration (kernels.excitation's record kind: `base` is the records) runs here
+too, on stage chains of its own (`_chain5_r`, `_chain8_r`: each lane reads its row's record
+through a call, so that loop is not vectorised, but the chain is still written out from the
+tableau), and every accepted step of a record goes to record_step, whose statistics are the
+scalar driver's: 1.8-1.9x the scalar driver's speed from a few records (benchmarks/RESULTS.md).
 """
 
 import math
@@ -145,7 +151,8 @@ _chain8, _chain8_p, _chain8_b, _chain8_pb, _chain8_r, _chain8_pr = _chains(
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _attempt(W, rtol, n_run, parametric, base, record):
-    """One Dormand-Prince attempt in every lane of W: the stages (`_chain5`, from dopri5.A,
+    """One Dormand-Prince attempt in every lane of W (record: `excitation.record_switch`,
+    True for a random record's chains): the stages (`_chain5`, from dopri5.A,
     B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
     y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
     count runs across the lanes with straight-line arithmetic, so LLVM vectorises it rather
