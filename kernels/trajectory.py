@@ -876,12 +876,10 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     acc[FV] = K[last, 1]
 
 
-def _quintic_gram() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(M, D, E): the Gram matrices over [0, 1] of the quintic Hermite basis H_i (the
-    polynomials of degree 5 with H_i's value, slope and second derivative at 0 and 1 the unit
-    vector e_i, in the order value, slope, second derivative at 0, then at 1) and of their
-    first and second derivatives: M_ij = int H_i H_j, D_ij = int H_i' H_j', E_ij = int H_i''
-    H_j''. From the monomials' exact integrals; computed once, at import."""
+def _quintic_basis() -> np.ndarray:
+    """The quintic Hermite basis H_i (the polynomials of degree 5 with H_i's value, slope and
+    second derivative at 0 and 1 the unit vector e_i, in the order value, slope, second
+    derivative at 0, then at 1) as monomial coefficients: column i is H_i's."""
     conditions = np.zeros((6, 6))
     for k in range(6):                     # value, slope, second derivative of s^k at 0 and 1
         conditions[0, k] = 1.0 if k == 0 else 0.0
@@ -890,7 +888,15 @@ def _quintic_gram() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         conditions[3, k] = 1.0
         conditions[4, k] = float(k)
         conditions[5, k] = float(k * (k - 1))
-    basis = np.linalg.inv(conditions)      # column i: H_i's monomial coefficients
+    return np.linalg.inv(conditions)
+
+
+def _quintic_gram() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(M, D, E): the Gram matrices over [0, 1] of the quintic Hermite basis H_i
+    (`_quintic_basis`) and of their first and second derivatives: M_ij = int H_i H_j, D_ij =
+    int H_i' H_j', E_ij = int H_i'' H_j''. From the monomials' exact integrals; computed once,
+    at import."""
+    basis = _quintic_basis()
     powers = np.arange(6)
     plain = 1.0 / (powers[:, None] + powers[None, :] + 1.0)
     slope = np.zeros((6, 6))
@@ -907,19 +913,10 @@ _GRAM, _SLOPE_GRAM, _CURVE_GRAM = _quintic_gram()
 
 
 def _quintic_midpoint_row() -> tuple[float, ...]:
-    """The second derivatives at s = 1/2 of the quintic Hermite basis (`_quintic_gram`'s
-    order): q''(t + h/2) = sum_i row_i c_i / h^2, c = (q0, h v0, h^2 a0, q1, h v1, h^2 a1)."""
-    conditions = np.zeros((6, 6))
-    for k in range(6):
-        conditions[0, k] = 1.0 if k == 0 else 0.0
-        conditions[1, k] = 1.0 if k == 1 else 0.0
-        conditions[2, k] = 2.0 if k == 2 else 0.0
-        conditions[3, k] = 1.0
-        conditions[4, k] = float(k)
-        conditions[5, k] = float(k * (k - 1))
-    basis = np.linalg.inv(conditions)
+    """The second derivatives at s = 1/2 of the quintic Hermite basis (`_quintic_basis`):
+    q''(t + h/2) = sum_i row_i c_i / h^2, c = (q0, h v0, h^2 a0, q1, h v1, h^2 a1)."""
     second = np.array([k * (k - 1) * 0.5 ** (k - 2) if k >= 2 else 0.0 for k in range(6)])
-    return tuple(float(x) for x in second @ basis)
+    return tuple(float(x) for x in second @ _quintic_basis())
 
 
 _MID = _quintic_midpoint_row()
