@@ -761,7 +761,10 @@ def sweep_outputs(result: KernelResult, inputs: Inputs,
         out["peak_frequency"] = xr.DataArray(
             result.reals[:, tk.PEAK_FREQUENCY].reshape(shape), dims=dims,
             attrs={"units": "Hz", "long_name": "excitation frequency of the sweep when |q| had "
-                                               "its largest extremum"})
+                                               "its largest extremum during the sweep (with a "
+                                               "solver.t_end past the sweep's end, "
+                                               "peak_amplitude also covers the ring-down after "
+                                               "it, and may be larger)"})
     if inputs.bands is not None:
         n = inputs.bands[2]
         out["envelope"] = xr.DataArray(
