@@ -1009,8 +1009,9 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
     once the step starts at or after the tail window's start: the integrals of q^2, q'^2 and
     q''^2 on the quintic Hermite through q, q', q'' at both ends (`_quintic_squares`) and of
     (q'' + a_b)^2 by Simpson's rule (SCALAR_SLOTS; the trapezoidal rule on the ends read a
-    reviewer's clamped span's RMS 0.24-0.29 % high where the steps are long), and the crossings of zero and of settings' levels on the
-    step's monotone pieces, q_old to qe to q_new (a level grazed inside a step counts)."""
+    reviewer's clamped span's RMS 0.24-0.29 % high where the steps are long), and the
+    crossings of zero and of settings' levels on the step's monotone pieces, q_old to qe to
+    q_new (a level grazed inside a step counts)."""
     if t < acc[T_TAIL]:
         return
     if acc[IN_WINDOW] == 0.0:

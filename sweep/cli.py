@@ -41,11 +41,9 @@ def _one_line(text: object) -> str:
     return one_line(text)
 
 
-
 def _with_unit(text: str, units: str, example: str) -> float:
     """An argparse value: a plain number (SI) or a number with a unit, converted to `units`
     (sweep.scene.units, the scene keys' rules); ArgumentTypeError, one line, otherwise."""
-    import argparse
     try:
         return float(text)
     except ValueError:
@@ -67,6 +65,7 @@ def _metres(text: str) -> float:
 
 def _hertz(text: str) -> float:
     return _with_unit(text, "Hz", "'100 Hz'")
+
 
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sweep", description="Parameter sweeps of nonlinear cable vibration.")

@@ -315,7 +315,8 @@ def test_a_data_sheet_without_a_diameter_reports_no_bending_strain():
 
 
 @pytest.mark.parametrize("overrides, key", [
-    ({"cable.linear_mass": 53.4}, "cable.linear_mass"), ({"cable.diameter": 2.76}, "cable.diameter"),
+    ({"cable.linear_mass": 53.4}, "cable.linear_mass"),
+    ({"cable.diameter": 2.76}, "cable.diameter"),
     ({"cable.damping_ratio": 1.5}, "cable.damping_ratio"),
     ({"axes.length": [0.2, 150.0]}, "cable.length")])
 def test_a_data_sheet_number_without_its_unit_is_warned_of(overrides, key):

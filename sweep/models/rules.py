@@ -469,8 +469,8 @@ ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
 
 def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
-    or model.membrane, not both; none with the paper's Eq.32, whose is its own); a rotational stiffness with elastic clamps only, and always
-    with them; a diameter (the bending strains) not where a pinned span under model.membrane
+    or model.membrane, not both; none with the paper's Eq.32, whose is its own); a rotational
+    stiffness with elastic clamps only, and always with them; a diameter (the bending strains) not where a pinned span under model.membrane
     reports none (sweep.models.loads.wanted), unless it is part of a data-sheet cable
     (sweep.models.cable); ends other than pins need the consistent coefficients (Eq.32 is the
     pinned span's)."""
@@ -665,8 +665,8 @@ def _check_paper_cable(given: dict[str, Any]) -> None:
               "remove the key, or use model.coefficients = 'consistent' for another cable")
 
 
-TRANSVERSE_ONLY = ("cable.damping_ratio", "initial.displacement", "initial.velocity", "initial.modal_displacement",
-                   "initial.modal_velocity", "model.coefficients", "model.membrane",
+TRANSVERSE_ONLY = ("cable.damping_ratio", "initial.displacement", "initial.velocity",
+                   "initial.modal_displacement", "initial.modal_velocity", "model.coefficients", "model.membrane",
                    "model.paper_parametric", "solver.rtol", "solver.atol", "solver.method",
                    "solver.controller", "solver.driver", "solver.max_step", "solver.min_step",
                    "solver.first_step", "solver.steady_periods", "solver.steady_tolerance",

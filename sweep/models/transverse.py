@@ -29,6 +29,7 @@ from ..schema import BY_AXIS, G2_UNITS, G_UNITS, STANDARD_GRAVITY
 from . import excitation, loads, modal, random_outputs, response_asd
 from .basis import Basis, BasisFamily, end_stiffness, span_basis
 from .random_outputs import RandomInputs
+from .continuation import DIRECTION_DIM
 from .random_scene import REALISATION_DIM
 
 KIND = "transverse"
@@ -352,23 +353,26 @@ run warns: the cubic and quintic terms are the first of a series in the squared 
 model.md sec. 2), whose next term is about slope^6 of the curvature there (1.6 % at 0.5) and
 which diverges at 1 (modal.MAX_SLOPE)."""
 _DEFLECTIONS = ("max_deflection", "amplitude", "peak_amplitude", "peak_deflection")
+_WITHIN_A_POINT = (DIRECTION_DIM, REALISATION_DIM)   # a sweep's two ways, a point's records
 
 
 def _warn_steep(ds: xr.Dataset, inputs: Inputs) -> xr.Dataset:
-    """Warn (one line) where some point's largest deflection reported puts its slope, about
-    pi w / l, above STEEP_SLOPE: its answers are then qualitative. Returns ds."""
+    """Warn (one line) where some point's largest deflection reported (its largest over the
+    _DEFLECTIONS it has, both ways and every record) puts its slope, about pi w / l, above
+    STEEP_SLOPE: its answers are then qualitative. Returns ds."""
     import warnings
 
     from ..errors import CableSweepWarning
     length = derived(inputs.params["length"], inputs.coords)
-    steep = None
-    for name in _DEFLECTIONS:
-        if name in ds:
-            slope = (math.pi * ds[name] / length).where(np.isfinite(ds[name]))
-            steep = slope if steep is None else np.fmax(steep, slope.broadcast_like(steep))
-    if steep is None or not bool((steep > STEEP_SLOPE).any()):
+    slopes = [(math.pi * ds[name] / length).max([d for d in ds[name].dims
+                                                  if d in _WITHIN_A_POINT])
+              for name in _DEFLECTIONS if name in ds]
+    if not slopes:
         return ds
+    steep = xr.concat(slopes, "deflection").max("deflection")
     count = int((steep > STEEP_SLOPE).sum())
+    if count == 0:
+        return ds
     warnings.warn(f"{count} of {steep.size} points deflect to a slope of about "
                   f"{float(steep.max()):.2g} (pi w / l > {STEEP_SLOPE:g}): beyond the moderate "
                   "slopes the model's cubic and quintic terms describe (docs/model.md sec. 2), "

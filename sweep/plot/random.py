@@ -168,8 +168,9 @@ def plot_exceedance(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
                     ax: Axes | None = None) -> Figure:
     """The probability that |midspan deflection| exceeds each clearance level at least once
     in the test (`exceedance_probability`, 1: from the crossing rate pooled over the
-    realisations that did not escape) against the swept axis: one colour per clearance level (m, shown in mm), one line
-    style per value of at most one other swept axis. Returns the Figure."""
+    realisations that did not escape) against the swept axis: one colour per clearance level
+    (m, shown in mm), one line style per value of at most one other swept axis. Returns the
+    Figure."""
     if CLEARANCE_DIM not in ds.dims:
         raise UserError("the result has no clearance levels (give outputs.clearance)")
     ds, x, level, ax = _prepare(ds, select, ax, "exceedance_probability")

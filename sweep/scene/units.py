@@ -5,8 +5,9 @@ is one number (a point for decimals) and its unit: a comma, or a number or sign 
 other than an exponent, is refused, not computed ("53,4 g/m" would be 534 g/m to pint).
 UDUNITS' exponents ("N m2", "m s-2") are read as powers, and "mil" is a data sheet's 1/1000
 inch (pint's is an angle), "Nm" a newton metre (pint's is a "number metre"), and a sweep rate
-may say "oct/min" (pint's octave is a level ratio). An angle per time on a frequency key is read in cycles ("20 rad/s"
-is 20 / 2 pi Hz, "1200 rpm" 20 Hz), where pint would take the radian for a pure number.
+may say "oct/min" (pint's octave is a level ratio). An angle per time on a frequency key is
+read in cycles ("20 rad/s" is 20 / 2 pi Hz, "1200 rpm" 20 Hz), where pint would take the
+radian for a pure number.
 
 Where: every float key, the items of "floats" and "pairs" keys (a pair's first item is a
 frequency, Hz), the values of [axes] lists and ranges (start, stop) and of [points] lists.
