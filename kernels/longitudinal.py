@@ -155,18 +155,28 @@ def solve_span(p, settings, snapshot_times, reals, hist_u, hist_f, snap_u, snap_
             state = DIVERGED
             reals[FAILURE_TIME] = t_new
             break
-        peak_u = max(peak_u, abs(u_end))
-        peak_f = max(peak_f, abs(f_fixed))
+        # The metrics end at t_end: a last level past it (t_end not a whole number of steps)
+        # counts with its value interpolated back to t_end, as the histories take it.
+        span = dt                         # from the level before to the one seen
+        u_seen = u_end
+        f_seen = f_fixed
+        if level == n_levels and t_new > p[T_END]:
+            span = p[T_END] - (t_new - dt)
+            w_seen = span / dt
+            u_seen = u_end_old + w_seen * (u_end - u_end_old)
+            f_seen = f_old + w_seen * (f_fixed - f_old)
+        peak_u = max(peak_u, abs(u_seen))
+        peak_f = max(peak_f, abs(f_seen))
         if abs_load > 0.0:
-            if armed and abs(f_fixed) >= abs_load:
-                t_cross = t_new - dt + dt * (abs_load - abs(f_old)) / (abs(f_fixed) - abs(f_old))
+            if armed and abs(f_seen) >= abs_load:
+                t_cross = t_new - dt + span * (abs_load - abs(f_old)) / (abs(f_seen) - abs(f_old))
                 if rises == 0:
                     arrival = t_cross
                     first_rise = t_cross
                 last_rise = t_cross
                 rises += 1
                 armed = False
-            elif not armed and abs(f_fixed) < 0.5 * abs_load:
+            elif not armed and abs(f_seen) < 0.5 * abs_load:
                 armed = True
         # The last level stands for t_end, which level * dt may miss by rounding (n_needed
         # allows 1e-9 dt): samples up to t_end (+1e-9 of a sample, as the sweep counts them)

@@ -89,21 +89,27 @@ def available_memory(root: str = "/") -> tuple[float, str] | None:
     return min(found) if found else None
 
 
-def check_memory(n_points: int, bytes_per_point: float, what: str, root: str = "/") -> None:
+def check_memory(n_points: int, bytes_per_point: float, what: str, root: str = "/",
+                 working: float = 0.0, working_what: str = "", fix: str = "") -> None:
     """Refuse, before allocating, a sweep whose arrays would not fit in the memory this process
     can count on (available_memory: the least of physical memory, MemAvailable and the cgroup
     limit's room; `root` as there).
 
     bytes_per_point counts every array a point needs, with its copies (solve order, grid
-    order, Dataset). Raises UserError when the total passes 80 % of that memory.
+    order, Dataset); `working` the bytes the kernels' working arrays take besides
+    (`working_what` says what they are, `fix` how to shrink them). Raises UserError when the
+    total passes 80 % of that memory.
     """
-    need = n_points * bytes_per_point
+    need = n_points * bytes_per_point + working
     have = available_memory(root)
     if have is not None and need > 0.8 * have[0]:
+        besides = (f" and {working / 2**30:,.1f} GiB of {working_what}" if working > 0.0
+                   else "")
         raise UserError(f"scene: {n_points:,} points x {bytes_per_point / 1024:,.1f} KiB "
-                        f"({what}) need about {need / 2**30:,.1f} GiB, more than the "
-                        f"{have[0] / 2**30:,.1f} GiB of {have[1]} here allow (use fewer axis "
-                        "values, or store fewer samples or snapshots)")
+                        f"({what}){besides} need about {need / 2**30:,.1f} GiB, more than the "
+                        f"{have[0] / 2**30:,.1f} GiB of {have[1]} here allow ("
+                        + (fix or "use fewer axis values, or store fewer samples or "
+                           "snapshots") + ")")
 
 
 def check_disk(store, bytes_per_point: float) -> None:

@@ -149,7 +149,10 @@ KEYS: tuple[Key, ...] = (
         "the scene gives one (the paper scenes give 4 N)"),
     Key("load", "frequency_ratio", "float", None, units="1", minimum=0.0,
         long_name="load frequency over the span's first natural frequency, W/w1",
-        axis="frequency_ratio"),
+        axis="frequency_ratio",
+        help="load frequency over the span's first natural frequency, W/w1; 1.0 (W = w1) "
+        "where the scene gives neither load.frequency nor this key: give one for a harmonic "
+        "load (the principal parametric resonance is at 2)"),
     Key("load", "frequency", "float", None, units="Hz", minimum=0.0,
         long_name="load frequency W/(2 pi)", axis="frequency"),
     # [base]: both clamps move transversely, a_b(t) = A sin(2 pi f t) (docs/model.md sec. 5)

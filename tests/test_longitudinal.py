@@ -202,3 +202,26 @@ def test_last_history_sample_at_t_end_is_the_exact_value():
     np.testing.assert_allclose(u, exact_u(0.3, t, 0.3, 4.0), rtol=0, atol=1e-9 * 0.3 * 4.0 / EA)
     f = ds["fixed_end_force"].values
     assert np.isfinite(f).all() and f[-1] == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("t_end", [1.5e-4, 2.3e-4, 1e-12])
+def test_peaks_end_at_t_end_when_it_falls_between_levels(t_end):
+    """t_end not a whole number of steps: the last level lies past it. The peak end
+    displacement is d'Alembert's largest |u(l, t)| over [0, t_end] (a ramp rising to t_end
+    there, so its largest is at t_end), not the level's after it (14 % more at 1.5e-4 s in a
+    reviewer's 10 intervals)."""
+    scene = sweep.load_scene("paper-fig7", overrides={
+        "solver.intervals": 10, "solver.t_end": t_end, "outputs.snapshot_times": []})
+    ds = sweep.run(scene, progress=False)
+    times = np.linspace(0.0, t_end, 20001)
+    exact = np.max(np.abs(exact_u(1.0, times, 1.0, 4.0)))
+    assert float(ds["peak_end_displacement"]) == pytest.approx(exact, rel=1e-9, abs=1e-25)
+
+
+def test_more_intervals_than_memory_is_refused_in_one_line():
+    """The scheme's three time levels count: 2e9 intervals would need ~48 GiB a span."""
+    scene = sweep.load_scene("paper-fig7", overrides={
+        "solver.intervals": 2_000_000_000, "outputs.snapshot_times": []})
+    with pytest.raises(sweep.UserError, match="solver.intervals") as caught:
+        sweep.run(scene, progress=False)
+    assert "time levels" in str(caught.value) and "\n" not in str(caught.value)

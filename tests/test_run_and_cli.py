@@ -50,6 +50,19 @@ def test_paper_fig5_amplitudes():
     assert ds["elapsed_time"].values[-1] == pytest.approx(5.0)
 
 
+def test_an_undamped_span_has_no_settling_time():
+    """MODEL: never a settling time for an undamped response. paper-fig5 (Eq.32, undamped) is
+    steady from t = 0, which the envelope test reads as 0 s: NaN instead; with damping the
+    same span decays to its static state and has one (the last time |q| > tol * peak, found
+    by the kernels: positive and before t_end)."""
+    scene = sweep.load_scene("paper-fig5", overrides={"axes.length": [0.5],
+                                                      "axes.damping_ratio": [0.0, 0.3]})
+    ds = sweep.run(scene, progress=False).squeeze()
+    undamped, damped = ds["settling_time"].values
+    assert np.isnan(undamped) and ds["state"].values[0] == km.STEADY
+    assert 0.0 < damped < 5.0 and ds["state"].values[1] == km.DECAYED
+
+
 def test_dataset_layout_units_and_netcdf_round_trip(tmp_path):
     scene = sweep.load_scene_text(SMALL)
     out = tmp_path / "small.nc"

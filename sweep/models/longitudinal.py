@@ -10,6 +10,7 @@ Sign convention: tension positive, so the compressive forces here are negative.
 from __future__ import annotations
 
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass
@@ -84,8 +85,17 @@ def resolve(scene: Scene) -> Inputs:
 def _warn_courant(courant: float) -> None:
     if courant < 1.0:
         warnings.warn(f"solver.courant = {courant:g} < 1: the central difference is dispersive "
-                      "there, so fronts will ring (1.0 is exact at the nodes)",
-                      CableSweepWarning, stacklevel=3)
+                      "there, so fronts ring and the peaks overshoot (the fixed-end force's peak "
+                      "by 10-30 % of the exact 2 P0 at C = 0.5-0.999, more intervals do not "
+                      "shrink it: the ringing narrows, it does not fade); 1.0 is exact at the "
+                      "nodes", CableSweepWarning, stacklevel=3)
+
+
+def _working_bytes(n_spans: int, n_intervals: int, options: RunOptions) -> float:
+    """Bytes of the kernel's working arrays: three time levels of n_intervals + 1 nodes for
+    each span solved at once (one a thread, all the cores' threads by default)."""
+    threads = options.threads or os.cpu_count() or 1
+    return 3.0 * 8.0 * (n_intervals + 1) * min(max(n_spans, 1), threads)
 
 
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:
@@ -101,9 +111,14 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     snap_times = inputs.snapshot_times
     n_snap = snap_times.size
     fields = 5 if inputs.normalised else 3
+    # The scheme's three time levels of n_int + 1 nodes, for each span being solved at once
+    working = _working_bytes(n, n_int, options)
+    working_what = f"the scheme's three time levels of {n_int + 1:,} nodes a span"
+    fix = "use fewer solver.intervals, fewer axis values, or store fewer snapshots"
     # Histories need the longest end time; check the snapshots' size before that.
     check_memory(n, 3.0 * 8 * (lk.N_PARAMS + lk.N_REALS + 1 + fields * n_snap * (n_int + 1)),
-                 "parameters, metrics and snapshots")
+                 "parameters, metrics and snapshots", working=working,
+                 working_what=working_what, fix=fix)
     waves = wave_parameters(inputs.params, inputs.t_end, inputs.transits)
     table = grid.flatten(waves, lk.PARAM_NAMES, dims, shape)
     _warn_courant(courant)
@@ -112,7 +127,8 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     n_hist = int(math.floor(t_max / dt_sample + 1e-9)) + 1 if inputs.histories else 0
     check_memory(n, 3.0 * 8 * (lk.N_PARAMS + lk.N_REALS + 1 + 2 * n_hist
                                + fields * n_snap * (n_int + 1)),
-                 "parameters, metrics, histories and snapshots")
+                 "parameters, metrics, histories and snapshots", working=working,
+                 working_what=working_what, fix=fix)
     settings = np.zeros(lk.N_SETTINGS)
     settings[lk.INTERVALS] = n_int
     settings[lk.COURANT] = courant
@@ -153,7 +169,8 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
         scalar("dynamic_amplification", r[:, lk.PEAK_END_DISPLACEMENT] / np.abs(static), "1",
                "peak end displacement over the static one, P0 l/EA (exact: 2)")
         scalar("force_amplification", r[:, lk.PEAK_FIXED_END_FORCE] / np.abs(table[:, lk.LOAD]),
-               "1", "peak fixed-end force over P0 (exact: 2)")
+               "1", "peak fixed-end force over P0 (exact: 2; below solver.courant = 1 the "
+               "scheme's ringing overshoots it)")
     scalar("arrival_time", r[:, lk.ARRIVAL_TIME], "s",
            "first time |N(0, t)| reaches |P0| (half the 2 P0 step; exact: l/a)")
     scalar("period", r[:, lk.PERIOD], "s",

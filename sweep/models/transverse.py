@@ -45,7 +45,8 @@ _REALS = {
     "peak_amplitude": (tk.PEAK, "m", "max |q| over the whole run (overshoot)",
                        "outputs.peak_amplitude"),
     "settling_time": (tk.SETTLING, "s", "time after which every envelope peak stays within "
-                      "+-tolerance of its final level (decayed: last time |q| > tolerance * peak)",
+                      "+-tolerance of its final level (decayed: last time |q| > tolerance * "
+                      "peak); NaN where the span is undamped (nothing settles)",
                       "outputs.settling_time"),
     "response_period": (tk.PERIOD, "s", "mean time between maxima of q in the tail window",
                         "outputs.response_period"),
@@ -824,6 +825,14 @@ def state_attrs(swept: bool = False, random: bool = False) -> dict[str, Any]:
     }
 
 
+def _undamped_unsettled(settling: xr.DataArray, inputs: Inputs) -> xr.DataArray:
+    """settling_time with NaN where the span has no damping (damping_ratio 0): an undamped
+    response has no transient that settles, so a time would be an artefact of the tolerance
+    band (the paper's undamped Eq.32, periodic from t = 0, read 0 s)."""
+    undamped = derived(inputs.params["damping_ratio"], inputs.coords) == 0.0
+    return settling.where(~undamped).transpose(*settling.dims)
+
+
 def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
              elapsed: float, records: np.ndarray | None = None) -> xr.Dataset:
     """Build the result Dataset of the contract from the flat kernel result: the variables the
@@ -839,6 +848,8 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
         if switch is None or switch in inputs.wanted:
             data[name] = xr.DataArray(result.reals[:, col].reshape(shape), dims=dims,
                                       attrs={"units": units, "long_name": long_name})
+    if "settling_time" in data:
+        data["settling_time"] = _undamped_unsettled(data["settling_time"], inputs)
     if "outputs.solver_stats" in inputs.wanted:
         for name, (col, long_name) in _COUNTS.items():
             data[name] = xr.DataArray(counter(result.counts[:, col].reshape(shape)), dims=dims,
