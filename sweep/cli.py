@@ -408,8 +408,8 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
            else f"{signal.Signals(exc.signum).name} received")
     if not store.exists():
         return (f"{how} before any point was finished: nothing kept, no output written (a "
-                "first run compiles for a minute or so before it solves anything; run the "
-                "same command again)")
+                "first run compiles for up to a minute or two before it solves anything, and "
+                "on dask a chunk is kept when its task ends; run the same command again)")
     words = list(sys.argv[1:] if argv is None else argv)
     command = "sweep " + shlex.join(words + ([] if "--resume" in words else ["--resume"]))
     kept = exc.kept_text() if hasattr(exc, "kept_text") else "finished chunks are kept"

@@ -80,7 +80,8 @@ STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVER
 """`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance", "state", "stability")
-"""The criteria in the order they are named when the shortest span fails several."""
+"""The criteria in the order they are named when the shortest span fails several; a failed
+solve (`state`) comes first wherever it fails, as its NaN values fail no limit."""
 LIMITED_BY = CRITERIA + ("grid",)
 NO_CRITERION = ("design: no criterion given (give --min-frequency HZ, --max-amplitude M, "
                 "--max-deflection M, --max-strain S, --max-rms M, --max-peak M or "
@@ -368,6 +369,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
             continue
         b = int(np.argmin(passes))               # the first failing length
         failing = [k for k in CRITERIA if k in flat and not flat[k][0][i, b] >= 0.0]
+        if "state" in failing:      # the solve failed there: its NaN values fail no limit
+            failing = ["state"] + [k for k in failing
+                                   if k != "state" and np.isfinite(flat[k][1][i, b])]
         if b == 0:
             spans[i], limited[i] = np.nan, failing[0]
             continue

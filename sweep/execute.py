@@ -453,14 +453,20 @@ def chunk_ranges(n: int, chunk_size: int) -> list[tuple[int, int]]:
     return [(lo, min(n, lo + chunk_size)) for lo in range(0, n, chunk_size)]
 
 
+DASK_LEAST_TASK_POINTS = 64
+"""A dask task's fewest points: four lock-step groups of lanes; its scheduling costs a few ms,
+a point 0.02-300 ms."""
+
+
 def default_chunk_size(n: int, backend: str, workers: int) -> int:
     """Points per chunk, at most: for threads, enough for every thread's lanes and at most 100
     chunks (checkpoints and progress come from the blocks inside a chunk, by time); for dask,
-    about 8 tasks per worker of at least 2 000 points (a task then runs long enough to hide the
-    scheduler's per-task overhead of a few ms)."""
+    about 8 tasks per worker, of at least DASK_LEAST_TASK_POINTS: a task is saved only when it
+    ends, so every worker gets several and an interrupt keeps the finished ones (a minimum of
+    2 000 points made any sweep below 2 000 x 8 x workers one task, all lost on Ctrl-C)."""
     import numba
     if backend == "dask":
-        return max(2000, -(-n // (8 * max(workers, 1))))
+        return max(DASK_LEAST_TASK_POINTS, -(-n // (8 * max(workers, 1))))
     return max(4096 * numba.get_num_threads(), -(-n // 100))
 
 

@@ -218,6 +218,23 @@ def test_a_failed_state_ends_the_walk(results):
     assert str(out["limited_by"].values) == "state"
 
 
+@pytest.mark.parametrize("where", [0, 2])
+def test_a_failed_solve_is_named_not_the_limit_its_nan_fails(results, where):
+    """A point whose solve failed (max_steps_reached, amplitude NaN) fails the amplitude limit
+    only through its NaN: the design names `state` (a reviewer's run named max_amplitude, the
+    user then changing the design rather than the solver), at the shortest span and inside."""
+    ds, _ = results["coarse"]
+    bad = ds.copy(deep=True)
+    meanings = bad["state"].attrs["flag_meanings"].split()
+    values = list(np.atleast_1d(bad["state"].attrs["flag_values"]))
+    bad["state"].values[where] = values[meanings.index("max_steps_reached")]
+    bad["amplitude"].values[where] = np.nan
+    out = max_span(bad, max_amplitude=1.0)
+    assert str(out["limited_by"].values) == "state"
+    expected = np.nan if where == 0 else float(ds["length"][where - 1])
+    np.testing.assert_equal(float(out["max_span"]), expected)
+
+
 @pytest.mark.parametrize("kwargs, fragment", [
     ({}, "no criterion"),
     ({"max_amplitude": 1e-3, "quantity": "nonesuch"}, "nonesuch"),

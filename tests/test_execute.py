@@ -523,3 +523,16 @@ def test_the_memory_guard_counts_available_memory_and_the_cgroup_limit(tmp_path,
     assert available_memory(v1) == (2 * gib, "memory the cgroup limit leaves")
     with pytest.raises(sweep.UserError, match="cgroup"):
         check_memory(10**5, 40 * 1024, "test", root=v1)
+
+
+@pytest.mark.parametrize("n, workers", [(180, 2), (1000, 1), (50, 4), (200_000, 2)])
+def test_dask_tasks_are_several_per_worker_so_an_interrupt_keeps_some(n, workers):
+    """A dask task is saved when it ends: a 180-point, 5-mode sweep (0.26 s a point) ran as one
+    task and an interrupt lost it all. Now: about 8 tasks a worker, at least
+    DASK_LEAST_TASK_POINTS points each (so a small grid still fills the lanes)."""
+    from sweep.execute import DASK_LEAST_TASK_POINTS, chunk_ranges, default_chunk_size
+    size = default_chunk_size(n, "dask", workers)
+    tasks = chunk_ranges(n, size)
+    assert sum(hi - lo for lo, hi in tasks) == n
+    assert size >= DASK_LEAST_TASK_POINTS
+    assert min(8 * workers, n // DASK_LEAST_TASK_POINTS) <= len(tasks) <= 8 * workers
