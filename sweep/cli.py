@@ -222,8 +222,8 @@ def _run(args: argparse.Namespace) -> int:
     _check_dask_flags(args, scene.get("run.backend"))
     if args.workers is not None:     # checked against the backend first: its own line above
         scene = load_scene(args.scene, overrides={**overrides, "run.workers": args.workers})
-    if args.output is not None:
-        check_output_path(args.output, args.overwrite)   # before any work, in one line
+    if args.output is not None:      # before any work, in one line
+        check_output_path(args.output, args.overwrite, args.resume)
     started = time.perf_counter()
     from .numba_start import start_without_scipy
     start_without_scipy()        # Numba's registries without importing SciPy (0.15 s)

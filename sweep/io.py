@@ -19,11 +19,13 @@ if TYPE_CHECKING:
     import xarray as xr
 
 
-def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
+def check_output_path(path: str | os.PathLike, overwrite: bool = False,
+                      resume: bool = False) -> Path:
     """Refuse, before any work is done, an output path that cannot be written.
 
     Raises UserError naming the file: missing or read-only directory, an existing file
-    without `overwrite`, a directory in the way, or a name that is not .nc.
+    without `overwrite` (with `resume` and no chunk store beside it: the run is already
+    complete), a directory in the way, or a name that is not .nc.
     """
     raw = os.fspath(path)
     if isinstance(raw, bytes):
@@ -37,13 +39,13 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False) -> Path:
     if "\0" in raw:
         raise UserError(f"output {ascii(raw)}: the name holds a NUL character (choose another name)")
     try:
-        return _check_output_path(raw, overwrite)
+        return _check_output_path(raw, overwrite, resume)
     except OSError as exc:
         raise UserError(f"output '{raw}': cannot be checked ({exc.strerror or exc}; choose "
                         "another -o path)") from None
 
 
-def _check_output_path(raw: str, overwrite: bool) -> Path:
+def _check_output_path(raw: str, overwrite: bool, resume: bool = False) -> Path:
     """check_output_path's checks on a name already known to be UTF-8 (may raise OSError)."""
     if not raw.strip():
         raise UserError(f"output '{raw}': empty file name (give a file name ending in .nc, "
@@ -68,6 +70,11 @@ def _check_output_path(raw: str, overwrite: bool) -> Path:
     if out.is_dir():
         raise UserError(f"output '{out}': is a directory (give a file name ending in .nc)")
     if out.exists() and not overwrite:
+        from .store import store_path
+        if resume and not os.path.lexists(store_path(out)):
+            raise UserError(f"output '{out}': the run is already complete (the file holds it "
+                            "and no chunk store is left to resume; use --overwrite to run it "
+                            "again)")
         raise UserError(f"output '{out}': file exists (use --overwrite, or overwrite=True, to replace it)")
     return out
 

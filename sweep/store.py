@@ -112,11 +112,12 @@ class ChunkStore:
             self._lock()
             return self._prepare(existed, resume, overwrite, chunk_size)
         except OSError as exc:
-            self.release()
+            self.release(discard_empty=not existed)     # leave no store this run made
             if exc.errno in _FULL:
+                need = self.space_needed()
+                amount = f"the run needs about {mib(need)} there; " if need > 0.0 else ""
                 raise UserError(f"chunk store '{self.directory}': no space left on the device "
-                                f"(the run needs about {mib(self.space_needed())} there; free "
-                                "space and run again)") from exc
+                                f"({amount}free space and run again)") from exc
             raise UserError(f"chunk store '{self.directory}': cannot be used "
                             f"({exc.strerror or exc})") from exc
 

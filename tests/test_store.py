@@ -429,3 +429,32 @@ def test_a_store_made_by_other_kernels_is_never_resumed(tmp_path, monkeypatch):
     with pytest.raises(UserError, match="another version of cable-sweep") as refused:
         ChunkStore(tmp_path / "o.nc", mine).open(resume=True, overwrite=False, chunk_size=2)
     assert "\n" not in str(refused.value)
+
+
+def test_a_full_disk_while_the_store_is_made_leaves_no_store(tmp_path, monkeypatch):
+    """The disk full as the store writes its run.json: one line (no '0.0 MiB' estimate: none
+    is known yet), and no empty store with its lock left behind (a reviewer found one)."""
+    import errno
+
+    def full(self, path, data):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(ChunkStore, "_write_atomic", full)
+    scene = sweep.load_scene_text(SCENE)
+    with pytest.raises(sweep.UserError, match="no space left on the device") as caught:
+        sweep.run(scene, output=tmp_path / "out.nc", progress=False)
+    assert "0.0 MiB" not in str(caught.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_resuming_a_finished_run_says_it_is_complete(tmp_path):
+    """--resume on a file whose run finished (no store left): not 'file exists', which reads
+    as if the run had to start again."""
+    scene = sweep.load_scene_text(SCENE)
+    out = tmp_path / "out.nc"
+    sweep.run(scene, output=out, progress=False)
+    with pytest.raises(sweep.UserError, match="already complete") as caught:
+        sweep.run(scene, output=out, resume=True, progress=False)
+    assert "--overwrite" in str(caught.value)
+    with pytest.raises(sweep.UserError, match="file exists"):
+        sweep.run(scene, output=out, progress=False)
