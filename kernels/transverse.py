@@ -114,8 +114,18 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
     system's own at-rest test: `at_rest` for the oscillator).
 
     A trajectory that came to rest away from zero without oscillating is integrated a second
-    time to find when it settled on its final value (SECOND_PASS).
+    time to find when it settled on its final value (SECOND_PASS). A random record's
+    (`base` the records) are its statistics' (`random_outputs`): each kind compiles only its
+    own (excitation.by_kind; the response's states cost a record scene 3 s of compile).
     """
+    return _metrics_of_kind(settings, acc, buf, reals, counts, resting, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _metrics_start(settings, acc, reals, counts, base):
+    """What every finished trajectory reports (counts, the end state, amplitude, peak, a
+    base excitation's acceleration); returns its status: a failure's, or mt.RUNNING for a
+    trajectory that ran to its end."""
     for j in range(N_REALS):
         reals[j] = math.nan
     counts[STEPS] = int(acc[tj.STEPS])
@@ -125,24 +135,40 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
     if status != mt.RUNNING:
         reals[FAILURE_TIME] = acc[tj.T_STOP]
         return status
-
     reals[Q_END] = acc[tj.Q]
     reals[V_END] = acc[tj.V]
+    if acc[tj.T_FINAL] < settings[T_END]:
+        reals[STOP_TIME] = acc[tj.T_FINAL]
+    reals[AMPLITUDE] = acc[tj.TAIL_AMP]
+    reals[PEAK] = acc[tj.PEAK]
+    if base is not None:
+        reals[ACCELERATION] = acc[tj.ACC_AMP]
+    return status
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _record_metrics(settings, acc, buf, reals, counts, resting, base):
+    """classify_metrics for a random record: its statistics (`random_outputs`)."""
+    status = _metrics_start(settings, acc, reals, counts, base)
+    if status != mt.RUNNING:
+        return status
+    return random_outputs(settings, acc, reals)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _response_metrics(settings, acc, buf, reals, counts, resting, base):
+    """classify_metrics for the sine kinds or none: the response's state from its extrema
+    (docs/model.md, section 3)."""
+    status = _metrics_start(settings, acc, reals, counts, base)
+    if status != mt.RUNNING:
+        return status
     want_settling = settings[WANT_SETTLING] != 0.0
     tol = settings[TOL]
     t_tail = acc[tj.T_TAIL]          # t_end (1 - tail), or where the point was found steady
     t_end = acc[tj.T_FINAL]
-    if t_end < settings[T_END]:
-        reals[STOP_TIME] = t_end
     tail_amp = acc[tj.TAIL_AMP]
     peak = acc[tj.PEAK]
     n_ext = int(acc[tj.N_EXT])
-    reals[AMPLITUDE] = tail_amp
-    reals[PEAK] = peak
-    if base is not None:
-        reals[ACCELERATION] = acc[tj.ACC_AMP]
-    if ex.is_record(base):
-        return random_outputs(settings, acc, reals)
     n_max, n_min, period = mt.tail_counts(buf, n_ext, t_tail)
     reals[PERIOD] = period
     band = tol * tail_amp
@@ -175,6 +201,9 @@ def classify_metrics(settings, acc, buf, reals, counts, base, resting):
     # Too few oscillations in the tail to judge, or a slow motion that has only begun (a run
     # shorter than one period moves little and yet is not at rest).
     return mt.UNSETTLED
+
+
+_metrics_of_kind = ex.by_kind(_response_metrics, _record_metrics)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
