@@ -219,6 +219,11 @@ def test_a_scene_of_the_zero_solution_warns():
         load_scene_text("")
     with pytest.warns(CableSweepWarning, match="stays at q = 0"):
         load_scene_text("[axes]\ninitial_displacement = [0.0]\n")
+    # it says why: with no end load, not that the end load changes the stiffness
+    with pytest.warns(CableSweepWarning, match="nothing drives the span"):
+        load_scene_text("[cable]\nlength = 0.5\n")
+    with pytest.warns(CableSweepWarning, match="end load only changes the stiffness"):
+        load_scene_text("[load]\namplitude = 2.0\nfrequency_ratio = 2.0\n")
 
 
 @pytest.mark.parametrize("text", ["[initial]\ndisplacement = 1e-4\n",

@@ -807,10 +807,14 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
         what = (f"the scene sets no keys, so it runs one point of the defaults (a "
                 f"{values['cable.length']:g} m span, {values['load.amplitude']:g} N "
                 f"{values['load.type']} end load, {values['solver.t_end']:g} s): ")
-    warnings.warn(f"{what}initial.displacement = initial.velocity = 0 at every point, and the "
-                  "end load only changes the stiffness, so every point stays at q = 0 "
-                  "(state decayed, amplitude 0); give a start, e.g. initial.displacement = "
-                  "1e-4 (m)", CableSweepWarning, stacklevel=5)
+    loaded = (_extreme(values, axes, "load.amplitude", np.min) != 0.0
+              or _extreme(values, axes, "load.amplitude", np.max) != 0.0)
+    why = ("the end load only changes the stiffness" if loaded
+           else "nothing drives the span (no end load, no base excitation)")
+    warnings.warn(f"{what}initial.displacement = initial.velocity = 0 at every point, and "
+                  f"{why}, so every point stays at q = 0 (state decayed, amplitude 0); give a "
+                  "start, e.g. initial.displacement = 1e-4 (m)", CableSweepWarning,
+                  stacklevel=5)
 
 
 def _check_snapshot_times(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
