@@ -17,6 +17,7 @@ to fix it; a sweep too large for memory counts as one), 1 on an internal error.
 from __future__ import annotations
 
 import argparse
+import os
 import shlex
 import signal
 import sys
@@ -125,8 +126,10 @@ def _parser() -> argparse.ArgumentParser:
     design = sub.add_parser("design", help="the largest span between clamps meeting the "
                                            "criteria, from a result with a length axis (limits "
                                            "in SI, or with a unit: --max-amplitude '2 mm')")
-    design.add_argument("result", metavar="RESULT.nc",
-                        help="a netCDF file written by 'sweep run' with a length axis")
+    design.add_argument("result", metavar="RESULT.nc", nargs="+",
+                        help="a netCDF file written by 'sweep run' with a length axis; several "
+                             "(a launch's sine and random results): each is asked the criteria "
+                             "it holds, and the shortest span binds")
     design.add_argument("--min-frequency", type=_hertz, default=None, metavar="HZ",
                         help="first natural frequency at least this (Hz)")
     design.add_argument("--max-amplitude", type=_metres, default=None, metavar="M",
@@ -309,16 +312,25 @@ def _design(args: argparse.Namespace) -> int:
                         "bisects to; give --refine too")
     if args.output is not None:
         check_output_path(args.output, args.overwrite)   # before any work, in one line
-    ds = load_result(args.result)
+    if len(args.result) > 1 and args.refine:
+        raise UserError("design: --refine takes one result (it runs that result's scene); "
+                        "refine each result alone, or leave --refine out")
     criteria = dict(min_frequency=args.min_frequency, max_amplitude=args.max_amplitude,
                     quantity=args.quantity, max_deflection=args.max_deflection,
                     max_strain=args.max_strain, max_rms=args.max_rms,
                     max_peak=args.max_peak, clearance=args.clearance,
                     max_probability=args.max_probability)
-    if args.refine:
+    if len(args.result) > 1:
+        from .governing import governing_span
+        results = [(os.path.basename(path), load_result(path)) for path in args.result]
+        ds = results[0][1]
+        result = governing_span(results, **criteria)
+    elif args.refine:
+        ds = load_result(args.result[0])
         result = refine_span(ds, **criteria,
                              tolerance=1e-3 if args.tolerance is None else args.tolerance)
     else:
+        ds = load_result(args.result[0])
         result = max_span(ds, **criteria)
     print(f"{result.attrs['title']} ({result.attrs['criteria']})")
     print(table(result))
@@ -326,8 +338,13 @@ def _design(args: argparse.Namespace) -> int:
         print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
               f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
     elif interpolated(result, criteria):
-        fix = ("refine the scene's length axis (and add base.realisations) to narrow it"
-               if "realisation" in ds.dims else "--refine runs the engine to bracket it")
+        if len(args.result) > 1:
+            fix = ("--refine runs the engine to bracket it, one sine result at a time; a random "
+                   "result's length axis refined (and base.realisations added) narrows it")
+        elif "realisation" in ds.dims:
+            fix = "refine the scene's length axis (and add base.realisations) to narrow it"
+        else:
+            fix = "--refine runs the engine to bracket it"
         print("interpolated between the grid's lengths, not run there: a response that peaks "
               f"between two of them (a resonance) can put the true limit shorter; {fix}")
     if args.output is not None:
@@ -454,6 +471,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt as exc:
         print(f"sweep: {_interrupted(exc, args, argv)}", file=sys.stderr)
         return 128 + int(getattr(exc, "signum", 2))      # 130 for Ctrl-C, 143 SIGTERM, 129 SIGHUP
+    except BrokenPipeError:
+        # the reader of stdout went away (`sweep design ... | head`): no traceback, and no
+        # second one when Python flushes stdout at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141                                       # 128 + SIGPIPE, as a shell reports
 
 
 if __name__ == "__main__":

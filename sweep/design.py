@@ -195,6 +195,30 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
     return limits
 
 
+def check_result(ds: xr.Dataset, name: str | None = None) -> tuple[str, ...]:
+    """The axes of a result `max_span` can walk (its state's or stability's dims), or a
+    one-line UserError (naming the result `name` where given): not a Dataset, neither state
+    nor stability, no positive finite `length` axis."""
+    which = "the result" if name is None else f"result '{name}'"
+    if not isinstance(ds, xr.Dataset):
+        raise UserError(f"max_span: needs a result (an xarray Dataset), got "
+                        f"{type(ds).__name__}")
+    template = "state" if "state" in ds else "stability" if "stability" in ds else None
+    if template is None:
+        raise UserError(f"design: {which} has neither 'state' nor 'stability' (give a "
+                        "result written by 'sweep run ... -o FILE.nc')")
+    axes = tuple(str(d) for d in ds[template].dims)
+    if LENGTH not in axes or LENGTH not in ds.coords:
+        have = ", ".join(a for a in axes if a not in WORST_OVER) or "none"
+        raise UserError(f"design: {which} has no 'length' axis (its axes: {have}); run the "
+                        "scene with one, e.g. --set 'axes.length={start=0.1, stop=0.6, num=11}'")
+    lengths = np.asarray(ds[LENGTH].values, float)
+    if not (np.all(np.isfinite(lengths)) and np.all(lengths > 0)):
+        raise UserError(f"design: {which}'s 'length' axis holds values that are not "
+                        "positive finite lengths (m); give a result written by 'sweep run'")
+    return axes
+
+
 def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
            quantity: str | None, max_deflection: float | None = None,
            max_strain: float | None = None, max_rms: float | None = None,
@@ -208,19 +232,7 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
     if all(c is None for c in (min_frequency, max_amplitude, max_deflection, max_strain,
                                max_rms, max_peak, clearance)):
         raise UserError(NO_CRITERION)
-    template = "state" if "state" in ds else "stability" if "stability" in ds else None
-    if template is None:
-        raise UserError("design: the result has neither 'state' nor 'stability' (give a "
-                        "result written by 'sweep run ... -o FILE.nc')")
-    axes = tuple(str(d) for d in ds[template].dims)
-    if LENGTH not in axes or LENGTH not in ds.coords:
-        have = ", ".join(a for a in axes if a not in WORST_OVER) or "none"
-        raise UserError(f"design: the result has no 'length' axis (its axes: {have}); run the "
-                        "scene with one, e.g. --set 'axes.length={start=0.1, stop=0.6, num=11}'")
-    lengths = np.asarray(ds[LENGTH].values, float)
-    if not (np.all(np.isfinite(lengths)) and np.all(lengths > 0)):
-        raise UserError("design: the result's 'length' axis holds values that are not "
-                        "positive finite lengths (m); give a result written by 'sweep run'")
+    axes = check_result(ds)
     if min_frequency is not None and "natural_frequency" not in ds:
         raise UserError("design: --min-frequency needs the variable 'natural_frequency' (Hz), "
                         "which this result lacks (a transverse result has it)")
@@ -558,7 +570,8 @@ def table(result: xr.Dataset) -> str:
     dims = list(span.dims)
     on_points = [c for c in result.coords if c != POINT_DIM and result[c].dims == (POINT_DIM,)]
     columns = [(d, d) for d in dims] + [(c, POINT_DIM) for c in on_points]
-    head = [c for c, _ in columns] + ["max_span_mm", "limited_by"]
+    where = "limited_in" in result          # several results (sweep.governing)
+    head = [c for c, _ in columns] + ["max_span_mm", "limited_by"] + (["in"] if where else [])
     rows = []
     for index in np.ndindex(*span.shape):
         at = dict(zip(dims, index))
@@ -567,7 +580,8 @@ def table(result: xr.Dataset) -> str:
         s = float(span.values[index])
         by = str(result["limited_by"].values[index])
         rows.append([*values, f"{s * 1e3:.2f}" if np.isfinite(s) else "nan",
-                     by if np.isfinite(s) else f"{by} (shortest span fails)"])
+                     by if np.isfinite(s) else f"{by} (shortest span fails)"]
+                    + ([str(result["limited_in"].values[index])] if where else []))
     widths = [max(len(r[j]) for r in [head, *rows]) for j in range(len(head))]
     lines = ["  ".join(c.rjust(w) if j < len(head) - 1 else c
                        for j, (c, w) in enumerate(zip(r, widths))) for r in [head, *rows]]

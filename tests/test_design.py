@@ -570,3 +570,62 @@ def test_refine_the_stability_criterion():
     # the growth rate's zero, which max_span interpolates linearly, within the bracket
     assert got == pytest.approx(float(max_span(ds, min_frequency=1.0)["max_span"].squeeze()),
                                 abs=5e-3)
+
+
+# --- several results at once (sweep.governing) ------------------------------------------------
+
+def _frequency_only(results) -> xr.Dataset:
+    """The coarse result without its responses: only the frequency criterion applies to it."""
+    ds, _ = results["coarse"]
+    return ds.drop_vars([v for v in ("amplitude", "peak_amplitude") if v in ds])
+
+
+@pytest.mark.parametrize("limit, f_min, binds, where", [
+    (1e-7, 40.0, "max_amplitude", "linear.nc"),      # 0.2447 m against 0.3089 m
+    (5e-7, 60.0, "min_frequency", None),             # 0.3123 m against 0.2522 m
+])
+def test_several_results_the_shortest_span_binds_and_says_where(results, limit, f_min,
+                                                                binds, where):
+    """A launch's tests as separate results: each answers the criteria it holds (here the
+    amplitude only the linear span's, the frequency both), and the closed forms' smaller span
+    binds, named with the result it binds in."""
+    from sweep.governing import governing_span
+    linear, _ = results["linear"]
+    out = governing_span([("linear.nc", linear), ("coarse.nc", _frequency_only(results))],
+                         max_amplitude=limit, min_frequency=f_min)
+    expected = min(_amplitude_reference(limit), l_max_frequency(f_min))
+    assert float(out["max_span"]) == pytest.approx(expected, rel=2e-3)
+    assert str(out["limited_by"].values) == binds
+    if where is not None:
+        assert str(out["limited_in"].values) == where
+    assert "linear.nc" in out.attrs["criteria"] and "coarse.nc" in out.attrs["criteria"]
+
+
+def test_several_results_refuse_what_none_or_no_criterion_answers(results):
+    from sweep.governing import governing_span
+    linear, _ = results["linear"]
+    pair = [("linear.nc", linear), ("coarse.nc", _frequency_only(results))]
+    with pytest.raises(sweep.UserError, match="nor does any other result"):
+        governing_span(pair, max_rms=1e-3)
+    with pytest.raises(sweep.UserError, match="result 'coarse.nc': none of the criteria"):
+        governing_span(pair, max_amplitude=1e-7)
+    nolength, _ = results["no_length"]
+    with pytest.raises(sweep.UserError, match="result 'n.nc' has no 'length' axis"):
+        governing_span([("linear.nc", linear), ("n.nc", nolength)], min_frequency=40.0)
+    a = linear.expand_dims(damping_ratio=[0.01])
+    b = _frequency_only(results).expand_dims(damping_ratio=[0.02])
+    with pytest.raises(sweep.UserError, match="shared axes \\(damping_ratio\\)"):
+        governing_span([("a.nc", a), ("b.nc", b)], min_frequency=40.0)
+
+
+def test_cli_design_of_two_results_prints_where_it_binds(results, tmp_path, capsys):
+    _, linear_path = results["linear"]
+    other = tmp_path / "coarse.nc"
+    _frequency_only(results).to_netcdf(other)
+    assert main(["design", str(linear_path), str(other), "--max-amplitude", "1e-7",
+                 "--min-frequency", "40"]) == 0
+    out = capsys.readouterr().out
+    assert "limited_by" in out and "linear.nc" in out and "max_amplitude" in out
+    assert main(["design", str(linear_path), str(other), "--min-frequency", "40",
+                 "--refine"]) == 2
+    assert "--refine takes one result" in capsys.readouterr().err

@@ -227,3 +227,16 @@ def test_output_file_follows_the_umask(tmp_path, umask, mode):
     finally:
         os.umask(old)
     assert os.stat(out).st_mode & 0o777 == mode
+
+
+def test_a_closed_pipe_on_stdout_is_no_traceback():
+    """`sweep keys | head -1`: the reader has gone when the command writes: exit 141 as a
+    shell reports SIGPIPE, no traceback."""
+    read, write = os.pipe()
+    os.close(read)
+    proc = subprocess.Popen([sys.executable, "-m", "sweep.cli", "keys"], stdout=write,
+                            stderr=subprocess.PIPE)
+    os.close(write)
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141, err
+    assert "Traceback" not in err and "BrokenPipe" not in err

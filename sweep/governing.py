@@ -1,0 +1,142 @@
+"""The clamp spacing under several results at once: a launch's sine and random tests.
+
+A harness span must pass every test of its load case, each its own result (a sine sweep, a
+random test, a resonant dwell). `governing_span(results, **criteria)` asks each result the
+criteria it holds the variables of (`sweep.design.max_span`: --min-frequency of every
+transverse result, --max-rms of a random one, --max-amplitude of a sine one ...), and keeps,
+for every combination of the results' other axes, the shortest of their spans, `limited_by`
+the criterion that binds there and `limited_in` the result it binds in. Every criterion must
+apply to some result, and every result must have a criterion that applies to it; axes the
+results share must hold the same values (an axis only one of them has spreads over the
+others, whose spans do not vary along it).
+"""
+
+from __future__ import annotations
+
+import datetime
+from typing import Any, Sequence
+
+import numpy as np
+import xarray as xr
+
+from .design import NO_CRITERION, check_result, max_span
+from .errors import UserError
+
+CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
+            "max_peak", "clearance")
+"""The criteria a result may or may not hold the variables of (sweep.design's limits)."""
+
+
+def _criterion(name: str, criteria: dict[str, Any]) -> dict[str, Any]:
+    """The keyword arguments of max_span for criterion `name` alone (with its companion:
+    --quantity for --max-amplitude, --max-probability for --clearance)."""
+    one = {name: criteria[name]}
+    if name == "max_amplitude" and criteria.get("quantity") is not None:
+        one["quantity"] = criteria["quantity"]
+    if name == "clearance" and criteria.get("max_probability") is not None:
+        one["max_probability"] = criteria["max_probability"]
+    return one
+
+
+def _applies(ds: xr.Dataset, one: dict[str, Any]) -> str | None:
+    """None where max_span can answer the criterion `one` on `ds`, else its one-line reason."""
+    try:
+        max_span(ds, **one)
+    except UserError as exc:
+        return str(exc)
+    return None
+
+
+def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
+                   min_frequency: float | None = None, max_amplitude: float | None = None,
+                   quantity: str | None = None, max_deflection: float | None = None,
+                   max_strain: float | None = None, max_rms: float | None = None,
+                   max_peak: float | None = None, clearance: float | None = None,
+                   max_probability: float | None = None) -> xr.Dataset:
+    """The largest span between clamps (m) that meets every criterion in every result it
+    applies to: `max_span` of each (name, result) pair with its own criteria, the shortest
+    over the results at each combination of their other axes. Returns a Dataset with
+    `max_span`, `limited_by` (sweep.design.LIMITED_BY) and `limited_in` (the binding
+    result's name); attributes `criteria` (each result's) and `results`. A NaN span (a
+    result's shortest length fails) wins over any other.
+
+    Raises UserError (one line): no criterion, a criterion no result holds the variables of
+    (its reason in the first result), a result no criterion applies to, axes the results
+    share with different values.
+    """
+    criteria = dict(min_frequency=min_frequency, max_amplitude=max_amplitude,
+                    quantity=quantity, max_deflection=max_deflection, max_strain=max_strain,
+                    max_rms=max_rms, max_peak=max_peak, clearance=clearance,
+                    max_probability=max_probability)
+    given = [c for c in CRITERIA if criteria[c] is not None]
+    if not given:
+        raise UserError(NO_CRITERION)
+    for name, ds in results:
+        check_result(ds, name)
+    asked: list[dict[str, Any]] = [{} for _ in results]
+    for c in given:
+        one = _criterion(c, criteria)
+        reasons = [_applies(ds, one) for _, ds in results]
+        if all(r is not None for r in reasons):
+            raise UserError(f"{reasons[0]} (nor does any other result given)")
+        for i, reason in enumerate(reasons):
+            if reason is None:
+                asked[i].update(one)
+    spans = []
+    for (name, ds), own in zip(results, asked):
+        if not own:
+            raise UserError(f"design: result '{name}': none of the criteria given reads its "
+                            "variables (leave it out, or give one it holds)")
+        spans.append(max_span(ds, **own))
+    return _shortest(spans, [name for name, _ in results])
+
+
+def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
+    """The shortest of several max_span results at each combination of their axes."""
+    try:
+        aligned = xr.align(*[s["max_span"] for s in spans], join="exact")
+    except ValueError:
+        shared = sorted(set.intersection(*[set(s["max_span"].dims) for s in spans]))
+        raise UserError("design: the results' shared axes (" + ", ".join(shared) + ") hold "
+                        "different values; run them over the same values") from None
+    values = xr.broadcast(*aligned)
+    limited = xr.broadcast(*[s["limited_by"] for s in spans])
+    dims = values[0].dims
+    stack = np.stack([v.transpose(*dims).values for v in values])
+    by = np.stack([b.transpose(*dims).values for b in limited])
+    # a NaN span (the shortest length fails) binds first; then the shortest
+    order = np.where(np.isnan(stack), -np.inf, stack)
+    pick = np.argmin(order, axis=0)
+    span = np.take_along_axis(stack, pick[None], axis=0)[0]
+    limited_by = np.asarray(np.take_along_axis(by, pick[None], axis=0)[0], dtype=object)
+    grid = np.all(by == "grid", axis=0)
+    limited_in = np.asarray(np.where(grid, "", np.asarray(names, dtype=object)[pick]),
+                            dtype=object)
+    first = spans[0]
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    criteria = " | ".join(f"{n}: {s.attrs.get('criteria', '')}" for n, s in zip(names, spans))
+    coords = {d: values[0][d] for d in dims if d in values[0].coords}
+    for s in spans:                     # a [points] set's own coordinates
+        for c in s.coords:
+            if c not in coords and set(s[c].dims) <= set(dims):
+                coords[c] = s[c]
+    return xr.Dataset(
+        {"max_span": xr.DataArray(span, dims=dims, attrs={
+            **first["max_span"].attrs,
+            "long_name": "largest span between clamps meeting the criteria in every result "
+                         "they apply to, every shorter grid span passing (interpolated between "
+                         "grid lengths)"}),
+         "limited_by": xr.DataArray(limited_by.astype(str).astype(object), dims=dims,
+                                    attrs=first["limited_by"].attrs),
+         "limited_in": xr.DataArray(limited_in.astype(str).astype(object), dims=dims, attrs={
+             "long_name": "the result the binding criterion holds in (empty: every result's "
+                          "grid passes)"})},
+        coords=coords,
+        attrs={"title": "maximum span: " + " + ".join(str(s.attrs.get("source_title") or n)
+                                                      for n, s in zip(names, spans)),
+               "Conventions": first.attrs.get("Conventions", "CF-1.11"),
+               "source": first.attrs.get("source", ""),
+               "history": f"{now} governing span of {', '.join(names)} ({criteria})",
+               "cable_sweep_version": first.attrs.get("cable_sweep_version", ""),
+               "criteria": criteria,
+               "results": ", ".join(names)})
