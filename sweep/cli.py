@@ -233,6 +233,7 @@ def _run(args: argparse.Namespace) -> int:
     ds = run(scene, output=args.output, overwrite=args.overwrite, resume=args.resume,
              threads=args.threads, scheduler=args.scheduler,
              progress=False if args.quiet else None)
+    args.complete = True             # a signal from here on finds the result whole
     if not args.quiet:
         line = _summary(ds, time.perf_counter() - started)
         print(line + (f" -> {args.output}" if args.output else ""))
@@ -409,6 +410,12 @@ def _one_line_warnings() -> None:
     warnings.showwarning = show
 
 
+def _signal_name(exc: KeyboardInterrupt) -> str:
+    """The signal a KeyboardInterrupt stands for: SIGINT (Ctrl-C), or the one
+    `execute.terminate_raises` turned into it (SIGTERM, SIGHUP)."""
+    return signal.Signals(int(getattr(exc, "signum", 2))).name
+
+
 def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                  argv: Sequence[str] | None) -> str:
     """The one line Ctrl-C leaves: what was kept, and the command that finishes the run."""
@@ -421,8 +428,8 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
                 "finished chunks, in OUT.nc.chunks/, and 'sweep run ... -o OUT.nc --resume' "
                 "finishes it)")
     store = store_path(output)
-    how = ("interrupted" if getattr(exc, "signum", 2) == 2
-           else f"{signal.Signals(exc.signum).name} received")
+    how = _signal_name(exc)
+    how = "interrupted" if how == "SIGINT" else f"{how} received"
     if not store.exists():
         return (f"{how} before any point was finished: nothing kept, no output written (a "
                 "first run compiles for up to a minute or two before it solves anything, and "
@@ -469,6 +476,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                   file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
+        if getattr(args, "complete", False):
+            where = f": {args.output} is whole" if args.output else ""
+            print(f"sweep: {_signal_name(exc)} received after the run was complete{where}",
+                  file=sys.stderr)
+            return 0
         print(f"sweep: {_interrupted(exc, args, argv)}", file=sys.stderr)
         return 128 + int(getattr(exc, "signum", 2))      # 130 for Ctrl-C, 143 SIGTERM, 129 SIGHUP
     except BrokenPipeError:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -240,3 +241,23 @@ def test_a_closed_pipe_on_stdout_is_no_traceback():
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 141, err
     assert "Traceback" not in err and "BrokenPipe" not in err
+
+
+def test_a_signal_after_the_run_is_complete_exits_0(tmp_path, monkeypatch, capsys):
+    """SIGTERM between the file's write and the summary line (a reviewer's run exited 143
+    though the file was whole): exit 0, saying the result is whole."""
+    import sweep.cli as cli
+    scene = tmp_path / "small.toml"
+    scene.write_text(SMALL)
+    out = tmp_path / "small.nc"
+
+    def terminated(*args, **kwargs):
+        exc = KeyboardInterrupt()
+        exc.signum = signal.SIGTERM
+        raise exc
+
+    monkeypatch.setattr(cli, "_summary", terminated)
+    assert cli.main(["run", str(scene), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "SIGTERM received after the run was complete" in err and str(out) in err
+    assert xr.open_dataset(out)["state"].size > 0
