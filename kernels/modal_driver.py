@@ -193,8 +193,10 @@ def modal_size(n_modes):
     are observed at all (factor_slot(N) + 1: settings[LOADS], 1.0 or 0.0), both set by
     `start`; under a random base acceleration with the loads observed, the integrals over the
     statistics window of c_e^2, c_e'^2 and c_e''^2 for the clamp at s = 0 and midspan
-    (square_slot(N) + 0..2, + 3..5; m^2 s, m^2/s, m^2/s^3; `_observe_bend_squares`)."""
-    return 3 * n_modes + 15
+    (square_slot(N) + 0..2, + 3..5; m^2 s, m^2/s, m^2/s^3; `_observe_bend_squares`); the end
+    load's factors for the clamp's reaction (end_load_slot(N) + 0..3: kernels.modes
+    `end_load_factors`)."""
+    return 3 * n_modes + 19
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -223,6 +225,20 @@ def load_slot(n_modes):
 def factor_slot(n_modes):
     """The slot of the shear factor kappa (kernels.modes.shear_factor) in the accumulator."""
     return 3 * n_modes + 7
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def end_load_slot(n_modes):
+    """The first of the end load's four factors in the accumulator (kernels.modes
+    `end_load_factors`: its P l^2 / EI mean and cosine amplitude, W, phi_W)."""
+    return 3 * n_modes + 15
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def end_load_at(modal, n_modes, t):
+    """(P l^2 / EI, its rate) of the end load at t (s), from the accumulator's factors."""
+    s = end_load_slot(n_modes)
+    return md.end_load(modal[s], modal[s + 1], modal[s + 2], modal[s + 3], t)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -506,13 +522,15 @@ ROOT_ITERATIONS = 48
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _loads_at(y, h, QA, x, n, basis, kappa, qv, out):
-    """kernels.modes.span_loads at the fraction x of the step, on every mode's interpolant
-    (QA); qv (2N): scratch for q and its rate there."""
+def _loads_at(t, y, h, QA, x, n, basis, modal, qv, out):
+    """kernels.modes.span_loads at the fraction x of the step from t (s), on every mode's
+    interpolant (QA); qv (2N): scratch for q and its rate there."""
     for c in range(n):
         qv[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
         qv[n + c] = dopri5.dense_value(y[n + c], h, QA[c, 1], x)
-    md.span_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n, kappa, out)
+    load, rate = end_load_at(modal, n, t + x * h)
+    md.span_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n,
+                  modal[factor_slot(n)], load, rate, out)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -539,8 +557,10 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
     a = qx[3 * n:3 * n + 6]
     b = qx[3 * n + 6:3 * n + 12]
     m = qx[3 * n + 12:3 * n + 18]
-    md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, a)
-    md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, b)
+    load, rate = end_load_at(modal, n, t)
+    md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, a)
+    load, rate = end_load_at(modal, n, t_new)
+    md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, load, rate, b)
     inside = t < t_tail
     need = inside
     for k in range(3):
@@ -553,7 +573,7 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
         located = True
     if inside:
-        _loads_at(y, h, QA, (t_tail - t) / h, n, basis, kappa, qv, m)
+        _loads_at(t, y, h, QA, (t_tail - t) / h, n, basis, modal, qv, m)
         for k in range(3):
             modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
     for k in range(3):
@@ -563,13 +583,13 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
         hi = 1.0
         for _ in range(ROOT_ITERATIONS):
             mid = 0.5 * (lo + hi)
-            _loads_at(y, h, QA, mid, n, basis, kappa, qv, m)
+            _loads_at(t, y, h, QA, mid, n, basis, modal, qv, m)
             if _load_rises(m, k) > 0.0:
                 lo = mid
             else:
                 hi = mid
         if t + lo * h >= t_tail:
-            _loads_at(y, h, QA, lo, n, basis, kappa, qv, m)
+            _loads_at(t, y, h, QA, lo, n, basis, modal, qv, m)
             modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
     return located
 
@@ -703,8 +723,14 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     kappa = md.shear_factor(pp, n)
     modal[factor_slot(n)] = kappa
     modal[factor_slot(n) + 1] = settings[LOADS]
+    mean, amplitude, omega, phase = md.end_load_factors(pp, n)
+    modal[end_load_slot(n)] = mean
+    modal[end_load_slot(n) + 1] = amplitude
+    modal[end_load_slot(n) + 2] = omega
+    modal[end_load_slot(n) + 3] = phase
     loads = np.empty(6)
-    md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, loads)
+    load, rate = end_load_at(modal, n, 0.0)
+    md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, loads)
     for k in range(3):
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     for k in range(6):

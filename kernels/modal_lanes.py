@@ -284,8 +284,10 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, b
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
-        md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], a)
-        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], b)
+        load, rate = _end_load(MOD, n, l, W[tj.T * L + l])
+        md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], load, rate, a)
+        load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
+        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, b)
         for k in range(3):
             if drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0:
                 EV[l] = 1.0
@@ -340,6 +342,13 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     return n_flagged
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _end_load(MOD, n, l, t):
+    """modal_driver.end_load_at for lane l, whose accumulator is MOD[:, l]."""
+    s = drv.end_load_slot(n)
+    return md.end_load(MOD[s, l], MOD[s + 1, l], MOD[s + 2, l], MOD[s + 3, l], t)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
@@ -376,7 +385,8 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, base):
                 & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
         if not take:
             continue
-        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], b)
+        load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
+        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, b)
         for k in range(3):
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 

@@ -111,13 +111,15 @@ N_OBSERVED = 7
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def span_loads(rows, coupling, q, v, n_modes, kappa, out):
+def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, out):
     """The stretching and the clamps' shear as the load observers watch them, for the modes'
     q (m) and rates v (m/s): out = (E, E', F_0, F_0', F_1, F_1') with E = q^T C q (m^2; C =
     `coupling`, A_ij / pi^2: the span's elongation is (pi^2 / 2 l) E, its uniform tension
-    N = k_s pi^2 E / (2 l)) and F_e = s3_e . q - kappa E s1_e . q (m; s3_e, s1_e: `rows`'
-    SHEAR_e and SLOPE_e): the transverse reaction at clamp e, V = -EI w''' + N w', is
-    -(EI / l^3) F_e there (kappa = k_s pi^2 l / (2 EI), 1/m^2); E' and F_e' their rates (/s)."""
+    N = k_s pi^2 E / (2 l)) and F_e = s3_e . q - (kappa E - load) s1_e . q (m; s3_e, s1_e:
+    `rows`' SHEAR_e and SLOPE_e): the transverse reaction at clamp e,
+    V = -EI w''' + (N - P) w', is -(EI / l^3) F_e there (kappa = k_s pi^2 l / (2 EI), 1/m^2;
+    load = P l^2 / EI of the end load P at that instant, compression positive (`end_load`),
+    load_rate its rate, 1/s); E' and F_e' their rates (/s)."""
     e = 0.0
     de = 0.0
     for i in range(n_modes):
@@ -131,6 +133,8 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, out):
         de += q[i] * di + v[i] * ci
     out[0] = e
     out[1] = de
+    axial = kappa * e - load                  # (N - P) l^2 / EI
+    axial_rate = kappa * de - load_rate
     for end in range(2):
         s3 = 0.0
         d3 = 0.0
@@ -143,8 +147,27 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, out):
             d3 += a * v[i]
             s1 += b * q[i]
             d1 += b * v[i]
-        out[2 + 2 * end] = s3 - kappa * e * s1
-        out[3 + 2 * end] = d3 - kappa * (de * s1 + e * d1)
+        out[2 + 2 * end] = s3 - axial * s1
+        out[3 + 2 * end] = d3 - (axial_rate * s1 + axial * d1)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def end_load_factors(pp, n_modes):
+    """The end load P(t) = P_mean + P_cos cos(W t + phi_W) of a prepared row as
+    (P_mean l^2 / EI, P_cos l^2 / EI, W (rad/s), phi_W (rad)) for `end_load`: pi^2 times the
+    row's linear load terms (P k^2 / rho A, 1/s^2) over w_p^2 = (EI / rho A) k^4."""
+    s = 3 * n_modes
+    w_p2 = pp[s + S_BETA_B] * pp[s + S_BETA_B] / pp[s + S_BETA_Q]
+    scale = math.pi * math.pi / w_p2
+    return (scale * pp[s + S_LOAD_MEAN], scale * pp[s + S_LOAD_COS], pp[s + S_OMEGA],
+            pp[s + S_LOAD_PHASE])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def end_load(mean, amplitude, omega, phase, t):
+    """(P l^2 / EI, its rate, 1/s) at t (s) of the end load `end_load_factors` gives."""
+    x = omega * t + phase
+    return mean + amplitude * math.cos(x), -amplitude * omega * math.sin(x)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -4,10 +4,13 @@ tension and strain, and the largest strain of them all, each its peak over the t
 
 Several modes: from the multi-mode kernels' load observers (kernels/modal_driver.py: the
 curvature sum phi_n''(s) q_n at s = 0, 1, 1/2, the stretch E = q^T C q and the clamp shear
-F_e = sum phi_n'''(e) q_n - kappa E sum phi_n'(e) q_n, each's largest over the tail window).
+F_e = sum phi_n'''(e) q_n - (kappa E - P(t) l^2 / EI) sum phi_n'(e) q_n, each's largest over
+the tail window).
 One mode: every one of them grows with |q| (the curvatures as |q|, the stretch as q^2, the
-shear as |q| (|phi'''(0)| + kappa E |phi'(0)|), both terms of one sign), so each peaks where q
-does and is the mode's integral times the tail amplitude (sweep.models.basis.one_mode_integrals).
+shear as |q| (|phi'''(0)| + (kappa E - P l^2 / EI) |phi'(0)|), its terms of one sign below
+buckling), so each peaks where q does and is the mode's integral times the tail amplitude
+(sweep.models.basis.one_mode_integrals); under a harmonic end load P(t) the shear need not peak
+with q, and one mode reports none (NaN: run two modes or more, whose observers watch it).
 
 In SI, l the length, EI the bending and EA the axial stiffness, d the cable's outer diameter:
 curvature kappa = c / l^2 (c the observed curvature sum), strain (d / 2) kappa, moment EI kappa;
@@ -87,9 +90,10 @@ OUTPUTS = (
     Output("midspan_bending_strain", "1", "bending strain of the outer fibre at midspan: "
            "(d / 2) max |w_xx(l/2)| over the tail window", _strain("midspan"), diameter=True),
     Output("clamp_force", "N", "transverse reaction at the clamp: max |V| at either clamp over "
-           "the tail window, V = -EI w_xxx + N w_x (the shear plus the stretching tension's "
-           "transverse part; without model.membrane's local term and without an end load's "
-           "part -P w_x; converges like 1/N with the modes kept: check with sweep modes)",
+           "the tail window, V = -EI w_xxx + (N - P) w_x (the shear, the stretching "
+           "tension's transverse part and the end load's, P compression positive; without "
+           "model.membrane's local term; one mode under a harmonic end load: NaN, its peak is "
+           "not where q peaks; converges like 1/N with the modes kept: check with sweep modes)",
            lambda p, s: s.bending * p.shear / s.length ** 3),
     Output("axial_tension", "N", "stretching tension of the span: its largest N = k_s e over "
            "the tail window (e = (1/2) int w_x^2 dx the elongation, k_s the span and its clamps "
@@ -152,7 +156,14 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
     _, k_s = modal.stretching(p)
     kappa = 0.0 if k_s is None else derived(
         k_s * math.pi ** 2 * p["length"] / (2.0 * p["youngs_modulus"] * p["inertia"]), coords)
-    shear = q * (ends["clamp_shear"] + kappa * stretch * ends["clamp_slope"])
+    # the end load's part -P w_x (compression positive), as P l^2 / EI: with a constant load
+    # the reaction still grows with |q| below buckling and peaks where q does; under a
+    # harmonic one it need not, and one mode's peak |q| cannot give it: NaN there
+    load = derived(p["load_amplitude"] * p["length"] ** 2
+                   / (p["youngs_modulus"] * p["inertia"]), coords)
+    shear = abs(q * (ends["clamp_shear"] + (kappa * stretch - load) * ends["clamp_slope"]))
+    if p.get("load_type") == "harmonic":
+        shear = shear.where(load == 0.0)
     return Peaks(q * ends["clamp_curvature"], q * ends["midspan_curvature"], stretch, shear)
 
 

@@ -40,7 +40,7 @@ OUTPUTS: tuple[tuple[str, int, str, str], ...] = (
     ("rms_deflection", tk.RMS_DEFLECTION, "m",
      "RMS midspan deflection over the statistics window"),
     ("rms_velocity", tk.RMS_VELOCITY, "m s-1",
-     "RMS midspan velocity over the statistics window"),
+     "RMS midspan velocity relative to the clamps over the statistics window"),
     ("rms_acceleration", tk.RMS_ACCELERATION, "m s-2",
      "RMS absolute midspan acceleration q'' + a_b over the statistics window"),
     ("rms_relative_acceleration", tk.RMS_RELATIVE, "m s-2",
