@@ -226,7 +226,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.workers is not None:     # checked against the backend first: its own line above
         scene = load_scene(args.scene, overrides={**overrides, "run.workers": args.workers})
     if args.output is not None:      # before any work, in one line
-        check_output_path(args.output, args.overwrite, args.resume)
+        check_output_path(args.output, args.overwrite, scene if args.resume else None)
     started = time.perf_counter()
     from .numba_start import start_without_scipy
     start_without_scipy()        # Numba's registries without importing SciPy (0.15 s)
@@ -323,7 +323,7 @@ def _design(args: argparse.Namespace) -> int:
                     max_probability=args.max_probability)
     if len(args.result) > 1:
         from .governing import governing_span
-        results = [(os.path.basename(path), load_result(path)) for path in args.result]
+        results = [(path, load_result(path)) for path in args.result]
         ds = results[0][1]
         result = governing_span(results, **criteria)
     elif args.refine:

@@ -3,7 +3,8 @@
 A harness span must pass every test of its load case, each its own result (a sine sweep, a
 random test, a resonant dwell). `governing_span(results, **criteria)` asks each result the
 criteria it holds the variables of (`sweep.design.max_span`: --min-frequency of every
-transverse result, --max-rms of a random one, --max-amplitude of a sine one ...), and keeps,
+transverse result, --max-rms of a random one, --max-amplitude of a sine one: a sine response's
+limits go to a random result only where no other result answers them), and keeps,
 for every combination of the results' other axes, the shortest of their spans, `limited_by`
 the criterion that binds there and `limited_in` the result it binds in. Every criterion must
 apply to some result, and every result must have a criterion that applies to it; axes the
@@ -21,10 +22,14 @@ import xarray as xr
 
 from .design import NO_CRITERION, check_result, max_span
 from .errors import UserError
+from .models.random_scene import REALISATION_DIM
 
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance")
 """The criteria a result may or may not hold the variables of (sweep.design's limits)."""
+RESPONSE_LIMITS = ("max_amplitude", "max_deflection", "max_strain")
+"""Limits of a sine response: a random result holds the same variables (each record's tail
+peak), but where a sine result answers them they are the sine test's, not the random one's."""
 
 
 def _criterion(name: str, criteria: dict[str, Any]) -> dict[str, Any]:
@@ -73,14 +78,16 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
         raise UserError(NO_CRITERION)
     for name, ds in results:
         check_result(ds, name)
+    random = [REALISATION_DIM in ds.dims for _, ds in results]
     asked: list[dict[str, Any]] = [{} for _ in results]
     for c in given:
         one = _criterion(c, criteria)
         reasons = [_applies(ds, one) for _, ds in results]
         if all(r is not None for r in reasons):
             raise UserError(f"{reasons[0]} (nor does any other result given)")
+        sine_answers = any(r is None and not rnd for r, rnd in zip(reasons, random))
         for i, reason in enumerate(reasons):
-            if reason is None:
+            if reason is None and not (c in RESPONSE_LIMITS and random[i] and sine_answers):
                 asked[i].update(one)
     spans = []
     for (name, ds), own in zip(results, asked):
@@ -93,12 +100,18 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
 
 def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
     """The shortest of several max_span results at each combination of their axes."""
+    shared = sorted(set.intersection(*[set(s["max_span"].dims) for s in spans]))
+    different = UserError("design: the results' shared axes (" + ", ".join(shared) + ") hold "
+                          "different values; run them over the same values")
     try:
         aligned = xr.align(*[s["max_span"] for s in spans], join="exact")
     except ValueError:
-        shared = sorted(set.intersection(*[set(s["max_span"].dims) for s in spans]))
-        raise UserError("design: the results' shared axes (" + ", ".join(shared) + ") hold "
-                        "different values; run them over the same values") from None
+        raise different from None
+    for s in spans[1:]:       # a [points] set's values ride on `point`, not on its index
+        for c in s.coords:
+            if (c in spans[0].coords and set(s[c].dims) <= set(shared)
+                    and not np.array_equal(s[c].values, spans[0][c].values)):
+                raise different
     values = xr.broadcast(*aligned)
     limited = xr.broadcast(*[s["limited_by"] for s in spans])
     dims = values[0].dims

@@ -9,7 +9,7 @@ import re
 import stat
 import tempfile
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .errors import UserError
 from .files import free_bytes, fsync_directory, mib, new_file_mode
@@ -20,12 +20,13 @@ if TYPE_CHECKING:
 
 
 def check_output_path(path: str | os.PathLike, overwrite: bool = False,
-                      resume: bool = False) -> Path:
+                      resume: Any = None) -> Path:
     """Refuse, before any work is done, an output path that cannot be written.
 
     Raises UserError naming the file: missing or read-only directory, an existing file
-    without `overwrite` (with `resume` and no chunk store beside it: the run is already
-    complete), a directory in the way, or a name that is not .nc.
+    without `overwrite` (`resume`: the Scene being resumed; where the file holds that scene's
+    finished run and no chunk store is left, the message says the run is complete), a
+    directory in the way, or a name that is not .nc.
     """
     raw = os.fspath(path)
     if isinstance(raw, bytes):
@@ -45,7 +46,7 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False,
                         "another -o path)") from None
 
 
-def _check_output_path(raw: str, overwrite: bool, resume: bool = False) -> Path:
+def _check_output_path(raw: str, overwrite: bool, resume: Any = None) -> Path:
     """check_output_path's checks on a name already known to be UTF-8 (may raise OSError)."""
     if not raw.strip():
         raise UserError(f"output '{raw}': empty file name (give a file name ending in .nc, "
@@ -70,13 +71,25 @@ def _check_output_path(raw: str, overwrite: bool, resume: bool = False) -> Path:
     if out.is_dir():
         raise UserError(f"output '{out}': is a directory (give a file name ending in .nc)")
     if out.exists() and not overwrite:
-        from .store import store_path
-        if resume and not os.path.lexists(store_path(out)):
+        if resume is not None and not os.path.lexists(store_path(out)) and _holds(out, resume):
             raise UserError(f"output '{out}': the run is already complete (the file holds it "
                             "and no chunk store is left to resume; use --overwrite to run it "
                             "again)")
         raise UserError(f"output '{out}': file exists (use --overwrite, or overwrite=True, to replace it)")
     return out
+
+
+def _holds(path: Path, scene: Any) -> bool:
+    """Whether the netCDF file `path` holds a finished run of `scene` (its `scene` attribute,
+    the resolved scene, loads back equal to it); False for anything unreadable."""
+    try:
+        import netCDF4
+        from .scene import load_scene_text
+        with netCDF4.Dataset(path) as nc:
+            text = nc.getncattr("scene")
+        return load_scene_text(text) == scene
+    except Exception:        # not netCDF, no scene, another scene's: not this run's file
+        return False
 
 
 def _can_create_in(directory: Path) -> bool:

@@ -60,7 +60,7 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     defer()                                       # no dask import unless the run uses dask
     from .runner import run_options
     if output is not None:
-        check_output_path(output, overwrite, resume)
+        check_output_path(output, overwrite, scene if resume else None)
     # The bar only on a terminal; the lines that say a cold start is compiling (minutes on a
     # first run) wherever the caller has not asked for quiet: a CI log, nohup, a notebook.
     announce = progress is not False

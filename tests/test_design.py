@@ -629,3 +629,30 @@ def test_cli_design_of_two_results_prints_where_it_binds(results, tmp_path, caps
     assert main(["design", str(linear_path), str(other), "--min-frequency", "40",
                  "--refine"]) == 2
     assert "--refine takes one result" in capsys.readouterr().err
+
+
+def test_several_results_refuse_points_whose_sets_differ(results):
+    """Two [points] results with as many sets but other values: combined by index they would
+    put one cable's span under another's name (a reviewer's case): refused."""
+    from sweep.governing import governing_span
+    linear, _ = results["linear"]
+    a = linear.expand_dims(point=[0, 1]).assign_coords(area=("point", [6e-6, 4e-6]))
+    b = linear.expand_dims(point=[0, 1]).assign_coords(area=("point", [3e-6, 8e-6]))
+    with pytest.raises(sweep.UserError, match="shared axes \\(point\\)"):
+        governing_span([("a.nc", a), ("b.nc", b)], min_frequency=40.0)
+    same = governing_span([("a.nc", a), ("c.nc", a.copy())], min_frequency=40.0)
+    assert same["max_span"].dims == ("point",)
+
+
+def test_a_sine_limit_binds_the_sine_result_not_the_random_one(results):
+    """--max-amplitude given with a sine and a random result limits the sine one (the random
+    result's `amplitude`, each record's tail peak, is not the sine test's response); alone, a
+    random result still answers it."""
+    from sweep.governing import governing_span
+    linear, _ = results["linear"]
+    randomlike = linear.expand_dims(realisation=[0, 1])
+    randomlike["amplitude"] = randomlike["amplitude"] * 0.0 + 1.0       # fails every length
+    out = governing_span([("sine.nc", linear), ("random.nc", randomlike)],
+                         max_amplitude=1e-7, min_frequency=40.0)
+    assert float(out["max_span"]) == pytest.approx(_amplitude_reference(1e-7), rel=2e-3)
+    assert str(out["limited_in"].values) == "sine.nc"

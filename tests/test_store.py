@@ -458,3 +458,11 @@ def test_resuming_a_finished_run_says_it_is_complete(tmp_path):
     assert "--overwrite" in str(caught.value)
     with pytest.raises(sweep.UserError, match="file exists"):
         sweep.run(scene, output=out, progress=False)
+    # not for a file that holds something else: another scene's run, or no run at all
+    other = sweep.load_scene_text(SCENE.replace("t_end = 1.0", "t_end = 0.9"))
+    with pytest.raises(sweep.UserError, match="file exists"):
+        sweep.run(other, output=out, resume=True, progress=False)
+    junk = tmp_path / "junk.nc"
+    junk.write_text("garbage")
+    with pytest.raises(sweep.UserError, match="file exists"):
+        sweep.run(scene, output=junk, resume=True, progress=False)
