@@ -76,6 +76,8 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
     given = [c for c in CRITERIA if criteria[c] is not None]
     if not given:
         raise UserError(NO_CRITERION)
+    if not results:
+        raise UserError("design: no result given (give one or more RESULT.nc)")
     for name, ds in results:
         check_result(ds, name)
     random = [REALISATION_DIM in ds.dims for _, ds in results]
