@@ -563,3 +563,18 @@ def test_the_span_loads_get_a_strain_figure_and_two_stiffnesses_decades_apart_a_
     assert "log" in scales and "rotational stiffness" in labels
     for fig in figures.values():
         fig.clf()
+
+
+@pytest.mark.parametrize("clamps, says", [
+    ("", "pinned ends"),
+    ('rotation = "clamped"\naxial_stiffness = 0.0', "clamped ends, sliding axially"),
+    ('rotation = "elastic"\nrotational_stiffness = 0.5', "elastic ends (k_t = 0.5 N m/rad)"),
+])
+def test_the_footer_says_what_the_clamps_hold(clamps, says):
+    """A clamped map and an elastic one differ by up to 2.3x in f1 and amplitude: the load
+    case says which ends they are (a reviewer found the same footer on both)."""
+    text = f"[model]\nmodes = 1\n[clamps]\n{clamps}\n[base]\nacceleration_g = 1.0\n" \
+           "frequency = 20.0\n[axes]\nlength = [0.3, 0.4]\n"
+    ds = xr.Dataset({"state": ("length", [2, 2])}, coords={"length": [0.3, 0.4]},
+                    attrs={"scene": text})
+    assert says in splot.footer(ds)

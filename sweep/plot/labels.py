@@ -141,6 +141,7 @@ def footer(ds: xr.Dataset) -> str:
     elif get("model", "membrane") is not None:
         text += f", membrane {num(get('model', 'membrane'))}"
     parts.insert(0, text)
+    parts.insert(1, _ends_text(doc, get, num))
     zeta = get("cable", "damping_ratio")
     if zeta is not None:
         parts.append(f"damping ratio {num(zeta)}")
@@ -164,6 +165,21 @@ def footer(ds: xr.Dataset) -> str:
         parts.append(f"tail {num(metrics.get('tail', 0.5))}, "
                      f"tolerance {num(metrics.get('tolerance', 0.02))}")
     return "Load case: " + "; ".join(parts)
+
+
+def _ends_text(doc: dict, get: Any, num: Any) -> str:
+    """What the clamps hold, for the footer: pinned, clamped or elastic ends (with k_t where
+    it is fixed), and their axial restraint where the scene gives one (0: sliding)."""
+    rotation = doc.get("clamps", {}).get("rotation", "pinned")
+    text = {"pinned": "pinned ends", "clamped": "clamped ends"}.get(rotation, "elastic ends")
+    stiffness = get("clamps", "rotational_stiffness")
+    if rotation == "elastic" and stiffness is not None:
+        text += f" (k_t = {num(stiffness)} N m/rad)"
+    axial = get("clamps", "axial_stiffness")
+    if axial is not None:
+        text += (", sliding axially" if float(axial) == 0.0
+                 else f", axial stiffness {num(axial)} N/m")
+    return text
 
 
 def _add_footer(fig: Figure, ds: xr.Dataset) -> None:

@@ -267,6 +267,8 @@ def _paper_fig5_bands(ax: Axes, ds: xr.Dataset, point: xr.Dataset, var: str, fac
         ax.axhline(sign * amplitude, color="k", ls="--", lw=0.9,
                    label=f"paper Fig 5: \u00b1{amplitude:g} {units}" if sign > 0
                    else None)
+    bottom, top = ax.get_ylim()          # headroom above the crests for the legend, so
+    ax.set_ylim(bottom, max(top, 2.0 * amplitude))       # that it hides none of q(t)
     ax.legend(loc="upper right", fontsize="x-small", framealpha=0.9)
 
 

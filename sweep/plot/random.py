@@ -16,6 +16,7 @@ most one other (`MAX_LEVELS` of them).
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any, Mapping
 
 import numpy as np
@@ -245,6 +246,10 @@ def _spread(n: int, most: int) -> list[int]:
     return sorted({int(round(k)) for k in np.linspace(0, n - 1, min(n, most))})
 
 
+TITLE_CHARS = 72
+"""Characters a line of the ASD figure's title holds at its 7 in width (wrapped beyond)."""
+
+
 def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
              ax: Axes | None = None) -> Figure:
     """The spectral density of the absolute midspan acceleration (`acceleration_asd`, g^2/Hz,
@@ -260,7 +265,9 @@ def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
     ds = select_points(ds, select)
     axes = swept_axes(ds)
     x = "length" if "length" in axes else (axes[0] if axes else None)
+    dropped = []
     for other in [d for d in axes if d != x]:
+        dropped.append(f"the highest of {ds.sizes[other]} values (--select another)")
         ds = ds.isel({other: int(np.argmax(np.asarray(ds[other].values, float)))})
     ax = ax if ax is not None else _new_axes((7.0, 5.4))
     f = np.asarray(ds[ASD_FREQUENCY_DIM].values, float)
@@ -298,8 +305,9 @@ def plot_asd(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
             ax.set_ylim(drawn.min() / 2.0, drawn.max() * 2.0)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("acceleration spectral density [g$^2$/Hz]")
-    ax.set_title(_title(ds, f"midspan acceleration ASD, mean of {_records(ds)}"),
-                 fontsize="medium")
+    title = _title(ds, f"midspan acceleration ASD, mean of {_records(ds)}")
+    title = "\n".join(textwrap.wrap("; ".join([title] + dropped), TITLE_CHARS))
+    ax.set_title(title, fontsize="medium")
     ax.grid(True, which="both", color="0.92", zorder=0)
     _legend(ax, handles)
     return ax.figure
