@@ -578,3 +578,13 @@ def test_the_footer_says_what_the_clamps_hold(clamps, says):
     ds = xr.Dataset({"state": ("length", [2, 2])}, coords={"length": [0.3, 0.4]},
                     attrs={"scene": text})
     assert says in splot.footer(ds)
+
+
+def test_a_shortened_axis_label_keeps_its_ratio_symbol():
+    """A long name too long for an axis falls back to the variable's name; a ratio keeps its
+    symbol (a stepped sweep's axis read 'base frequency ratio', not of what)."""
+    from sweep.plot.labels import label
+    da = xr.DataArray([1.0], dims="x", name="base_frequency_ratio", attrs={
+        "units": "1", "long_name": "base excitation frequency over the unloaded span's first "
+                                   "natural frequency, f/f1"})
+    assert label(da) == "base frequency ratio, f/f1"

@@ -28,7 +28,10 @@ def label(da: xr.DataArray, units: str | None = None) -> str:
     if len(name) > 40 and " (" in name and name.index(" (") >= 10:
         name = name[:name.index(" (")]
     if len(name) > _MAX_LABEL:
+        symbol = name.rsplit(", ", 1)[-1]        # a ratio's symbol, as "f/f1", kept
         name = str(da.name or name).replace("_", " ")
+        if "/" in symbol and len(symbol) <= 8 and " " not in symbol:
+            name += f", {symbol}"
     units = da.attrs.get("units") if units is None else units
     if units and name.endswith(f" in {units}"):        # not "... in g [g]"
         name = name[:-len(f" in {units}")]
