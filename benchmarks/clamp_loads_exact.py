@@ -4,8 +4,9 @@ What it measures
 ----------------
 A linear span (clamps.axial_stiffness = 0: no stretching; the Table 1 bundle's data as the
 built-in harness scenes give them, 0.3 m, damping ratio 0.005 and t_end = 15 / (zeta w1), the
-tail window its last 20 %, so that the start's free vibration has decayed by e^-12 there) shaken at 0.1 g below, near and above its first natural frequency, with
-pinned, clamped and elastic clamps (rotational stiffness --stiffness N m/rad), each with
+tail window its last 20 %, so that the start's free vibration has decayed by e^-12 there)
+shaken at 0.1 g below, near and above its first natural frequency, with pinned, clamped and
+elastic clamps (rotational stiffness --stiffness N m/rad), each with
 model.modes = 1, 3, 5 and 7 through the public API (`sweep.run`, the scene's own modal
 drivers). Each output is its peak over the tail window; the reference is the exact
 steady-state of the Euler-Bernoulli beam under a uniform base acceleration, undamped

@@ -3,15 +3,17 @@
     sweep run SCENE [-o OUT.nc] [--set KEY=VALUE ...] [--overwrite] [--threads N] [--quiet]
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
-    sweep design RESULT.nc [--min-frequency HZ] [--max-amplitude M] [--quantity NAME]
-                 [--max-deflection M] [--max-strain S] [--max-rms M] [--max-peak M]
+    sweep design RESULT.nc [RESULT.nc ...] [--min-frequency HZ] [--max-amplitude M]
+                 [--quantity NAME] [--max-deflection M] [--max-strain S] [--max-rms M] [--max-peak M]
                  [--clearance M [--max-probability P]] [--refine [--tolerance M]] [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
 
 Exit status: 0 on success, 2 on a user error (one line on stderr: what is wrong, where, and how
-to fix it; a sweep too large for memory counts as one), 1 on an internal error.
+to fix it; a sweep too large for memory counts as one), 1 on an internal error; 130, 143, 129
+when Ctrl-C, SIGTERM or SIGHUP stopped a run (0 when it came after the result was whole), 141
+when the reader of stdout went away.
 """
 
 from __future__ import annotations
