@@ -76,8 +76,12 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
     given = [c for c in CRITERIA if criteria[c] is not None]
     if not given:
         raise UserError(NO_CRITERION)
-    if not results:
-        raise UserError("design: no result given (give one or more RESULT.nc)")
+    if (isinstance(results, (str, xr.Dataset)) or not results
+            or not all(isinstance(r, (tuple, list)) and len(r) == 2
+                       and isinstance(r[1], xr.Dataset) for r in results)):
+        raise UserError("governing_span: results must be (name, Dataset) pairs, e.g. "
+                        "[('qual.nc', ds_sine), ('gevs.nc', ds_random)] (open a file with "
+                        "sweep.plot.load_result)")
     for name, ds in results:
         check_result(ds, name)
     random = [REALISATION_DIM in ds.dims for _, ds in results]

@@ -28,6 +28,9 @@ def check_output_path(path: str | os.PathLike, overwrite: bool = False,
     finished run and no chunk store is left, the message says the run is complete), a
     directory in the way, or a name that is not .nc.
     """
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise UserError(f"output {path!r:.60}: not a file name (give a path ending in .nc, "
+                        "e.g. 'out.nc')")
     raw = os.fspath(path)
     if isinstance(raw, bytes):
         raw = os.fsdecode(raw)

@@ -291,3 +291,28 @@ def test_a_comparison_of_nothing_gives_no_verdict():
     report = compare(failed, failed, tolerance=0.01)
     assert not report.compared() and not report.enough()
     assert "no verdict" in report.text() and "enough for" not in report.text()
+
+
+def test_sweep_modes_compares_a_random_results_means_once_a_point():
+    """A random result's means over its records (what `sweep design --max-rms` reads) are
+    compared, once per point where every record succeeded (the state has a realisation
+    dimension, the mean does not)."""
+    import xarray as xr
+    from sweep.convergence import compare
+    state = xr.DataArray(np.full((2, 3), 8, np.int8), dims=("length", "realisation"),
+                         coords={"length": [0.1, 0.2], "realisation": [0, 1, 2]},
+                         attrs={"flag_values": np.arange(9, dtype=np.int8),
+                                "flag_meanings": " ".join(["invalid_input", "decayed", "steady",
+                                                           "modulated", "unsettled",
+                                                           "diverged", "step_size_too_small",
+                                                           "max_steps_reached",
+                                                           "completed"])})
+    coarse = xr.Dataset({"state": state,
+                         "rms_deflection_mean": ("length", [1.0e-3, 2.0e-3])})
+    fine = coarse.copy(deep=True)
+    fine["rms_deflection_mean"] = ("length", [1.0e-3, 2.2e-3])
+    fine["state"].values[0, 1] = 5                       # a record that diverged: not compared
+    report = compare(coarse, fine, 0.01)
+    change = next(c for c in report.changes if c.metric == "rms_deflection_mean")
+    assert change.compared == 1 and change.over == 1
+    assert change.relative == pytest.approx(0.2 / 2.2)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import sweep
 from sweep import schema
 from sweep.errors import SceneError
 from sweep.scene import (DEFAULT_T_END, DEFAULT_TRANSITS, PAPER_VELOCITY, Scene, builtin_scenes,
@@ -916,3 +917,32 @@ def test_a_stepped_sweep_counts_its_lines_for_the_default_driver(overrides, expe
     continuation axis do not fill the lanes."""
     from sweep import load_scene
     assert load_scene("harness-stepped-sine", overrides).get("solver.driver") == expected
+
+
+def test_a_validated_scene_is_read_only_and_still_pickles():
+    """An edited value would run unchecked (a reviewer's negative damping ran as a divergence,
+    a string one failed deep in the model): refused in one line; dask still pickles it."""
+    import pickle
+    scene = sweep.load_scene("paper-fig5")
+    with pytest.raises(TypeError, match="read-only once validated"):
+        scene.values["cable.damping_ratio"] = -1.0
+    with pytest.raises(TypeError, match="read-only"):
+        scene.axes.update(length=[0.3])
+    again = pickle.loads(pickle.dumps(scene))
+    assert again == scene
+
+
+@pytest.mark.parametrize("call, fragment", [
+    (lambda: sweep.load_scene(5), "not a scene name or a path"),
+    (lambda: sweep.load_scene("paper-fig5", "model.modes=3"), "not a mapping of dotted keys"),
+    (lambda: sweep.load_scene_text(5), "not TOML text"),
+    (lambda: sweep.load_scene_text("[model]\nmodes = 1\n", {"model.modes": 2}),
+     "give overrides by keyword"),
+    (lambda: sweep.run(sweep.load_scene("paper-fig5"), output=5, progress=False),
+     "not a file name"),
+])
+def test_api_arguments_of_the_wrong_kind_are_one_line(call, fragment):
+    """A script's mistake (load_scene_text's second argument is the source's name, not the
+    overrides: they were silently dropped) gets one UserError, not a deep traceback."""
+    with pytest.raises(sweep.UserError, match=fragment):
+        call()

@@ -93,13 +93,16 @@ def plot(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> Figures:
     Longitudinal: 'snapshots',
     'histories' (when stored), and 'peak_end_displacement', 'dynamic_amplification' over the
     swept axes. A quantity that says nothing (all NaN, or one value at every point, e.g. the
-    settling times of an undamped run, all 0 s; a state map with one state) gets no figure:
+    settling times of an undamped run, all NaN; a state map with one state) gets no figure:
     the reason goes to `Figures.skipped` and the log (info here; `save` repeats it as a
     warning, which reaches stderr by default).
     Each figure has the load case in a footer (`footer`). An empty result when nothing fits.
     Raises UserError (one line) for a Dataset the figures cannot be drawn from faithfully
     (`check_result`), before drawing anything.
     """
+    if not isinstance(ds, xr.Dataset):
+        raise UserError(f"plot: {ds!r:.60} is not a result Dataset (open a file with "
+                        "sweep.plot.load_result(PATH), or pass what sweep.run returned)")
     if is_design_result(ds):                   # 'sweep design -o': the design chart alone
         return _design_figures(ds, select)
     check_result(ds)

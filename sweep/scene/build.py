@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from .. import models, schema
+from ..errors import SceneError
 from ..models import cable, rules
 from ..models.swept import Swept
 from .axes import _check_axes, _flatten_axes
@@ -30,6 +31,10 @@ def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = N
     overrides: dotted key -> value, applied to the document before validation. Values may be
     Python values or strings; strings are parsed as TOML values (see `parse_override`).
     """
+    if not isinstance(scene, (str, os.PathLike)):
+        raise SceneError(f"load_scene: scene {scene!r:.60}: not a scene name or a path (give a "
+                         "built-in name such as 'paper-fig5', or the path of a .toml file)")
+    _check_overrides(overrides, "load_scene")
     source, text, default_name = _read_scene(scene)
     return _build(text, source, default_name, overrides)
 
@@ -37,7 +42,22 @@ def load_scene(scene: str | os.PathLike, overrides: Mapping[str, Any] | None = N
 def load_scene_text(text: str, source: str = "<string>",
                     overrides: Mapping[str, Any] | None = None) -> Scene:
     """Like `load_scene`, from TOML text; ``source`` is used in error messages."""
+    if not isinstance(text, str):
+        raise SceneError(f"load_scene_text: text {type(text).__name__}: not TOML text (give "
+                         "the scene as a str; a file's path goes to load_scene)")
+    if not isinstance(source, str):
+        raise SceneError(f"load_scene_text: source {type(source).__name__}: the second "
+                         "argument names the text in messages; give overrides by keyword, "
+                         "load_scene_text(text, overrides={...})")
+    _check_overrides(overrides, "load_scene_text")
     return _build(text, source, "unnamed", overrides)
+
+
+def _check_overrides(overrides: Any, where: str) -> None:
+    """Overrides are a mapping of dotted keys (or None): refuse anything else in one line."""
+    if overrides is not None and not isinstance(overrides, Mapping):
+        raise SceneError(f"{where}: overrides {overrides!r:.60}: not a mapping of dotted keys "
+                         "(give e.g. overrides={'model.modes': 3})")
 
 
 def _build(text: str, source: str, default_name: str,

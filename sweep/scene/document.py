@@ -19,6 +19,23 @@ order."""
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 
 
+class ReadOnly(dict):
+    """A Scene's values, axes or points: a dict that refuses changes, so that a scene is run as
+    it was validated (an edited value would skip every check: a negative damping ran as a
+    divergence, a string one failed deep in the model). Pickles as a dict (dask workers)."""
+
+    def _refuse(self, *args: Any, **kwargs: Any) -> None:
+        raise TypeError("a Scene is read-only once validated: load it again with the change "
+                        "as an override, e.g. sweep.load_scene(NAME, overrides={KEY: VALUE})")
+
+    __setitem__ = __delitem__ = _refuse
+    clear = pop = popitem = setdefault = update = _refuse
+    __ior__ = _refuse
+
+    def __reduce__(self) -> tuple:
+        return (ReadOnly, (dict(self),))
+
+
 @dataclass(frozen=True, eq=False)
 class Scene:
     """A validated, fully resolved scene.
@@ -45,6 +62,10 @@ class Scene:
     source: str
     overrides: dict[str, Any] = field(default_factory=dict)
     points: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in ("values", "axes", "points", "overrides"):
+            object.__setattr__(self, name, ReadOnly(getattr(self, name)))
 
     @property
     def swept(self) -> Swept:
