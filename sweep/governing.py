@@ -82,6 +82,10 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
         raise UserError("governing_span: results must be (name, Dataset) pairs, e.g. "
                         "[('qual.nc', ds_sine), ('gevs.nc', ds_random)] (open a file with "
                         "sweep.plot.load_result)")
+    names = [name for name, _ in results]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise UserError(f"design: result '{twice[0]}' given twice (give each result once)")
     for name, ds in results:
         check_result(ds, name)
     random = [REALISATION_DIM in ds.dims for _, ds in results]
@@ -131,6 +135,14 @@ def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
     grid = np.all(by == "grid", axis=0)
     limited_in = np.asarray(np.where(grid, "", np.asarray(names, dtype=object)[pick]),
                             dtype=object)
+    nan = np.isnan(span)                  # the shortest length fails: name every result
+    if nan.any():                         # it fails in, not the first given
+        failing = np.isnan(stack)
+        every = np.empty(span.shape, dtype=object)
+        for index in np.ndindex(span.shape):
+            every[index] = ", ".join(n for n, f in zip(names, failing[(slice(None), *index)])
+                                     if f)
+        limited_in = np.asarray(np.where(nan, every, limited_in), dtype=object)
     first = spans[0]
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     criteria = " | ".join(f"{n}: {s.attrs.get('criteria', '')}" for n, s in zip(names, spans))

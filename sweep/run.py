@@ -63,6 +63,9 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
         check_output_path(output, overwrite, scene if resume else None)
     # The bar only on a terminal; the lines that say a cold start is compiling (minutes on a
     # first run) wherever the caller has not asked for quiet: a CI log, nohup, a notebook.
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise UserError(f"sweep.run: progress = {progress!r:.40}: give True, False or None "
+                        "(None: a bar only when stderr is a terminal)")
     announce = progress is not False
     if progress is None:
         progress = sys.stderr.isatty()

@@ -656,3 +656,17 @@ def test_a_sine_limit_binds_the_sine_result_not_the_random_one(results):
                          max_amplitude=1e-7, min_frequency=40.0)
     assert float(out["max_span"]) == pytest.approx(_amplitude_reference(1e-7), rel=2e-3)
     assert str(out["limited_in"].values) == "sine.nc"
+
+
+def test_several_results_name_every_one_that_fails_at_the_shortest(results):
+    """Where the shortest length fails in several results, limited_in names them all (the
+    first given alone made the answer depend on the files' order); a result given twice is
+    refused."""
+    from sweep.governing import governing_span
+    linear, _ = results["linear"]
+    other = _frequency_only(results)
+    out = governing_span([("a.nc", linear), ("b.nc", other)], min_frequency=1e4)
+    assert np.isnan(float(out["max_span"]))
+    assert str(out["limited_in"].values) == "a.nc, b.nc"
+    with pytest.raises(sweep.UserError, match="given twice"):
+        governing_span([("a.nc", linear), ("a.nc", other)], min_frequency=40.0)

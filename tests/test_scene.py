@@ -940,6 +940,7 @@ def test_a_validated_scene_is_read_only_and_still_pickles():
      "give overrides by keyword"),
     (lambda: sweep.run(sweep.load_scene("paper-fig5"), output=5, progress=False),
      "not a file name"),
+    (lambda: sweep.run(sweep.load_scene("paper-fig5"), progress="no"), "give True, False"),
 ])
 def test_api_arguments_of_the_wrong_kind_are_one_line(call, fragment):
     """A script's mistake (load_scene_text's second argument is the source's name, not the
