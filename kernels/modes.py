@@ -165,7 +165,11 @@ def end_load_factors(pp, n_modes):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def end_load(mean, amplitude, omega, phase, t):
-    """(P l^2 / EI, its rate, 1/s) at t (s) of the end load `end_load_factors` gives."""
+    """(P l^2 / EI, its rate, 1/s) at t (s) of the end load `end_load_factors` gives; no
+    cosine or sine where the load is constant or absent (every load observation of a span
+    without a harmonic end load would pay them)."""
+    if amplitude == 0.0:
+        return mean, 0.0
     x = omega * t + phase
     return mean + amplitude * math.cos(x), -amplitude * omega * math.sin(x)
 
