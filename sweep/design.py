@@ -196,13 +196,10 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
 
 
 def check_result(ds: xr.Dataset, name: str | None = None) -> tuple[str, ...]:
-    """The axes of a result `max_span` can walk (its state's or stability's dims), or a
-    one-line UserError (naming the result `name` where given): not a Dataset, neither state
-    nor stability, no positive finite `length` axis."""
+    """The axes of a result (a Dataset) `max_span` can walk (its state's or stability's dims),
+    or a one-line UserError (naming the result `name` where given): neither state nor
+    stability, no positive finite `length` axis."""
     which = "the result" if name is None else f"result '{name}'"
-    if not isinstance(ds, xr.Dataset):
-        raise UserError(f"max_span: needs a result (an xarray Dataset), got "
-                        f"{type(ds).__name__}")
     template = "state" if "state" in ds else "stability" if "stability" in ds else None
     if template is None:
         raise UserError(f"design: {which} has neither 'state' nor 'stability' (give a "
@@ -259,6 +256,22 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
                         f"not a swept axis (give --quantity NAME of one over the axes only: "
                         f"{choices})")
     return axes, {"max_amplitude": (name, max_amplitude, None), **limits}
+
+
+def validated(ds: xr.Dataset, *, min_frequency: Any = None, max_amplitude: Any = None,
+              quantity: str | None = None, max_deflection: Any = None,
+              max_strain: Any = None, max_rms: Any = None, max_peak: Any = None,
+              clearance: Any = None, max_probability: Any = None
+              ) -> tuple[dict[str, float | None], tuple[str, ...], Limits]:
+    """The criteria parsed (`_parse`) and checked against the result (`_check`), each refused
+    in one line: the limits as floats, the result's axes and the upper limits with the
+    variables they read. What `max_span` answers, without answering it."""
+    c = _parse(min_frequency, max_amplitude, max_deflection, max_strain, max_rms, max_peak,
+               clearance, max_probability)
+    axes, limits = _check(ds, c["min_frequency"], c["max_amplitude"], quantity,
+                          c["max_deflection"], c["max_strain"], c["max_rms"], c["max_peak"],
+                          c["clearance"], c["max_probability"])
+    return c, axes, limits
 
 
 def _parse(min_frequency: Any, max_amplitude: Any, max_deflection: Any, max_strain: Any,
@@ -353,12 +366,11 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     variable a criterion reads (a random one's for max_rms, max_peak, clearance), a clearance
     level the result does not hold.
     """
-    c = _parse(min_frequency, max_amplitude, max_deflection, max_strain, max_rms, max_peak,
-               clearance, max_probability)
+    c, axes, limits = validated(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
+                                quantity=quantity, max_deflection=max_deflection,
+                                max_strain=max_strain, max_rms=max_rms, max_peak=max_peak,
+                                clearance=clearance, max_probability=max_probability)
     fmin = c["min_frequency"]
-    axes, limits = _check(ds, fmin, c["max_amplitude"], quantity, c["max_deflection"],
-                          c["max_strain"], c["max_rms"], c["max_peak"], c["clearance"],
-                          c["max_probability"])
     ds = ds.sortby(LENGTH)
     others = tuple(a for a in axes if a not in (LENGTH, *WORST_OVER))
     template_name = "state" if "state" in ds else "stability"
@@ -641,11 +653,8 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                     max_deflection=max_deflection, max_strain=max_strain, max_rms=max_rms,
                     max_peak=max_peak, clearance=clearance, max_probability=max_probability)
     grid = max_span(ds, quantity=quantity, **criteria)
-    c = _parse(**criteria)
+    c, axes, limits = validated(ds, quantity=quantity, **criteria)
     fmin = c["min_frequency"]
-    axes, limits = _check(ds, fmin, c["max_amplitude"], quantity, c["max_deflection"],
-                          c["max_strain"], c["max_rms"], c["max_peak"], c["clearance"],
-                          c["max_probability"])
     text = ds.attrs.get("scene")
     if not isinstance(text, str) or not text.strip():
         raise UserError("design --refine: the result has no 'scene' attribute to run again "

@@ -20,7 +20,7 @@ from typing import Any, Sequence
 import numpy as np
 import xarray as xr
 
-from .design import NO_CRITERION, check_result, max_span
+from .design import NO_CRITERION, check_result, max_span, validated
 from .errors import UserError
 from .models.random_scene import REALISATION_DIM
 
@@ -44,9 +44,10 @@ def _criterion(name: str, criteria: dict[str, Any]) -> dict[str, Any]:
 
 
 def _applies(ds: xr.Dataset, one: dict[str, Any]) -> str | None:
-    """None where max_span can answer the criterion `one` on `ds`, else its one-line reason."""
+    """None where max_span can answer the criterion `one` on `ds`, else its one-line reason
+    (sweep.design.validated: its checks, without the answer)."""
     try:
-        max_span(ds, **one)
+        validated(ds, **one)
     except UserError as exc:
         return str(exc)
     return None
@@ -105,7 +106,7 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
             raise UserError(f"design: result '{name}': none of the criteria given reads its "
                             "variables (leave it out, or give one it holds)")
         spans.append(max_span(ds, **own))
-    return _shortest(spans, [name for name, _ in results])
+    return _shortest(spans, names)
 
 
 def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
