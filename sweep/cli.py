@@ -4,8 +4,9 @@
     sweep plot RESULT.nc [-o DIR] [--format png,svg] [--select DIM=VALUE ...] [--dpi N]
     sweep modes SCENE [--modes N] [--set KEY=VALUE ...] [--tolerance 0.01] [--threads N]
     sweep design RESULT.nc [RESULT.nc ...] [--min-frequency HZ] [--max-amplitude M]
-                 [--quantity NAME] [--max-deflection M] [--max-strain S] [--max-rms M] [--max-peak M]
-                 [--clearance M [--max-probability P]] [--refine [--tolerance M]] [-o OUT.nc]
+                 [--quantity NAME] [--max-deflection M] [--max-strain S] [--max-rms M]
+                 [--max-peak M] [--clearance M [--max-probability P]] [--refine [--tolerance M]]
+                 [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -325,16 +326,13 @@ def _design(args: argparse.Namespace) -> int:
                     max_probability=args.max_probability)
     if len(args.result) > 1:
         from .governing import governing_span
-        results = [(path, load_result(path)) for path in args.result]
-        ds = results[0][1]
-        result = governing_span(results, **criteria)
-    elif args.refine:
-        ds = load_result(args.result[0])
-        result = refine_span(ds, **criteria,
-                             tolerance=1e-3 if args.tolerance is None else args.tolerance)
+        result = governing_span([(path, load_result(path)) for path in args.result],
+                                **criteria)
     else:
         ds = load_result(args.result[0])
-        result = max_span(ds, **criteria)
+        result = (refine_span(ds, **criteria,
+                              tolerance=1e-3 if args.tolerance is None else args.tolerance)
+                  if args.refine else max_span(ds, **criteria))
     print(f"{result.attrs['title']} ({result.attrs['criteria']})")
     print(table(result))
     if args.refine:

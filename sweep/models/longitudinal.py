@@ -10,7 +10,6 @@ Sign convention: tension positive, so the compressive forces here are negative.
 from __future__ import annotations
 
 import math
-import os
 import time
 import warnings
 from dataclasses import dataclass
@@ -93,9 +92,9 @@ def _warn_courant(courant: float) -> None:
 
 def _working_bytes(n_spans: int, n_intervals: int, options: RunOptions) -> float:
     """Bytes of the kernel's working arrays: three time levels of n_intervals + 1 nodes for
-    each span solved at once (one a thread, all the cores' threads by default)."""
-    threads = options.threads or os.cpu_count() or 1
-    return 3.0 * 8.0 * (n_intervals + 1) * min(max(n_spans, 1), threads)
+    each span solved at once (one a thread: sweep.threads.thread_count)."""
+    from ..threads import thread_count
+    return 3.0 * 8.0 * (n_intervals + 1) * min(max(n_spans, 1), thread_count(options.threads))
 
 
 def run(scene: Scene, options: RunOptions) -> xr.Dataset:

@@ -470,10 +470,10 @@ ROTATIONAL_STIFFNESS = "clamps.rotational_stiffness"
 def _check_clamps(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of [clamps] (docs/model.md sec. 10): one stretching (the clamps' axial stiffness
     or model.membrane, not both; none with the paper's Eq.32, whose is its own); a rotational
-    stiffness with elastic clamps only, and always with them; a diameter (the bending strains) not where a pinned span under model.membrane
-    reports none (sweep.models.loads.wanted), unless it is part of a data-sheet cable
-    (sweep.models.cable); ends other than pins need the consistent coefficients (Eq.32 is the
-    pinned span's)."""
+    stiffness with elastic clamps only, and always with them; a diameter (the bending strains)
+    not where a pinned span under model.membrane reports none (sweep.models.loads.wanted),
+    unless it is part of a data-sheet cable (sweep.models.cable); ends other than pins need the
+    consistent coefficients (Eq.32 is the pinned span's)."""
     if _present("clamps.axial_stiffness", given, axes) and _present("model.membrane", given,
                                                                     axes):
         _fail(f"{_where('clamps.axial_stiffness', axes)} and "
@@ -666,8 +666,8 @@ def _check_paper_cable(given: dict[str, Any]) -> None:
 
 
 TRANSVERSE_ONLY = ("cable.damping_ratio", "initial.displacement", "initial.velocity",
-                   "initial.modal_displacement", "initial.modal_velocity", "model.coefficients", "model.membrane",
-                   "model.paper_parametric", "solver.rtol", "solver.atol", "solver.method",
+                   "initial.modal_displacement", "initial.modal_velocity",
+                   "model.coefficients", "model.membrane", "model.paper_parametric", "solver.rtol", "solver.atol", "solver.method",
                    "solver.controller", "solver.driver", "solver.max_step", "solver.min_step",
                    "solver.first_step", "solver.steady_periods", "solver.steady_tolerance",
                    "metrics.tail", "metrics.tolerance", "outputs.amplitude",
