@@ -195,8 +195,9 @@ def modal_size(n_modes):
     statistics window of c_e^2, c_e'^2 and c_e''^2 for the clamp at s = 0 and midspan
     (square_slot(N) + 0..2, + 3..5; m^2 s, m^2/s, m^2/s^3; `_observe_bend_squares`); the end
     load's factors for the clamp's reaction (end_load_slot(N) + 0..3: kernels.modes
-    `end_load_factors`)."""
-    return 3 * n_modes + 19
+    `end_load_factors`); the base inertia's factor for it (inertia_slot(N), s^2:
+    kernels.modes.inertia_factor; 0 without base excitation)."""
+    return 3 * n_modes + 20
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -232,6 +233,43 @@ def end_load_slot(n_modes):
     """The first of the end load's four factors in the accumulator (kernels.modes
     `end_load_factors`: its P l^2 / EI mean and cosine amplitude, W, phi_W)."""
     return 3 * n_modes + 15
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def inertia_slot(n_modes):
+    """The slot of the base inertia's factor (kernels.modes.inertia_factor) in the
+    accumulator."""
+    return 3 * n_modes + 19
+
+
+INERTIA_DIFFERENCE = 1e-4
+"""The central difference of a_b's rate in `inertia_at`, as a fraction of the step: its
+truncation error (1e-4 h)^2 / 6 of a_b''' / a_b', its round-off 1e-16 / (1e-4 h w), both far
+below the bisection's needs (the rate's sign near a load's maximum)."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def inertia_at(factor, t, h, p1, base):
+    """(inertia, its rate) (m, m/s) for kernels.modes.span_loads at t (s): `factor` (the
+    accumulator's, kernels.modes.inertia_factor, s^2) times a_b(t) of the Observer row p1
+    (`observer_row`: the base excitation block, any kind), the rate by a central difference
+    over INERTIA_DIFFERENCE x h (h, s: the step the observation lies in). (0, 0) without base
+    excitation."""
+    if base is None:
+        return 0.0, 0.0
+    if factor == 0.0:
+        return 0.0, 0.0
+    d = INERTIA_DIFFERENCE * h
+    a = _base_signal(t, p1, base)
+    rate = (_base_signal(t + d, p1, base) - _base_signal(t - d, p1, base)) / (2.0 * d)
+    return factor * a, factor * rate
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _base_signal(t, p1, base):
+    """a_b(t) (m/s^2) of the Observer row p1 (a call of its own: kernels.excitation.signal
+    inlined three times into one function trips Numba's IR checks)."""
+    return ex.signal(t, p1, osc.EXCITATION, 1, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -397,7 +435,7 @@ def negligible(peak, largest):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
-                   basis, Qp):
+                   basis, Qp, p1, base):
     """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each mode's
     peak at the step's end; in the tail window each mode's tail amplitude max |q_i| (the step's
     end, the tail's start inside the step, and an extremum of q_i inside the step, on its own
@@ -408,7 +446,9 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
     (kernels.modes). And where the deflection at the place x* of the largest so far turns inside
     the step (a crest there that no mode's extremum marks), the span there too. The loads
     (`_observe_bends`, `_observe_loads`) over the tail window, or over the whole run where
-    `start` marked it so (a sine sweep: their peak over the whole sweep)."""
+    `start` marked it so (a sine sweep: their peak over the whole sweep). p1, base: the
+    Observer row and the excitation switch, for the base inertia's part of the clamp shear
+    (`inertia_at`)."""
     n = n_modes
     largest = 0.0
     for i in range(n):
@@ -422,7 +462,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
         located = _observe_bends(t, t_new, 0.0, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
                                  Qp, located)
         located = _observe_loads(t, t_new, 0.0, y, y_new, K, h, n, eighth, modal, Km, QA,
-                                 basis, located, qx)
+                                 basis, located, qx, p1, base)
     if t_new < t_tail:
         return
     r0 = 0.0
@@ -464,7 +504,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
     located = _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
                              Qp, located)
     _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, located,
-                   qx)
+                   qx, p1, base)
 
 
 TAIL_WINDOW = 1.0
@@ -522,15 +562,16 @@ ROOT_ITERATIONS = 48
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _loads_at(t, y, h, QA, x, n, basis, modal, qv, out):
+def _loads_at(t, y, h, QA, x, n, basis, modal, qv, out, p1, base):
     """kernels.modes.span_loads at the fraction x of the step from t (s), on every mode's
-    interpolant (QA); qv (2N): scratch for q and its rate there."""
+    interpolant (QA); qv (2N): scratch for q and its rate there; p1, base: `inertia_at`'s."""
     for c in range(n):
         qv[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
         qv[n + c] = dopri5.dense_value(y[n + c], h, QA[c, 1], x)
     load, rate = end_load_at(modal, n, t + x * h)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t + x * h, h, p1, base)
     md.span_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n,
-                  modal[factor_slot(n)], load, rate, out)
+                  modal[factor_slot(n)], load, rate, inertia, inertia_rate, out)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -542,14 +583,14 @@ def _load_rises(out, k):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
-                   located, qx):
+                   located, qx, p1, base):
     """The largest stretch E and clamp shears |F_0|, |F_1| (kernels.modes.span_loads) over
     the accepted step [t, t_new] ending in the tail window, into modal[load_slot(N) + k]: at
     the step's end, at the tail's start inside the step and, where |L_k| rises at the step's
     start and falls at its end, at its maximum inside the step (bisection on its rate, on
     every mode's interpolant: the loads are not linear in q, so no root of one polynomial
     gives it). qx: scratch (`observer_scratch`). Returns whether the interpolants are now
-    computed."""
+    computed. p1, base: `inertia_at`'s."""
     slot = load_slot(n)
     kappa = modal[factor_slot(n)]
     rows = basis[md.CLAMPS]
@@ -558,9 +599,13 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
     b = qx[3 * n + 6:3 * n + 12]
     m = qx[3 * n + 12:3 * n + 18]
     load, rate = end_load_at(modal, n, t)
-    md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, a)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t, h, p1, base)
+    md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, inertia,
+                  inertia_rate, a)
     load, rate = end_load_at(modal, n, t_new)
-    md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, load, rate, b)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t_new, h, p1, base)
+    md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, load, rate,
+                  inertia, inertia_rate, b)
     inside = t < t_tail
     need = inside
     for k in range(3):
@@ -573,7 +618,7 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
         located = True
     if inside:
-        _loads_at(t, y, h, QA, (t_tail - t) / h, n, basis, modal, qv, m)
+        _loads_at(t, y, h, QA, (t_tail - t) / h, n, basis, modal, qv, m, p1, base)
         for k in range(3):
             modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
     for k in range(3):
@@ -583,13 +628,13 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
         hi = 1.0
         for _ in range(ROOT_ITERATIONS):
             mid = 0.5 * (lo + hi)
-            _loads_at(t, y, h, QA, mid, n, basis, modal, qv, m)
+            _loads_at(t, y, h, QA, mid, n, basis, modal, qv, m, p1, base)
             if _load_rises(m, k) > 0.0:
                 lo = mid
             else:
                 hi = mid
         if t + lo * h >= t_tail:
-            _loads_at(t, y, h, QA, lo, n, basis, modal, qv, m)
+            _loads_at(t, y, h, QA, lo, n, basis, modal, qv, m, p1, base)
             modal[slot + k] = max(modal[slot + k], abs(m[2 * k]))
     return located
 
@@ -605,7 +650,7 @@ def _combined(weights, y, h, QA, x, n):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
-                  basis, Qp):
+                  basis, Qp, p1, base):
     """After trajectory.record_step on the step [t, t_new]: where the early stop
     (solver.stop_when_steady) moved the tail window to start inside it (acc[T_TAIL] is no
     longer t_tail), each mode's tail amplitude and the span's restart there, as the midspan's
@@ -618,7 +663,7 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
     for k in range(6):
         modal[clamp_slot(n_modes) + k] = 0.0
     _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, QA,
-                   qx, basis, Qp)
+                   qx, basis, Qp, p1, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -728,9 +773,12 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     modal[end_load_slot(n) + 1] = amplitude
     modal[end_load_slot(n) + 2] = omega
     modal[end_load_slot(n) + 3] = phase
+    modal[inertia_slot(n)] = md.inertia_factor(row, n, curvature) if base is not None else 0.0
     loads = np.empty(6)
     load, rate = end_load_at(modal, n, 0.0)
-    md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, loads)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], 0.0, h_abs, p1, base)
+    md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, inertia,
+                  inertia_rate, loads)
     for k in range(3):
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     for k in range(6):
@@ -801,7 +849,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
             break
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
-                       basis, Qc)
+                       basis, Qc, p1, base)
         observe_random_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
@@ -813,7 +861,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series, track,
                        centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
-                      basis, Qc)
+                      basis, Qc, p1, base)
         for i in range(dim):
             y[i] = y_new[i]
         K[0, :] = K[n_stages, :]

@@ -229,7 +229,7 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, base):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, an extremum of q_n in a mode not negligible
     beside the largest (modal_driver.negligible; BIG: scratch, the largest mode's peak) or a
@@ -237,9 +237,10 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, b
     modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV: the
     basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a maximum
     of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis' coupling;
-    MOD's shear factor; LD (2, 6): scratch), where the scene observes the loads
-    (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch,
-    read only by excitation.by_kind (`_sine_mode_events`: a record's steps never call this)."""
+    MOD's shear factor; LD (2, 6): scratch; P1L: the lanes' Observer rows, for the base
+    inertia's part of the shear, modal_driver.inertia_at), where the scene observes the loads
+    (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch
+    (excitation.by_kind, `_sine_mode_events`: a record's steps never call this)."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
@@ -281,13 +282,20 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, b
     a = LD[0]
     b = LD[1]
     kappa_at = drv.factor_slot(n)
+    mass_at = drv.inertia_slot(n)
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
         load, rate = _end_load(MOD, n, l, W[tj.T * L + l])
-        md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], load, rate, a)
+        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T * L + l], H[l],
+                                               P1L[l], base)
+        md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
+                      inertia_rate, a)
         load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
-        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, b)
+        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], H[l],
+                                               P1L[l], base)
+        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
+                      inertia_rate, b)
         for k in range(3):
             if drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0:
                 EV[l] = 1.0
@@ -350,14 +358,15 @@ def _end_load(MOD, n, l, t):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, base):
+def _tail_modes(W, YN, H, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
     same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
     their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
-    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch). base:
-    read only by excitation.by_kind (`_sine_tail_modes`)."""
+    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; H, P1L:
+    the steps and Observer rows, modal_driver.inertia_at's). base: the excitation switch
+    (excitation.by_kind, `_sine_tail_modes`)."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
@@ -380,13 +389,17 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, base):
     b = LD[0]
     loads = drv.load_slot(n)
     kappa_at = drv.factor_slot(n)
+    mass_at = drv.inertia_slot(n)
     for l in range(n_run):
         take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
                 & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
         if not take:
             continue
         load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
-        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, b)
+        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], H[l],
+                                               P1L[l], base)
+        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
+                      inertia_rate, b)
         for k in range(3):
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 
@@ -525,7 +538,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
         ml[c] = MOD[c, j]
     t_tail = acc[tj.T_TAIL]
     drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, basis,
-                       Qc)
+                       Qc, P1L[j], base)
     drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis, ml, base)
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
@@ -535,7 +548,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
     tj.record_step(P1L[j], 0, 1, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
                    track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx,
-                      basis, Qc)
+                      basis, Qc, P1L[j], base)
     for c in range(MOD.shape[0]):
         MOD[c, j] = ml[c]
     return True                  # (a midspan divergence moves on, as in the scalar driver)
@@ -681,11 +694,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
         # (a record's steps: no events to find, no ordinary step: the _sine_ functions)
         _sine_mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
-                          basis[md.COUPLING], LD, base)
+                          basis[md.COUPLING], LD, P1L, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _sine_tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
-                         basis[md.COUPLING], LD, base)
+        _sine_tail_modes(W, YN, H, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
+                         basis[md.COUPLING], LD, P1L, base)
         if base is not None:
             _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema
         if n_flagged > 0:

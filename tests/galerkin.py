@@ -298,6 +298,19 @@ def bending_energy(ei: float, w1: np.ndarray, w2: np.ndarray, weights: np.ndarra
     return 0.5 * ei * (w2 ** 2 * (1.0 - 3.0 * w1 ** 2 + 6.0 * w1 ** 4)) @ weights
 
 
+def reaction_left_out(shapes: list, length: float, nodes: int = 96) -> float:
+    """r = 1/2 - sum_n Gamma_n int (l - x) phi_n dx / l^2 (Gamma_n = int phi_n / int
+    phi_n^2, Gauss-Legendre on `nodes` nodes): the share of a uniform load's reaction at the
+    clamp x = 0 (statically 1/2 of the load) that the modes `shapes` do not carry. The
+    mode-acceleration correction carries it there: V(0) gains -rho A l r a_b(t), V(l) the
+    opposite."""
+    g, weights = np.polynomial.legendre.leggauss(nodes)
+    x, weights = 0.5 * length * (g + 1.0), 0.5 * length * weights
+    phi = np.array([s(x, 0) for s in shapes])
+    gamma = (phi @ weights) / ((phi ** 2) @ weights)
+    return 0.5 - float(gamma @ ((phi * (length - x)) @ weights)) / length ** 2
+
+
 def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration: float = 0.0,
                base_frequency: float = 0.0, nodes: int = 96,
                tension_stiffness: float | None = None) -> Callable:

@@ -252,3 +252,25 @@ def test_the_observed_rows_are_the_shapes_derivatives_and_mode_1_pushes_one_way(
         scale = basis.shapes[:, 0] ** k
         assert np.allclose(basis.clamps[row], numeric, atol=1e-6 * scale.max()), row
     assert -basis.clamps[3, 0] > 0.0 and basis.clamps[5, 0] >= -1e-12
+
+
+@pytest.mark.parametrize("stiffness", [0.0, 3.0, math.inf])
+def test_the_modes_share_of_a_uniform_loads_reaction_tends_to_one_half(stiffness):
+    """Basis.clamps' last row, Gamma_n int (1 - s) phi_n ds, is each mode's share of the
+    reaction at a clamp to a uniform load (statically 1/2 of it, any ends): against a
+    trapezoidal quadrature of the shapes written here, summing to less than 1/2 and to
+    1/2 as the modes grow, the rest shrinking like 1/N (what the clamp observers add back)."""
+    from sweep.models.basis import span_basis
+    s = np.linspace(0.0, 1.0, 20001)
+    w = np.full(s.size, s[1])
+    w[[0, -1]] = s[1] / 2.0                         # the trapezoidal rule's weights
+    rest = []
+    for n in (1, 5, 21):
+        basis = span_basis(stiffness, n)
+        phi = shape_values(basis.shapes, s)
+        gamma = (phi @ w) / (phi ** 2 @ w)
+        share = gamma * ((phi * (1.0 - s)) @ w)
+        assert np.allclose(basis.clamps[7], share, atol=1e-8)
+        rest.append(0.5 - basis.clamps[7].sum())
+    assert 0.0 < rest[2] < rest[1] < rest[0] < 0.2
+    assert rest[2] < 0.03 and rest[1] / rest[2] > 3.0

@@ -41,8 +41,8 @@ def _scipy_peaks(n_modes: int, level_g: float, ratio: float, t_end: float,
     (clamped cosh/cos or pinned sines), stretching by the uniform tension k_s e (tension = k_s,
     N/m; default the immovable clamps' EA / l): |w(l/2)| (m, midspan), |w_xx(0)| (1/m,
     clamp_curvature), |w_xx(l/2)| (midspan_curvature), N = k_s (1/2) int w_x^2 dx (N, tension,
-    the integral by Gauss-Legendre here) and the reaction |-EI w_xxx + N w_x| at either clamp
-    (N, force), each located at the sign change of its own rate (brentq)."""
+    the integral by Gauss-Legendre here) and the reaction at either clamp (N, force:
+    `_peaks_of`), each located at the sign change of its own rate (brentq)."""
     from scipy.integrate import solve_ivp
     cable = g.Cable(length=LENGTH, damping_ratio=ZETA)
     if clamped:
@@ -55,13 +55,23 @@ def _scipy_peaks(n_modes: int, level_g: float, ratio: float, t_end: float,
                      ratio * omega_n[0] / (2 * math.pi), tension_stiffness=tension)
     sol = solve_ivp(f, (0.0, t_end), np.zeros(2 * n_modes), method="DOP853", rtol=1e-10,
                     atol=1e-15, dense_output=True).sol
-    return _peaks_of(sol, n_modes, shapes, np.linspace(0.75 * t_end, t_end, 20001), tension)
+    level, w_b = level_g * 9.80665, ratio * omega_n[0]
+    base = (lambda s: level * np.sin(w_b * s), lambda s: level * w_b * np.cos(w_b * s), level)
+    return _peaks_of(sol, n_modes, shapes, np.linspace(0.75 * t_end, t_end, 20001), tension,
+                     base)
 
 
-def _peaks_of(sol, n: int, shapes: list, t: np.ndarray,
-              tension: float | None) -> dict[str, float]:
+def _peaks_of(sol, n: int, shapes: list, t: np.ndarray, tension: float | None,
+              base: tuple) -> dict[str, float]:
     """`_scipy_peaks`' maxima over the times t (s) of a dense solution `sol` of the Galerkin
-    equations on `shapes` (k_s = tension, N/m, None: no stretching)."""
+    equations on `shapes` (k_s = tension, N/m, None: no stretching) under the base
+    acceleration base = (a_b(t), a_b'(t), its peak) (m/s^2): the reaction at either clamp,
+    V = -EI w_xxx + N w_x with the mode-acceleration correction, the part of the base's
+    inertia load the modes leave out carried to the clamps as statically (`force`: -+ rho A l
+    r a_b(t) at x = 0, l, r from galerkin.reaction_left_out on these shapes), and, for one
+    mode's bound, the modes' part's peak (`force_modes`) and that part's (`left_out`)."""
+    rho_a_l_r = (8900.0 * 6e-6 * LENGTH) * g.reaction_left_out(shapes, LENGTH)
+    accel, jerk, peak_level = base
     x, w = np.polynomial.legendre.leggauss(60)
     x, w = 0.5 * LENGTH * (x + 1.0), 0.5 * LENGTH * w
     slopes = np.array([s(x, 1) for s in shapes])
@@ -82,20 +92,26 @@ def _peaks_of(sol, n: int, shapes: list, t: np.ndarray,
         return (k_s * 0.5 * np.einsum("i...,ij,j...->...", q, axial, q),
                 k_s * np.einsum("i...,ij,j...->...", q, axial, v))
 
-    def force(s, e):
+    def force(s, e, inertia=1.0):
         y = sol(s)
         q, v = y[:n], y[n:]
         third, slope = ends[e]
         big_n, rate_n = tension_of(s)
-        value = -EI * (third @ q) + big_n * (slope @ q)
-        rate = -EI * (third @ v) + rate_n * (slope @ q) + big_n * (slope @ v)
+        sign = inertia * (-1.0 if e == 0 else 1.0)
+        value = -EI * (third @ q) + big_n * (slope @ q) + sign * rho_a_l_r * accel(s)
+        rate = (-EI * (third @ v) + rate_n * (slope @ q) + big_n * (slope @ v)
+                + sign * rho_a_l_r * jerk(s))
         return value, value * rate                     # d|V|/dt has the sign of V V'
 
     return {"midspan": linear(mid), "clamp_curvature": linear(at_clamp),
             "midspan_curvature": linear(bend_mid),
             "tension": g._tail_max(lambda s: tension_of(s)[0], lambda s: tension_of(s)[1], t),
             "force": max(g._tail_max(lambda s, e=e: force(s, e)[0],
-                                     lambda s, e=e: force(s, e)[1], t) for e in (0, 1))}
+                                     lambda s, e=e: force(s, e)[1], t) for e in (0, 1)),
+            "force_modes": max(g._tail_max(lambda s, e=e: force(s, e, 0.0)[0],
+                                           lambda s, e=e: force(s, e, 0.0)[1], t)
+                               for e in (0, 1)),
+            "left_out": rho_a_l_r * peak_level}
 
 
 @pytest.mark.parametrize("rotation", ["pinned", "clamped"])
@@ -152,7 +168,7 @@ def test_the_clamped_span_and_its_clamp_bending_match_scipy(modes, ratio):
     assert _one(ds, "amplitude") == pytest.approx(midspan, rel=1e-6)
     kappa = _one(ds, "clamp_moment") / EI
     assert kappa == pytest.approx(curvature, rel=1e-6)
-    _check_loads(ds, peaks)
+    _check_loads(ds, peaks, modes)
     assert _one(ds, "clamp_bending_strain") == pytest.approx(
         math.sqrt(4 * 6e-6 / math.pi) / 2 * kappa, rel=1e-12)
     thick = sweep.run(sweep.load_scene_text(scene_text(
@@ -161,16 +177,23 @@ def test_the_clamped_span_and_its_clamp_bending_match_scipy(modes, ratio):
     assert _one(thick, "clamp_bending_strain") == pytest.approx(0.002 * kappa, rel=1e-9)
 
 
-def _check_loads(ds, peaks: dict[str, float]) -> None:
+def _check_loads(ds, peaks: dict[str, float], modes: int = 3) -> None:
     """The span's loads against SciPy's peaks (`_scipy_peaks`), to 1e-6: the midspan bending
     strain (d / 2 the solid section's), the stretching tension and strain, the clamp's
-    reaction, and max_strain from its parts."""
+    reaction (one mode, from its steady crest: within 5e-3 of the peak in time, which the
+    nonlinear span's harmonics move, and never above the bound of its two parts' peaks
+    added), and max_strain from its parts."""
     d = math.sqrt(4 * 6e-6 / math.pi)
     assert _one(ds, "midspan_bending_strain") == pytest.approx(
         d / 2 * peaks["midspan_curvature"], rel=1e-6)
     assert _one(ds, "axial_tension") == pytest.approx(peaks["tension"], rel=1e-6)
     assert _one(ds, "axial_strain") == pytest.approx(peaks["tension"] / EA, rel=1e-6)
-    assert _one(ds, "clamp_force") == pytest.approx(peaks["force"], rel=1e-6)
+    if modes == 1:
+        bound = peaks["force_modes"] + peaks["left_out"]
+        assert _one(ds, "clamp_force") <= bound * (1.0 + 1e-9)
+        assert _one(ds, "clamp_force") == pytest.approx(peaks["force"], rel=5e-3)
+    else:
+        assert _one(ds, "clamp_force") == pytest.approx(peaks["force"], rel=1e-6)
     bending = max(peaks["clamp_curvature"], peaks["midspan_curvature"]) * d / 2
     assert _one(ds, "max_strain") == pytest.approx(bending + peaks["tension"] / EA, rel=1e-6)
 
@@ -185,7 +208,7 @@ def test_a_pinned_span_reports_its_tension_reaction_and_midspan_strain(modes, ra
     peaks = _scipy_peaks(modes, 2.0, ratio, 1.5, clamped=False)
     assert peaks["clamp_curvature"] == 0.0 and "clamp_bending_strain" not in ds
     assert _one(ds, "amplitude") == pytest.approx(peaks["midspan"], rel=1e-6)
-    _check_loads(ds, peaks)
+    _check_loads(ds, peaks, modes)
 
 
 def test_pinned_clamps_bend_nothing_and_the_paper_membrane_takes_no_diameter():
@@ -294,9 +317,17 @@ def test_a_sine_sweep_reports_the_loads_peak_over_the_whole_sweep():
             f = free(t, y)
             f[3:] -= gamma * chirp(t)
             return f
+        def chirp_rate(t: float) -> float:
+            u = math.pi * t / rise
+            ramp, ramp_rate = ((0.5 - 0.5 * math.cos(u), 0.5 * math.pi / rise * math.sin(u))
+                               if t < rise else (1.0, 0.0))
+            phase = 2.0 * math.pi * start * math.expm1(lam * t) / lam
+            return 2.0 * 9.80665 * (ramp_rate * math.sin(phase) + ramp * 2.0 * math.pi
+                                    * start * math.exp(lam * t) * math.cos(phase))
         sol = solve_ivp(rhs, (0.0, 1.0), np.zeros(6), method="DOP853", rtol=1e-10, atol=1e-15,
                         dense_output=True).sol
-        peaks = _peaks_of(sol, 3, shapes, np.linspace(0.0, 1.0, 40001), EA / LENGTH)
+        peaks = _peaks_of(sol, 3, shapes, np.linspace(0.0, 1.0, 40001), EA / LENGTH,
+                          (np.vectorize(chirp), np.vectorize(chirp_rate), 2.0 * 9.80665))
         assert _one(ds, "peak_amplitude") == pytest.approx(peaks["midspan"], rel=1e-6)
         assert _one(ds, "clamp_moment") / EI == pytest.approx(peaks["clamp_curvature"],
                                                               rel=1e-6)
@@ -313,7 +344,9 @@ def test_the_clamp_reaction_holds_the_end_load_part(modes, kind):
     reaction holds -P w_x, largest at a pin (there P0 w_x is 40 % of the shear here). A linear
     span (clamps.axial_stiffness = 0, a base level of 1e-5 g: the cubic terms are 1e-10 of
     the linear ones) against SciPy's DOP853 on the sines' linear Galerkin equations with the
-    load's P(t) A q, M, A and G by quadrature here. (A clamped end has no slope: no part.)"""
+    load's P(t) A q, M, A and G by quadrature here, and the base inertia the modes leave out
+    (galerkin.reaction_left_out; one mode from its steady crest, to 1e-3, never above the
+    bound of the two parts' peaks added). (A clamped end has no slope: no part.)"""
     from scipy.integrate import solve_ivp
     p0, load_hz, level, ratio, t_end = 7.8, 7.0, 1e-5 * 9.80665, 0.8, 3.0
     extra = (f"axial_stiffness = 0.0\n[load]\ntype = \"{kind}\"\namplitude = {p0}\n"
@@ -348,24 +381,32 @@ def test_the_clamp_reaction_holds_the_end_load_part(modes, kind):
     times = np.linspace(0.75 * t_end, t_end, 20001)
     ends = [(np.array([float(s(e, 3)) for s in shapes]), np.array([float(s(e, 1)) for s in shapes]))
             for e in (0.0, LENGTH)]
+    left_out = rho_a * LENGTH * g.reaction_left_out(shapes, LENGTH)
 
-    def force(s, e):
+    def force(s, e, inertia=1.0, end_load=1.0):
         y = sol(s)
         q, v = y[:modes], y[modes:]
         third, first = ends[e]
-        load = p0 * np.cos(w_load * s)
-        rate = -p0 * w_load * np.sin(w_load * s)
-        value = -EI * (third @ q) - load * (first @ q)
-        change = -EI * (third @ v) - rate * (first @ q) - load * (first @ v)
+        load = end_load * p0 * np.cos(w_load * s)
+        rate = -end_load * p0 * w_load * np.sin(w_load * s)
+        sign = inertia * (-1.0 if e == 0 else 1.0) * left_out * level
+        value = -EI * (third @ q) - load * (first @ q) + sign * np.sin(w_base * s)
+        change = (-EI * (third @ v) - rate * (first @ q) - load * (first @ v)
+                  + sign * w_base * np.cos(w_base * s))
         return value, value * change
 
-    expected = max(g._tail_max(lambda s, e=e: force(s, e)[0], lambda s, e=e: force(s, e)[1],
-                               times) for e in (0, 1))
-    shear_only = max(g._tail_max(lambda s, e=e: -EI * (ends[e][0] @ sol(s)[:modes]),
-                                 lambda s, e=e: (ends[e][0] @ sol(s)[:modes])
-                                 * (ends[e][0] @ sol(s)[modes:]), times) for e in (0, 1))
-    assert abs(expected / shear_only - 1.0) > 0.05          # the end load's part shows
-    assert _one(ds, "clamp_force") == pytest.approx(expected, rel=1e-6)
+    def peak(inertia, end_load=1.0):
+        return max(g._tail_max(lambda s, e=e: force(s, e, inertia, end_load)[0],
+                               lambda s, e=e: force(s, e, inertia, end_load)[1], times)
+                   for e in (0, 1))
+
+    expected = peak(1.0)
+    assert abs(expected / peak(1.0, 0.0) - 1.0) > 0.05      # the end load's part shows
+    if modes == 1:            # from the steady crest (sweep.models.loads), within the bound
+        assert _one(ds, "clamp_force") <= (peak(0.0) + left_out * level) * (1.0 + 1e-9)
+        assert _one(ds, "clamp_force") == pytest.approx(expected, rel=1e-3)
+    else:
+        assert _one(ds, "clamp_force") == pytest.approx(expected, rel=1e-6)
 
 
 def test_one_mode_under_a_harmonic_end_load_reports_no_clamp_force():
@@ -378,3 +419,55 @@ def test_one_mode_under_a_harmonic_end_load_reports_no_clamp_force():
                    progress=False)
     force = ds["clamp_force"].values.ravel()
     assert np.isfinite(force[0]) and np.isnan(force[1])
+
+
+EXACT_SCENE = """
+name = "clamp-loads-exact"
+[model]
+kind = "transverse"
+coefficients = "consistent"
+[cable]
+linear_mass = "53.4 g/m"
+bending_rigidity = "0.31515 N m^2"
+axial_rigidity = "660 kN"
+diameter = "2.76395 mm"
+damping_ratio = 0.005
+[clamps]
+axial_stiffness = 0.0
+[base]
+acceleration_g = 0.1
+[metrics]
+tail = 0.2
+[initial]
+displacement = 0.0
+velocity = 0.0
+[axes]
+length = [0.3]
+base_frequency_ratio = [0.3, 0.7, 1.4]
+"""
+
+
+@pytest.mark.parametrize("modes", [1, 3])
+@pytest.mark.parametrize("rotation", ["pinned", "clamped", "elastic"])
+def test_the_clamp_reaction_is_the_continuous_beams(rotation, modes):
+    """The clamp's transverse reaction against the exact steady state of the continuous
+    Euler-Bernoulli beam (tests/exact_beam.py: no modes at all), a linear 0.3 m bundle span
+    (no stretching) at 0.1 g below, near and above its own f1, pinned, clamped and elastic
+    (0.1 N m/rad) ends: within 3 % with one mode (the modes left out still move a little
+    above resonance: 2.6 % clamped at 1.4 f1, 0.4 % pinned) and 2e-3 with three. The modes'
+    shear sum alone (without the base inertia the modes leave out) is 6-80 % off here, and
+    converges like 1/N. The damping (0.5 %) moves the exact values by about 1e-4 at these ratios; the
+    run is 15 / (zeta w1) long, its tail the last 20 %."""
+    from exact_beam import first_frequency, steady_loads
+    k_end = {"pinned": 0.0, "clamped": None, "elastic": 0.1}[rotation]
+    over = {"clamps.rotation": rotation}
+    if rotation == "elastic":
+        over["clamps.rotational_stiffness"] = 0.1
+    w1 = first_frequency(0.3, 0.0534, 0.31515, k_end)
+    ds = sweep.run(sweep.load_scene_text(EXACT_SCENE, overrides={
+        **over, "model.modes": modes, "solver.t_end": 15.0 / (0.005 * w1),
+        "run.threads": 1}), progress=False)
+    for ratio in (0.3, 0.7, 1.4):
+        exact = steady_loads(ratio * w1, 0.1 * 9.80665, 0.3, 0.0534, 0.31515, k_end)[2]
+        force = float(ds["clamp_force"].sel(base_frequency_ratio=ratio).squeeze())
+        assert force == pytest.approx(exact, rel=3e-2 if modes == 1 else 2e-3), ratio

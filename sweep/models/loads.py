@@ -6,11 +6,24 @@ Several modes: from the multi-mode kernels' load observers (kernels/modal_driver
 curvature sum phi_n''(s) q_n at s = 0, 1, 1/2, the stretch E = q^T C q and the clamp shear
 F_e = sum phi_n'''(e) q_n - (kappa E - P(t) l^2 / EI) sum phi_n'(e) q_n, each's largest over
 the tail window).
-One mode: every one of them grows with |q| (the curvatures as |q|, the stretch as q^2, the
-shear as |q| (|phi'''(0)| + (kappa E - P l^2 / EI) |phi'(0)|), its terms of one sign below
-buckling), so each peaks where q does and is the mode's integral times the tail amplitude
-(sweep.models.basis.one_mode_integrals); under a harmonic end load P(t) the shear need not peak
-with q, and one mode reports none (NaN: run two modes or more, whose observers watch it).
+The clamp shear holds, beside the modes' part, the part of the base's inertia load that the
+modes kept leave out, r (rho A l^4 / EI) a_b(t) (r = 1/2 - sum_n Gamma_n int (1 - s) phi_n:
+the mode-acceleration correction, kernels.modes.inertia_factor); without it the reaction
+converges like 1/N and one mode misses 19 % (pinned) to 31 % (clamped) of a quasi-static one.
+One mode: every one of them but the shear grows with |q| (the curvatures as |q|, the stretch
+as q^2), so each peaks where q does and is the mode's integral times the tail amplitude
+(sweep.models.basis.one_mode_integrals). Its shear is F = -a q + c a_b(t) (a = |phi'''(0)| +
+(kappa E - P l^2 / EI) |phi'(0)|, of one sign below buckling; c the left-out inertia's
+factor), which need not peak with q. Two estimates from the tail amplitude Q: the bound
+a Q + c A (A the base's peak level; |F| can never exceed it), and the steady harmonic crest,
+where q' = 0, q'' = -W^2 q and the mode's own equation gives a_b = (W^2 q - R(q)) / Gamma
+(R(q) = k0 q + g0 q^3 + h q^5, its restoring force), with the damping's quadrature part:
+Q sqrt((a + c (R(Q)/Q - W^2) / Gamma)^2 + (c d W / Gamma)^2) (d = 2 zeta w1, W the base's
+angular frequency, a sweep's where q peaked). The smaller of the two: the crest below, at and
+above resonance in a steady response (a linear span's exactly), the bound where the crest
+would exceed it. Two modes or more follow F in time. A random record (no one frequency or
+peak level) and a harmonic end load (whose -P(t) w_x need not peak with q) give one mode none
+(NaN).
 
 In SI, l the length, EI the bending and EA the axial stiffness, d the cable's outer diameter:
 curvature kappa = c / l^2 (c the observed curvature sum), strain (d / 2) kappa, moment EI kappa;
@@ -92,8 +105,10 @@ OUTPUTS = (
     Output("clamp_force", "N", "transverse reaction at the clamp: max |V| at either clamp over "
            "the tail window, V = -EI w_xxx + (N - P) w_x (the shear, the stretching "
            "tension's transverse part and the end load's, P compression positive; without "
-           "model.membrane's local term; one mode under a harmonic end load: NaN, its peak is "
-           "not where q peaks; converges like 1/N with the modes kept: check with sweep modes)",
+           "model.membrane's local term), with the base inertia the modes kept leave out "
+           "carried to the clamps as statically (mode acceleration); one mode: from its "
+           "steady harmonic crest, at most the bound of its two parts' peaks added (NaN "
+           "under a random record or a harmonic end load)",
            lambda p, s: s.bending * p.shear / s.length ** 3),
     Output("axial_tension", "N", "stretching tension of the span: its largest N = k_s e over "
            "the tail window (e = (1/2) int w_x^2 dx the elongation, k_s the span and its clamps "
@@ -142,9 +157,24 @@ def observation(scene: Any, swept: bool) -> float:
     return WHOLE_RUN if swept else TAIL_WINDOW
 
 
+class OneMode(NamedTuple):
+    """What one mode's clamp shear needs beside its tail amplitude (module docstring), each a
+    number or a DataArray over the grid: the base's peak level A (m/s^2; NaN for a random
+    record), its angular frequency W (rad/s; a sweep's where q peaked), the mode's equation
+    q'' + d q' + k0 q + g0 q^3 + h q^5 = -Gamma a_b (d, 1/s; k0, 1/s^2; g0, 1/(s^2 m^2); h,
+    1/(s^2 m^4); Gamma, 1)."""
+    level: Any
+    omega: Any
+    damping: Any
+    k0: Any
+    g0: Any
+    h: Any
+    participation: Any
+
+
 def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
-                    coords: dict[str, xr.DataArray]) -> Peaks:
-    """The peaks of one mode from its largest |q| (module docstring)."""
+                    coords: dict[str, xr.DataArray], mode: OneMode) -> Peaks:
+    """The peaks of one mode from its largest |q| and its equation (module docstring)."""
     p = params
     stiffness = end_stiffness(p.get("clamps_rotation") or "pinned",
                               p.get("clamp_rotational_stiffness"), p["length"],
@@ -161,7 +191,18 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
     # harmonic one it need not, and one mode's peak |q| cannot give it: NaN there
     load = derived(p["load_amplitude"] * p["length"] ** 2
                    / (p["youngs_modulus"] * p["inertia"]), coords)
-    shear = abs(q * (ends["clamp_shear"] + (kappa * stretch - load) * ends["clamp_slope"]))
+    a = ends["clamp_shear"] + (kappa * stretch - load) * ends["clamp_slope"]
+    l2 = p["length"] * p["length"]     # (not ** 4: pow may round differently by array length)
+    c = ends["inertia"] * derived(p["density"] * p["area"] * (l2 * l2)
+                                  / (p["youngs_modulus"] * p["inertia"]), coords)
+    bound = abs(a * q) + c * mode.level
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q2 = q * q
+        restoring = mode.k0 + (mode.g0 + mode.h * q2) * q2              # R(Q) / Q
+        w2 = mode.omega * mode.omega
+        crest = q * np.sqrt((a + c * (restoring - w2) / mode.participation) ** 2
+                            + (c * mode.damping * mode.omega / mode.participation) ** 2)
+    shear = xr.where(np.isfinite(crest), np.minimum(bound, crest), bound)
     if p.get("load_type") == "harmonic":
         shear = shear.where(load == 0.0)
     return Peaks(q * ends["clamp_curvature"], q * ends["midspan_curvature"], stretch, shear)
@@ -183,19 +224,20 @@ def strain_per_curvature(params: dict[str, Any], coords: dict[str, xr.DataArray]
 
 def load_outputs(params: dict[str, Any], reals: np.ndarray, multi_mode: bool,
                  dims: tuple[str, ...], shape: tuple[int, ...],
-                 coords: dict[str, xr.DataArray], swept: bool = False
-                 ) -> dict[str, xr.DataArray]:
+                 coords: dict[str, xr.DataArray], swept: bool = False,
+                 one_mode: OneMode | None = None) -> dict[str, xr.DataArray]:
     """The rows of `OUTPUTS` a scene gets (`wanted`), from a transverse run's `reals` (n,
     kernels.layout.N_REALS): the load observers' columns with several modes, the tail
-    amplitude with one; `swept`: a sine sweep's, each peak over the whole sweep (one mode:
-    from its peak over the run)."""
+    amplitude and `one_mode` with one (`_one_mode_peaks`); `swept`: a sine sweep's, each peak
+    over the whole sweep (one mode: from its peak over the run)."""
     def column(c: int) -> xr.DataArray:
         return xr.DataArray(reals[:, c].reshape(shape), dims=dims)
     if multi_mode:
         peaks = Peaks(column(tk.CLAMP_BEND), column(tk.MID_BEND), column(tk.STRETCH),
                       column(tk.CLAMP_SHEAR))
     else:
-        peaks = _one_mode_peaks(params, column(tk.PEAK if swept else tk.AMPLITUDE), coords)
+        peaks = _one_mode_peaks(params, column(tk.PEAK if swept else tk.AMPLITUDE), coords,
+                                one_mode)
     p = params
     diameter = outer_diameter(p, coords)
     _, k_s = modal.stretching(p)

@@ -393,6 +393,31 @@ def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
     return out
 
 
+def _one_mode(inputs: Any, coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
+              reals: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...]
+              ) -> loads.OneMode:
+    """What one mode's clamp reaction needs (sweep.models.loads.OneMode): the base's largest
+    |a_b| over a run (m/s^2: the level, a fixed frequency's from a table there, a swept
+    table's largest over the sweep; 0 without base excitation) and its angular frequency
+    (a sweep's where q peaked), the mode's equation's coefficients; NaN level and frequency
+    for a random record."""
+    p = inputs.params
+    levels = p.get("base_levels_g")
+    if inputs.random is not None:
+        level = omega = math.nan
+    elif inputs.swept:
+        level = (derived(excitation.peak_level(levels, p["base_sweep_start"],
+                                               p["base_sweep_stop"]), coords)
+                 if levels is not None else derived(coeffs["base_accel"], coords))
+        omega = 2.0 * math.pi * xr.DataArray(reals[:, tk.PEAK_FREQUENCY].reshape(shape),
+                                             dims=dims)
+    else:
+        level = derived(coeffs["base_accel"], coords)
+        omega = derived(coeffs["base_omega"], coords)
+    return loads.OneMode(level, omega, *(derived(coeffs[k], coords) for k in (
+        "damping", "k0", "g0", "h", "participation")))
+
+
 def _derived_table(coeffs: dict[str, Any], has_base: bool) -> dict[str, tuple[str, str]]:
     """The closed forms a time-domain result stores: _DERIVED, without load_frequency where
     the scene has no end load at any point (it would be a frequency of nothing), and with
@@ -870,8 +895,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                        "max |w(x, t)| over 0 <= x <= l and the tail window (amplitude is the "
                        "midspan's)"})
     if inputs.settings[tk.LOADS] != 0.0:
-        data.update(loads.load_outputs(inputs.params, result.reals, result.modal is not None,
-                                       dims, shape, coords, inputs.swept))
+        data.update(loads.load_outputs(
+            inputs.params, result.reals, result.modal is not None, dims, shape, coords,
+            inputs.swept, _one_mode(inputs, coeffs, coords, result.reals, dims, shape)))
     if inputs.random is not None:
         variables, extra = random_outputs.outputs(
             result.reals, result.states, dims, shape, coords, inputs.random, coeffs,
