@@ -39,7 +39,8 @@ and a stability chart's Floquet results; a random result's means over its record
 peak deflection, RMS acceleration; their intervals say how far sampling alone moves them);
 every load output of the span (sweep.models.loads:
 the bending at the clamps converges more slowly with the modes than the midspan, the shape
-sharpens there, and the clamp's shear, clamp_force, more slowly still: like 1/N)."""
+sharpens there; clamp_force carries the base inertia the modes leave out, and converges
+about as fast as the midspan)."""
 SUCCESS_STATES = ("decayed", "steady", "modulated", "unsettled", "completed")
 """States whose metrics mean something (the failure states have NaN metrics)."""
 TAIL_METRICS = ("amplitude", "response_period", "absolute_acceleration", "modal_amplitude",
