@@ -96,7 +96,7 @@ MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
 SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
-CLAMPS = 6          # (8, N): what the load observers watch per mode (rows below; s = x / l)
+CLAMPS = 6          # (10, N): what the load observers watch per mode (rows below; s = x / l)
 
 # Rows of basis[CLAMPS]: what the load observers of the modal drivers read (per unit q_n).
 BEND_0 = 0          # phi_n''(0): the curvature at the clamp x = 0 (times 1 / l^2)
@@ -104,12 +104,14 @@ BEND_1 = 1          # phi_n''(1): at the clamp x = l
 BEND_MID = 2        # phi_n''(1/2): at midspan
 SHEAR_0 = 3         # phi_n'''(0): the shear's shape at x = 0 (times 1 / l^3)
 SHEAR_1 = 4         # phi_n'''(1)
-SLOPE_0 = 5         # phi_n'(0): the slope at x = 0 (times 1 / l)
+SLOPE_0 = 5         # phi_n'(0): the slope at x = 0 (times 1 / l; the reaction reads AXIAL_0)
 SLOPE_1 = 6         # phi_n'(1)
 INERTIA = 7         # Gamma_n int (1 - s) phi_n ds: mode n's share of a uniform load's reaction
                     # at a clamp (1/2 of the load times l for all the modes: `inertia_factor`)
+AXIAL_0 = 8         # the axial load's reaction at x = 0 per unit q_n and (N - P) / l, the part
+AXIAL_1 = 9         # the modes leave out carried statically (phi_n'(e) for pinned sines)
 N_BENDS = 3         # rows 0..2: the curvatures, linear in q, watched alike
-N_OBSERVED = 8
+N_OBSERVED = 10
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -119,14 +121,15 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, i
     q (m) and rates v (m/s): out = (E, E', F_0, F_0', F_1, F_1') with E = q^T C q (m^2; C =
     `coupling`, A_ij / pi^2: the span's elongation is (pi^2 / 2 l) E, its uniform tension
     N = k_s pi^2 E / (2 l)) and F_e = s3_e . q - (kappa E - load) s1_e . q +- inertia (m;
-    s3_e, s1_e: `rows`' SHEAR_e and SLOPE_e; + at e = 0, - at e = 1): the transverse reaction
-    at clamp e, V = -EI w''' + (N - P) w', is -(EI / l^3) F_e there (kappa = k_s pi^2 l /
-    (2 EI), 1/m^2; load = P l^2 / EI of the end load P at that instant, compression positive
-    (`end_load`), load_rate its rate, 1/s; inertia: the part of the base's inertia load the
-    modes kept do not carry, which goes to the clamps as it would statically, r (rho A l^4 /
-    EI) a_b(t) (`inertia_factor`), and inertia_rate its rate, m/s: the mode-acceleration
-    correction, without which the reaction converges like 1/N); E' and F_e' their rates
-    (/s)."""
+    s3_e, s1_e: `rows`' SHEAR_e and AXIAL_e; + at e = 0, - at e = 1): the transverse
+    reaction at clamp e, V = -EI w''' + (N - P) w', is -(EI / l^3) F_e there, with the loads'
+    parts that the modes kept do not carry going to the clamps as they would statically (the
+    mode-acceleration correction, without which the reaction converges like 1/N): the axial
+    load's through AXIAL_e (phi_n'(e) for sines; not 0 at a clamped end) and the base
+    inertia's, r (rho A l^4 / EI) a_b(t) (`inertia_factor`; inertia and inertia_rate, m and
+    m/s). kappa = k_s pi^2 l / (2 EI), 1/m^2; load = P l^2 / EI of the end load P at that
+    instant, compression positive (`end_load`), load_rate its rate, 1/s; E' and F_e' their
+    rates (/s)."""
     e = 0.0
     de = 0.0
     for i in range(n_modes):
@@ -149,7 +152,7 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, i
         d1 = 0.0
         for i in range(n_modes):
             a = rows[SHEAR_0 + end, i]
-            b = rows[SLOPE_0 + end, i]
+            b = rows[AXIAL_0 + end, i]
             s3 += a * q[i]
             d3 += a * v[i]
             s1 += b * q[i]

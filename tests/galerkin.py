@@ -311,6 +311,24 @@ def reaction_left_out(shapes: list, length: float, nodes: int = 96) -> float:
     return 0.5 - float(gamma @ ((phi * (length - x)) @ weights)) / length ** 2
 
 
+def axial_reaction(shapes: list, length: float, nodes: int = 96) -> tuple[np.ndarray, np.ndarray]:
+    """(e_0, e_1) (1/m, per unit q_n): the reaction of the axial load (N - P) w_xx at x = 0
+    and x = l per unit (N - P) and q_n, as the span's equilibrium gives it with the part of
+    the load the modes leave out carried statically: e_0 = (1/l) sum_m A_nm int (l - x) phi_m
+    / int phi_m^2, e_1 = -(1/l) sum_m A_nm int x phi_m / int phi_m^2, A_nm = int phi_n'
+    phi_m' dx (Gauss-Legendre on `nodes` nodes). For sines these are phi_n'(0) and
+    phi_n'(l); at a clamped end, where phi_n' = 0, they are not."""
+    g, weights = np.polynomial.legendre.leggauss(nodes)
+    x, weights = 0.5 * length * (g + 1.0), 0.5 * length * weights
+    phi = np.array([s(x, 0) for s in shapes])
+    slope = np.array([s(x, 1) for s in shapes])
+    mass = (phi ** 2) @ weights
+    axial = (slope * weights) @ slope.T
+    left = (phi * (length - x)) @ weights / mass
+    right = (phi * x) @ weights / mass
+    return axial @ left / length, -(axial @ right) / length
+
+
 def shapes_rhs(cable: Cable, shapes: list, omegas: np.ndarray, base_acceleration: float = 0.0,
                base_frequency: float = 0.0, nodes: int = 96,
                tension_stiffness: float | None = None) -> Callable:

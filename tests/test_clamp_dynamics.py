@@ -66,10 +66,11 @@ def _peaks_of(sol, n: int, shapes: list, t: np.ndarray, tension: float | None,
     """`_scipy_peaks`' maxima over the times t (s) of a dense solution `sol` of the Galerkin
     equations on `shapes` (k_s = tension, N/m, None: no stretching) under the base
     acceleration base = (a_b(t), a_b'(t), its peak) (m/s^2): the reaction at either clamp,
-    V = -EI w_xxx + N w_x with the mode-acceleration correction, the part of the base's
-    inertia load the modes leave out carried to the clamps as statically (`force`: -+ rho A l
-    r a_b(t) at x = 0, l, r from galerkin.reaction_left_out on these shapes), and, for one
-    mode's bound, the modes' part's peak (`force_modes`) and that part's (`left_out`)."""
+    V = -EI w_xxx + N w_x with the mode-acceleration correction, the parts of the loads the
+    modes leave out carried to the clamps as statically (`force`: the axial load's through
+    galerkin.axial_reaction in place of w_x, the base inertia's -+ rho A l r a_b(t) at x = 0,
+    l, r from galerkin.reaction_left_out on these shapes), and, for one mode's bound, the
+    modes' part's peak (`force_modes`) and that part's (`left_out`)."""
     rho_a_l_r = (8900.0 * 6e-6 * LENGTH) * g.reaction_left_out(shapes, LENGTH)
     accel, jerk, peak_level = base
     x, w = np.polynomial.legendre.leggauss(60)
@@ -80,8 +81,8 @@ def _peaks_of(sol, n: int, shapes: list, t: np.ndarray, tension: float | None,
     mid = np.array([float(s(LENGTH / 2.0, 0)) for s in shapes])
     at_clamp = np.array([float(s(0.0, 2)) for s in shapes])
     bend_mid = np.array([float(s(LENGTH / 2.0, 2)) for s in shapes])
-    ends = [(np.array([float(s(e, 3)) for s in shapes]), np.array([float(s(e, 1)) for s in shapes]))
-            for e in (0.0, LENGTH)]
+    ends = list(zip([np.array([float(s(e, 3)) for s in shapes]) for e in (0.0, LENGTH)],
+                    g.axial_reaction(shapes, LENGTH)))       # the shear's, the axial load's
 
     def linear(weights: np.ndarray) -> float:
         return g._tail_max(lambda s: weights @ sol(s)[:n], lambda s: weights @ sol(s)[n:], t)
@@ -346,7 +347,7 @@ def test_the_clamp_reaction_holds_the_end_load_part(modes, kind):
     the linear ones) against SciPy's DOP853 on the sines' linear Galerkin equations with the
     load's P(t) A q, M, A and G by quadrature here, and the base inertia the modes leave out
     (galerkin.reaction_left_out; one mode from its steady crest, to 1e-3, never above the
-    bound of the two parts' peaks added). (A clamped end has no slope: no part.)"""
+    bound of the two parts' peaks added). (For sines the axial part is -P w_x itself.)"""
     from scipy.integrate import solve_ivp
     p0, load_hz, level, ratio, t_end = 7.8, 7.0, 1e-5 * 9.80665, 0.8, 3.0
     extra = (f"axial_stiffness = 0.0\n[load]\ntype = \"{kind}\"\namplitude = {p0}\n"
@@ -379,8 +380,8 @@ def test_the_clamp_reaction_holds_the_end_load_part(modes, kind):
     sol = solve_ivp(rhs, (0.0, t_end), np.zeros(2 * modes), method="DOP853", rtol=1e-11,
                     atol=1e-18, dense_output=True).sol
     times = np.linspace(0.75 * t_end, t_end, 20001)
-    ends = [(np.array([float(s(e, 3)) for s in shapes]), np.array([float(s(e, 1)) for s in shapes]))
-            for e in (0.0, LENGTH)]
+    ends = list(zip([np.array([float(s(e, 3)) for s in shapes]) for e in (0.0, LENGTH)],
+                    g.axial_reaction(shapes, LENGTH)))       # the shear's, the axial load's
     left_out = rho_a * LENGTH * g.reaction_left_out(shapes, LENGTH)
 
     def force(s, e, inertia=1.0, end_load=1.0):

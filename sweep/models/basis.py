@@ -54,11 +54,12 @@ class Basis:
     bending force from the span's energy, kernels/modes.py); midspan (N,): phi_n(1/2); stations ((M + 1), N): phi_n at
     s_k = k / M, M = SPAN_STATIONS_PER_MODE N; coupling (N, N): A_ij / pi^2, A_ij = int phi_i'
     phi_j' ds (the span's elongation is (l k^2 / 2) q^T coupling q, k = pi / l: the uniform
-    stretching tension's); clamps (8, N): what the load observers watch per unit q_n
+    stretching tension's); clamps (10, N): what the load observers watch per unit q_n
     (`OBSERVED`): phi_n'' at both clamps and at midspan (the curvature times l^2), phi_n'''
-    and phi_n' at both clamps (the shear and the slope), then `inertia_row` (each mode's
-    share of a uniform load's reaction at the clamp). name: what the modes are; mode_text and
-    frequency_text: mode n and its frequency in words, for the dataset's long names."""
+    and phi_n' at both clamps (the shear and the slope), then `reaction_rows` (each mode's
+    share of a uniform load's reaction at the clamp, and of the axial load's). name: what
+    the modes are; mode_text and frequency_text: mode n and its frequency in words, for the
+    dataset's long names."""
 
     name: str
     shapes: np.ndarray
@@ -164,31 +165,48 @@ def observed_rows(shapes: np.ndarray) -> np.ndarray:
     return np.array([shape_values(shapes, np.array([s]), k)[:, 0] for k, s in OBSERVED])
 
 
-def inertia_row(shapes: np.ndarray, nodes: int) -> np.ndarray:
-    """Gamma_n int (1 - s) phi_n ds (Gamma_n = int phi_n / int phi_n^2; Gauss-Legendre on
-    `nodes` nodes): mode n's share of the reaction at the clamp s = 0 to a uniform load, per
-    unit load times l. Statically that reaction is 1/2; the modes' shares sum to 1/2 only as
-    N -> infinity, and the clamp observers add the rest (kernels.modes.span_loads: the
-    mode-acceleration correction, docs/model.md sec. 10.5). A span whose ends are alike has
-    the same shares at s = 1 (each mode has Gamma_n = 0 or is symmetric)."""
+def reaction_rows(shapes: np.ndarray, nodes: int) -> np.ndarray:
+    """The rows of Basis.clamps that make the clamp's reaction the span's equilibrium rather
+    than the modes' shear sum (Gauss-Legendre on `nodes` nodes; docs/model.md sec. 10.5),
+    (3, N):
+
+    - INERTIA: Gamma_n int (1 - s) phi_n ds (Gamma_n = int phi_n / int phi_n^2): mode n's
+      share of the reaction at the clamp s = 0 to a uniform load, per unit load times l.
+      Statically that reaction is 1/2; the modes' shares sum to 1/2 only as N -> infinity,
+      and the observers add the rest (kernels.modes.inertia_factor: mode acceleration);
+    - AXIAL_0, AXIAL_1: sum_m A_nm int (1 - s) phi_m / int phi_m^2 and -sum_m A_nm int s
+      phi_m / int phi_m^2 (A_nm = int phi_n' phi_m' ds): the axial load's (N - P) w_xx
+      reaction at s = 0 and 1 per unit q_n, as the modes kept carry it with the part they
+      leave out carried statically: phi_n'(0), phi_n'(1) where the axial load's field has no
+      part outside the modes (pinned sines); not 0 at a clamped end, where phi_n' is.
+
+    A span whose ends are alike has the same inertia share at s = 1 (each mode has
+    Gamma_n = 0 or is symmetric)."""
     x, w = np.polynomial.legendre.leggauss(nodes)
     s, w = (x + 1.0) / 2.0, w / 2.0
     phi = shape_values(shapes, s)
-    gamma = (phi @ w) / (phi ** 2 @ w)
-    return gamma * ((phi * (1.0 - s)) @ w)
+    slope = shape_values(shapes, s, 1)
+    mass = phi ** 2 @ w
+    gamma = (phi @ w) / mass
+    left = (phi * (1.0 - s)) @ w
+    right = (phi * s) @ w
+    axial = (slope * w) @ slope.T
+    return np.array([gamma * left, axial @ (left / mass), -axial @ (right / mass)])
 
 
 def _pinned_rows(n: int) -> np.ndarray:
-    """`observed_rows` and `inertia_row` of sin(n pi s) in closed form: phi'' = 0 at the
+    """`observed_rows` and `reaction_rows` of sin(n pi s) in closed form: phi'' = 0 at the
     clamps, -(n pi)^2 sin(n pi / 2) at midspan; phi''' = -(n pi)^3 cos(n pi s); phi' = n pi
     cos(n pi s); Gamma_n int (1 - s) phi_n = (4 / (n pi)) (1 / (n pi)) for odd n, 0 for even
-    (over the odd n they sum to (4 / pi^2) (pi^2 / 8) = 1/2)."""
+    (over the odd n they sum to (4 / pi^2) (pi^2 / 8) = 1/2); the axial rows are the slopes
+    (A is diagonal, (n pi)^2 / 2: A_nn (1 / (n pi)) / (1/2) = n pi)."""
     k = np.arange(1, n + 1) * math.pi
     sign = np.where(np.arange(1, n + 1) % 2 == 0, 1.0, -1.0)          # cos(n pi)
     mid = np.array([0.0 if i % 2 else (1.0 if (i // 2) % 2 == 0 else -1.0) for i in range(n)])
     zero = np.zeros(n)
     inertia = np.where(np.arange(1, n + 1) % 2 == 1, 4.0 / k ** 2, 0.0)
-    return np.array([zero, zero, -k ** 2 * mid, -k ** 3, -k ** 3 * sign, k, k * sign, inertia])
+    return np.array([zero, zero, -k ** 2 * mid, -k ** 3, -k ** 3 * sign, k, k * sign, inertia,
+                     k, k * sign])
 
 
 def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mode shape n",
@@ -219,7 +237,7 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     coupling = (slope * w) @ slope.T / math.pi ** 2
     return Basis(name=name, shapes=shapes, frequency_ratio=(shapes[:, 0] / math.pi) ** 2,
                  coupling=coupling,
-                 clamps=np.vstack([observed_rows(shapes), inertia_row(shapes, nodes)]),
+                 clamps=np.vstack([observed_rows(shapes), reaction_rows(shapes, nodes)]),
                  participation_ratio=gamma / (4.0 / math.pi),
                  tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations),
                  mode_text=mode_text, frequency_text=frequency_text)
@@ -365,7 +383,9 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     (the clamp's reaction, docs/model.md sec. 10.5); slope_square = int phi'^2 (the span's
     elongation is slope_square q^2 / (2 l)); inertia = 1/2 - gamma int (1 - s) phi (the share
     of a uniform load's reaction at a clamp that the one mode leaves out: kernels.modes
-    inertia_factor); mass =
+    inertia_factor) and axial_slope (the axial load's reaction at a clamp per unit q and
+    (N - P) / l: `reaction_rows`' AXIAL_0; pi for the pinned mode, where clamp_slope is 0
+    for the clamped one); mass =
     int phi^2 itself (not divided). By
     Gauss-Legendre on 4 x the basis' own nodes; pinned sines give -pi^2, -pi^4 / 4, 5 pi^6 /
     4, -pi^8 / 8, 3 pi^6 / 2, 9 pi^8 / 4, 4 / pi and pi."""
@@ -376,7 +396,7 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     mass = d[0] ** 2 @ w
     fine = np.linspace(0.0, 1.0, 4097)
     bend_0, _, bend_mid, shear_0, _, slope_0, _ = observed_rows(row)[:, 0]
-    gamma_share = (d[0] @ w / mass) * ((d[0] * (1.0 - s)) @ w)      # `inertia_row`'s
+    gamma_share, axial_slope, _ = reaction_rows(row, 4 * quadrature_nodes(1))[:, 0]
     return {
         "mass": float(mass),
         "beta": float(row[0, 0]),
@@ -395,6 +415,7 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
         "clamp_slope": float(abs(slope_0)),
         "slope_square": float(d[1] ** 2 @ w),
         "inertia": float(0.5 - gamma_share),
+        "axial_slope": float(axial_slope),
     }
 
 

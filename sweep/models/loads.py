@@ -4,16 +4,20 @@ tension and strain, and the largest strain of them all, each its peak over the t
 
 Several modes: from the multi-mode kernels' load observers (kernels/modal_driver.py: the
 curvature sum phi_n''(s) q_n at s = 0, 1, 1/2, the stretch E = q^T C q and the clamp shear
-F_e = sum phi_n'''(e) q_n - (kappa E - P(t) l^2 / EI) sum phi_n'(e) q_n, each's largest over
-the tail window).
-The clamp shear holds, beside the modes' part, the part of the base's inertia load that the
-modes kept leave out, r (rho A l^4 / EI) a_b(t) (r = 1/2 - sum_n Gamma_n int (1 - s) phi_n:
-the mode-acceleration correction, kernels.modes.inertia_factor); without it the reaction
-converges like 1/N and one mode misses 19 % (pinned) to 31 % (clamped) of a quasi-static one.
+F_e = sum phi_n'''(e) q_n - (kappa E - P(t) l^2 / EI) sum a_n(e) q_n +- r (rho A l^4 / EI)
+a_b(t), each's largest over the tail window).
+The clamp shear is the span's equilibrium: beside the modes' shear, the parts of the loads
+that the modes kept leave out go to the clamps as they would statically (the mode-acceleration
+correction, docs/model.md sec. 10.5): the base's inertia load's, r (rho A l^4 / EI) a_b(t)
+(r = 1/2 - sum_n Gamma_n int (1 - s) phi_n, kernels.modes.inertia_factor), and the axial
+load's, through a_n(e) (sweep.models.basis.reaction_rows: phi_n'(e) for pinned sines, not 0
+at a clamped end, where the tension's true shape bends over a boundary layer the modes do not
+hold). Without them the reaction converges like 1/N and one mode misses 19 % (pinned) to
+31 % (clamped) of a quasi-static one.
 One mode: every one of them but the shear grows with |q| (the curvatures as |q|, the stretch
 as q^2), so each peaks where q does and is the mode's integral times the tail amplitude
 (sweep.models.basis.one_mode_integrals). Its shear is F = -a q + c a_b(t) (a = |phi'''(0)| +
-(kappa E - P l^2 / EI) |phi'(0)|, of one sign below buckling; c the left-out inertia's
+(kappa E - P l^2 / EI) a_1(0), of one sign below buckling; c the left-out inertia's
 factor), which need not peak with q. Two estimates from the tail amplitude Q: the bound
 a Q + c A (A the base's peak level; |F| can never exceed it), and the steady harmonic crest,
 where q' = 0, q'' = -W^2 q and the mode's own equation gives a_b = (W^2 q - R(q)) / Gamma
@@ -191,7 +195,7 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
     # harmonic one it need not, and one mode's peak |q| cannot give it: NaN there
     load = derived(p["load_amplitude"] * p["length"] ** 2
                    / (p["youngs_modulus"] * p["inertia"]), coords)
-    a = ends["clamp_shear"] + (kappa * stretch - load) * ends["clamp_slope"]
+    a = ends["clamp_shear"] + (kappa * stretch - load) * ends["axial_slope"]
     l2 = p["length"] * p["length"]     # (not ** 4: pow may round differently by array length)
     c = ends["inertia"] * derived(p["density"] * p["area"] * (l2 * l2)
                                   / (p["youngs_modulus"] * p["inertia"]), coords)
