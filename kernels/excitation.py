@@ -86,14 +86,47 @@ def level(t, p, o, s):
     if t > p[o + END * s]:
         return 0.0
     u = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t
-    k = 0
-    while k + 1 < n and u >= p[o + (EDGE + k + 1) * s]:
-        k += 1
+    k = _segment(u, p, o, s, n)
     a = math.exp(p[o + (LOG_LEVEL + k) * s] + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
     ramp = p[o + RAMP * s]
     if t < ramp:
         a *= 0.5 - 0.5 * math.cos(math.pi * t / ramp)
     return a
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _segment(u, p, o, s, n):
+    """The level segment k (of n) that u = ln w holds: the last whose EDGE is <= u."""
+    k = 0
+    while k + 1 < n and u >= p[o + (EDGE + k + 1) * s]:
+        k += 1
+    return k
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def acceleration_and_rate(t, p, o, s):
+    """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the sine kinds: A' sin(phi) + A w(t) cos(phi), A'
+    = A SLOPE[k] lam on a level segment, plus the ramp's rise (for the loads' observers,
+    which need the rate where a load peaks: kernels.modal_driver.inertia_at)."""
+    phi = phase(t, p, o, s)
+    w = p[o + OMEGA * s] * math.exp(p[o + RATE * s] * t)
+    n = int(p[o + SEGMENTS * s])
+    if n == 0:
+        a = p[o + ACCEL * s]
+        return a * math.sin(phi), a * w * math.cos(phi)
+    if t > p[o + END * s]:
+        return 0.0, 0.0
+    u = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t
+    k = _segment(u, p, o, s, n)
+    a = math.exp(p[o + (LOG_LEVEL + k) * s] + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
+    rate = a * p[o + (SLOPE + k) * s] * p[o + RATE * s]
+    ramp = p[o + RAMP * s]
+    if t < ramp:
+        x = math.pi * t / ramp
+        rise = 0.5 - 0.5 * math.cos(x)
+        rate = rate * rise + a * 0.5 * math.pi / ramp * math.sin(x)
+        a *= rise
+    return a * math.sin(phi), rate * math.sin(phi) + a * w * math.cos(phi)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -132,6 +165,45 @@ def record_acceleration(t, p, o, s, records):
              + (3.0 * u2 - 2.0 * u3) * records[r, 0, k1]
              + (u3 - u2) * dt * records[r, 1, k1])
     return p[o + RECORD_SCALE * s] * value
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def record_and_rate(t, p, o, s, records):
+    """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the record kind: `record_acceleration` and the
+    time derivative of its cubic Hermite interpolant."""
+    n = records.shape[2]
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    x = t * fs
+    kf = math.floor(x)
+    u = x - kf
+    k = int(kf) % n
+    k1 = k + 1 if k + 1 < n else 0
+    dt = 1.0 / fs
+    u2 = u * u
+    u3 = u2 * u
+    y0, d0, y1, d1 = records[r, 0, k], records[r, 1, k], records[r, 0, k1], records[r, 1, k1]
+    value = ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
+             + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
+    slope = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * dt * d0
+             + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) * fs
+    scale = p[o + RECORD_SCALE * s]
+    return scale * value, scale * slope
+
+
+def signal_and_rate(t, p, o, s, base):
+    """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the excitation block for the scene's `base` switch,
+    as `signal` chooses."""
+    if isinstance(base, np.ndarray):
+        return record_and_rate(t, p, o, s, base)
+    return acceleration_and_rate(t, p, o, s)
+
+
+@overload(signal_and_rate)
+def _signal_and_rate(t, p, o, s, base):
+    if isinstance(base, types.Array):
+        return lambda t, p, o, s, base: record_and_rate(t, p, o, s, base)
+    return lambda t, p, o, s, base: acceleration_and_rate(t, p, o, s)
 
 
 def signal(t, p, o, s, base):

@@ -242,34 +242,18 @@ def inertia_slot(n_modes):
     return 3 * n_modes + 19
 
 
-INERTIA_DIFFERENCE = 1e-4
-"""The central difference of a_b's rate in `inertia_at`, as a fraction of the step: its
-truncation error (1e-4 h)^2 / 6 of a_b''' / a_b', its round-off 1e-16 / (1e-4 h w), both far
-below the bisection's needs (the rate's sign near a load's maximum)."""
-
-
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def inertia_at(factor, t, h, p1, base):
+def inertia_at(factor, t, p1, base):
     """(inertia, its rate) (m, m/s) for kernels.modes.span_loads at t (s): `factor` (the
-    accumulator's, kernels.modes.inertia_factor, s^2) times a_b(t) of the Observer row p1
-    (`observer_row`: the base excitation block, any kind), the rate by a central difference
-    over INERTIA_DIFFERENCE x h (h, s: the step the observation lies in). (0, 0) without base
-    excitation."""
+    accumulator's, kernels.modes.inertia_factor, s^2) times a_b(t) and a_b'(t) of the
+    Observer row p1 (`observer_row`: the base excitation block, any kind;
+    kernels.excitation.signal_and_rate). (0, 0) without base excitation."""
     if base is None:
         return 0.0, 0.0
     if factor == 0.0:
         return 0.0, 0.0
-    d = INERTIA_DIFFERENCE * h
-    a = _base_signal(t, p1, base)
-    rate = (_base_signal(t + d, p1, base) - _base_signal(t - d, p1, base)) / (2.0 * d)
+    a, rate = ex.signal_and_rate(t, p1, osc.EXCITATION, 1, base)
     return factor * a, factor * rate
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def _base_signal(t, p1, base):
-    """a_b(t) (m/s^2) of the Observer row p1 (a call of its own: kernels.excitation.signal
-    inlined three times into one function trips Numba's IR checks)."""
-    return ex.signal(t, p1, osc.EXCITATION, 1, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -572,7 +556,7 @@ def _loads_at(t, y, h, QA, x, n, basis, modal, qv, out, p1, base):
         qv[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
         qv[n + c] = dopri5.dense_value(y[n + c], h, QA[c, 1], x)
     load, rate = end_load_at(modal, n, t + x * h)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t + x * h, h, p1, base)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t + x * h, p1, base)
     md.span_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n,
                   modal[factor_slot(n)], load, rate, inertia, inertia_rate, out)
 
@@ -602,11 +586,11 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
     b = qx[3 * n + 6:3 * n + 12]
     m = qx[3 * n + 12:3 * n + 18]
     load, rate = end_load_at(modal, n, t)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t, h, p1, base)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t, p1, base)
     md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, inertia,
                   inertia_rate, a)
     load, rate = end_load_at(modal, n, t_new)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t_new, h, p1, base)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t_new, p1, base)
     md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, load, rate,
                   inertia, inertia_rate, b)
     inside = t < t_tail
@@ -813,7 +797,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     modal[inertia_slot(n)] = md.inertia_factor(row, n, curvature) if base is not None else 0.0
     loads = np.empty(6)
     load, rate = end_load_at(modal, n, 0.0)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], 0.0, h_abs, p1, base)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], 0.0, p1, base)
     md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, inertia,
                   inertia_rate, loads)
     for k in range(3):

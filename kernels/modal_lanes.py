@@ -287,13 +287,13 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
         load, rate = _end_load(MOD, n, l, W[tj.T * L + l])
-        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T * L + l], H[l],
-                                               P1L[l], base)
+        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T * L + l], P1L[l],
+                                               base)
         md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
                       inertia_rate, a)
         load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
-        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], H[l],
-                                               P1L[l], base)
+        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], P1L[l],
+                                               base)
         md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
                       inertia_rate, b)
         for k in range(3):
@@ -358,14 +358,14 @@ def _end_load(MOD, n, l, t):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _tail_modes(W, YN, H, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
     same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
     their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
-    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; H, P1L:
-    the steps and Observer rows, modal_driver.inertia_at's). base: the excitation switch
+    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
+    the Observer rows, modal_driver.inertia_at's). base: the excitation switch
     (excitation.by_kind, `_sine_tail_modes`)."""
     L = LANES
     for i in range(n):
@@ -396,8 +396,8 @@ def _tail_modes(W, YN, H, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
         if not take:
             continue
         load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
-        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], H[l],
-                                               P1L[l], base)
+        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], P1L[l],
+                                               base)
         md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
                       inertia_rate, b)
         for k in range(3):
@@ -697,7 +697,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                           basis[md.COUPLING], LD, P1L, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _sine_tail_modes(W, YN, H, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
+        _sine_tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
                          basis[md.COUPLING], LD, P1L, base)
         if base is not None:
             _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema
