@@ -468,6 +468,8 @@ def span_ends(stiffness: Any) -> dict[str, Any]:
     values = np.asarray(stiffness, float)
     unique, where = np.unique(values, return_inverse=True)
     tables = [_ends_of(float(k)) for k in unique]
+    if not tables:                        # no points (a caller sizing its rows): empty columns
+        return {name: np.empty(values.shape) for name in _ends_of(0.0)}
     out = {}
     for name in tables[0]:
         column = np.array([t[name] for t in tables])[where].reshape(values.shape)
