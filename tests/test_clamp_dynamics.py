@@ -181,7 +181,7 @@ def test_the_clamped_span_and_its_clamp_bending_match_scipy(modes, ratio):
 def _check_loads(ds, peaks: dict[str, float], modes: int = 3) -> None:
     """The span's loads against SciPy's peaks (`_scipy_peaks`), to 1e-6: the midspan bending
     strain (d / 2 the solid section's), the stretching tension and strain, the clamp's
-    reaction (one mode, from its steady crest: within 5e-3 of the peak in time, which the
+    reaction (one mode, from its steady phase: within 5e-3 of the peak in time, which the
     nonlinear span's harmonics move, and never above the bound of its two parts' peaks
     added), and max_strain from its parts."""
     d = math.sqrt(4 * 6e-6 / math.pi)
@@ -346,7 +346,7 @@ def test_the_clamp_reaction_holds_the_end_load_part(modes, kind):
     span (clamps.axial_stiffness = 0, a base level of 1e-5 g: the cubic terms are 1e-10 of
     the linear ones) against SciPy's DOP853 on the sines' linear Galerkin equations with the
     load's P(t) A q, M, A and G by quadrature here, and the base inertia the modes leave out
-    (galerkin.reaction_left_out; one mode from its steady crest, to 1e-3, never above the
+    (galerkin.reaction_left_out; one mode from its steady phase, to 1e-3, never above the
     bound of the two parts' peaks added). (For sines the axial part is -P w_x itself.)"""
     from scipy.integrate import solve_ivp
     p0, load_hz, level, ratio, t_end = 7.8, 7.0, 1e-5 * 9.80665, 0.8, 3.0
@@ -403,7 +403,7 @@ def test_the_clamp_reaction_holds_the_end_load_part(modes, kind):
 
     expected = peak(1.0)
     assert abs(expected / peak(1.0, 0.0) - 1.0) > 0.05      # the end load's part shows
-    if modes == 1:            # from the steady crest (sweep.models.loads), within the bound
+    if modes == 1:            # from the steady phase (sweep.models.loads), within the bound
         assert _one(ds, "clamp_force") <= (peak(0.0) + left_out * level) * (1.0 + 1e-9)
         assert _one(ds, "clamp_force") == pytest.approx(expected, rel=1e-3)
     else:

@@ -76,18 +76,6 @@ def table_level(levels_g: Sequence[Sequence[float]], frequency: Any) -> Any:
     return (values * STANDARD_GRAVITY)[()]
 
 
-def peak_level(levels_g: Sequence[Sequence[float]], start: Any, stop: Any) -> Any:
-    """The largest level (m/s^2 peak) of a table of (Hz, g) breakpoints over a sweep between
-    start and stop (Hz): at an end or at a breakpoint between them (log-log interpolation
-    has no maximum inside a segment); element-wise, DataArrays kept."""
-    low, high = np.minimum(start, stop), np.maximum(start, stop)
-    peak = np.maximum(table_level(levels_g, low), table_level(levels_g, high))
-    for f, g in levels_g:
-        inside = (low <= f) & (f <= high)
-        peak = np.maximum(peak, np.where(inside, g * STANDARD_GRAVITY, 0.0))
-    return peak
-
-
 def block(accel: Any, omega: Any, rate: Any = 0.0, end: Any = math.inf,
           levels_g: Sequence[Sequence[float]] | None = None, ramp: Any = 0.0) -> dict[str, Any]:
     """kernels.excitation's columns by name (its NAMES): constant level accel (m/s^2) or, with

@@ -18,16 +18,18 @@ One mode: every one of them but the shear grows with |q| (the curvatures as |q|,
 as q^2), so each peaks where q does and is the mode's integral times the tail amplitude
 (sweep.models.basis.one_mode_integrals). Its shear is F = -a q + c a_b(t) (a = |phi'''(0)| +
 (kappa E - P l^2 / EI) a_1(0), of one sign below buckling; c the left-out inertia's
-factor), which need not peak with q. Two estimates from the tail amplitude Q: the bound
-a Q + c A (A the base's peak level; |F| can never exceed it), and the steady harmonic crest,
-where q' = 0, q'' = -W^2 q and the mode's own equation gives a_b = (W^2 q - R(q)) / Gamma
-(R(q) = k0 q + g0 q^3 + h q^5, its restoring force), with the damping's quadrature part:
-Q sqrt((a + c (R(Q)/Q - W^2) / Gamma)^2 + (c d W / Gamma)^2) (d = 2 zeta w1, W the base's
-angular frequency, a sweep's where q peaked). The smaller of the two: the crest below, at and
-above resonance in a steady response (a linear span's exactly), the bound where the crest
-would exceed it. Two modes or more follow F in time. A random record (no one frequency or
-peak level) and a harmonic end load (whose -P(t) w_x need not peak with q) give one mode none
-(NaN).
+factor), which need not peak with q. In a steady response q lags the base's a_b = A sin(W t)
+by theta, and the damping's work per cycle gives sin(theta) = d W Q / (Gamma A) (d = 2 zeta
+w1, Gamma the participation, Q the tail amplitude; the mode's equation q'' + d q' + R(q) =
+-Gamma a_b, R = k0 q + g0 q^3 + h q^5): then max |F| = sqrt((a Q + c A cos(theta))^2 +
+(c A sin(theta))^2), cos(theta) > 0 below the span's resonance at that amplitude (W^2 <
+R(Q)/Q: the two parts in phase, their peaks added) and < 0 above it (opposed). W, A: the
+base's angular frequency and level (a sweep's where q peaked). Exact for a linear span in
+steady state; never above the bound a Q + c A. A sweep whose level table rises far above the
+level at resonance (tens of g at several f1) can peak where q is small and the inertia carries
+the reaction, which one mode misses. Two modes or more follow F in time. A random record (no
+one frequency or level) and a harmonic end load (whose -P(t) w_x need not peak with q) give
+one mode none (NaN).
 
 In SI, l the length, EI the bending and EA the axial stiffness, d the cable's outer diameter:
 curvature kappa = c / l^2 (c the observed curvature sum), strain (d / 2) kappa, moment EI kappa;
@@ -109,9 +111,10 @@ OUTPUTS = (
     Output("clamp_force", "N", "transverse reaction at the clamp: max |V| at either clamp over "
            "the tail window, V = -EI w_xxx + (N - P) w_x (the shear, the stretching "
            "tension's transverse part and the end load's, P compression positive; without "
-           "model.membrane's local term), with the base inertia the modes kept leave out "
-           "carried to the clamps as statically (mode acceleration); one mode: from its "
-           "steady harmonic crest, at most the bound of its two parts' peaks added (NaN "
+           "model.membrane's local term), by the span's equilibrium: the parts of the base's "
+           "inertia and of the axial load that the modes kept leave out carried to the clamps "
+           "as statically (mode acceleration); one mode: from its "
+           "steady response's phase, at most the bound of its two parts' peaks added (NaN "
            "under a random record or a harmonic end load)",
            lambda p, s: s.bending * p.shear / s.length ** 3),
     Output("axial_tension", "N", "stretching tension of the span: its largest N = k_s e over "
@@ -163,8 +166,8 @@ def observation(scene: Any, swept: bool) -> float:
 
 class OneMode(NamedTuple):
     """What one mode's clamp shear needs beside its tail amplitude (module docstring), each a
-    number or a DataArray over the grid: the base's peak level A (m/s^2; NaN for a random
-    record), its angular frequency W (rad/s; a sweep's where q peaked), the mode's equation
+    number or a DataArray over the grid: the base's level A (m/s^2; NaN for a random record)
+    and angular frequency W (rad/s), both a sweep's where q peaked, the mode's equation
     q'' + d q' + k0 q + g0 q^3 + h q^5 = -Gamma a_b (d, 1/s; k0, 1/s^2; g0, 1/(s^2 m^2); h,
     1/(s^2 m^4); Gamma, 1)."""
     level: Any
@@ -199,14 +202,16 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
     l2 = p["length"] * p["length"]     # (not ** 4: pow may round differently by array length)
     c = ends["inertia"] * derived(p["density"] * p["area"] * (l2 * l2)
                                   / (p["youngs_modulus"] * p["inertia"]), coords)
-    bound = abs(a * q) + c * mode.level
+    modes_part, inertia_part = abs(a * q), c * mode.level
     with np.errstate(divide="ignore", invalid="ignore"):
         q2 = q * q
         restoring = mode.k0 + (mode.g0 + mode.h * q2) * q2              # R(Q) / Q
         w2 = mode.omega * mode.omega
-        crest = q * np.sqrt((a + c * (restoring - w2) / mode.participation) ** 2
-                            + (c * mode.damping * mode.omega / mode.participation) ** 2)
-    shear = xr.where(np.isfinite(crest), np.minimum(bound, crest), bound)
+        lag = np.minimum(mode.damping * mode.omega * q / abs(mode.participation * mode.level),
+                         1.0)                                           # sin(theta)
+        lead = np.sqrt(1.0 - lag * lag) * xr.where(w2 > restoring, -1.0, 1.0)   # cos(theta)
+        shear = np.sqrt((modes_part + inertia_part * lead) ** 2 + (inertia_part * lag) ** 2)
+    shear = xr.where(inertia_part == 0.0, modes_part, shear)
     if p.get("load_type") == "harmonic":
         shear = shear.where(load == 0.0)
     return Peaks(q * ends["clamp_curvature"], q * ends["midspan_curvature"], stretch, shear)

@@ -396,21 +396,19 @@ def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
 def _one_mode(inputs: Any, coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
               reals: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...]
               ) -> loads.OneMode:
-    """What one mode's clamp reaction needs (sweep.models.loads.OneMode): the base's largest
-    |a_b| over a run (m/s^2: the level, a fixed frequency's from a table there, a swept
-    table's largest over the sweep; 0 without base excitation) and its angular frequency
-    (a sweep's where q peaked), the mode's equation's coefficients; NaN level and frequency
-    for a random record."""
+    """What one mode's clamp reaction needs (sweep.models.loads.OneMode): the base's level and
+    angular frequency where the response peaked (a fixed frequency's; a sweep's where q
+    peaked, its level table read there), the mode's equation's coefficients; NaN level and
+    frequency for a random record (no one of either)."""
     p = inputs.params
     levels = p.get("base_levels_g")
     if inputs.random is not None:
         level = omega = math.nan
     elif inputs.swept:
-        level = (derived(excitation.peak_level(levels, p["base_sweep_start"],
-                                               p["base_sweep_stop"]), coords)
-                 if levels is not None else derived(coeffs["base_accel"], coords))
-        omega = 2.0 * math.pi * xr.DataArray(reals[:, tk.PEAK_FREQUENCY].reshape(shape),
-                                             dims=dims)
+        hertz = xr.DataArray(reals[:, tk.PEAK_FREQUENCY].reshape(shape), dims=dims)
+        omega = 2.0 * math.pi * hertz
+        level = (excitation.table_level(levels, hertz) if levels is not None
+                 else derived(coeffs["base_accel"], coords))
     else:
         level = derived(coeffs["base_accel"], coords)
         omega = derived(coeffs["base_omega"], coords)
