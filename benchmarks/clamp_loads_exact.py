@@ -10,8 +10,8 @@ elastic clamps (rotational stiffness --stiffness N m/rad), each with
 model.modes = 1, 3, 5 and 7 through the public API (`sweep.run`, the scene's own modal
 drivers). Each output is its peak over the tail window; the reference is the exact
 steady-state of the Euler-Bernoulli beam under a uniform base acceleration, undamped
-(w = particular + cosh, sinh, cos, sin terms, the four end conditions solved here as a
-4 x 4 system): midspan deflection |w(l/2)|, clamp moment |EI w''(0)| and transverse reaction
+(w = particular + cosh, sinh, cos, sin terms, the four end conditions solved as a
+4 x 4 system in tests/exact_beam.py, which the tests share): midspan deflection |w(l/2)|, clamp moment |EI w''(0)| and transverse reaction
 |EI w'''(0)| (no stretching, no end load: V = -EI w'''). The Galerkin answer converges to it
 with the modes; this table shows how fast, so that a user can choose model.modes (or run
 `sweep modes`). The damping (0.5 % of critical) moves the exact values by about 1e-4 at
@@ -33,9 +33,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-import numpy as np  # noqa: E402
-from scipy.optimize import brentq  # noqa: E402
+import exact_beam  # noqa: E402
 
 from bench_common import machine, markdown_table  # noqa: E402
 
@@ -55,84 +55,20 @@ def _cases(stiffness: float) -> list[tuple[str, dict]]:
                                                "clamps.rotational_stiffness": stiffness})]
 
 
-def _boundary_rows(b: float, l: float, k_end: float | None) -> np.ndarray:
-    """4 x 4: rows of the end conditions on (C1 cosh bx, C2 sinh bx, C3 cos bx, C4 sin bx)
-    (k_end None: clamped (w' = 0); 0: pinned (w'' = 0); else EI w'' = +-k w')."""
-    def value(x):
-        return [np.cosh(b * x), np.sinh(b * x), np.cos(b * x), np.sin(b * x)]
-
-    def slope(x):
-        return [b * np.sinh(b * x), b * np.cosh(b * x), -b * np.sin(b * x), b * np.cos(b * x)]
-
-    def curve(x):
-        return [b * b * np.cosh(b * x), b * b * np.sinh(b * x), -b * b * np.cos(b * x),
-                -b * b * np.sin(b * x)]
-
-    rows = [value(0.0), value(l)]
-    for x, sign in ((0.0, 1.0), (l, -1.0)):
-        if k_end is None:
-            rows.append(slope(x))
-        else:       # EI w'' - sign k w' = 0
-            rows.append([BENDING * c - sign * k_end * s for c, s in zip(curve(x), slope(x))])
-    return np.array(rows)
-
-
 def exact(omega: float, l: float, k_end: float | None) -> tuple[float, float, float]:
     """(|w(l/2)|, |EI w''(0)|, |EI w'''(0)|) of the undamped beam's steady state under a base
-    acceleration of amplitude G_LEVEL g at omega (rad/s): w = A / omega^2 + homogeneous part,
-    A the acceleration (rho A w'' + EI w'''' = -rho A a_b, w the deflection relative to the
-    clamps)."""
-    b = (LINEAR_MASS * omega * omega / BENDING) ** 0.25
-    particular = G_LEVEL * G0 / omega ** 2
-    rows = _boundary_rows(b, l, k_end)
-    rhs = np.array([-particular, -particular, 0.0, 0.0])
-    c = np.linalg.solve(rows, rhs)
-    mid = (c[0] * np.cosh(b * l / 2) + c[1] * np.sinh(b * l / 2) + c[2] * np.cos(b * l / 2)
-           + c[3] * np.sin(b * l / 2) + particular)
-    curve0 = b * b * (c[0] - c[2])
-    third0 = b ** 3 * (c[1] - c[3])
-    return abs(mid), abs(BENDING * curve0), abs(BENDING * third0)
+    acceleration of amplitude G_LEVEL g at omega (rad/s) (tests/exact_beam.py: the closed
+    form, written independently of the tool)."""
+    return exact_beam.steady_loads(omega, G_LEVEL * G0, l, LINEAR_MASS, BENDING, k_end)
 
 
 def first_frequency(l: float, k_end: float | None) -> float:
-    """The exact first natural frequency (rad/s): the smallest b with a singular
-    `_boundary_rows` (a sign change of its determinant)."""
-    def det(b):
-        return np.linalg.det(_boundary_rows(b / l, l, k_end))
-
-    grid = np.linspace(2.0, 5.0, 3001)
-    values = [det(b) for b in grid]
-    for b0, b1, d0, d1 in zip(grid[:-1], grid[1:], values[:-1], values[1:]):
-        if d0 * d1 < 0.0:
-            bl = brentq(det, b0, b1, xtol=1e-14)
-            return (bl / l) ** 2 * np.sqrt(BENDING / LINEAR_MASS)
-    raise RuntimeError("no first eigenvalue in 2 < b l < 5")
+    """The exact first natural frequency (rad/s) (tests/exact_beam.py)."""
+    return exact_beam.first_frequency(l, LINEAR_MASS, BENDING, k_end)
 
 
-SCENE = """
-name = "clamp-loads-exact"
-[model]
-kind = "transverse"
-coefficients = "consistent"
-[cable]
-linear_mass = "53.4 g/m"
-bending_rigidity = "0.31515 N m^2"
-axial_rigidity = "660 kN"
-diameter = "2.76395 mm"
-damping_ratio = 0.005
-[clamps]
-axial_stiffness = 0.0
-[base]
-acceleration_g = 0.1
-[metrics]
-tail = 0.2
-[initial]
-displacement = 0.0
-velocity = 0.0
-[axes]
-length = [0.3]
-base_frequency_ratio = [1.0]
-"""
+SCENE = exact_beam.BUNDLE_SCENE
+"""The linear bundle span (tests/exact_beam.py), its axes set per run."""
 
 
 def tool(l: float, over: dict, modes: int, ratios: list[float], t_end: float):

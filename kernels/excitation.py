@@ -143,51 +143,48 @@ def frequency(t, p, o, s):
     return p[o + OMEGA * s] / (2.0 * math.pi) * math.exp(p[o + RATE * s] * t)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _record_interval(t, p, o, s, records):
+    """The sample interval of the record kind's row at time t (s): its two samples and their
+    derivatives (y0, d0, y1, d1), the fraction u of the interval, its length dt = 1 / fs (s)
+    and the level factor (`record_acceleration`)."""
+    n = records.shape[2]
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    x = t * fs
+    kf = math.floor(x)
+    u = x - kf
+    k = int(kf) % n
+    k1 = k + 1 if k + 1 < n else 0
+    return (records[r, 0, k], records[r, 1, k], records[r, 0, k1], records[r, 1, k1], u,
+            1.0 / fs, p[o + RECORD_SCALE * s])
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def record_acceleration(t, p, o, s, records):
     """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
     at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
     fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
     p[o + RECORD_SCALE * s]."""
-    n = records.shape[2]
-    r = int(p[o + RECORD * s])
-    fs = p[o + RECORD_RATE * s]
-    x = t * fs
-    kf = math.floor(x)
-    u = x - kf
-    k = int(kf) % n
-    k1 = k + 1 if k + 1 < n else 0
-    dt = 1.0 / fs
+    y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
     u2 = u * u
     u3 = u2 * u
-    value = ((2.0 * u3 - 3.0 * u2 + 1.0) * records[r, 0, k]
-             + (u3 - 2.0 * u2 + u) * dt * records[r, 1, k]
-             + (3.0 * u2 - 2.0 * u3) * records[r, 0, k1]
-             + (u3 - u2) * dt * records[r, 1, k1])
-    return p[o + RECORD_SCALE * s] * value
+    value = ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
+             + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
+    return scale * value
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def record_and_rate(t, p, o, s, records):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the record kind: `record_acceleration` and the
     time derivative of its cubic Hermite interpolant."""
-    n = records.shape[2]
-    r = int(p[o + RECORD * s])
-    fs = p[o + RECORD_RATE * s]
-    x = t * fs
-    kf = math.floor(x)
-    u = x - kf
-    k = int(kf) % n
-    k1 = k + 1 if k + 1 < n else 0
-    dt = 1.0 / fs
+    y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
     u2 = u * u
     u3 = u2 * u
-    y0, d0, y1, d1 = records[r, 0, k], records[r, 1, k], records[r, 0, k1], records[r, 1, k1]
     value = ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
              + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
     slope = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * dt * d0
-             + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) * fs
-    scale = p[o + RECORD_SCALE * s]
+             + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) / dt
     return scale * value, scale * slope
 
 

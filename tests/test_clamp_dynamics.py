@@ -422,30 +422,6 @@ def test_one_mode_under_a_harmonic_end_load_reports_no_clamp_force():
     assert np.isfinite(force[0]) and np.isnan(force[1])
 
 
-EXACT_SCENE = """
-name = "clamp-loads-exact"
-[model]
-kind = "transverse"
-coefficients = "consistent"
-[cable]
-linear_mass = "53.4 g/m"
-bending_rigidity = "0.31515 N m^2"
-axial_rigidity = "660 kN"
-diameter = "2.76395 mm"
-damping_ratio = 0.005
-[clamps]
-axial_stiffness = 0.0
-[base]
-acceleration_g = 0.1
-[metrics]
-tail = 0.2
-[initial]
-displacement = 0.0
-velocity = 0.0
-[axes]
-length = [0.3]
-base_frequency_ratio = [0.3, 0.7, 1.4]
-"""
 
 
 @pytest.mark.parametrize("modes", [1, 3])
@@ -459,13 +435,13 @@ def test_the_clamp_reaction_is_the_continuous_beams(rotation, modes):
     shear sum alone (without the base inertia the modes leave out) is 6-80 % off here, and
     converges like 1/N. The damping (0.5 %) moves the exact values by about 1e-4 at these ratios; the
     run is 15 / (zeta w1) long, its tail the last 20 %."""
-    from exact_beam import first_frequency, steady_loads
+    from exact_beam import BUNDLE_SCENE, first_frequency, steady_loads
     k_end = {"pinned": 0.0, "clamped": None, "elastic": 0.1}[rotation]
     over = {"clamps.rotation": rotation}
     if rotation == "elastic":
         over["clamps.rotational_stiffness"] = 0.1
     w1 = first_frequency(0.3, 0.0534, 0.31515, k_end)
-    ds = sweep.run(sweep.load_scene_text(EXACT_SCENE, overrides={
+    ds = sweep.run(sweep.load_scene_text(BUNDLE_SCENE, overrides={
         **over, "model.modes": modes, "solver.t_end": 15.0 / (0.005 * w1),
         "run.threads": 1}), progress=False)
     for ratio in (0.3, 0.7, 1.4):
