@@ -14,8 +14,9 @@ steady-state of the Euler-Bernoulli beam under a uniform base acceleration, unda
 4 x 4 system in tests/exact_beam.py, which the tests share): midspan deflection |w(l/2)|,
 clamp moment |EI w''(0)| and transverse reaction |EI w'''(0)| (no stretching, no end load:
 V = -EI w'''). The Galerkin answer converges to it with the modes; this table shows how
-fast, so that a user can choose model.modes (or run `sweep modes`). The damping (0.5 % of critical) moves the exact values by about 1e-4 at
-these ratios, which stay clear of each excited mode's resonance.
+fast, so that a user can choose model.modes (or run `sweep modes`). The damping (0.5 % of
+critical) moves the exact values by about 1e-4 at these ratios, which stay clear of each
+excited mode's resonance.
 
 Command
 -------
