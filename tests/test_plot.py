@@ -588,3 +588,21 @@ def test_a_shortened_axis_label_keeps_its_ratio_symbol():
         "units": "1", "long_name": "base excitation frequency over the unloaded span's first "
                                    "natural frequency, f/f1"})
     assert label(da) == "base frequency ratio, f/f1"
+
+
+def test_a_stepped_sweeps_hint_never_asks_to_fix_its_stepped_axis():
+    """A result with one axis too many for a figure names values to select; a stepped sweep's
+    hint must not name its continuation axis (fixing it leaves no branch to draw), which it
+    did where that axis came last (a reviewer's length x clamp stiffness x frequency)."""
+    dims = ("length", "clamp_rotational_stiffness", "base_frequency_ratio")
+    ds = xr.Dataset({"amplitude": (dims, np.ones((2, 2, 3))),
+                     "state": (dims, np.zeros((2, 2, 3), dtype="i1"),
+                               {"flag_values": np.array([0], dtype="i1"),
+                                "flag_meanings": "steady"})},
+                    coords={"length": [0.3, 0.4], "clamp_rotational_stiffness": [1.0, 100.0],
+                            "base_frequency_ratio": [0.8, 1.0, 1.2]},
+                    attrs={"continuation_axis": "base_frequency_ratio"})
+    with pytest.raises(sweep.errors.UserError) as info:
+        splot.select_points(ds)
+    assert "--select clamp_rotational_stiffness=1" in str(info.value)
+    assert "--select base_frequency_ratio" not in str(info.value)

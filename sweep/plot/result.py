@@ -558,7 +558,9 @@ def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr
     ds = ds.isel(single)
     axes = [d for d in axes if d not in single]
     if len(axes) > 2:
-        extra = axes[2:]
+        stepped = ds.attrs.get("continuation_axis")    # a stepped sweep's: never the one to fix
+        others = [d for d in axes if d != stepped]
+        extra = others[len(others) - (len(axes) - 2):]
         example = " ".join(f"--select {d}={float(ds[d].values[0]):g}" for d in extra)
         raise UserError(f"the result has {len(axes)} swept axes ({', '.join(axes)}): pick "
                         f"the values of all but two to plot, e.g. {example} (select= in "
