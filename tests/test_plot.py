@@ -545,6 +545,17 @@ def test_a_level_in_db_is_labelled_db_though_its_cf_units_are_one():
     assert label(ratio) == "ratio"
 
 
+@pytest.mark.parametrize("values, log", [([0.5, 7.88, 100.0], True), ([1.0, 50.0, 99.0], False),
+                                         ([1.0, 2.0, 4.0, 8.0], True), ([1.0, 2.0, 3.0], False),
+                                         ([0.01, 100.0], True), ([1.0, 5.0], False)])
+def test_an_axis_over_decades_is_drawn_log(values, log):
+    """A coordinate is drawn on a log axis when geometric, or, not arithmetic, spanning two
+    decades (a reviewer's clamp stiffnesses 0.5, 7.88, 100 N m/rad: the first two cells were
+    slivers on a linear axis), or two values a decade apart; else linear."""
+    from sweep.plot.style import _is_log_spaced
+    assert _is_log_spaced(np.array(values)) is log
+
+
 def test_the_span_loads_get_a_strain_figure_and_two_stiffnesses_decades_apart_a_log_axis():
     """A span that reports its loads gets 'max_strain' (the quantity `sweep design
     --max-strain` limits; harness-clamps had no strain figure), and an axis of two clamp

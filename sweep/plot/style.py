@@ -172,8 +172,10 @@ def _new_axes(figsize: tuple[float, float] = (6.4, 4.8)) -> Axes:
 
 def _is_log_spaced(values: np.ndarray) -> bool:
     """Whether a coordinate is drawn on a log axis: three or more positive values in a
-    geometric (not an arithmetic) progression, or two positive values a decade or more apart
-    (a linear axis put their cells' edges below zero: k_t = 0.01 and 100 N m/rad)."""
+    geometric (not an arithmetic) progression or, not arithmetic, spanning two decades or more
+    (k_t = 0.5, 7.88, 100 N m/rad: a linear axis left the first two cells slivers), or two
+    positive values a decade or more apart (a linear axis put their cells' edges below zero:
+    k_t = 0.01 and 100 N m/rad)."""
     v = np.asarray(values, dtype=float)
     if v.size == 2 and np.all(v > 0):
         return bool(max(v) >= 10.0 * min(v))
@@ -182,6 +184,8 @@ def _is_log_spaced(values: np.ndarray) -> bool:
     d = np.diff(v)
     if np.allclose(d, d[0], rtol=1e-6):
         return False
+    if max(v) >= 100.0 * min(v):
+        return True
     r = v[1:] / v[:-1]
     return bool(np.allclose(r, r[0], rtol=1e-6))
 
