@@ -160,6 +160,16 @@ def _record_interval(t, p, o, s, records):
             1.0 / fs, p[o + RECORD_SCALE * s])
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _hermite(y0, d0, y1, d1, u, dt):
+    """The cubic Hermite interpolant through (y0, d0) and (y1, d1) at the fraction u of an
+    interval dt (s) long."""
+    u2 = u * u
+    u3 = u2 * u
+    return ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
+            + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def record_acceleration(t, p, o, s, records):
     """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
@@ -167,11 +177,7 @@ def record_acceleration(t, p, o, s, records):
     fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
     p[o + RECORD_SCALE * s]."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
-    u2 = u * u
-    u3 = u2 * u
-    value = ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
-             + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
-    return scale * value
+    return scale * _hermite(y0, d0, y1, d1, u, dt)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -180,12 +186,9 @@ def record_and_rate(t, p, o, s, records):
     time derivative of its cubic Hermite interpolant."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
     u2 = u * u
-    u3 = u2 * u
-    value = ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
-             + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
     slope = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * dt * d0
              + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) / dt
-    return scale * value, scale * slope
+    return scale * _hermite(y0, d0, y1, d1, u, dt), scale * slope
 
 
 def signal_and_rate(t, p, o, s, base):

@@ -263,6 +263,18 @@ def end_load_at(modal, n_modes, t):
     return md.end_load(modal[s], modal[s + 1], modal[s + 2], modal[s + 3], t)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def state_loads(rows, coupling, q, v, n_modes, modal, t, p1, base, out):
+    """kernels.modes.span_loads of the modes' state (q, v) at t (s), its shear factor, end load
+    and base inertia read from the modes' accumulator `modal` (`modal_size`; a lane's column
+    in the lanes driver) and the Observer row p1 (`inertia_at`): what every load observer of
+    both multi-mode drivers calls. rows, coupling: the basis' CLAMPS and COUPLING."""
+    load, rate = end_load_at(modal, n_modes, t)
+    inertia, inertia_rate = inertia_at(modal[inertia_slot(n_modes)], t, p1, base)
+    md.span_loads(rows, coupling, q, v, n_modes, modal[factor_slot(n_modes)], load, rate,
+                  inertia, inertia_rate, out)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def square_slot(n_modes):
     """The first of the six curvature-square integrals of the modes' accumulator
@@ -555,10 +567,8 @@ def _loads_at(t, y, h, QA, x, n, basis, modal, qv, out, p1, base):
     for c in range(n):
         qv[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
         qv[n + c] = dopri5.dense_value(y[n + c], h, QA[c, 1], x)
-    load, rate = end_load_at(modal, n, t + x * h)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t + x * h, p1, base)
-    md.span_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n,
-                  modal[factor_slot(n)], load, rate, inertia, inertia_rate, out)
+    state_loads(basis[md.CLAMPS], basis[md.COUPLING], qv[:n], qv[n:], n, modal, t + x * h, p1,
+                base, out)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -574,25 +584,18 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
     """The largest stretch E and clamp shears |F_0|, |F_1| (kernels.modes.span_loads) over
     the accepted step [t, t_new] ending in the tail window, into modal[load_slot(N) + k]: at
     the step's end, at the tail's start inside the step and, where |L_k| rises at the step's
-    start and falls at its end, at its maximum inside the step (bisection on its rate, on
-    every mode's interpolant: the loads are not linear in q, so no root of one polynomial
-    gives it). qx: scratch (`observer_scratch`). Returns whether the interpolants are now
+    start and falls at its end, at its maximum inside the step (`_load_peak`, a root of its
+    rate on every mode's interpolant: the loads are not linear in q, so no root of one
+    polynomial gives it). qx: scratch (`observer_scratch`). Returns whether the interpolants are now
     computed. p1, base: `inertia_at`'s."""
     slot = load_slot(n)
-    kappa = modal[factor_slot(n)]
     rows = basis[md.CLAMPS]
     qv = qx[n:3 * n]
     a = qx[3 * n:3 * n + 6]
     b = qx[3 * n + 6:3 * n + 12]
     m = qx[3 * n + 12:3 * n + 18]
-    load, rate = end_load_at(modal, n, t)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t, p1, base)
-    md.span_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, inertia,
-                  inertia_rate, a)
-    load, rate = end_load_at(modal, n, t_new)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], t_new, p1, base)
-    md.span_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, kappa, load, rate,
-                  inertia, inertia_rate, b)
+    state_loads(rows, basis[md.COUPLING], y[:n], y[n:], n, modal, t, p1, base, a)
+    state_loads(rows, basis[md.COUPLING], y_new[:n], y_new[n:], n, modal, t_new, p1, base, b)
     inside = t < t_tail
     need = inside
     for k in range(3):
@@ -786,8 +789,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         for i in range(n):
             c0 += curvature[e, i] * y[i]
         modal[clamp_slot(n) + e] = abs(c0) if t_loads <= 0.0 else 0.0
-    kappa = md.shear_factor(pp, n)
-    modal[factor_slot(n)] = kappa
+    modal[factor_slot(n)] = md.shear_factor(pp, n)
     modal[factor_slot(n) + 1] = settings[LOADS]
     mean, amplitude, omega, phase = md.end_load_factors(pp, n)
     modal[end_load_slot(n)] = mean
@@ -796,10 +798,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     modal[end_load_slot(n) + 3] = phase
     modal[inertia_slot(n)] = md.inertia_factor(row, n, curvature) if base is not None else 0.0
     loads = np.empty(6)
-    load, rate = end_load_at(modal, n, 0.0)
-    inertia, inertia_rate = inertia_at(modal[inertia_slot(n)], 0.0, p1, base)
-    md.span_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, kappa, load, rate, inertia,
-                  inertia_rate, loads)
+    state_loads(curvature, basis[md.COUPLING], y[:n], y[n:], n, modal, 0.0, p1, base, loads)
     for k in range(3):
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     for k in range(6):

@@ -281,21 +281,13 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
             EV[l] = 1.0 if crest & tail else EV[l]
     a = LD[0]
     b = LD[1]
-    kappa_at = drv.factor_slot(n)
-    mass_at = drv.inertia_slot(n)
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
-        load, rate = _end_load(MOD, n, l, W[tj.T * L + l])
-        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T * L + l], P1L[l],
-                                               base)
-        md.span_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
-                      inertia_rate, a)
-        load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
-        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], P1L[l],
-                                               base)
-        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
-                      inertia_rate, b)
+        drv.state_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[:, l], W[tj.T * L + l],
+                        P1L[l], base, a)
+        drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
+                        P1L[l], base, b)
         for k in range(3):
             if drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0:
                 EV[l] = 1.0
@@ -350,13 +342,6 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     return n_flagged
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _end_load(MOD, n, l, t):
-    """modal_driver.end_load_at for lane l, whose accumulator is MOD[:, l]."""
-    s = drv.end_load_slot(n)
-    return md.end_load(MOD[s, l], MOD[s + 1, l], MOD[s + 2, l], MOD[s + 3, l], t)
-
-
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
@@ -388,18 +373,13 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
             MOD[slot + e, l] = max(MOD[slot + e, l], abs(c)) if take else MOD[slot + e, l]
     b = LD[0]
     loads = drv.load_slot(n)
-    kappa_at = drv.factor_slot(n)
-    mass_at = drv.inertia_slot(n)
     for l in range(n_run):
         take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
                 & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
         if not take:
             continue
-        load, rate = _end_load(MOD, n, l, W[tj.T_NEW * L + l])
-        inertia, inertia_rate = drv.inertia_at(MOD[mass_at, l], W[tj.T_NEW * L + l], P1L[l],
-                                               base)
-        md.span_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[kappa_at, l], load, rate, inertia,
-                      inertia_rate, b)
+        drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
+                        P1L[l], base, b)
         for k in range(3):
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 

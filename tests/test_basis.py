@@ -240,8 +240,10 @@ def test_elastic_ends_are_the_rotational_spring_table(stiffness, beta, end, mid,
 def test_the_observed_rows_are_the_shapes_derivatives_and_mode_1_pushes_one_way(stiffness):
     """Basis.clamps holds phi'' at s = 0, 1, 1/2, phi''' and phi' at s = 0, 1 (pinned: the
     closed forms), equal to finite differences of the shapes themselves; and the first mode's
-    reaction terms have one sign, -phi'''(0) > 0 and phi'(0) >= 0, whatever the ends (the
-    one-mode clamp_force is |q| (|phi'''(0)| + kappa E |phi'(0)|) only because of that)."""
+    reaction terms have one sign, -phi'''(0) > 0, phi'(0) >= 0 and its axial row (the axial
+    load's reaction by the span's equilibrium, `reaction_rows`) > 0, whatever the ends (the
+    one-mode clamp_force adds |q| |phi'''(0)| and (kappa E - P l^2 / EI) |q| a_1(0) only
+    because of that)."""
     from sweep.models.basis import span_basis
     basis = span_basis(stiffness, 3)
     h = 1e-4
@@ -252,6 +254,7 @@ def test_the_observed_rows_are_the_shapes_derivatives_and_mode_1_pushes_one_way(
         scale = basis.shapes[:, 0] ** k
         assert np.allclose(basis.clamps[row], numeric, atol=1e-6 * scale.max()), row
     assert -basis.clamps[3, 0] > 0.0 and basis.clamps[5, 0] >= -1e-12
+    assert basis.clamps[8, 0] > 0.0
 
 
 @pytest.mark.parametrize("stiffness", [0.0, 3.0, math.inf])

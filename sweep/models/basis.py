@@ -379,13 +379,13 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     q^3 + bend_quintic q^5) int phi^2 / l^6, ^8); gamma = int phi / int phi^2 (base
     participation); slope = max |phi'| (the mode's largest slope per unit amplitude);
     clamp_curvature = |phi''(0)| (the curvature at the clamps per unit amplitude);
-    midspan_curvature = |phi''(1/2)|; clamp_shear = |phi'''(0)| and clamp_slope = |phi'(0)|
-    (the clamp's reaction, docs/model.md sec. 10.5); slope_square = int phi'^2 (the span's
-    elongation is slope_square q^2 / (2 l)); inertia = 1/2 - gamma int (1 - s) phi (the share
-    of a uniform load's reaction at a clamp that the one mode leaves out: kernels.modes
-    inertia_factor) and axial_slope (the axial load's reaction at a clamp per unit q and
-    (N - P) / l: `reaction_rows`' AXIAL_0; pi for the pinned mode, where clamp_slope is 0
-    for the clamped one); mass =
+    midspan_curvature = |phi''(1/2)|; clamp_shear = |phi'''(0)| (the clamp's reaction,
+    docs/model.md sec. 10.5); slope_square = int phi'^2 (the span's elongation is
+    slope_square q^2 / (2 l)); inertia = 1/2 - gamma int (1 - s) phi (the share of a uniform
+    load's reaction at a clamp that the one mode leaves out: kernels.modes inertia_factor) and
+    axial_slope (the axial load's reaction at a clamp per unit q and (N - P) / l:
+    `reaction_rows`' AXIAL_0; pi for the pinned mode, 3.22 for the clamped one, whose
+    phi'(0) is 0); mass =
     int phi^2 itself (not divided). By
     Gauss-Legendre on 4 x the basis' own nodes; pinned sines give -pi^2, -pi^4 / 4, 5 pi^6 /
     4, -pi^8 / 8, 3 pi^6 / 2, 9 pi^8 / 4, 4 / pi and pi."""
@@ -395,7 +395,7 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
     d = [shape_values(row, s, k)[0] for k in range(5)]
     mass = d[0] ** 2 @ w
     fine = np.linspace(0.0, 1.0, 4097)
-    bend_0, _, bend_mid, shear_0, _, slope_0, _ = observed_rows(row)[:, 0]
+    bend_0, _, bend_mid, shear_0, _, _, _ = observed_rows(row)[:, 0]
     gamma_share, axial_slope, _ = reaction_rows(row, 4 * quadrature_nodes(1))[:, 0]
     return {
         "mass": float(mass),
@@ -412,7 +412,6 @@ def one_mode_integrals(basis: Basis) -> dict[str, float]:
         "clamp_curvature": float(abs(bend_0)),
         "midspan_curvature": float(abs(bend_mid)),
         "clamp_shear": float(abs(shear_0)),
-        "clamp_slope": float(abs(slope_0)),
         "slope_square": float(d[1] ** 2 @ w),
         "inertia": float(0.5 - gamma_share),
         "axial_slope": float(axial_slope),
