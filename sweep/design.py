@@ -384,14 +384,17 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     n = int(np.prod(shape[:-1], dtype=int))
     spans = np.full(n, np.nan)
     limited = np.empty(n, dtype=object)
+    passed = np.zeros((n, shape[-1]), bool)      # the grid lengths below each first failure
     for i in range(n):
         passes = np.ones(shape[-1], bool)
         for m, _, _ in flat.values():
             passes &= m[i] >= 0.0                # NaN margin: fails
         if passes.all():
             spans[i], limited[i] = lengths[-1], "grid"
+            passed[i] = True
             continue
         b = int(np.argmin(passes))               # the first failing length
+        passed[i, :b] = True
         failing = [k for k in CRITERIA if k in flat and not flat[k][0][i, b] >= 0.0]
         if "state" in failing:      # the solve failed there: its NaN values fail no limit
             failing = ["state"] + [k for k in failing
@@ -408,6 +411,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
             if span < best[0]:
                 best = (span, k)
         spans[i], limited[i] = best
+    if "clearance" in limits:
+        _warn_unresolved(ds, limits["clearance"], like, passed, lengths)
     out_shape = shape[:-1]
     coords = {d: _coordinate(ds, d) for d in others}
     if POINT_DIM in others:                      # each parameter set's [points] values
@@ -474,6 +479,40 @@ def _limited(ds: xr.Dataset, name: str, level: float | None) -> xr.DataArray:
     if REALISATION in var.dims:
         var = var.mean(REALISATION)
     return _worst(var, "max")
+
+
+def _warn_unresolved(ds: xr.Dataset, limit: tuple[str, float, float | None],
+                     like: xr.DataArray, passed: np.ndarray, lengths: np.ndarray) -> None:
+    """Warn (one line) where the clearance criterion passed a grid length below the span's
+    first failure on an estimate the records cannot vouch for: its exceedance_probability
+    at most the limit, its upper confidence bound (`exceedance_probability_upper`: few or no
+    crossings seen) above it. Such a span may be long; more records decide. A result
+    written before the bound was stored is not checked."""
+    name, p, level = limit
+    upper_name = "exceedance_probability_upper"
+    if upper_name not in ds or level is None:
+        return
+    estimate = _broadcast(_limited(ds, name, level), like).reshape(passed.shape)
+    upper = _broadcast(_limited(ds, upper_name, level), like).reshape(passed.shape)
+    weak = passed & (estimate <= p) & ~(upper <= p)
+    if not weak.any():
+        return
+    import warnings
+
+    from .errors import CableSweepWarning
+    from .models.random_outputs import CONFIDENCE
+    i, j = (int(k[0]) for k in np.nonzero(weak))
+    where = ", ".join(f"{d} {_coordinate(ds, str(d)).values[k]}" for d, k in
+                      zip(like.dims[:-1], np.unravel_index(i, like.shape[:-1])))
+    at = f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
+    warnings.warn(f"design: --clearance {level:g}: {int(weak.sum())} passing grid span(s) rest "
+              f"on too few crossings to vouch for a probability <= {p:g} (e.g. {at}: "
+              f"exceedance_probability {estimate[i, j]:.3g}, its {CONFIDENCE:.0%} upper bound "
+              f"{upper[i, j]:.3g}; exceedance_probability_upper), so max_span may be long: "
+              f"counting vouches for it only once the records without a crossing are "
+              f"{3.0 / -math.log1p(-p):.3g} times the test's duration; more realisations "
+              "(base.realisations) narrow it",
+              CableSweepWarning, stacklevel=3)
 
 
 def _margins(ds: xr.Dataset, fmin: float | None, limits: Limits,

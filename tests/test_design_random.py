@@ -6,6 +6,8 @@ launch-random-gevs for the CLI end to end."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -219,3 +221,20 @@ def test_cli_design_of_a_random_result_end_to_end(random_file, tmp_path, capsys)
     assert info.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--max-peak" in err
+
+
+def test_a_clearance_pass_the_records_cannot_vouch_for_is_warned_in_one_line():
+    """A span that passes --clearance on an estimate whose upper confidence bound
+    (exceedance_probability_upper: few or no crossings counted) is above the limit is named
+    in one warning; none where every passing span's bound is below it."""
+    from sweep.errors import CableSweepWarning
+    ds = synthetic()
+    estimate = ds["exceedance_probability"].mean("realisation")
+    weak = ds.assign(exceedance_probability_upper=(estimate + 0.5).clip(max=1.0))
+    with pytest.warns(CableSweepWarning, match=r"--clearance 0.001: \d+ passing grid span"):
+        out = max_span(weak, clearance=0.001)
+    assert float(out["max_span"]) == float(max_span(ds, clearance=0.001)["max_span"])
+    sure = ds.assign(exceedance_probability_upper=estimate * 1.0001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CableSweepWarning)
+        max_span(sure, clearance=0.001)

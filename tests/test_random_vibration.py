@@ -453,6 +453,26 @@ def test_a_rare_clearance_is_judged_from_every_record_at_once():
     assert got == pytest.approx(rice_low, rel=0.2)
     assert float(ds.exceedance_probability.sel(clearance=low)) == pytest.approx(
         1.0 - math.exp(-got))
+    # the upper bound: chi2(0.95, 2 n + 2) / 2 crossings over the windows' total (SciPy here)
+    from scipy.stats import chi2
+    for level in (low, rare):
+        n = float(ds.clearance_upcrossings.sel(clearance=level))
+        bound = chi2.ppf(0.95, 2.0 * n + 2.0) / 2.0 / window.sum() * 120.0
+        upper = float(ds.exceedance_probability_upper.sel(clearance=level))
+        assert upper == pytest.approx(1.0 - math.exp(-bound), rel=1e-9)
+        assert upper >= float(ds.exceedance_probability.sel(clearance=level))
+
+
+@pytest.mark.parametrize("count", [0, 1, 3, 17, 150, 200, 201, 5000, 2e6])
+def test_the_poisson_upper_bound_is_the_chi_square_quantile(count):
+    """The one-sided 95 % upper bound of a Poisson mean behind exceedance_probability_upper
+    (no SciPy at run time) against SciPy's chi-square quantile: 3.0 for no event (the rule
+    of three)."""
+    from scipy.stats import chi2
+
+    from sweep.models.random_outputs import poisson_upper
+    assert poisson_upper(count) == pytest.approx(chi2.ppf(0.95, 2 * count + 2) / 2, rel=3e-6)
+    assert math.isnan(poisson_upper(math.nan)) and math.isnan(poisson_upper(-1.0))
 
 
 def test_a_steps_absolute_acceleration_is_integrated_by_simpson_on_its_quintic():
