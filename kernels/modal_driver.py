@@ -42,11 +42,14 @@ HIDDEN_FLOOR = 1e-9  # such a mode is judged (`span_state`) above this x the lar
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def observer_row(row, n_modes):
+def observer_row(row, n_modes, pp):
     """The oscillator-layout row (kernels.oscillator columns) the trajectory module's Observer
-    reads for the midspan deflection: its divergence bound, scales and base excitation."""
+    reads for the midspan deflection: its divergence bound, scales and base excitation, and
+    the first mode's damping from the prepared row pp (-2 zeta w_1, 1/s: the early stop's
+    decay time)."""
     p = np.zeros(osc.N_PARAMS)
     p[osc.MASS] = 1.0
+    p[osc.DAMPING] = pp[md.P_DAMPING * n_modes]
     p[osc.BOUND] = row[md.BOUND]
     p[osc.Q_SCALE] = row[md.Q_SCALE]
     p[osc.V_SCALE] = row[md.V_SCALE]
@@ -833,7 +836,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     pp = np.empty(md.prepared_size(n))
     md.prepare(row, n, pp, basis[md.RATIOS])
     S = md.scratch(pp, n, basis[md.COUPLING])
-    p1 = observer_row(row, n)
+    p1 = observer_row(row, n, pp)
     K = np.empty((n_stages + 1, dim))
     K_mid = np.empty((n_stages + 1, 2))
     Km = np.empty((n_stages + 1, 2))

@@ -422,7 +422,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states,
     S = md.scratch(pp, n, basis[md.COUPLING])
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
-    p1 = drv.observer_row(row, n)
+    p1 = drv.observer_row(row, n, pp)
     for c in range(N_PARAMS):
         P1[c * L + j] = p1[c]
         P1L[j, c] = p1[c]

@@ -32,7 +32,7 @@ from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STE
                      LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
                      STEADY_PERIODS, STEADY_TOL, TAIL, T_END)
 from .layout import RHS_EVALS as EVALS_COLUMN, SETTLING
-from .oscillator import (BOUND, EXCITATION, Q0, Q_SCALE, V0, V_SCALE, acceleration,
+from .oscillator import (BOUND, DAMPING, EXCITATION, Q0, Q_SCALE, V0, V_SCALE, acceleration,
                          base_acceleration)
 from .stages import InlineWhereTrue
 from .vecmath import log2_fast
@@ -824,7 +824,8 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qe)
         if (steady is not None and kind == mt.MAXIMUM
                 and acc[T_FINAL] == settings[T_END]):
-            t_tail = _stop_when_steady(settings, acc, buf, te, qe, t_tail)
+            t_tail = _stop_when_steady(settings, acc, buf, te, qe, t_tail,
+                                       p[o + DAMPING * s])
 
     if t < t_tail <= t_new:
         if not have_qc:
@@ -1032,14 +1033,25 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _stop_when_steady(settings, acc, buf, te, qe, t_tail):
+def _stop_when_steady(settings, acc, buf, te, qe, t_tail, damping):
     """At a maximum of q at te (s, q = qe m), with settings[STOP_STEADY]: if the extrema say
     the response is steady or has decayed (`metrics.steady_period`), move the trajectory's
     tail window to start here and end M periods later (M = settings[STEADY_PERIODS]), where
     the trajectory then ends, when that is before its end time: the tail's metrics restart
-    from this maximum. Returns the tail window's start (s)."""
+    from this maximum. Returns the tail window's start (s).
+
+    Not before the start-up transient can have decayed to eps = settings[STEADY_TOL] of its
+    size: te >= ln(1/eps) / (zeta w1), from `damping` = -2 zeta w1 (1/s, the prepared row's
+    DAMPING; the slowest mode's). A lightly damped span near resonance beats slowly as it
+    settles, and where the beat's envelope turns its extrema repeat for many periods while
+    still 0.6 % short of the steady level (a reviewer's zeta = 0.002 span at 0.995 f1); the
+    extrema alone cannot tell that turn from a steady state, the damping can. Undamped:
+    never (no transient decays)."""
+    eps = settings[STEADY_TOL]
+    if not te * (-0.5 * damping) >= math.log(1.0 / eps):
+        return t_tail
     period = mt.steady_period(buf, int(acc[N_EXT]), int(settings[STEADY_PERIODS]),
-                              settings[STEADY_TOL], acc[PEAK])
+                              eps, acc[PEAK])
     end = te + settings[STEADY_PERIODS] * period
     if not (period > 0.0 and end < acc[T_FINAL]):
         return t_tail
