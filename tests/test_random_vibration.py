@@ -500,3 +500,25 @@ def test_a_steps_absolute_acceleration_is_integrated_by_simpson_on_its_quintic()
     trapezoid = 0.5 * h * (a(t0) ** 2 + a(t1) ** 2)
     assert acc[tj.SUM_A2] == pytest.approx(exact, rel=2e-3)
     assert abs(trapezoid / exact - 1.0) > 0.01
+
+
+def test_escapes_in_the_start_up_transient_are_warned_in_one_line():
+    """A realisation that escaped before its point's statistics window opened (t_end less the
+    window of those that did not escape) escaped in the start-up kick of a record switched on
+    at full level: one warning line names how many and when; none for later escapes."""
+    import xarray as xr
+
+    from sweep.errors import CableSweepWarning
+    from sweep.models.random_outputs import _warn_startup_escapes
+    dims = ("length", "realisation")
+    escaped = xr.DataArray([[True, False, False], [False, True, False]], dims=dims)
+    window = xr.DataArray([[np.nan, 3.5, 3.5], [3.0, np.nan, 3.0]], dims=dims)
+    early = xr.DataArray([[0.05, np.nan, np.nan], [np.nan, 1.5, np.nan]], dims=dims)
+    with pytest.warns(CableSweepWarning, match=r"1 of 2 escaped realisations escaped in the "
+                      r"start-up transient \(0\.05-0\.05 s"):
+        _warn_startup_escapes(escaped, early, window, 4.0)
+    late = early.where(~escaped, 2.5)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CableSweepWarning)
+        _warn_startup_escapes(escaped, late, window, 4.0)
