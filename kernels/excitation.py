@@ -59,6 +59,7 @@ RECORD_RATE = OMEGA    # fs, the records' sample rate (Hz)
 RECORD = PHASE         # r, which record (realisation) the row follows (an index, as a float)
 RECORD_START = END     # the row's statistics start no earlier than this (s): its start-up
                        # transient's end (kernels.trajectory.delay_window)
+                       # (RAMP, as the sweeps': the record's level rises from 0 over RAMP s)
 
 NAMES = (("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments",
           "sweep_end", "log_base_omega")
@@ -175,20 +176,33 @@ def record_acceleration(t, p, o, s, records):
     """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
     at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
     fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
-    p[o + RECORD_SCALE * s]."""
+    p[o + RECORD_SCALE * s], and over the first RAMP seconds (base.ramp; 0: none) by the
+    ramp's (1 - cos(pi t / RAMP)) / 2, as a shaker brings its level up."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
-    return scale * _hermite(y0, d0, y1, d1, u, dt)
+    a = scale * _hermite(y0, d0, y1, d1, u, dt)
+    ramp = p[o + RAMP * s]
+    if t < ramp:
+        a *= 0.5 - 0.5 * math.cos(math.pi * t / ramp)
+    return a
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def record_and_rate(t, p, o, s, records):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the record kind: `record_acceleration` and the
-    time derivative of its cubic Hermite interpolant."""
+    time derivative of its cubic Hermite interpolant (and of the ramp's rise)."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
     u2 = u * u
     slope = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * dt * d0
              + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) / dt
-    return scale * _hermite(y0, d0, y1, d1, u, dt), scale * slope
+    a = scale * _hermite(y0, d0, y1, d1, u, dt)
+    rate = scale * slope
+    ramp = p[o + RAMP * s]
+    if t < ramp:
+        x = math.pi * t / ramp
+        rise = 0.5 - 0.5 * math.cos(x)
+        rate = rate * rise + a * 0.5 * math.pi / ramp * math.sin(x)
+        a *= rise
+    return a, rate
 
 
 def signal_and_rate(t, p, o, s, base):

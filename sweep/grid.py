@@ -77,16 +77,18 @@ def random_parameters(values: dict[str, Any], coords: dict[str, xr.DataArray]
     """A random scene's parameters (None where the scene is not random): base_asd, its
     spectrum as (f in Hz, W in (m/s^2)^2/Hz) breakpoints; base_sample_rate (Hz); realisation,
     the record each point follows (on the realisation dimension); statistics_tolerance, the
-    decay (metrics.tolerance) after which a point's statistics start."""
+    decay (metrics.tolerance) after which a point's statistics start; base_ramp (s), the
+    records' level rise (base.ramp, 0: none)."""
     key = random_scene.spectrum_key(values)
     if key is None:
         return {"base_asd": None, "base_sample_rate": None, "realisation": None,
-                "statistics_tolerance": None}
+                "statistics_tolerance": None, "base_ramp": None}
     from .models.random import spectrum
     return {"base_asd": spectrum(values[key], key=key, per_g2=key == "base.asd_g2"),
             "base_sample_rate": random_scene.sample_rate(values),
             "realisation": coords[random_scene.REALISATION_DIM].astype(float),
-            "statistics_tolerance": values["metrics.tolerance"]}
+            "statistics_tolerance": values["metrics.tolerance"],
+            "base_ramp": random_scene.ramp_time(values)}
 
 
 def flatten(values: dict[str, Any], names: tuple[str, ...], dims: tuple[str, ...],

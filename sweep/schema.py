@@ -215,6 +215,11 @@ KEYS: tuple[Key, ...] = (
                   "over the realisations, the relative half-width of its 95 % confidence "
                   "interval (0.02: +-2 %); a scene whose realisations cannot reach it at some "
                   "point is refused, with the count that does"),
+    Key("base", "ramp", "float", None, units="s", minimum=0.0,
+        long_name="random base acceleration: the records' level rises from 0 over this time, "
+                  "(1 - cos(pi t / ramp)) / 2, as a shaker brings its level up; each point's "
+                  "statistics start that much later (default 0: full level from t = 0, "
+                  "which kicks a span whose first mode lies below the spectrum's band)"),
     Key("base", "test_duration", "float", None, units="s", minimum=0.0, exclusive_min=True,
         long_name="random base acceleration: the test's duration for the expected number of "
                   "exceedances of outputs.clearance (default base.duration; GEVS: 120 s an "

@@ -337,7 +337,8 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
         block["base_phase"] = p["realisation"]
         # the row's statistics start after its own start-up transient
         block["sweep_end"] = transient_time(omega_1, p["damping_ratio"],
-                                            p["statistics_tolerance"])
+                                            p["statistics_tolerance"], p["base_ramp"])
+        block["level_ramp"] = p["base_ramp"]    # the records' level rise (s; 0: none)
         return {"participation": PARTICIPATION, **block}
     if p.get("base_acceleration") is None and p.get("base_acceleration_g") is None \
             and levels is None:

@@ -62,7 +62,8 @@ MEANS: tuple[str, ...] = ("rms_deflection", "rms_acceleration_g", "peak_deflecti
 class RandomInputs:
     """A random scene's base acceleration, resolved once: spectrum (f Hz, W (m/s^2)^2/Hz) at
     0 dB; duration (s, each record); t_end (s, the run); sample_rate (Hz); realisations;
-    seed; test_duration (s, for the expected exceedances); clearance (m, levels of |q|)."""
+    seed; test_duration (s, for the expected exceedances); clearance (m, levels of |q|);
+    ramp (s, base.ramp: the records' level rises over it; 0: none)."""
     spectrum: tuple[np.ndarray, np.ndarray]
     duration: float
     t_end: float
@@ -71,6 +72,7 @@ class RandomInputs:
     seed: int
     test_duration: float
     clearance: tuple[float, ...]
+    ramp: float = 0.0
 
     @classmethod
     def of(cls, values: dict[str, Any]) -> RandomInputs | None:
@@ -87,7 +89,8 @@ class RandomInputs:
                    realisations=int(values["base.realisations"]),
                    seed=int(values["base.seed"]),
                    test_duration=float(test) if test is not None else duration,
-                   clearance=tuple(float(u) for u in values.get("outputs.clearance") or ()))
+                   clearance=tuple(float(u) for u in values.get("outputs.clearance") or ()),
+                   ramp=random_scene.ramp_time(values))
 
     def records(self) -> np.ndarray:
         """The records the kernels take as their `base` switch: (R, 2, N) samples of a_b at
@@ -106,7 +109,8 @@ def set_settings(settings: np.ndarray, random: RandomInputs, coeffs: dict[str, A
     row's RECORD_START, sweep/models/modal.py); a run too short for the least-damped point is
     refused (`random_scene.check_duration`)."""
     random_scene.check_duration(random.t_end, random_scene.startup_time(
-        coeffs["natural_frequency"], params["damping_ratio"], tolerance))
+        coeffs["natural_frequency"], params["damping_ratio"], tolerance, random.ramp),
+        random.ramp)
     settings[tk.WANT_SETTLING] = 0.0
     settings[tk.N_LEVELS] = len(random.clearance)
     for k, level in enumerate(random.clearance):
@@ -374,8 +378,9 @@ def _warn_startup_escapes(escaped: xr.DataArray, failed_at: xr.DataArray,
                   f"start-up transient ({float(times.min()):.3g}-{float(times.max()):.3g} s, "
                   "before the statistics window): the record starts at full level on a span "
                   "at rest, which kicks a span whose first mode lies below the spectrum's "
-                  "band; escape_probability counts them, so read it with escape_time_mean "
-                  "(docs/model.md sec. 11)", CableSweepWarning, stacklevel=5)
+                  "band; escape_probability counts them: bring the level up as a shaker "
+                  "does, e.g. base.ramp = 1.0 (s; docs/model.md sec. 11)", CableSweepWarning,
+                  stacklevel=5)
 
 
 def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],

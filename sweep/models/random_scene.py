@@ -28,7 +28,7 @@ from ..scene.messages import _fail, _show
 RANDOM_KEYS: tuple[str, str] = ("base.asd_g2", "base.asd")
 """The two spellings of the spectrum (g^2/Hz and (m/s^2)^2/Hz)."""
 RANDOM_ONLY: tuple[str, ...] = ("base.asd_scale", "base.duration", "base.realisations",
-                                "base.seed", "base.sample_rate", "base.test_duration",
+                                "base.seed", "base.sample_rate", "base.test_duration", "base.ramp",
                                 "base.rms_accuracy", "outputs.clearance",
                                 "outputs.response_asd", "outputs.asd_resolution")
 """Keys that mean something only with a spectrum."""
@@ -171,20 +171,29 @@ def sample_rate(values: Mapping[str, Any]) -> float:
     return float(given) if given is not None else 10.0 * float(values[spectrum_key(values)][-1][0])
 
 
-def transient_time(omega_1: Any, damping_ratio: Any, tolerance: Any) -> Any:
-    """How long (s) a span's start-up transient takes to decay to `tolerance` of its size:
-    ln(1/tolerance) / (zeta w1), w1 (rad/s) its first mode's (mode 1 decays slowest: every
-    mode's zeta w_n is w_n / w1 times mode 1's); infinite undamped. Element-wise: each row's
-    statistics start after its own (sweep/models/modal.py's record block)."""
+def ramp_time(values: Mapping[str, Any]) -> float:
+    """base.ramp (s) of a scene's values: how long the records' level takes to rise from 0
+    (0: none, the default)."""
+    return float(values.get("base.ramp") or 0.0)
+
+
+def transient_time(omega_1: Any, damping_ratio: Any, tolerance: Any, ramp: Any = 0.0) -> Any:
+    """How long (s) a span's start-up takes: the records' level ramp (s, base.ramp), then its
+    transient's decay to `tolerance` of its size, ln(1/tolerance) / (zeta w1), w1 (rad/s) its
+    first mode's (mode 1 decays slowest: every mode's zeta w_n is w_n / w1 times mode 1's);
+    infinite undamped. Element-wise: each row's statistics start after its own
+    (sweep/models/modal.py's record block)."""
     with np.errstate(divide="ignore"):
-        return np.log(1.0 / tolerance) / (damping_ratio * omega_1)
+        return ramp + np.log(1.0 / tolerance) / (damping_ratio * omega_1)
 
 
-def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float) -> float:
-    """The longest start-up transient (s, `transient_time`) over the grid: of the least-damped
-    point, natural_frequency its f1 (Hz)."""
+def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float,
+                 ramp: float = 0.0) -> float:
+    """The longest start-up (s, `transient_time`, after a level ramp of `ramp` s) over the
+    grid: of the least-damped point, natural_frequency its f1 (Hz)."""
     return float(np.max(np.asarray(
-        transient_time(2.0 * math.pi * natural_frequency, damping_ratio, tolerance), float)))
+        transient_time(2.0 * math.pi * natural_frequency, damping_ratio, tolerance, ramp),
+        float)))
 
 
 CONFIDENCE_Z = 1.96
@@ -231,7 +240,8 @@ def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
     with np.errstate(divide="ignore", invalid="ignore"):
         window = statistics_window(float(values["solver.t_end"]),
                                    float(values["metrics.tail"]),
-                                   transient_time(omega, zeta, float(values["metrics.tolerance"])))
+                                   transient_time(omega, zeta, float(values["metrics.tolerance"]),
+                                                  ramp_time(values)))
         ok = (window > 0.0) & np.isfinite(window) & (zeta > 0.0)
         if not ok.any():
             return
@@ -276,7 +286,7 @@ def spectra_rate(values: Mapping[str, Any]) -> float:
 
 
 def shortest_window(t_end: float, tail: float, tolerance: float, natural_frequency: Any,
-                    damping_ratio: Any) -> float:
+                    damping_ratio: Any, ramp: float = 0.0) -> float:
     """The shortest statistics window (s, `statistics_window`) over the points of a run of
     t_end s (tail: metrics.tail; tolerance: metrics.tolerance, for the start-up transient):
     natural_frequency f1 (Hz) and damping_ratio on the grid, or at its corners, where zeta w1
@@ -285,7 +295,7 @@ def shortest_window(t_end: float, tail: float, tolerance: float, natural_frequen
         2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
         np.atleast_1d(np.asarray(damping_ratio, float)))
     with np.errstate(divide="ignore", invalid="ignore"):
-        window = statistics_window(t_end, tail, transient_time(omega, zeta, tolerance))
+        window = statistics_window(t_end, tail, transient_time(omega, zeta, tolerance, ramp))
     return float(np.min(window)) if window.size else 0.0
 
 
@@ -299,13 +309,13 @@ def check_spectra_window(values: Mapping[str, Any], natural_frequency: Any,
     t_end = float(values["solver.t_end"])
     window = shortest_window(t_end, float(values["metrics.tail"]),
                              float(values["metrics.tolerance"]), natural_frequency,
-                             damping_ratio)
+                             damping_ratio, ramp_time(values))
     if not window > 0.1 * t_end:
         return                  # a run too short for the start-up: check_duration's refusal
     segment_length(window, spectra_rate(values), values.get("outputs.asd_resolution"))
 
 
-def check_duration(t_end: float, startup: float) -> None:
+def check_duration(t_end: float, startup: float, ramp: float = 0.0) -> None:
     """Refuse (one line) a run that leaves less than a tenth of itself after the start-up
     transient of its least-damped point (`startup_time`, s): each point's statistics start
     after its own transient (kernels.trajectory.delay_window)."""
@@ -316,5 +326,6 @@ def check_duration(t_end: float, startup: float) -> None:
     if not startup < 0.9 * t_end:
         _fail("scene key 'base.duration'", f"the run ({t_end:g} s) leaves less than a tenth "
               f"of it after the start-up transient has decayed ({startup:.3g} s = "
-              "ln(1/metrics.tolerance) / (zeta w1) at the least-damped point)",
+              + (f"base.ramp {ramp:g} s + " if ramp > 0.0 else "")
+              + "ln(1/metrics.tolerance) / (zeta w1) at the least-damped point)",
               f"give base.duration of at least {10.0 * startup:.3g} s, or more damping")

@@ -496,7 +496,8 @@ def _spectra(inputs: Inputs, coeffs: dict[str, Any],
     from .random_scene import shortest_window
     t_end = float(settings[tk.T_END])
     window = shortest_window(t_end, float(settings[tk.TAIL]), float(settings[tk.TOL]),
-                             coeffs["natural_frequency"], inputs.params["damping_ratio"])
+                             coeffs["natural_frequency"], inputs.params["damping_ratio"],
+                             inputs.random.ramp)
     block = osc.EXCITATION if inputs.n_modes == 1 else md.EXCITATION
     return response_asd.reduction(
         inputs.random, window, inputs.resolution, t_end,
