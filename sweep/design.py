@@ -348,7 +348,10 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
 
     Every length must also have a `state` that is not a failure (invalid_input, diverged,
     step_size_too_small, max_steps_reached on either direction or in any realisation) and,
-    where the result has `stability`, be stable (growth_rate <= 0).
+    where the result has `stability`, be stable (growth_rate <= 0). Warned (one line,
+    CableSweepWarning), not failed: a passing length whose state is unsettled (its response
+    still changing at t_end), and a clearance pass whose crossings are too few to vouch for
+    the limit (`exceedance_probability_upper` above it).
 
     Returns
     -------
@@ -413,6 +416,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         spans[i], limited[i] = best
     if "clearance" in limits:
         _warn_unresolved(ds, limits["clearance"], like, passed, lengths)
+    if limits:
+        _warn_unsettled(ds, like, passed, lengths)
     out_shape = shape[:-1]
     coords = {d: _coordinate(ds, d) for d in others}
     if POINT_DIM in others:                      # each parameter set's [points] values
@@ -479,6 +484,36 @@ def _limited(ds: xr.Dataset, name: str, level: float | None) -> xr.DataArray:
     if REALISATION in var.dims:
         var = var.mean(REALISATION)
     return _worst(var, "max")
+
+
+def _warn_unsettled(ds: xr.Dataset, like: xr.DataArray, passed: np.ndarray,
+                    lengths: np.ndarray) -> None:
+    """Warn (one line) where a response criterion passed a grid length whose state is
+    unsettled (in any direction or realisation): its response still changed over the tail
+    window at t_end (a parametric response still growing, a transient still fading), so its
+    amplitude is not yet the steady one and may grow. A reviewer's parametric map passed
+    every span at t_end = 5 s and limited it at 0.53 m at 30 s."""
+    if "state" not in ds:
+        return
+    flag = {m: v for v, m in _flags(ds["state"]).items()}.get(
+        km.STATE_MEANINGS[km.UNSETTLED])
+    if flag is None:
+        return
+    unsettled = _broadcast(_worst(ds["state"] == flag, "max"), like).reshape(passed.shape) > 0
+    weak = passed & unsettled
+    if not weak.any():
+        return
+    import warnings
+
+    from .errors import CableSweepWarning
+    i, j = (int(k[0]) for k in np.nonzero(weak))
+    where = ", ".join(f"{d} {_coordinate(ds, str(d)).values[k]}" for d, k in
+                      zip(like.dims[:-1], np.unravel_index(i, like.shape[:-1])))
+    at = f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
+    warnings.warn(f"design: {int(weak.sum())} passing grid span(s) are unsettled (e.g. {at}): "
+                  "their response still changed at the run's end, so their amplitude may not "
+                  "be the steady one (a parametric response still growing); run them longer "
+                  "(solver.t_end) before trusting max_span", CableSweepWarning, stacklevel=3)
 
 
 def _warn_unresolved(ds: xr.Dataset, limit: tuple[str, float, float | None],

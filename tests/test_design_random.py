@@ -238,3 +238,25 @@ def test_a_clearance_pass_the_records_cannot_vouch_for_is_warned_in_one_line():
     with warnings.catch_warnings():
         warnings.simplefilter("error", CableSweepWarning)
         max_span(sure, clearance=0.001)
+
+
+def test_a_passing_span_whose_response_is_unsettled_is_warned_in_one_line():
+    """A response criterion that passes a grid length whose state is unsettled (its response
+    still changing at t_end: a parametric growth) warns in one line naming it; the span is
+    unchanged, and a result with every passing length settled says nothing."""
+    from sweep.errors import CableSweepWarning
+    ds = synthetic()
+    state = ds["state"].copy()
+    state[1, 0] = 4
+    flags = dict(flag_values=np.array([0, 8, 5, 6, 7, 4], np.int8),
+                 flag_meanings="invalid_input completed diverged step_size_too_small "
+                               "max_steps_reached unsettled", units="1")
+    unsettled = ds.assign(state=state.assign_attrs(flags))
+    with pytest.warns(CableSweepWarning, match=r"1 passing grid span\(s\) are unsettled "
+                      r"\(e\.g\. length 0\.15 m\)"):
+        out = max_span(unsettled, max_rms=0.0025)
+    assert float(out["max_span"]) == float(max_span(ds, max_rms=0.0025)["max_span"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CableSweepWarning)
+        max_span(ds.assign(state=ds["state"].assign_attrs(flags)), max_rms=0.0025)
+        max_span(unsettled, min_frequency=10.0)    # the frequency reads no response

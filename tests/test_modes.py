@@ -499,3 +499,18 @@ def test_the_one_state_right_hand_side_is_the_lanes_one(rotation, membrane):
             y = rng.normal(size=8) * np.r_[np.full(4, 5e-3), np.full(4, 2.0)]
             got, want = both(row, basis, y, rng.uniform(0.0, 2.0), base)
             np.testing.assert_allclose(got, want, rtol=0, atol=1e-14 * np.abs(want).max())
+
+
+def test_one_modes_modal_lists_are_its_initial_state():
+    """model.modes = 1 with initial.modal_displacement / modal_velocity (one entry each): the
+    same run as initial.displacement / velocity (a reviewer found the lists accepted and then
+    ignored: the span started at rest and read 'decayed', amplitude 0)."""
+    text = ("[model]\nmodes = 1\n[cable]\nlength = 0.5\ndamping_ratio = 0.02\n[load]\n"
+            "amplitude = 0.0\n[initial]\n{init}\n[solver]\nt_end = 0.1\n")
+    listed = sweep.run(sweep.load_scene_text(text.format(
+        init="modal_displacement = [1e-3]\nmodal_velocity = [0.05]")), progress=False)
+    single = sweep.run(sweep.load_scene_text(text.format(
+        init="displacement = 1e-3\nvelocity = 0.05")), progress=False)
+    assert float(listed.peak_amplitude) > 1e-3
+    for name in ("peak_amplitude", "amplitude", "state"):
+        assert float(listed[name]) == float(single[name])

@@ -290,6 +290,8 @@ def resolve(scene: Scene) -> Inputs:
         values = scene.get(listed)
         initial.append(tuple(values) if values is not None
                        else (params[single],) + (0.0,) * (n_modes - 1))
+        if values is not None and n_modes == 1:    # one mode's driver reads the single key
+            params[single] = float(values[0])
     return Inputs(coords=coords, dims=dims, shape=tuple(coords[d].size for d in dims),
                   params=params, settings=settings, sample_times=times,
                   driver=scene.get("solver.driver"), method=scene.get("solver.method"),
