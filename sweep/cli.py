@@ -224,6 +224,9 @@ def _run(args: argparse.Namespace) -> int:
             overrides[key] = value
     if args.resume and not args.output:
         raise UserError("--resume: needs -o OUT.nc, the file whose interrupted run to finish")
+    if args.quiet and not args.output:
+        raise UserError("--quiet without -o: the result would be neither written nor shown "
+                        "(give -o OUT.nc to keep it, or drop --quiet to see it)")
     scene = load_scene(args.scene, overrides=overrides)
     _check_dask_flags(args, scene.get("run.backend"))
     if args.workers is not None:     # checked against the backend first: its own line above
@@ -303,6 +306,20 @@ def _modes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _refuse_writing_over_an_input(output: str, inputs: list[str]) -> None:
+    """Refuse (one line) an output path that is one of the command's input files (--overwrite
+    would replace the result being read with what is made from it)."""
+    import os
+    for path in inputs:
+        try:
+            same = os.path.samefile(output, path)
+        except OSError:                  # either does not exist (yet): not the same file
+            same = False
+        if same:
+            raise UserError(f"-o {output}: is the input result '{path}'; writing there would "
+                            "replace the result with its design: give another file name")
+
+
 def _design(args: argparse.Namespace) -> int:
     from .design import NO_CRITERION, interpolated, max_span, refine_span, table
     from .io import check_output_path, write_netcdf
@@ -316,6 +333,7 @@ def _design(args: argparse.Namespace) -> int:
                         "bisects to; give --refine too")
     if args.output is not None:
         check_output_path(args.output, args.overwrite)   # before any work, in one line
+        _refuse_writing_over_an_input(args.output, args.result)
     if len(args.result) > 1 and args.refine:
         raise UserError("design: --refine takes one result (it runs that result's scene); "
                         "refine each result alone, or leave --refine out")

@@ -255,9 +255,11 @@ def test_a_listener_that_never_answers_is_one_line_not_a_hang(tmp_path, capsys, 
     try:
         scene = tmp_path / "s.toml"
         scene.write_text(TINY)
-        assert sweep_main(["run", str(scene), "-q", "--scheduler", address]) == 2
+        assert sweep_main(["run", str(scene), "-q", "-o", str(tmp_path / "o.nc"),
+                           "--scheduler", address]) == 2
         line = _one_error_line(capsys.readouterr().err)
         assert f"dask scheduler '{address}': none answers there" in line
+        assert not (tmp_path / "o.nc").exists()
     finally:
         listener.close()
 

@@ -260,3 +260,30 @@ def test_a_passing_span_whose_response_is_unsettled_is_warned_in_one_line():
         warnings.simplefilter("error", CableSweepWarning)
         max_span(ds.assign(state=ds["state"].assign_attrs(flags)), max_rms=0.0025)
         max_span(unsettled, min_frequency=10.0)    # the frequency reads no response
+
+
+def test_design_refuses_to_write_over_its_input_in_one_line(random_file, tmp_path, capsys):
+    """-o naming the input result (even by another path), with --overwrite: refused in one
+    line before any work, the result left as it was."""
+    import os
+    import shutil
+    _, path = random_file
+    mine = tmp_path / "mine.nc"
+    shutil.copy(path, mine)
+    before = mine.read_bytes()
+    link = tmp_path / "again.nc"
+    os.symlink(mine, link)
+    for output in (mine, link):
+        assert main(["design", str(mine), "--max-rms", "0.001", "-o", str(output),
+                     "--overwrite"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "is the input result" in err[0]
+    assert mine.read_bytes() == before
+
+
+def test_a_quiet_run_without_an_output_is_refused_before_any_work(capsys):
+    """`sweep run SCENE -q` without -o would compute a result and neither write nor show it:
+    one line, exit 2."""
+    assert main(["run", "paper-fig5", "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--quiet without -o" in err[0]

@@ -947,3 +947,15 @@ def test_api_arguments_of_the_wrong_kind_are_one_line(call, fragment):
     overrides: they were silently dropped) gets one UserError, not a deep traceback."""
     with pytest.raises(sweep.UserError, match=fragment):
         call()
+
+
+def test_a_table_override_of_a_section_merges_key_by_key():
+    """--set 'cable={length=0.3}' (or overrides={'cable': {...}}) sets the keys it names and
+    keeps the section's others (a reviewer found it replaced [cable] whole: the damping fell
+    to 0 unsaid); the command line's parsed form does the same."""
+    from sweep.scene import parse_override
+    text = "[cable]\nlength = 0.5\ndamping_ratio = 0.02\n[solver]\nt_end = 0.5\n"
+    for overrides in ({"cable": {"length": 0.3}}, dict([parse_override("cable={length=0.3}")])):
+        scene = sweep.load_scene_text(text, overrides=overrides)
+        assert scene.get("cable.length") == 0.3
+        assert scene.get("cable.damping_ratio") == 0.02

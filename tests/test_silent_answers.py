@@ -241,7 +241,8 @@ def test_cli_says_in_one_line_what_an_empty_scene_ran(tmp_path):
     empty = tmp_path / "empty.toml"
     empty.write_text("")
     root = Path(__file__).resolve().parents[1]
-    done = subprocess.run([sys.executable, "-m", "sweep.cli", "run", str(empty), "-q"],
+    done = subprocess.run([sys.executable, "-m", "sweep.cli", "run", str(empty), "-q", "-o",
+                           str(tmp_path / "empty.nc")],
                           capture_output=True, text=True, cwd=tmp_path, timeout=600,
                           env={**os.environ, "PYTHONPATH": str(root)})
     assert done.returncode == 0, done.stderr

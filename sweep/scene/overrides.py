@@ -112,7 +112,11 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
     """Write overrides into the parsed document (in place), before validation."""
     for dotted, value in overrides.items():
         section, _, name = dotted.partition(".")
-        if not name:
+        if not name and isinstance(value, Mapping) and isinstance(doc.get(dotted), dict):
+            # a table for a whole section merges key by key, as `section.key` overrides do
+            # (replacing it would drop the section's other keys to their defaults unsaid)
+            _apply_overrides(doc, {f"{dotted}.{k}": v for k, v in value.items()})
+        elif not name:
             doc[dotted] = value
         elif section in schema.SWEPT_SECTIONS:
             _override_axis(doc, name, value, section)
