@@ -313,7 +313,7 @@ KEYS: tuple[Key, ...] = (
         long_name="transverse, harmonic load: Floquet multiplier, growth rate and stability of "
                   "the straight span, from one load period (with the time-domain outputs off, "
                   "nothing else is integrated)"),
-    Key("outputs", "clearance", "floats", None, units="m", minimum=0.0,
+    Key("outputs", "clearance", "floats", None, units="m", minimum=0.0, exclusive_min=True,
         long_name="random base acceleration: levels of |midspan deflection| (at most 4) whose "
                   "up-crossing rates, expected exceedances in base.test_duration and "
                   "probability of at least one are stored"),

@@ -194,6 +194,7 @@ def test_time_series_and_spectra_together():
     ({"outputs.response_asd": False, "outputs.asd_resolution": 1.0},
      "only with outputs.response_asd"),
     ({"outputs.asd_resolution": 0.1}, "holds no Welch segment at 0.1 Hz"),
+    ({"outputs.asd_resolution": 1000.0}, "(Hz) or finer"),
     ({"base.duration": 5000.0}, "samples a point, more than 10,000,000"),
 ])
 def test_bad_spectra_keys_are_one_line(overrides, words):

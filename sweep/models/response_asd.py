@@ -68,6 +68,10 @@ def segment_length(window: float, rate: float, resolution: float | None) -> int:
         n = 2 ** int(math.floor(math.log2(max(fits * 2.0 / (SEGMENTS + 1), 2.0))))
     else:
         n = 2 ** int(math.ceil(math.log2(min(max(rate / resolution, 2.0), most))))
+    if n < 16 and resolution is not None and fits >= 16:
+        _fail("scene key 'outputs.asd_resolution'", f"{_show(resolution)} Hz is coarser than "
+              f"a Welch segment of 16 samples at {rate:.6g} Hz resolves",
+              f"give outputs.asd_resolution = {rate / 16.0:.3g} (Hz) or finer")
     if n < 16 or n > fits:
         finest = 2 ** int(math.floor(math.log2(max(fits, 1.0))))
         coarsest = rate / max(finest, 1)
