@@ -276,7 +276,9 @@ def linear_spectra(random: RandomInputs, coeffs: dict[str, Any], params: dict[st
     return {"linear_deflection_asd": deflection.assign_attrs(
                 units="m2 Hz-1", long_name="exact spectral density of the midspan deflection "
                 "of the same span made linear (no stretching, no end load) under the same "
-                "spectrum: beside deflection_asd, the nonlinearity's effect"),
+                "spectrum, at each bin's frequency: beside deflection_asd, the nonlinearity's "
+                "effect where a resonance spans several bins (Welch's Hann window spreads a "
+                "narrower one over about 4 bins: a finer outputs.asd_resolution compares it)"),
             "linear_acceleration_asd": acceleration.assign_attrs(
                 units=G2_UNITS, long_name="exact spectral density of the absolute midspan "
                 "acceleration of the same span made linear, in g^2/Hz: beside "
