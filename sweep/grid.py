@@ -78,17 +78,18 @@ def random_parameters(values: dict[str, Any], coords: dict[str, xr.DataArray]
     spectrum as (f in Hz, W in (m/s^2)^2/Hz) breakpoints; base_sample_rate (Hz); realisation,
     the record each point follows (on the realisation dimension); statistics_tolerance, the
     decay (metrics.tolerance) after which a point's statistics start; base_ramp (s), the
-    records' level rise (base.ramp, 0: none)."""
+    records' level rise (base.ramp, 0: none); record_t_end (s), the run's end."""
     key = random_scene.spectrum_key(values)
     if key is None:
         return {"base_asd": None, "base_sample_rate": None, "realisation": None,
-                "statistics_tolerance": None, "base_ramp": None}
+                "statistics_tolerance": None, "base_ramp": None, "record_t_end": None}
     from .models.random import spectrum
     return {"base_asd": spectrum(values[key], key=key, per_g2=key == "base.asd_g2"),
             "base_sample_rate": random_scene.sample_rate(values),
             "realisation": coords[random_scene.REALISATION_DIM].astype(float),
             "statistics_tolerance": values["metrics.tolerance"],
-            "base_ramp": random_scene.ramp_time(values)}
+            "base_ramp": random_scene.ramp_time(values),
+            "record_t_end": float(values["solver.t_end"])}
 
 
 def flatten(values: dict[str, Any], names: tuple[str, ...], dims: tuple[str, ...],

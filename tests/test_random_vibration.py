@@ -326,6 +326,21 @@ def test_a_record_shorter_than_the_start_up_is_refused():
     assert "start-up transient" in str(caught.value)
 
 
+def test_a_span_whose_start_up_outlasts_the_record_is_flagged_the_others_run():
+    """One setting of the grid too lightly damped for the record (its start-up longer than
+    90 % of it) is flagged invalid_input with a one-line warning; the rest of the grid runs
+    and keeps its statistics (a reviewer found one long span refusing the whole map)."""
+    from sweep.errors import CableSweepWarning
+    with pytest.warns(CableSweepWarning, match=r"1 of 2 span settings start up for longer "
+                      r"than 90% of the 1 s run .* flagged invalid_input, the others run"):
+        ds = sweep.run(scene({"base.realisations": 1},
+                             axes={"damping_ratio": [0.001, 0.05]}), progress=False)
+    states = ds.state.transpose("damping_ratio", ...).values.reshape(2, -1)
+    assert np.all(states[0] == 0) and np.all(states[1] == 8)      # invalid_input, completed
+    rms = ds.rms_deflection.transpose("damping_ratio", ...).values.reshape(2, -1)
+    assert np.all(np.isnan(rms[0])) and np.all(rms[1] > 0.0)
+
+
 def test_a_softening_oscillator_escapes_and_has_no_rms():
     """q'' + 2 zeta w q' + w^2 q - k q^3 = -a_b with the barrier at q_b = w / sqrt(k) equal to
     1.5 linear RMS: every realisation leaves through it within 8 s (the divergence bound put

@@ -332,12 +332,16 @@ def base_excitation(p: Mapping[str, Any], omega_1: Any) -> dict[str, Any]:
     level (no [base] table)."""
     levels = p.get("base_levels_g")
     if p.get("base_asd") is not None:     # the record kind: level factor, sample rate, record
-        from .random_scene import transient_time
+        from .random_scene import runs_after_startup, transient_time
         block = excitation.block(random_level(p), p["base_sample_rate"])
         block["base_phase"] = p["realisation"]
-        # the row's statistics start after its own start-up transient
-        block["sweep_end"] = transient_time(omega_1, p["damping_ratio"],
-                                            p["statistics_tolerance"], p["base_ramp"])
+        # the row's statistics start after its own start-up transient; a row whose start-up
+        # outlasts the run has none: NaN, which the kernels flag invalid_input
+        start = transient_time(omega_1, p["damping_ratio"], p["statistics_tolerance"],
+                               p["base_ramp"])
+        keep = runs_after_startup(start, p["record_t_end"])
+        block["sweep_end"] = (start.where(keep) if _is_dataarray(start)
+                              else np.where(keep, start, np.nan)[()])
         block["level_ramp"] = p["base_ramp"]    # the records' level rise (s; 0: none)
         return {"participation": PARTICIPATION, **block}
     if p.get("base_acceleration") is None and p.get("base_acceleration_g") is None \

@@ -108,9 +108,11 @@ def set_settings(settings: np.ndarray, random: RandomInputs, coeffs: dict[str, A
     by default), each point's starting no earlier than its own start-up transient's end (its
     row's RECORD_START, sweep/models/modal.py); a run too short for the least-damped point is
     refused (`random_scene.check_duration`)."""
-    random_scene.check_duration(random.t_end, random_scene.startup_time(
-        coeffs["natural_frequency"], params["damping_ratio"], tolerance, random.ramp),
-        random.ramp)
+    starts = random_scene.transient_time(2.0 * math.pi * coeffs["natural_frequency"],
+                                         params["damping_ratio"], tolerance, random.ramp)
+    random_scene.check_duration(random.t_end, float(np.min(np.asarray(starts, float))),
+                                random.ramp)
+    random_scene.warn_long_startups(random.t_end, starts)
     settings[tk.WANT_SETTLING] = 0.0
     settings[tk.N_LEVELS] = len(random.clearance)
     for k, level in enumerate(random.clearance):

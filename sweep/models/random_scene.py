@@ -8,7 +8,8 @@ records replace the sine ([base] acceleration, frequency, sweep and levels_g are
 them), every grid point sees the same ``base.realisations`` records (a ``realisation``
 dimension), the run ends with the record (``base.duration``; ``solver.t_end`` may be shorter,
 never longer: the record is periodic), and the statistics are taken after the start-up
-transient has decayed (`startup_time`). With ``base.rms_accuracy`` a scene whose realisations
+transient has decayed (`transient_time`; a point whose start-up outlasts the run is flagged
+invalid_input, `warn_long_startups`). With ``base.rms_accuracy`` a scene whose realisations
 are too few for that accuracy at some point is refused, with the count that reaches it
 (`check_accuracy`).
 """
@@ -187,17 +188,40 @@ def transient_time(omega_1: Any, damping_ratio: Any, tolerance: Any, ramp: Any =
         return ramp + np.log(1.0 / tolerance) / (damping_ratio * omega_1)
 
 
-def startup_time(natural_frequency: Any, damping_ratio: Any, tolerance: float,
-                 ramp: float = 0.0) -> float:
-    """The longest start-up (s, `transient_time`, after a level ramp of `ramp` s) over the
-    grid: of the least-damped point, natural_frequency its f1 (Hz)."""
-    return float(np.max(np.asarray(
-        transient_time(2.0 * math.pi * natural_frequency, damping_ratio, tolerance, ramp),
-        float)))
+STARTUP_SHARE = 0.9
+"""A point runs when its start-up ends before this share of the run (its statistics window
+at least a tenth of it); one whose start-up lasts longer is flagged invalid_input, and a run
+where no point runs is refused (`check_duration`)."""
+
+
+def runs_after_startup(startup: Any, t_end: float) -> Any:
+    """Whether a point whose start-up takes `startup` s (`transient_time`) runs in a run of
+    t_end s (element-wise; STARTUP_SHARE)."""
+    return startup < STARTUP_SHARE * t_end
 
 
 CONFIDENCE_Z = 1.96
 """The normal quantile of a two-sided 95 % interval (base.rms_accuracy's confidence)."""
+
+
+def warn_long_startups(t_end: float, startups: Any) -> None:
+    """Warn (one line) where some points' start-up (`startups`, s, over the grid) outlasts
+    STARTUP_SHARE of the run: they are flagged invalid_input, the others run."""
+    import warnings
+
+    from ..errors import CableSweepWarning
+    starts = np.asarray(startups, float).ravel()
+    long = ~runs_after_startup(starts, t_end)
+    if not long.any() or long.all():
+        return
+    worst = float(np.max(starts))
+    fix = (f"give base.duration of at least {worst / STARTUP_SHARE:.3g} s to run them too"
+           if math.isfinite(worst) else "give them damping (cable.damping_ratio > 0)")
+    warnings.warn(f"{int(long.sum())} of {starts.size} span settings start up for longer than "
+                  f"{STARTUP_SHARE:.0%} of the {t_end:g} s run (up to {worst:.3g} s: "
+                  "ln(1/metrics.tolerance) / (zeta w1) of a long, lightly damped span): their "
+                  f"points are flagged invalid_input, the others run; {fix}",
+                  CableSweepWarning, stacklevel=5)
 
 
 def statistics_window(t_end: Any, tail: float, transient: Any) -> Any:
@@ -242,7 +266,8 @@ def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
                                    float(values["metrics.tail"]),
                                    transient_time(omega, zeta, float(values["metrics.tolerance"]),
                                                   ramp_time(values)))
-        ok = (window > 0.0) & np.isfinite(window) & (zeta > 0.0)
+        ok = (window > (1.0 - STARTUP_SHARE) * float(values["solver.t_end"]))
+        ok &= np.isfinite(window) & (zeta > 0.0)
         if not ok.any():
             return
         omega, zeta, window = omega[ok], zeta[ok], window[ok]
@@ -295,7 +320,11 @@ def shortest_window(t_end: float, tail: float, tolerance: float, natural_frequen
         2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
         np.atleast_1d(np.asarray(damping_ratio, float)))
     with np.errstate(divide="ignore", invalid="ignore"):
-        window = statistics_window(t_end, tail, transient_time(omega, zeta, tolerance, ramp))
+        start = transient_time(omega, zeta, tolerance, ramp)
+        window = statistics_window(t_end, tail, start)
+    running = window[runs_after_startup(start, t_end)]    # the others are invalid_input
+    if running.size:
+        return float(np.min(running))
     return float(np.min(window)) if window.size else 0.0
 
 
@@ -317,15 +346,17 @@ def check_spectra_window(values: Mapping[str, Any], natural_frequency: Any,
 
 def check_duration(t_end: float, startup: float, ramp: float = 0.0) -> None:
     """Refuse (one line) a run that leaves less than a tenth of itself after the start-up
-    transient of its least-damped point (`startup_time`, s): each point's statistics start
-    after its own transient (kernels.trajectory.delay_window)."""
+    of its best-damped point (`startup`, s: the shortest over the grid), so that no point has
+    a statistics window: each point's statistics start after its own transient
+    (kernels.trajectory.delay_window), and a point whose own start-up is too long is flagged
+    invalid_input (`warn_long_startups`)."""
     if not math.isfinite(startup):
         _fail("scene key 'cable.damping_ratio'", "a random response needs damping: without it "
               "the start-up transient never decays and the response has no stationary "
               "statistics", "give a damping ratio above 0, e.g. 0.02")
-    if not startup < 0.9 * t_end:
+    if not runs_after_startup(startup, t_end):
         _fail("scene key 'base.duration'", f"the run ({t_end:g} s) leaves less than a tenth "
               f"of it after the start-up transient has decayed ({startup:.3g} s = "
               + (f"base.ramp {ramp:g} s + " if ramp > 0.0 else "")
-              + "ln(1/metrics.tolerance) / (zeta w1) at the least-damped point)",
+              + "ln(1/metrics.tolerance) / (zeta w1) at the best-damped point)",
               f"give base.duration of at least {10.0 * startup:.3g} s, or more damping")
