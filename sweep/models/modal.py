@@ -217,7 +217,7 @@ def escape_barrier(k: Any, g: Any, h: Any, length: Any) -> Any:
     the mode's largest slope there, pi q_b / length (length in m), exceeds MAX_SLOPE (the
     Table 1 cable's 1 m span would otherwise report 55 m).
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         q2 = (-g - np.sqrt(g * g - 4.0 * h * k)) / (2.0 * h)
         q_b = np.sqrt(q2)
         valid = (h < 0) & (k > 0) & (np.pi * q_b / length <= MAX_SLOPE)
