@@ -398,9 +398,12 @@ def test_toml_syntax_error_at_end_of_text():
 
 def test_unknown_scene_name():
     with pytest.raises(SceneError) as info:
-        load_scene("paper-fig6")
-    assert str(info.value) == ("scene 'paper-fig6': no built-in scene of that name and no such "
+        load_scene("qwerty")
+    assert str(info.value) == ("scene 'qwerty': no built-in scene of that name and no such "
                                "file (run 'sweep scenes' for the built-in names)")
+    with pytest.raises(SceneError) as info:
+        load_scene("launch-random-gev")
+    assert str(info.value).endswith("no such file (did you mean 'launch-random-gevs'?)")
 
 
 def test_directory_refused(tmp_path):
