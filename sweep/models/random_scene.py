@@ -182,10 +182,13 @@ def transient_time(omega_1: Any, damping_ratio: Any, tolerance: Any, ramp: Any =
     """How long (s) a span's start-up takes: the records' level ramp (s, base.ramp), then its
     transient's decay to `tolerance` of its size, ln(1/tolerance) / (zeta w1), w1 (rad/s) its
     first mode's (mode 1 decays slowest: every mode's zeta w_n is w_n / w1 times mode 1's);
-    infinite undamped. Element-wise: each row's statistics start after its own
-    (sweep/models/modal.py's record block)."""
+    infinite undamped. An overdamped mode (zeta > 1) decays by its slow root,
+    w1 (zeta - sqrt(zeta^2 - 1)), not zeta w1. Element-wise: each row's statistics start
+    after its own (sweep/models/modal.py's record block)."""
+    zeta = damping_ratio
+    over = np.sqrt(np.maximum(zeta * zeta - 1.0, 0.0))
     with np.errstate(divide="ignore"):
-        return ramp + np.log(1.0 / tolerance) / (damping_ratio * omega_1)
+        return ramp + np.log(1.0 / tolerance) / ((zeta - over) * omega_1)
 
 
 STARTUP_SHARE = 0.9
