@@ -518,18 +518,21 @@ def _warn_unsettled(ds: xr.Dataset, like: xr.DataArray, passed: np.ndarray,
 
 def _warn_unresolved(ds: xr.Dataset, limit: tuple[str, float, float | None],
                      like: xr.DataArray, passed: np.ndarray, lengths: np.ndarray) -> None:
-    """Warn (one line) where the clearance criterion passed a grid length below the span's
-    first failure on an estimate the records cannot vouch for: its exceedance_probability
-    at most the limit, its upper confidence bound (`exceedance_probability_upper`: few or no
-    crossings seen) above it. Such a span may be long; more records decide. A result
-    written before the bound was stored is not checked."""
+    """Warn (one line) where the clearance criterion passed the last grid length before the
+    span's first failure (the one max_span rests on) on an estimate the records cannot vouch
+    for: its exceedance_probability at most the limit, its upper confidence bound
+    (`exceedance_probability_upper`: few or no crossings seen) above it. Such a span may be
+    long; more records decide. A result written before the bound was stored is not checked."""
     name, p, level = limit
     upper_name = "exceedance_probability_upper"
     if upper_name not in ds or level is None:
         return
     estimate = _broadcast(_limited(ds, name, level), like).reshape(passed.shape)
     upper = _broadcast(_limited(ds, upper_name, level), like).reshape(passed.shape)
-    weak = passed & (estimate <= p) & ~(upper <= p)
+    last = np.zeros_like(passed)
+    rows = np.flatnonzero(passed.any(axis=1))
+    last[rows, passed[rows].sum(axis=1) - 1] = True
+    weak = last & (estimate <= p) & ~(upper <= p)
     if not weak.any():
         return
     import warnings
@@ -540,8 +543,8 @@ def _warn_unresolved(ds: xr.Dataset, limit: tuple[str, float, float | None],
     where = ", ".join(f"{d} {_coordinate(ds, str(d)).values[k]}" for d, k in
                       zip(like.dims[:-1], np.unravel_index(i, like.shape[:-1])))
     at = f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
-    warnings.warn(f"design: --clearance {level:g}: {int(weak.sum())} passing grid span(s) rest "
-              f"on too few crossings to vouch for a probability <= {p:g} (e.g. {at}: "
+    warnings.warn(f"design: --clearance {level:g}: {int(weak.sum())} span(s) rest on a grid "
+              f"length with too few crossings to vouch for a probability <= {p:g} (e.g. {at}: "
               f"exceedance_probability {estimate[i, j]:.3g}, its {CONFIDENCE:.0%} upper bound "
               f"{upper[i, j]:.3g}; exceedance_probability_upper), so max_span may be long: "
               f"counting vouches for it only once the records without a crossing are "

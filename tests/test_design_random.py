@@ -231,7 +231,8 @@ def test_a_clearance_pass_the_records_cannot_vouch_for_is_warned_in_one_line():
     ds = synthetic()
     estimate = ds["exceedance_probability"].mean("realisation")
     weak = ds.assign(exceedance_probability_upper=(estimate + 0.5).clip(max=1.0))
-    with pytest.warns(CableSweepWarning, match=r"--clearance 0.001: \d+ passing grid span"):
+    with pytest.warns(CableSweepWarning,
+                      match=r"--clearance 0.001: 1 span\(s\) rest on a grid length"):
         out = max_span(weak, clearance=0.001)
     assert float(out["max_span"]) == float(max_span(ds, clearance=0.001)["max_span"])
     sure = ds.assign(exceedance_probability_upper=estimate * 1.0001)

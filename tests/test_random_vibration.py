@@ -112,6 +112,12 @@ def test_one_realisation_matches_scipy_on_the_same_record(n_modes, drivers, ramp
         transient = math.log(1.0 / float(sc.values["metrics.tolerance"])) / (
             cable.damping_ratio * cable.w1)
         assert window == pytest.approx(random.t_end - ramp - transient, rel=1e-3)
+        samples = record[0, :int(math.floor(random.t_end * fs)) + 1]
+        t_k = np.arange(samples.size) / fs
+        rise = 0.5 - 0.5 * np.cos(np.pi * t_k / max(ramp, 1e-300))
+        shaken = samples * np.where(t_k < ramp, rise, 1.0)
+        assert float(ds.base_grms.values.ravel()[0]) == pytest.approx(
+            math.sqrt(np.mean(shaken ** 2)) / 9.80665, rel=1e-12)
         rms_q, rms_v, peak, up = _window_statistics(sol, weights, random.t_end - window,
                                                     random.t_end, n_modes, f, record, fs,
                                                     gamma)
@@ -528,25 +534,28 @@ def test_a_steps_absolute_acceleration_is_integrated_by_simpson_on_its_quintic()
 
 
 def test_escapes_in_the_start_up_transient_are_warned_in_one_line():
-    """A realisation that escaped before its point's statistics window opened (t_end less the
-    window of those that did not escape) escaped in the start-up kick of a record switched on
-    at full level: one warning line names how many and when; none for later escapes."""
+    """A realisation that escaped before its point's start-up ended (its level ramp and
+    transient: the row's own, not the survivors' window, so a point where every record
+    escaped counts too) escaped in the start-up kick: one warning line names how many and
+    when, and what to do with or without a ramp; none for later escapes."""
+    import warnings
+
     import xarray as xr
 
     from sweep.errors import CableSweepWarning
     from sweep.models.random_outputs import _warn_startup_escapes
     dims = ("length", "realisation")
-    escaped = xr.DataArray([[True, False, False], [False, True, False]], dims=dims)
-    window = xr.DataArray([[np.nan, 3.5, 3.5], [3.0, np.nan, 3.0]], dims=dims)
-    early = xr.DataArray([[0.05, np.nan, np.nan], [np.nan, 1.5, np.nan]], dims=dims)
-    with pytest.warns(CableSweepWarning, match=r"1 of 2 escaped realisations escaped in the "
-                      r"start-up transient \(0\.05-0\.05 s"):
-        _warn_startup_escapes(escaped, early, window, 4.0)
-    late = early.where(~escaped, 2.5)
-    import warnings
+    escaped = xr.DataArray([[True, True], [False, True]], dims=dims)
+    startup = xr.DataArray([0.5, 1.0], dims="length")
+    early = xr.DataArray([[0.05, 0.1], [np.nan, 1.5]], dims=dims)
+    with pytest.warns(CableSweepWarning, match=r"2 of 3 escaped realisations escaped in the "
+                      r"start-up \(0\.05-0\.1 s.*e\.g\. base\.ramp = 1\.0"):
+        _warn_startup_escapes(escaped, early, startup, 0.0)
+    with pytest.warns(CableSweepWarning, match=r"rise over base\.ramp = 0\.3 s"):
+        _warn_startup_escapes(escaped, early, startup, 0.3)
     with warnings.catch_warnings():
         warnings.simplefilter("error", CableSweepWarning)
-        _warn_startup_escapes(escaped, late, window, 4.0)
+        _warn_startup_escapes(escaped, early.where(~escaped, 2.5), startup, 0.0)
 
 
 @pytest.mark.slow
@@ -559,7 +568,7 @@ def test_a_ramped_record_does_not_kick_a_span_below_the_band_over_its_barrier():
     over = {"model.membrane": 0.0, "load.type": "constant", "axes.length": [0.15],
             "axes.load_amplitude": [0.98 * 43.86], "axes.base_asd_scale": [12.0],
             "base.realisations": 8, "base.duration": 4.0, "outputs.response_asd": False}
-    with pytest.warns(CableSweepWarning, match="escaped in the start-up transient"):
+    with pytest.warns(CableSweepWarning, match="escaped in the start-up "):
         kicked = sweep.run(sweep.load_scene("launch-random-gevs", overrides=over),
                            progress=False)
     assert float(kicked.escape_probability.max()) > 0.0

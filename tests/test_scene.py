@@ -403,7 +403,8 @@ def test_unknown_scene_name():
                                "file (run 'sweep scenes' for the built-in names)")
     with pytest.raises(SceneError) as info:
         load_scene("launch-random-gev")
-    assert str(info.value).endswith("no such file (did you mean 'launch-random-gevs'?)")
+    assert str(info.value).endswith("no such file (did you mean 'launch-random-gevs'? run "
+                                    "'sweep scenes' for the built-in names)")
 
 
 def test_directory_refused(tmp_path):
@@ -962,3 +963,20 @@ def test_a_table_override_of_a_section_merges_key_by_key():
         scene = sweep.load_scene_text(text, overrides=overrides)
         assert scene.get("cable.length") == 0.3
         assert scene.get("cable.damping_ratio") == 0.02
+
+
+def test_a_section_table_override_flattens_nested_tables_and_keeps_the_pair_rules():
+    """base={sweep={rate=1}} sets base.sweep.rate alone (it replaced the sweep's table,
+    dropping start and stop); points={length=[...]} replaces the length axis as
+    points.length does; both keys of an either-or pair in one table are refused as two
+    overrides are."""
+    from sweep.scene import parse_override
+    scene = sweep.load_scene("launch-sine-qualification",
+                             overrides=dict([parse_override("base={sweep={rate=1}}")]))
+    assert scene.get("base.sweep.rate") == 1.0 and scene.get("base.sweep.start") == 5.0
+    scene = sweep.load_scene("harness-base-sine",
+                             overrides=dict([parse_override("points={length=[0.2,0.25]}")]))
+    assert "length" in scene.points and "length" not in scene.axes
+    with pytest.raises(SceneError, match="give one, not both"):
+        sweep.load_scene("harness-base-sine", overrides=dict(
+            [parse_override("base={acceleration_g=1, acceleration=3}")]))

@@ -340,9 +340,14 @@ def spectral_moments(data: dict[str, xr.DataArray], n_modes: int,
 
 
 def realised_grms(records: np.ndarray, random: RandomInputs) -> np.ndarray:
-    """Each record's RMS (g, at 0 dB) over the run [0, t_end] (s), from its samples."""
+    """Each record's RMS (g, at 0 dB) over the run [0, t_end] (s), from its samples, as the
+    span is shaken: with base.ramp, the samples of its first `ramp` seconds at the ramp's
+    level (1 - cos(pi t / ramp)) / 2."""
     last = int(math.floor(random.t_end * random.sample_rate))
     run = records[:, 0, :last + 1]
+    if random.ramp > 0.0:
+        t = np.arange(run.shape[1]) / random.sample_rate
+        run = run * np.where(t < random.ramp, 0.5 - 0.5 * np.cos(np.pi * t / random.ramp), 1.0)
     return np.sqrt(np.mean(run * run, axis=1)) / STANDARD_GRAVITY
 
 
@@ -361,30 +366,31 @@ def pooled_crossings(rate: xr.DataArray, window: xr.DataArray, kept: xr.DataArra
 
 
 def _warn_startup_escapes(escaped: xr.DataArray, failed_at: xr.DataArray,
-                          window: xr.DataArray, t_end: float) -> None:
-    """Warn (one line) where realisations escaped before their point's statistics window
-    opened (t_end less the window of the realisations that did not escape): in the start-up
-    transient. The record is switched on at full level at t = 0 with the span at rest, so a
-    span whose first mode lies below the spectrum's band takes the base's velocity at t = 0
+                          startup: Any, ramp: float) -> None:
+    """Warn (one line) where realisations escaped in their point's start-up (`startup`, s:
+    the ramp and the transient, random_scene.transient_time, the row's RECORD_START), before
+    its statistics could start. A record switched on at full level at t = 0 on a span at rest
+    gives a span whose first mode lies below the spectrum's band the base's velocity at t = 0
     as a kick of the transient's size (a reviewer: every escape of a span loaded to 0.95-0.98
     Pcr fell at 0.03-0.09 s, none later, and none with the same records ramped up over 1 s).
     escape_probability counts them; they say how the test starts, not how the span fares."""
     import warnings
 
     from ..errors import CableSweepWarning
-    opens = t_end - window.where(~escaped).max(REALISATION_DIM)
-    early = escaped & (failed_at < opens)
+    early = escaped & (failed_at < startup)
     count = int(early.sum())
     if count == 0:
         return
     times = failed_at.where(early)
+    how = (f"the records rise over base.ramp = {ramp:g} s, and the kick is still there: a "
+           "longer ramp eases it" if ramp > 0.0 else
+           "the record starts at full level on a span at rest, which kicks a span whose first "
+           "mode lies below the spectrum's band; bring the level up as a shaker does, e.g. "
+           "base.ramp = 1.0 (s)")
     warnings.warn(f"{count} of {int(escaped.sum())} escaped realisations escaped in the "
-                  f"start-up transient ({float(times.min()):.3g}-{float(times.max()):.3g} s, "
-                  "before the statistics window): the record starts at full level on a span "
-                  "at rest, which kicks a span whose first mode lies below the spectrum's "
-                  "band; escape_probability counts them: bring the level up as a shaker "
-                  "does, e.g. base.ramp = 1.0 (s; docs/model.md sec. 11)", CableSweepWarning,
-                  stacklevel=5)
+                  f"start-up ({float(times.min()):.3g}-{float(times.max()):.3g} s, before "
+                  f"their statistics start): {how}; escape_probability counts them "
+                  "(docs/model.md sec. 11)", CableSweepWarning, stacklevel=5)
 
 
 def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
@@ -429,7 +435,10 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
         "metrics.divergence_bound says otherwise; a crossing of escape_barrier that comes "
         "back does not count): a softening span's measure, where an RMS means nothing")
     failed_at = xr.DataArray(reals[:, tk.FAILURE_TIME].reshape(shape), dims=dims)
-    _warn_startup_escapes(escaped, failed_at, data["statistics_window"], random.t_end)
+    startup = random_scene.transient_time(
+        2.0 * math.pi * derived(coeffs["natural_frequency"], coords),
+        derived(params["damping_ratio"], coords), params["statistics_tolerance"], random.ramp)
+    _warn_startup_escapes(escaped, failed_at, startup, random.ramp)
     data["escape_time_mean"] = failed_at.where(escaped).mean(REALISATION_DIM).assign_attrs(
         units="s", long_name="mean time of escape (divergence) over the realisations that "
         "escaped; NaN where none did")
@@ -466,10 +475,13 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
         with np.errstate(divide="ignore", invalid="ignore"):
             upper_expected = upper / observed * random.test_duration
         data["exceedance_probability_upper"] = (1.0 - np.exp(-upper_expected)).assign_attrs(
-            units="1", long_name=f"{CONFIDENCE:.0%} upper confidence bound of "
-            "exceedance_probability: the same with the pooled rate's one-sided upper bound "
-            "(Poisson on clearance_upcrossings; with none counted, 3 over the windows' total "
-            "length): what the records can vouch for, where few or none crossed the level")
+            units="1", long_name=f"{CONFIDENCE:.0%} upper confidence bound of the "
+            "probability of at least one exceedance in the test: 1 - exp(-nu T) with the pooled "
+            "rate's one-sided upper bound, the count clearance_upcrossings taken as Poisson "
+            "(with none counted, 3 over the windows' total length; crossings that come in "
+            "clumps make the bound on the rate optimistic, while 1 - exp(-nu T) counts each "
+            "crossing as a new exceedance, which errs high): what the records can vouch for "
+            "where few or none crossed the level")
     curvatures = None
     if n_modes != 1 and loads:
         from .loads import strain_per_curvature

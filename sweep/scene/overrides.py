@@ -85,7 +85,13 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
             _fail(f"override {key!r}", "has no key",
                   "write KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
         key = key.strip()
-        parsed[key] = _override_value(key, value)
+        value = _override_value(key, value)
+        if "." not in key and isinstance(value, Mapping):
+            # a table for a whole section sets the keys it names, as `section.key` overrides
+            # do (replacing the section would drop its other keys to their defaults unsaid)
+            parsed.update(_section_keys(key, value))
+        else:
+            parsed[key] = value
     for pair in PAIRS:
         if len({_pair_target(k, pair) for k in parsed} - {None}) == 2:
             _fail(f"overrides '{pair[0]}' and '{pair[1]}'", "give one, not both",
@@ -94,6 +100,21 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
         _fail("overrides 'solver.t_end' and 'solver.transits'", "give one, not both",
               "remove one of the two overrides")
     return parsed
+
+
+def _section_keys(prefix: str, table: Mapping[str, Any]) -> dict[str, Any]:
+    """A section's table as dotted overrides: nested tables flattened (base={sweep={rate=1}}
+    is base.sweep.rate) down to a key the schema knows or an entry of [axes] or [points],
+    whose value a table may be ({start, stop, num})."""
+    out: dict[str, Any] = {}
+    for name, value in table.items():
+        dotted = f"{prefix}.{name}"
+        if (isinstance(value, Mapping) and dotted not in schema.BY_DOTTED
+                and prefix not in schema.SWEPT_SECTIONS):
+            out.update(_section_keys(dotted, value))
+        else:
+            out[dotted] = _plain(value)
+    return out
 
 
 def _pair_target(dotted: str, pair: tuple[str, str]) -> str | None:
@@ -112,11 +133,7 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
     """Write overrides into the parsed document (in place), before validation."""
     for dotted, value in overrides.items():
         section, _, name = dotted.partition(".")
-        if not name and isinstance(value, Mapping) and isinstance(doc.get(dotted), dict):
-            # a table for a whole section merges key by key, as `section.key` overrides do
-            # (replacing it would drop the section's other keys to their defaults unsaid)
-            _apply_overrides(doc, {f"{dotted}.{k}": v for k, v in value.items()})
-        elif not name:
+        if not name:
             doc[dotted] = value
         elif section in schema.SWEPT_SECTIONS:
             _override_axis(doc, name, value, section)

@@ -16,7 +16,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .messages import _close, _fail, _suggestion
+from .messages import _close, _fail
 
 MAX_SCENE_BYTES = 8 * 2**20
 """A scene file longer than this (bytes) is refused before it is read; 8 MiB holds an axis of
@@ -73,9 +73,10 @@ def _read_scene(scene: str | os.PathLike) -> tuple[str, str, str]:
     if info is None:
         if _looks_like_path(source):
             _fail(where, "no such file", "check the path; 'sweep scenes' lists the built-in names")
+        guess = _close(source, builtin_scenes())
         _fail(f"scene '{source}'", "no built-in scene of that name and no such file",
-              _suggestion(_close(source, builtin_scenes()),
-                          "run 'sweep scenes' for the built-in names"))
+              (f"did you mean '{guess}'? " if guess else "")
+              + "run 'sweep scenes' for the built-in names")
     _check_text(where, source, "the file name", "give the file (and its folders) a UTF-8 name")
     if stat.S_ISDIR(info.st_mode):
         _fail(where, "is a directory, not a TOML file", "give the path of a .toml scene file")
