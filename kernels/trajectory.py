@@ -1045,7 +1045,8 @@ def _stop_when_steady(settings, acc, buf, te, qe, t_tail, damping):
     DAMPING; the slowest mode's). A lightly damped span near resonance beats slowly as it
     settles, and where the beat's envelope turns its extrema repeat for many periods while
     still 0.6 % short of the steady level (a reviewer's zeta = 0.002 span at 0.995 f1); the
-    extrema alone cannot tell that turn from a steady state, the damping can. Undamped:
+    extrema alone cannot tell that turn from a steady state. A floor, not a proof: near a
+    parametric tongue's edge or a jump a response settles slower than zeta w1. Undamped:
     never (no transient decays)."""
     eps = settings[STEADY_TOL]
     if not te * (-0.5 * damping) >= math.log(1.0 / eps):
