@@ -9,7 +9,9 @@ for every combination of the results' other axes, the shortest of their spans, `
 the criterion that binds there and `limited_in` the result it binds in. Every criterion must
 apply to some result, and every result must have a criterion that applies to it; axes the
 results share must hold the same values (an axis only one of them has spreads over the
-others, whose spans do not vary along it).
+others, whose spans do not vary along it). Results whose stored scenes describe different spans
+(the cable's mass, rigidities and damping, the clamps: `_check_same_span`) are warned of in one
+line.
 """
 
 from __future__ import annotations
@@ -89,6 +91,7 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
         raise UserError(f"design: result '{twice[0]}' given twice (give each result once)")
     for name, ds in results:
         check_result(ds, name)
+    _check_same_span(results)
     random = [REALISATION_DIM in ds.dims for _, ds in results]
     asked: list[dict[str, Any]] = [{} for _ in results]
     for c in given:
@@ -107,6 +110,80 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
                             "variables (leave it out, or give one it holds)")
         spans.append(max_span(ds, **own))
     return _shortest(spans, names)
+
+
+SPAN = (("linear_mass", "kg/m"), ("bending_rigidity", "N m^2"), ("axial_rigidity", "N"),
+        ("damping_ratio", "1"), ("clamps_rotation", ""), ("clamp_rotational_stiffness", "N m/rad"),
+        ("clamp_axial_stiffness", "N/m"))
+"""What makes two results the same span (its cable and its clamps, whatever the spelling:
+a data sheet's or the material's), compared by `_check_same_span`."""
+
+
+def _span_of(ds: xr.Dataset) -> dict[str, Any] | None:
+    """The span a result describes, from its stored scene: SPAN's quantities, each a number, a
+    string or a DataArray over the axes or the [points] dimension it varies on; None for a
+    result without a readable scene (an old or hand-made file: not compared)."""
+    from . import grid
+    from .scene import load_scene_text
+    text = ds.attrs.get("scene")
+    if not isinstance(text, str) or not text.strip():
+        return None
+    try:
+        scene = load_scene_text(text, source="the result's scene")
+        p = grid.parameters(scene, grid.coordinates(scene))
+    except Exception:                     # a scene this version cannot read: not compared
+        return None
+    span = {"linear_mass": p["density"] * p["area"],
+            "bending_rigidity": p["youngs_modulus"] * p["inertia"],
+            "axial_rigidity": p["youngs_modulus"] * p["area"]}
+    span.update({name: p.get(name) for name, _ in SPAN[3:]})
+    return span
+
+
+def _differs(a: Any, b: Any) -> Any:
+    """Where two span quantities differ (a bool or a boolean DataArray, broadcast): numbers
+    beyond 1e-9 relative, None against a value, strings unequal."""
+    if a is None or b is None:
+        return (a is None) != (b is None)
+    if isinstance(a, str) or isinstance(b, str):
+        return a != b
+    with np.errstate(invalid="ignore"):
+        return ~(abs(a - b) <= 1e-9 * np.maximum(abs(a), abs(b)))
+
+
+def _check_same_span(results: Sequence[tuple[str, xr.Dataset]]) -> None:
+    """Warn (one line) where results describe different spans (SPAN: the cable's mass,
+    rigidities and damping, the clamps) at some combination of their axes and [points]
+    sets: their spans' shortest mixes one cable's limit into another's (a reviewer's
+    bundle's frequency criterion bound a second cable of a [points] result at the bundle's
+    span). A quantity one result sweeps and another does not must match at every value.
+    A warning, not a refusal: bracketing a cable by two others is a question one may ask."""
+    import warnings
+
+    from .errors import CableSweepWarning
+    spans = [(name, _span_of(ds)) for name, ds in results]
+    spans = [(n, s) for n, s in spans if s is not None]
+    for (name_a, a), (name_b, b) in zip(spans, spans[1:]):
+        for quantity, units in SPAN:
+            diff = _differs(a[quantity], b[quantity])
+            if not bool(np.any(diff)):
+                continue
+            where, first = "", {}
+            if isinstance(diff, xr.DataArray) and diff.ndim:
+                first = {d: int(i[0]) for d, i in zip(diff.dims, np.nonzero(diff.values))}
+                where = " at " + ", ".join(f"{d} {i}" if d == "point" else
+                                           f"{d} {diff[d].values[i]}" for d, i in first.items())
+
+            def show(v: Any) -> str:
+                if isinstance(v, xr.DataArray):
+                    v = v.isel({d: i for d, i in first.items() if d in v.dims}).values[()]
+                return "none" if v is None else f"{v:.4g}" if not isinstance(v, str) else v
+            warnings.warn(f"design: results '{name_a}' and '{name_b}' describe different spans "
+                          f"({quantity.replace('_', ' ')} {show(a[quantity])} against "
+                          f"{show(b[quantity])}{(' ' + units) if units else ''}{where}): the "
+                          "shortest of their spans gives one span another's limit; design each "
+                          "span from its own results", CableSweepWarning, stacklevel=3)
+            return
 
 
 def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:

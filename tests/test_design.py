@@ -670,3 +670,41 @@ def test_several_results_name_every_one_that_fails_at_the_shortest(results):
     assert str(out["limited_in"].values) == "a.nc, b.nc"
     with pytest.raises(sweep.UserError, match="given twice"):
         governing_span([("a.nc", linear), ("a.nc", other)], min_frequency=40.0)
+
+
+def test_several_results_of_different_spans_are_warned_in_one_line(results):
+    """Results whose stored scenes describe different spans (the cable's mass, rigidities or
+    damping, the clamps) are warned of: the shortest of their spans gives one span another's
+    limit (a reviewer's bundle bound a second cable of a [points] result). The same cable
+    written from its data sheet is the same span: no warning."""
+    import warnings
+
+    from sweep.errors import CableSweepWarning
+    from sweep.governing import governing_span
+    linear, _ = results["linear"]
+    stored = sweep.load_scene_text(linear.attrs["scene"])
+
+    def with_scene(**overrides):
+        ds = linear.copy()
+        ds.attrs["scene"] = sweep.load_scene_text(stored.to_toml(), overrides=overrides).to_toml()
+        return ds
+    damped = with_scene(**{"cable.damping_ratio": 0.05})
+    with pytest.warns(CableSweepWarning, match=r"results 'a.nc' and 'b.nc' describe different "
+                      r"spans \(damping ratio"):
+        governing_span([("a.nc", linear), ("b.nc", damped)], min_frequency=40.0)
+    clamped = with_scene(**{"clamps.rotation": "clamped"})
+    with pytest.warns(CableSweepWarning, match=r"clamps rotation pinned against clamped"):
+        governing_span([("a.nc", linear), ("b.nc", clamped)], min_frequency=40.0)
+    v = stored.values
+    lines = [line for line in stored.to_toml().splitlines()
+             if not line.startswith(("youngs_modulus", "density", "area", "inertia"))]
+    at = lines.index("[cable]") + 1
+    lines[at:at] = [f"linear_mass = {v['cable.density'] * v['cable.area']!r}",
+                    f"bending_rigidity = {v['cable.youngs_modulus'] * v['cable.inertia']!r}",
+                    f"axial_rigidity = {v['cable.youngs_modulus'] * v['cable.area']!r}"]
+    sheet = linear.copy()
+    sheet.attrs["scene"] = "\n".join(lines) + "\n"
+    assert sweep.load_scene_text(sheet.attrs["scene"]).get("cable.linear_mass") is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CableSweepWarning)
+        governing_span([("a.nc", linear), ("b.nc", sheet)], min_frequency=40.0)
