@@ -708,3 +708,34 @@ def test_several_results_of_different_spans_are_warned_in_one_line(results):
     with warnings.catch_warnings():
         warnings.simplefilter("error", CableSweepWarning)
         governing_span([("a.nc", linear), ("b.nc", sheet)], min_frequency=40.0)
+
+
+def test_a_mode_with_a_node_at_midspan_that_moved_is_warned_in_one_line():
+    """A midspan criterion (--max-amplitude) passing a length where mode 2 (a node at
+    midspan) moved by more than 1 % of the midspan's amplitude warns in one line naming it (a
+    reviewer's 3-mode sweep: the stretching excited mode 2, the largest deflection along the
+    span 10.6 % above the midspan's); none where the even modes stayed at rest, and none for
+    --max-deflection, which reads the whole span."""
+    import warnings
+
+    from sweep.errors import CableSweepWarning
+    lengths = np.array([0.1, 0.2, 0.3])
+    amplitude = np.array([1e-3, 2e-3, 5e-3])
+    modal = np.array([[1e-3, 0.0, 1e-5], [2e-3, 4.5e-4, 2e-5], [5e-3, 1.4e-3, 5e-5]])
+    ds = xr.Dataset(
+        {"amplitude": ("length", amplitude, {"units": "m"}),
+         "max_deflection": ("length", amplitude * 1.1, {"units": "m"}),
+         "modal_amplitude": (("length", "mode"), modal, {"units": "m"}),
+         "state": ("length", np.full(3, 2, np.int8),
+                   {"flag_values": np.array([0, 1, 2], np.int8),
+                    "flag_meanings": "invalid_input decayed steady"})},
+        coords={"length": ("length", lengths, {"units": "m"}), "mode": [1, 2, 3]})
+    with pytest.warns(CableSweepWarning, match=r"at 1 passing grid span\(s\) a mode with a "
+                      r"node at midspan moved \(e\.g\. length 0\.2 m: 22\.5%"):
+        max_span(ds, max_amplitude=3e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CableSweepWarning)
+        max_span(ds, max_deflection=3e-3)
+        still = ds.copy(deep=True)
+        still["modal_amplitude"][:, 1] = 0.0
+        max_span(still, max_amplitude=3e-3)
