@@ -342,3 +342,17 @@ def test_bundle_keys_beside_a_data_sheet_without_a_wire_are_refused(extra):
         load(text)
     message = str(info.value)
     assert "cable.wire" in message and extra.split()[0] in message and "\n" not in message
+
+
+@pytest.mark.parametrize("key, value, words", [
+    ("cable.axial_rigidity", "1.65 mN", "is less than 1000 N: a harness cable's EA is kN to MN"),
+    ("cable.bending_rigidity", "0.1 N mm^2", "is less than 1e-06 N m^2"),
+    ("cable.linear_mass", "0.01 g/m", "is less than 0.0001 kg/m"),
+])
+def test_a_data_sheet_value_a_million_times_too_small_is_warned(key, value, words):
+    """A unit mistyped by 1e6 ('mN' for 'MN') gives a cable that silently does not stretch or
+    bend as a cable does: one warning line, the run still allowed (a reviewer's case)."""
+    from sweep.errors import CableSweepWarning
+    import re
+    with pytest.warns(CableSweepWarning, match=re.escape(words)):
+        sweep.load_scene("launch-random-gevs", overrides={key: value})

@@ -1117,19 +1117,34 @@ PLAUSIBLE = (
 """(key, largest plausible value, its unit as shown, the hint): a plain number is SI, and a
 data sheet's number typed without its unit lands far above these (a warning, not a refusal:
 the physics allows them)."""
+PLAUSIBLE_LOW = (
+    ("cable.length", 0.01, "m", "a clamp spacing is a few cm to a metre: was it in mm where m "
+     "were meant? write e.g. '150 mm'"),
+    ("cable.axial_rigidity", 1e3, "N", "a harness cable's EA is kN to MN: 'mN' is "
+     "milli-newtons, 'MN' mega; write e.g. '1.65 MN'"),
+    ("cable.bending_rigidity", 1e-6, "N m^2", "even a thin wire's EI is above 1e-5 N m^2: was "
+     "it in N mm^2? write e.g. '0.1 N m^2'"),
+    ("cable.linear_mass", 1e-4, "kg/m", "a harness wire weighs a gram or more a metre: write "
+     "e.g. '53.4 g/m'"),
+)
+"""(key, smallest plausible value, its unit as shown, the hint): a unit mistyped by a factor of
+1e6 ('mN' for 'MN') or a plain number in the wrong unit lands far below these (a warning:
+a stretching span whose EA is 1e-3 N does not stretch, silently)."""
 
 
 def _warn_implausible(values: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Warn, one line a key, where a key of PLAUSIBLE is above its largest plausible value at
     some point of the grid."""
-    for dotted, largest, units, hint in PLAUSIBLE:
-        axis = schema.BY_DOTTED[dotted].axis
-        if axis not in axes and values.get(dotted) is None:
-            continue
-        value = _extreme(values, axes, dotted, np.max)
-        if value > largest:
-            warnings.warn(f"{dotted} = {value:g} {units} (plain numbers are SI) is more than "
-                          f"{largest:g} {units}: {hint}", CableSweepWarning, stacklevel=5)
+    for table, extreme, beyond, word in ((PLAUSIBLE, np.max, np.greater, "more"),
+                                         (PLAUSIBLE_LOW, np.min, np.less, "less")):
+        for dotted, bound, units, hint in table:
+            axis = schema.BY_DOTTED[dotted].axis
+            if axis not in axes and values.get(dotted) is None:
+                continue
+            value = _extreme(values, axes, dotted, extreme)
+            if beyond(value, bound):
+                warnings.warn(f"{dotted} = {value:g} {units} (plain numbers are SI) is {word} "
+                              f"than {bound:g} {units}: {hint}", CableSweepWarning, stacklevel=5)
 
 
 def _check_transverse_resolved(values: dict[str, Any], axes: dict[str, np.ndarray],
