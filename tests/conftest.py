@@ -95,3 +95,17 @@ def fast_first(cases, fast) -> list:
     return [pytest.param(*(c if isinstance(c, tuple) else (c,)),
                          marks=() if c == fast else pytest.mark.slow)
             for c in cases]
+
+
+@pytest.fixture
+def ctrl_c_raises():
+    """SIGINT answered by Python's own handler (KeyboardInterrupt) for the test, as in an
+    interactive shell: a suite started in the background of a non-interactive shell (CI
+    scripts, `nohup`) inherits SIGINT ignored, and the tests that press Ctrl-C in-process
+    would see nothing. The handler before is restored after."""
+    import signal
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)

@@ -375,7 +375,7 @@ def test_sigterm_and_sighup_stop_like_ctrl_c(tmp_path, signum):
     assert list(store.glob("chunk-*.npz")) and not list(store.glob(".*.tmp"))
 
 
-def test_a_signal_during_the_final_write_waits_for_it():
+def test_a_signal_during_the_final_write_waits_for_it(ctrl_c_raises):
     """Ctrl-C, SIGTERM or SIGHUP while the finished run is written is held until the file is
     whole (an exception inside xarray's write left its file lock taken: the process hung in
     close), then reported; outside the write the handlers are the caller's again."""

@@ -122,7 +122,7 @@ class _Dwells:
 
 
 def test_a_stepped_resume_counts_the_lines_the_interrupt_kept_whole(tmp_path, monkeypatch,
-                                                                     capsys):
+                                                                     capsys, ctrl_c_raises):
     """Stopped after the up lines finished and the down lines began (one chunk of 6 lines:
     3 whole, 3 part-way), the interrupt's count and the resume's agree: 3 of 6 lines were
     already done (it said 0 of 6 done and 6 computed, the whole ones among those 'from where
@@ -144,7 +144,8 @@ def test_a_stepped_resume_counts_the_lines_the_interrupt_kept_whole(tmp_path, mo
 
 def test_a_stepped_run_stopped_mid_line_resumes_each_line_from_its_last_dwell(tmp_path,
                                                                              monkeypatch,
-                                                                             capsys):
+                                                                             capsys,
+                                                                             ctrl_c_raises):
     """An interrupt part-way along the lines keeps every finished dwell (the chunk's progress:
     outputs, dwells done, the carried state and phases), and --resume goes on from there: it
     solves only the dwells left, and the result is the same to the bit as a run never
