@@ -104,6 +104,17 @@ def _segment(u, p, o, s, n):
     return k
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _ramped(t, ramp, a, rate):
+    """(a, rate) of a level a (m/s^2) and its rate (m/s^3) at t (s) under the ramp's rise
+    (1 - cos(pi t / ramp)) / 2 over its first `ramp` seconds (RAMP), unchanged after."""
+    if t < ramp:
+        x = math.pi * t / ramp
+        rise = 0.5 - 0.5 * math.cos(x)
+        return a * rise, rate * rise + a * 0.5 * math.pi / ramp * math.sin(x)
+    return a, rate
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def acceleration_and_rate(t, p, o, s):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the sine kinds: A' sin(phi) + A w(t) cos(phi), A'
@@ -120,13 +131,7 @@ def acceleration_and_rate(t, p, o, s):
     u = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t
     k = _segment(u, p, o, s, n)
     a = math.exp(p[o + (LOG_LEVEL + k) * s] + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
-    rate = a * p[o + (SLOPE + k) * s] * p[o + RATE * s]
-    ramp = p[o + RAMP * s]
-    if t < ramp:
-        x = math.pi * t / ramp
-        rise = 0.5 - 0.5 * math.cos(x)
-        rate = rate * rise + a * 0.5 * math.pi / ramp * math.sin(x)
-        a *= rise
+    a, rate = _ramped(t, p[o + RAMP * s], a, a * p[o + (SLOPE + k) * s] * p[o + RATE * s])
     return a * math.sin(phi), rate * math.sin(phi) + a * w * math.cos(phi)
 
 
@@ -194,15 +199,7 @@ def record_and_rate(t, p, o, s, records):
     u2 = u * u
     slope = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * dt * d0
              + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) / dt
-    a = scale * _hermite(y0, d0, y1, d1, u, dt)
-    rate = scale * slope
-    ramp = p[o + RAMP * s]
-    if t < ramp:
-        x = math.pi * t / ramp
-        rise = 0.5 - 0.5 * math.cos(x)
-        rate = rate * rise + a * 0.5 * math.pi / ramp * math.sin(x)
-        a *= rise
-    return a, rate
+    return _ramped(t, p[o + RAMP * s], scale * _hermite(y0, d0, y1, d1, u, dt), scale * slope)
 
 
 def signal_and_rate(t, p, o, s, base):

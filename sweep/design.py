@@ -505,17 +505,29 @@ def _warn_unsettled(ds: xr.Dataset, like: xr.DataArray, passed: np.ndarray,
     weak = passed & unsettled
     if not weak.any():
         return
-    import warnings
+    i, j, at = _first(ds, like, weak, lengths)
+    _warn(f"design: {int(weak.sum())} passing grid span(s) are unsettled (e.g. {at}): "
+                  "their response still changed at the run's end, so their amplitude may not "
+                  "be the steady one (a parametric response still growing); run them longer "
+                  "(solver.t_end) before trusting max_span")
 
-    from .errors import CableSweepWarning
+
+def _first(ds: xr.Dataset, like: xr.DataArray, weak: np.ndarray, lengths: np.ndarray
+           ) -> tuple[int, int, str]:
+    """The first flagged (row, length) of `weak` (shaped like the design's rows x lengths) and
+    where it is, in words: its length and the other axes' values."""
     i, j = (int(k[0]) for k in np.nonzero(weak))
     where = ", ".join(f"{d} {_coordinate(ds, str(d)).values[k]}" for d, k in
                       zip(like.dims[:-1], np.unravel_index(i, like.shape[:-1])))
-    at = f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
-    warnings.warn(f"design: {int(weak.sum())} passing grid span(s) are unsettled (e.g. {at}): "
-                  "their response still changed at the run's end, so their amplitude may not "
-                  "be the steady one (a parametric response still growing); run them longer "
-                  "(solver.t_end) before trusting max_span", CableSweepWarning, stacklevel=3)
+    return i, j, f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
+
+
+def _warn(message: str) -> None:
+    """A design's caveat, one line (CableSweepWarning), reported at max_span's caller."""
+    import warnings
+
+    from .errors import CableSweepWarning
+    warnings.warn(message, CableSweepWarning, stacklevel=4)
 
 
 MIDSPAN_SHARE = 0.01
@@ -548,19 +560,13 @@ def _warn_off_midspan(ds: xr.Dataset, limits: Limits, like: xr.DataArray, passed
     weak = passed & (share > MIDSPAN_SHARE)
     if not weak.any():
         return
-    import warnings
-
-    from .errors import CableSweepWarning
-    i, j = (int(k[0]) for k in np.nonzero(weak))
-    where = ", ".join(f"{d} {_coordinate(ds, str(d)).values[k]}" for d, k in
-                      zip(like.dims[:-1], np.unravel_index(i, like.shape[:-1])))
-    at = f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
-    warnings.warn(f"design: at {int(weak.sum())} passing grid span(s) a mode with a node at "
+    i, j, at = _first(ds, like, weak, lengths)
+    _warn(f"design: at {int(weak.sum())} passing grid span(s) a mode with a node at "
                   f"midspan moved (e.g. {at}: {share[i, j]:.1%} of the midspan's amplitude, "
                   "modal_amplitude), which the midspan criteria ("
                   + ", ".join(midspan) + ") do not see: the largest deflection along the span "
                   "can be larger (a fixed-frequency run's max_deflection holds it: "
-                  "--max-deflection)", CableSweepWarning, stacklevel=3)
+                  "--max-deflection)")
 
 
 def _warn_unresolved(ds: xr.Dataset, limit: tuple[str, float, float | None],
@@ -582,22 +588,15 @@ def _warn_unresolved(ds: xr.Dataset, limit: tuple[str, float, float | None],
     weak = last & (estimate <= p) & ~(upper <= p)
     if not weak.any():
         return
-    import warnings
-
-    from .errors import CableSweepWarning
     from .models.random_outputs import CONFIDENCE
-    i, j = (int(k[0]) for k in np.nonzero(weak))
-    where = ", ".join(f"{d} {_coordinate(ds, str(d)).values[k]}" for d, k in
-                      zip(like.dims[:-1], np.unravel_index(i, like.shape[:-1])))
-    at = f"length {lengths[j]:g} m" + (f" at {where}" if where else "")
-    warnings.warn(f"design: --clearance {level:g}: {int(weak.sum())} span(s) rest on a grid "
+    i, j, at = _first(ds, like, weak, lengths)
+    _warn(f"design: --clearance {level:g}: {int(weak.sum())} span(s) rest on a grid "
               f"length with too few crossings to vouch for a probability <= {p:g} (e.g. {at}: "
               f"exceedance_probability {estimate[i, j]:.3g}, its {CONFIDENCE:.0%} upper bound "
               f"{upper[i, j]:.3g}; exceedance_probability_upper), so max_span may be long: "
               f"counting vouches for it only once the records without a crossing are "
               f"{3.0 / -math.log1p(-p):.3g} times the test's duration; more realisations "
-              "(base.realisations) narrow it",
-              CableSweepWarning, stacklevel=3)
+              "(base.realisations) narrow it")
 
 
 def _margins(ds: xr.Dataset, fmin: float | None, limits: Limits,
