@@ -71,7 +71,8 @@ def _window_statistics(sol, weights, t0, t1, n_modes, rhs, record, fs, gamma):
 @pytest.mark.parametrize("n_modes, drivers, ramp", [(1, ("scalar", "lanes"), 0.0),
                                                     (3, ("scalar", "lanes"), 0.0),
                                                     (1, ("lanes",), 0.25),
-                                                    (3, ("scalar",), 0.25)])
+                                                    pytest.param(3, ("scalar",), 0.25,
+                                                                 marks=pytest.mark.slow)])
 def test_one_realisation_matches_scipy_on_the_same_record(n_modes, drivers, ramp):
     """A 0.3 m span with the paper's membrane stretching (strongly nonlinear at this level:
     the linear RMS is 1.27x the nonlinear one), 1 s of one record: RMS deflection and velocity
