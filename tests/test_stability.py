@@ -138,3 +138,16 @@ def test_stability_without_a_period_is_refused_in_one_line(text, words):
         sweep.load_scene_text(text)
     message = str(info.value)
     assert "\n" not in message and all(w in message for w in words), message
+
+
+def test_points_without_a_floquet_answer_are_warned_with_the_reason():
+    """A load frequency so low that one period needs more steps than the kernel takes gives
+    invalid_input at those points (the rest of the chart answers) and one warning line
+    saying why and what to keep (a reviewer found the flag alone, without a reason)."""
+    from sweep.errors import CableSweepWarning
+    scene = sweep.load_scene("harness-stability",
+                             overrides={"axes.frequency_ratio": [2e-5, 2.0]})
+    with pytest.warns(CableSweepWarning, match=r"have no Floquet answer .* W/w1 down to 2e-05"):
+        ds = sweep.run(scene, progress=False)
+    kinds = ds.stability.transpose("frequency_ratio", ...).values
+    assert np.all(kinds[0] == -1) and np.all(kinds[1] >= 0)

@@ -210,6 +210,32 @@ def _per_mode_points(per_point: dict[str, np.ndarray], n_modes: int, threads: in
     return best, growth, kind, np.where(bad, 0, mode)
 
 
+def _warn_unanswered(kind: np.ndarray, per_point: dict[str, np.ndarray]) -> None:
+    """Warn (one line) where points have no Floquet answer (kind -1, invalid_input) though
+    their inputs are finite, saying why: one load period needs more than the kernel's
+    MAX_STEPS steps (a load this slow, W/w1 below about 4e-5, is quasi-static: the span
+    buckles where P0 exceeds Pcr), or the damping decays the monodromy over one period past
+    double precision (zeta w1 T of several hundred)."""
+    finite = np.all([np.isfinite(v) for v in per_point.values()], axis=0)
+    bad = (kind < 0) & finite & (per_point["omega"] > 0.0)
+    if not bad.any():
+        return
+    import warnings
+
+    from ..errors import CableSweepWarning
+    with np.errstate(all="ignore"):
+        w1 = np.sqrt(per_point["k0"] / per_point["mass"])
+        ratio = per_point["omega"] / w1
+        decay = np.pi * per_point["damping"] / (per_point["mass"] * per_point["omega"])
+    warnings.warn(f"{int(bad.sum())} of {kind.size} points have no Floquet answer "
+                  f"(stability invalid_input) at W/w1 down to {float(np.min(ratio[bad])):.3g} "
+                  f"and zeta w1 T up to {float(np.max(decay[bad])):.3g}: one load period too "
+                  "long for the kernel's steps (a load this slow is quasi-static: the span "
+                  "buckles where P0 exceeds Pcr) or too damped for double precision (the "
+                  "span is stable there); keep W/w1 above 1e-4", CableSweepWarning,
+                  stacklevel=5)
+
+
 def stability_outputs(coeffs: dict[str, Any], dims: tuple[str, ...], shape: tuple[int, ...],
                       n_modes: int, threads: int = 0) -> dict[str, xr.DataArray]:
     """The Floquet outputs of every grid point (module docstring): coeffs are modal.oscillator's
@@ -225,6 +251,7 @@ def stability_outputs(coeffs: dict[str, Any], dims: tuple[str, ...], shape: tupl
     best, growth, kind, mode = (_coupled_points if coupled else _per_mode_points)(
         per_point, n_modes, threads)
     kind = kind.astype(np.int8)
+    _warn_unanswered(kind, per_point)
     out = {
         "floquet_multiplier": xr.DataArray(best.reshape(shape), dims=dims, attrs={
             "units": "1", "long_name": "largest Floquet multiplier |lambda| of the straight span "
