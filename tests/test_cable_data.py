@@ -128,7 +128,8 @@ def test_an_angle_where_the_key_has_none_is_refused_and_data_sheet_spellings_rea
 @pytest.mark.parametrize("text, words", [
     ("53,4 g/m", "comma"), ("1,000 g/m", "comma"), ("53.4 g/m 2", "inside its unit"),
     ("53.4 g/m + 1 g/m", "inside its unit"), ("53.4 g/m - 1 g/m", "inside its unit"),
-    ("2 53.4 g/m", "inside its unit")])
+    ("2 53.4 g/m", "inside its unit"), ("g/m", "does not start with a number"),
+    ("kg", "does not start with a number")])
 def test_a_unit_string_is_one_number_and_its_unit_not_arithmetic(text, words):
     """pint would compute these ('53,4 g/m' as 534 g/m: a European data sheet's decimal comma
     made the mass 10x): each is refused in one line naming the key."""

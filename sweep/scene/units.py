@@ -152,8 +152,8 @@ def _unit_text(where: str, text: str, example: str) -> str:
         _fail(where, f"{_show(text)} has a comma (a decimal comma or a thousands separator "
               "reads as another number)", fix)
     number = _LEADING_NUMBER.match(text)
-    if number is None:
-        return text                      # not a number first: pint's message, below
+    if number is None:                   # pint would read a unit alone as 1 of it ('a': a year)
+        _fail(where, f"{_show(text)} does not start with a number", fix)
     unit = _powers(" ".join(text[number.end():].split()))
     unit = _MIL.sub("thou", unit)        # a data sheet's mil, 1/1000 inch (pint's is an angle)
     unit = _NEWTON_METRE.sub("N m", unit)    # pint's Nm is a "number metre"
