@@ -325,7 +325,8 @@ def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, caps
     ("coarse", [], "no criterion"),
     ("no_length", ["--min-frequency", "100"], "length"),
     ("coarse", ["--max-amplitude", "1e-3", "--quantity", "nonesuch"], "nonesuch"),
-    ("coarse", ["--min-frequency", "abc"], "unknown unit"),
+    ("coarse", ["--min-frequency", "abc"], "does not start with a number"),
+    ("coarse", ["--min-frequency", "100 hz_x"], "unknown unit"),
     ("coarse", ["--max-strain", "1e-3"], "max_strain"),
     ("swept", ["--max-strain", "-1"], "positive"),
 ])
