@@ -106,8 +106,9 @@ def set_settings(settings: np.ndarray, random: RandomInputs, coeffs: dict[str, A
     """A random scene's kernel settings: no settling time, and the clearance levels whose
     crossings the kernels count. The statistics window is metrics.tail's (TAIL, the whole run
     by default), each point's starting no earlier than its own start-up transient's end (its
-    row's RECORD_START, sweep/models/modal.py); a run too short for the least-damped point is
-    refused (`random_scene.check_duration`)."""
+    row's RECORD_START, sweep/models/modal.py); a point whose start-up outlasts the run is
+    flagged invalid_input with a warning (`random_scene.warn_long_startups`), and a run in
+    which no point has a window is refused (`random_scene.check_duration`)."""
     starts = random_scene.transient_time(2.0 * math.pi * coeffs["natural_frequency"],
                                          params["damping_ratio"], tolerance, random.ramp)
     random_scene.check_duration(random.t_end, float(np.min(np.asarray(starts, float))),

@@ -222,7 +222,8 @@ def warn_long_startups(t_end: float, startups: Any) -> None:
            if math.isfinite(worst) else "give them damping (cable.damping_ratio > 0)")
     warnings.warn(f"{int(long.sum())} of {starts.size} span settings start up for longer than "
                   f"{STARTUP_SHARE:.0%} of the {t_end:g} s run (up to {worst:.3g} s: "
-                  "ln(1/metrics.tolerance) / (zeta w1) of a long, lightly damped span): their "
+                  "base.ramp plus ln(1/metrics.tolerance) / (zeta w1) of a long, lightly "
+                  "damped span): their "
                   f"points are flagged invalid_input, the others run; {fix}",
                   CableSweepWarning, stacklevel=5)
 
