@@ -89,10 +89,7 @@ def level(t, p, o, s):
     u = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t
     k = _segment(u, p, o, s, n)
     a = math.exp(p[o + (LOG_LEVEL + k) * s] + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
-    ramp = p[o + RAMP * s]
-    if t < ramp:
-        a *= 0.5 - 0.5 * math.cos(math.pi * t / ramp)
-    return a
+    return a * _rise(t, p[o + RAMP * s])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -105,13 +102,21 @@ def _segment(u, p, o, s, n):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _ramped(t, ramp, a, rate):
-    """(a, rate) of a level a (m/s^2) and its rate (m/s^3) at t (s) under the ramp's rise
-    (1 - cos(pi t / ramp)) / 2 over its first `ramp` seconds (RAMP), unchanged after."""
+def _rise(t, ramp):
+    """The ramp's rise at t (s): (1 - cos(pi t / ramp)) / 2 over its first `ramp` seconds
+    (RAMP; base.ramp or a sweep's ramp_cycles), 1 after (and with no ramp)."""
     if t < ramp:
-        x = math.pi * t / ramp
-        rise = 0.5 - 0.5 * math.cos(x)
-        return a * rise, rate * rise + a * 0.5 * math.pi / ramp * math.sin(x)
+        return 0.5 - 0.5 * math.cos(math.pi * t / ramp)
+    return 1.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _ramped(t, ramp, a, rate):
+    """(a, rate) of a level a (m/s^2) and its rate (m/s^3) at t (s) under the ramp's
+    `_rise`, unchanged after it."""
+    if t < ramp:
+        rise = _rise(t, ramp)
+        return a * rise, rate * rise + a * 0.5 * math.pi / ramp * math.sin(math.pi * t / ramp)
     return a, rate
 
 
@@ -184,11 +189,7 @@ def record_acceleration(t, p, o, s, records):
     p[o + RECORD_SCALE * s], and over the first RAMP seconds (base.ramp; 0: none) by the
     ramp's (1 - cos(pi t / RAMP)) / 2, as a shaker brings its level up."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
-    a = scale * _hermite(y0, d0, y1, d1, u, dt)
-    ramp = p[o + RAMP * s]
-    if t < ramp:
-        a *= 0.5 - 0.5 * math.cos(math.pi * t / ramp)
-    return a
+    return scale * _hermite(y0, d0, y1, d1, u, dt) * _rise(t, p[o + RAMP * s])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
