@@ -78,7 +78,9 @@ CURVATURE_M0 = RMS_RELATIVE + 1  # several modes, with the loads observed: the m
                     # sum phi_n''(0) q_n (m^2); + 1: of its rate (m^2/s^2); + 2: of its second
                     # derivative (m^2/s^4): c's spectral moments m0, m2, m4
 MID_CURVATURE_M0 = CURVATURE_M0 + 3  # the same three of the midspan's, sum phi_n''(1/2) q_n
-N_REALS = MID_CURVATURE_M0 + 3
+SPAN_PLACE = MID_CURVATURE_M0 + 3  # multi-mode: where SPAN_MAX occurred, x / l (0 to 1, from
+                    # the clamp at x = 0); NaN for one mode
+N_REALS = SPAN_PLACE + 1
 
 # Columns of the `counts` output.
 STEPS = 0           # accepted steps

@@ -31,7 +31,7 @@ from . import oscillator as osc
 from . import trajectory as tj
 from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, CURVATURE_M0, FAILURE_TIME,
                      FIRST_STEP, MAX_STEP, LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PEAK, PERIOD, RHS_EVALS, RTOL, SETTLING,
-                     SPAN_MAX, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
+                     SPAN_MAX, SPAN_PLACE, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
 from .transverse import classify_metrics, swept_outputs
 
 NODE = 1e-9          # a mode whose |phi(1/2)| is below this (shapes of unit scale) has a node
@@ -199,8 +199,9 @@ def modal_size(n_modes):
     (square_slot(N) + 0..2, + 3..5; m^2 s, m^2/s, m^2/s^3; `_observe_bend_squares`); the end
     load's factors for the clamp's reaction (end_load_slot(N) + 0..3: kernels.modes
     `end_load_factors`); the base inertia's factor for it (inertia_slot(N), s^2:
-    kernels.modes.inertia_factor; 0 without base excitation)."""
-    return 3 * n_modes + 20
+    kernels.modes.inertia_factor; 0 without base excitation); the place of slot 2N's
+    deflection, x* / l (place_slot(N); 1/2 until one is found)."""
+    return 3 * n_modes + 21
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -243,6 +244,13 @@ def inertia_slot(n_modes):
     """The slot of the base inertia's factor (kernels.modes.inertia_factor) in the
     accumulator."""
     return 3 * n_modes + 19
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def place_slot(n_modes):
+    """The slot of x* / l, the place of the span's largest deflection (slot 2N), in the
+    accumulator."""
+    return 3 * n_modes + 20
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -414,6 +422,7 @@ def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
             best = where
     if top > modal[2 * n]:
         modal[2 * n] = top
+        modal[place_slot(n)] = best
     else:
         best = -1.0
     if best >= 0.0:
@@ -687,6 +696,7 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
     for i in range(n_modes):
         modal[i] = 0.0
     modal[2 * n_modes] = 0.0
+    modal[place_slot(n_modes)] = 0.5
     for k in range(6):
         modal[clamp_slot(n_modes) + k] = 0.0
     _observe_modes(t, t_new, acc[tj.T_TAIL], y, y_new, K, h, n_modes, eighth, modal, Km, QA,
@@ -710,9 +720,7 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
     n = n_modes
     if state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS:
         return state
-    final = md.span_maximum(y, n, basis)
-    reals[SPAN_MAX] = max(modal[2 * n], final, reals[AMPLITUDE])
-    load_columns(modal, n, reals)
+    span_columns(modal, y, n, reals, basis)
     peak = 0.0
     for i in range(n):
         peak = max(peak, modal[n + i])
@@ -728,6 +736,28 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
         if state == mt.STEADY and _hidden(basis, i) and modal[i] > HIDDEN_FLOOR * peak:
             return mt.HIDDEN_MODE
     return state
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def span_columns(modal, y, n_modes, reals, basis):
+    """reals[SPAN_MAX], the largest deflection over the span in the tail window (m; a sine
+    sweep's: over the whole sweep), and reals[SPAN_PLACE], its place x* / l: modal[2N] at
+    its place (`_observe_modes`), the span at the final state y (a growing response peaks
+    there) and at least the midspan amplitude (reals[AMPLITUDE], at 1/2); then the loads'
+    columns (`load_columns`). basis: the span's (kernels.modes)."""
+    n = n_modes
+    top = modal[2 * n]
+    place = modal[place_slot(n)]
+    final, where = md.span_argmax(y, n, basis)
+    if final > top:
+        top = final
+        place = where
+    if reals[AMPLITUDE] > top:
+        top = reals[AMPLITUDE]
+        place = 0.5
+    reals[SPAN_MAX] = top
+    reals[SPAN_PLACE] = place
+    load_columns(modal, n, reals)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -784,7 +814,10 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     for i in range(n):
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
         modal[n + i] = abs(y[i])
-    modal[2 * n] = md.span_maximum(y, n, basis) if t_tail <= 0.0 else 0.0
+    modal[2 * n] = 0.0
+    modal[place_slot(n)] = 0.5
+    if t_tail <= 0.0:
+        modal[2 * n], modal[place_slot(n)] = md.span_argmax(y, n, basis)
     curvature = basis[md.CLAMPS]
     t_loads = 0.0 if settings[LOADS] == WHOLE_RUN else t_tail
     for e in range(md.N_BENDS):
@@ -958,7 +991,7 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
     if settings[SWEPT] != 0.0:
         state = swept_outputs(row, md.EXCITATION, 1, settings, acc, buf, state, reals, envelope)
         if not (state == mt.DIVERGED or state == mt.STEP_TOO_SMALL or state == mt.MAX_STEPS):
-            load_columns(ext, n_modes, reals)
+            span_columns(ext, y, n_modes, reals, basis)
     else:
         state = span_state(state, ext, y, n_modes, settings, reals, basis)
     if ex.is_record(base) and state == mt.COMPLETED:

@@ -280,13 +280,6 @@ def shape_at(shapes, i, x):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def span_maximum(q, n_modes, basis):
-    """max over the span 0 <= x <= l of |w(x)|, w = sum_n q_n phi_n(x / l) (m), for the
-    modal coefficients q[0..N-1] (m): `span_argmax`'s."""
-    return span_argmax(q, n_modes, basis)[0]
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
 def span_argmax(q, n_modes, basis):
     """(max over the span of |w(x)| (m), its x / l) for the modal coefficients q[0..N-1]
     (m), w = sum_n q_n phi_n(x / l): the values at the basis' stations (8 per half-wave of

@@ -150,7 +150,8 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
         else:
             raise UserError("design: --max-deflection needs the variable 'max_deflection' "
                             "(m, the largest deflection over the span), which this result "
-                            "lacks (a sine sweep has none; use --max-amplitude)")
+                            "lacks (a sine sweep of several modes written before 2026-12-05 "
+                            "has none: run it again, or use --max-amplitude)")
     if max_strain is not None:
         if "max_strain" not in ds:
             raise UserError("design: --max-strain needs the variable 'max_strain' (bending "

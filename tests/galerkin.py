@@ -194,10 +194,20 @@ def span_tail_maximum(sol: OdeSolution, n_modes: int, t_end: float, tail: float 
                       fastest_hz: float = 1.0, samples_per_period: int = 64,
                       stations: int = 801) -> float:
     """max |w(x, t)| = |sum_n q_n(t) sin(n pi x / l)| (m) over the span and the tail window
-    [t_end (1 - tail), t_end] (s) of a dense output, by brute force: on a grid of
-    samples_per_period instants per period of the fastest motion (fastest_hz, Hz) plus the
-    step ends, times `stations` equally spaced stations, then refined from the best few grid
-    points by Nelder-Mead in (t, x), kept inside the window and the span."""
+    [t_end (1 - tail), t_end] (s) of a dense output: `span_tail_argmax`'s value."""
+    return span_tail_argmax(sol, n_modes, t_end, tail, fastest_hz, samples_per_period,
+                            stations)[0]
+
+
+def span_tail_argmax(sol: OdeSolution, n_modes: int, t_end: float, tail: float = 0.5,
+                     fastest_hz: float = 1.0, samples_per_period: int = 64,
+                     stations: int = 801) -> tuple[float, float]:
+    """(max |w(x, t)| (m), its place x / l) over the span and the tail window
+    [t_end (1 - tail), t_end] (s) of a dense output, w = sum_n q_n(t) sin(n pi x / l), by brute
+    force: on a grid of samples_per_period instants per period of the fastest motion
+    (fastest_hz, Hz) plus the step ends, times `stations` equally spaced stations, then refined
+    from the best few grid points by Nelder-Mead in (t, x), kept inside the window and the
+    span."""
     from scipy.optimize import minimize
     t0 = t_end * (1.0 - tail)
     grid = np.linspace(t0, t_end, int(samples_per_period * fastest_hz * (t_end - t0)) + 2)
@@ -213,13 +223,15 @@ def span_tail_maximum(sol: OdeSolution, n_modes: int, t_end: float, tail: float 
         xi = min(max(z[1], 0.0), 1.0)
         return -abs(float(sol(s)[:n_modes] @ np.sin(n * math.pi * xi)))
 
-    best = float(w.max())
+    i, j = np.unravel_index(int(np.argmax(w)), w.shape)
+    best, place = float(w[i, j]), float(x[j])
     for flat in np.argsort(w, axis=None)[-5:]:
         i, j = np.unravel_index(flat, w.shape)
         found = minimize(deflection, np.array([t[i], x[j]]), method="Nelder-Mead",
                          options={"xatol": 1e-13, "fatol": 1e-18, "maxiter": 4000})
-        best = max(best, -float(found.fun))
-    return best
+        if -float(found.fun) > best:
+            best, place = -float(found.fun), min(max(float(found.x[1]), 0.0), 1.0)
+    return best, place
 
 
 def absolute_tail_maximum(sol: OdeSolution, f: Callable, n_modes: int, base_acceleration: float,

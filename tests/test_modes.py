@@ -35,7 +35,7 @@ from sweep.errors import UserError
 
 from conftest import fast_first
 from galerkin import (Cable, Projection, absolute_tail_maximum, galerkin_rhs, integrate,
-                      participation, span_tail_maximum, tail_maxima)
+                      participation, span_tail_argmax, tail_maxima)
 
 E = 1.1e11                     # Young's modulus, Pa
 RHO = 8900.0                   # density, kg/m^3
@@ -370,10 +370,10 @@ def test_mode_2_grows_in_its_principal_parametric_tongue_only(driver):
 
 @pytest.mark.parametrize("n_modes", [1, 2, 3, 6])
 def test_span_maximum_is_the_dense_grids_maximum(n_modes):
-    """kernels.modes.span_maximum (stations and Newton) against 200001 equally spaced stations
+    """kernels.modes.span_argmax (stations and Newton) against 200001 equally spaced stations
     for random modal coefficients: never above the grid's maximum by more than the grid's own
     miss (at most |w''| (dx / 2)^2 / 2, |w''| <= sum |q_n| (n pi)^2), never below it by more
-    than 1e-12 relative."""
+    than 1e-12 relative; its place is where w has that value."""
     from sweep.kernels import modes as md
     rng = np.random.default_rng(n_modes)
     x = np.linspace(0.0, 1.0, 200001)
@@ -383,10 +383,12 @@ def test_span_maximum_is_the_dense_grids_maximum(n_modes):
     for _ in range(200):
         q = rng.normal(size=n_modes) * rng.choice([1e-6, 1e-3, 1.0], size=n_modes)
         grid = float(np.max(np.abs(q @ shapes)))
-        value = md.span_maximum(q, n_modes, basis)
+        value, place = md.span_argmax(q, n_modes, basis)
         miss = np.sum(np.abs(q) * (np.arange(1, n_modes + 1) * math.pi) ** 2) \
             * (0.5 * (x[1] - x[0])) ** 2 / 2
         assert grid * (1 - 1e-12) <= value <= grid + miss, (q, value, grid)
+        at_place = abs(q @ np.sin(np.arange(1, n_modes + 1) * math.pi * place))
+        assert at_place == pytest.approx(value, rel=1e-12, abs=1e-300), (q, place)
 
 
 SPAN_CASES = {
@@ -407,13 +409,15 @@ def test_max_deflection_is_the_largest_over_span_and_tail(name, method):
     """max_deflection (m) against tests/galerkin.py's dense output searched by brute force
     over the span and the tail window (a grid of instants and 801 stations, then Nelder-Mead
     in (t, x)), rtol 1e-10: within 1e-7 relative (measured: 2.4e-9 at worst), and 4.6-32 %
-    above the midspan amplitude in every case (so the midspan could not pass for it)."""
+    above the midspan amplitude in every case (so the midspan could not pass for it); its
+    place (max_deflection_position, m from the nearer clamp) within 1e-3 l of the search's."""
     c = SPAN_CASES[name]
     n = len(c["q0"])
     cable = Cable(length=LENGTH, damping_ratio=c["zeta"])
     sol = integrate(cable, n, c["q0"] + [0.0] * n, SPAN_T_END, max(c["q0"]),
                     load_amplitude=c["load"], load_omega=c["ratio"] * cable.w1)
-    ref = span_tail_maximum(sol, n, SPAN_T_END, 0.5, fastest_hz=n ** 2 * cable.w1 / (2 * math.pi))
+    ref, place = span_tail_argmax(sol, n, SPAN_T_END, 0.5,
+                                  fastest_hz=n ** 2 * cable.w1 / (2 * math.pi))
     values = {"model.modes": n, "cable.damping_ratio": c["zeta"], "load.amplitude": c["load"],
               "solver.t_end": SPAN_T_END, "solver.rtol": 1e-10, "solver.method": method,
               "metrics.tail": 0.5, "initial.modal_displacement": c["q0"]}
@@ -424,13 +428,75 @@ def test_max_deflection_is_the_largest_over_span_and_tail(name, method):
     largest = float(ds["max_deflection"].values[0])
     assert abs(largest / ref - 1.0) < 1e-7, (largest, ref)
     assert largest > 1.04 * float(ds["amplitude"].values[0])
+    position = ds["max_deflection_position"]
+    assert position.attrs["units"] == "m"
+    assert abs(float(position.values[0]) - min(place, 1.0 - place) * LENGTH) < 1e-3 * LENGTH
 
 
-def test_one_mode_and_sweeps_store_no_max_deflection():
+SWEPT_T = dict(start=100.0, stop=180.0, rate=60.0, ramp_cycles=10.0)   # Hz, Hz, oct/min, 1
+
+
+def test_a_sine_sweeps_largest_deflection_over_the_span():
+    """A log sweep of three modes through mode 3's resonance (9 f1 = 137 Hz, the clamps at
+    2 g): max_deflection over the whole sweep and its place against tests/galerkin.py's
+    equations under the same swept base (MODEL.md sec. 6: f_s 2^(r t / 60), the level's
+    (1 - cos)/2 rise over ramp_cycles / f_s) integrated by SciPy DOP853 and searched by brute
+    force over the sweep and the span: within 1e-6 relative, and well above the midspan's
+    peak_amplitude (8.6 % above it: mode 3 moves the crest off midspan)."""
+    s = SWEPT_T
+    zeta, accel = 0.01, 2.0 * G
+    cable = Cable(length=LENGTH, damping_ratio=zeta)
+    lam = s["rate"] * math.log(2.0) / 60.0
+    duration = math.log(s["stop"] / s["start"]) / lam
+    rise = s["ramp_cycles"] / s["start"]
+    proj = Projection(cable, 3)
+    damping = 2.0 * zeta * cable.w1 * np.arange(1, 4) ** 2
+    gamma = participation(3)
+
+    def rhs(t, y):
+        ramp = 0.5 - 0.5 * math.cos(math.pi * t / rise) if t < rise else 1.0
+        a_b = accel * ramp * math.sin(2.0 * math.pi * s["start"] * math.expm1(lam * t) / lam)
+        return np.concatenate((y[3:], -damping * y[3:] - proj.force(y[:3], 0.0) - gamma * a_b))
+
+    from scipy.integrate import solve_ivp
+    sol = solve_ivp(rhs, (0.0, duration), np.zeros(6), method="DOP853", rtol=1e-11,
+                    atol=np.r_[np.full(3, 1e-15), np.full(3, 1e-12)], dense_output=True)
+    assert sol.success
+    ref, place = span_tail_argmax(sol.sol, 3, duration, 1.0, fastest_hz=s["stop"])
+    ds = sweep.load_scene_text(f"""name = "swept-span"
+[model]
+modes = 3
+membrane = 0.375
+[cable]
+youngs_modulus = {E!r}
+density = {RHO!r}
+area = {AREA!r}
+inertia = {INERTIA!r}
+length = {LENGTH!r}
+damping_ratio = {zeta!r}
+[load]
+amplitude = 0.0
+[base]
+acceleration = {accel!r}
+sweep = {{ start = {s['start']!r}, stop = {s['stop']!r}, rate = {s['rate']!r}, ramp_cycles = {s['ramp_cycles']!r} }}
+[solver]
+rtol = 1e-10
+""")
+    ds = sweep.run(ds)
+    largest = float(ds["max_deflection"])
+    assert "whole sweep" in ds["max_deflection"].attrs["long_name"]
+    assert abs(largest / ref - 1.0) < 1e-6, (largest, ref)
+    assert largest > 1.05 * float(ds["peak_amplitude"])     # measured 1.086
+    nearer = min(place, 1.0 - place) * LENGTH
+    assert abs(float(ds["max_deflection_position"]) - nearer) < 1e-3 * LENGTH
+    assert nearer < 0.45 * LENGTH                     # off midspan
+
+
+def test_one_mode_stores_no_max_deflection():
     """One mode: the largest deflection is the midspan's (amplitude), so no second copy."""
     ds = sweep.run(scene({"model.modes": 1, "solver.t_end": 0.05,
                           "initial.modal_displacement": [1e-4]}))
-    assert "max_deflection" not in ds
+    assert "max_deflection" not in ds and "max_deflection_position" not in ds
 
 
 # ------------------------------------------------------------------------------ 7. refusals

@@ -395,6 +395,25 @@ def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
     return out
 
 
+def span_outputs(reals: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...],
+                 swept: bool, length: xr.DataArray) -> dict[str, xr.DataArray]:
+    """Several modes: the largest deflection anywhere on the span (`max_deflection`, m, over
+    the tail window; a sine sweep's over the whole sweep) and its distance from the nearer
+    clamp (`max_deflection_position`, m; l/2 at midspan), from the kernels' SPAN_MAX and
+    SPAN_PLACE (x / l) columns; length: the span (m) on the result's axes."""
+    window = "the whole sweep" if swept else "the tail window"
+    place = reals[:, tk.SPAN_PLACE].reshape(shape)
+    nearer = xr.DataArray(np.minimum(place, 1.0 - place), dims=dims)
+    return {
+        "max_deflection": xr.DataArray(
+            reals[:, tk.SPAN_MAX].reshape(shape), dims=dims,
+            attrs={"units": "m", "long_name": "largest deflection anywhere on the span: max "
+                   f"|w(x, t)| over 0 <= x <= l and {window} (amplitude is the midspan's)"}),
+        "max_deflection_position": (nearer * length).assign_attrs(
+            units="m", long_name="where the largest deflection (max_deflection) occurred: "
+            "its distance from the nearer clamp (half the span: at midspan)")}
+
+
 def _one_mode(inputs: Any, coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
               reals: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...]
               ) -> loads.OneMode:
@@ -889,12 +908,10 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
             attrs = data["modal_amplitude"].attrs
             attrs["long_name"] = attrs["long_name"].replace("over the tail window",
                                                             "over the whole sweep")
-        if not inputs.swept and "outputs.amplitude" in inputs.wanted:
-            data["max_deflection"] = xr.DataArray(
-                result.reals[:, tk.SPAN_MAX].reshape(shape), dims=dims,
-                attrs={"units": "m", "long_name": "largest deflection anywhere on the span: "
-                       "max |w(x, t)| over 0 <= x <= l and the tail window (amplitude is the "
-                       "midspan's)"})
+        midspan = "outputs.peak_amplitude" if inputs.swept else "outputs.amplitude"
+        if midspan in inputs.wanted:                 # the span's beside the midspan's
+            data.update(span_outputs(result.reals, dims, shape, inputs.swept,
+                                     derived(inputs.params["length"], coords)))
     if inputs.settings[tk.LOADS] != 0.0:
         data.update(loads.load_outputs(
             inputs.params, result.reals, result.modal is not None, dims, shape, coords,
