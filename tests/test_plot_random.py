@@ -193,3 +193,19 @@ def test_asd_draws_the_response_over_the_input_spectrum(result):
     quiet = splot.plot_asd(ds, select={"base_asd_scale": -3.0})
     x, y = _lines(quiet, "base_asd_g2")[0].get_data()
     assert max(y) == pytest.approx(0.16 * 10 ** -0.3, rel=1e-9)
+
+
+def test_parameter_sets_are_points_not_a_curve():
+    """A random result over [points] (separate cables, not an ordered axis): markers with
+    error bars and no line between the sets, the x ticks naming each set's values."""
+    scene = sweep.load_scene("launch-random-gevs", {
+        "points.length": [0.1, 0.15, 0.2], "base.realisations": 2,
+        "base.duration": 2.0, "axes.base_asd_scale": [0.0]})
+    ds = sweep.run(scene, progress=False)
+    assert "point" in ds.dims
+    fig = splot.plot(ds)["rms"]
+    ax = fig.axes[0]
+    for line in _lines(fig, "rms_deflection_mean") + _lines(fig, "linear_rms"):
+        assert line.get_linestyle() == "None" and line.get_marker() not in (None, "None")
+    assert [t.get_text().split("\n")[0] for t in ax.get_xticklabels()] == ["0", "1", "2"]
+    assert "length" in ax.get_xlabel() and "parameter set" in ax.get_xlabel()

@@ -459,8 +459,9 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
         data["clearance_upcrossings"] = counted.assign_attrs(
             units="1", long_name="up-crossings of the clearance level by |midspan deflection| "
             "counted over the statistics windows of the realisations that did not escape (the "
-            "count behind expected_exceedances: its relative standard error is about "
-            "1 / sqrt(count))")
+            "count behind expected_exceedances: its relative standard error is at least "
+            "1 / sqrt(count), and several times that where crossings come in clumps, as a "
+            "narrow-band response crosses a high level on successive cycles)")
         with np.errstate(divide="ignore", invalid="ignore"):
             expected = counted / observed * random.test_duration
         data["expected_exceedances"] = expected.assign_attrs(
@@ -501,5 +502,5 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
     realised = xr.DataArray(realised_grms(records, random), dims=REALISATION_DIM)
     data["base_grms"] = (level * realised).assign_attrs(
         units=G_UNITS, long_name="RMS base acceleration of the record over the run (grms "
-                                 "as realised)")
+                                 "as realised and shaken: with base.ramp, its rise counted)")
     return data, extra

@@ -27,7 +27,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from ..errors import UserError
-from .labels import _point_text, _title, label
+from .labels import POINT_DIM, _point_text, _title, label, point_ticks
 from .result import (ASD_FREQUENCY_DIM, CLEARANCE_DIM, REALISATION_DIM, select_points,
                      swept_axes)
 from .style import _legend, _new_axes, _plain_ticks, _unit
@@ -86,21 +86,28 @@ def _prepare(ds: xr.Dataset, select: Mapping[str, Any] | None,
 
 def _mean_with_band(ax: Axes, ds: xr.Dataset, x: str, level: str | None, name: str) -> list:
     """`NAME_mean` against `x` (a line with markers per level) and `NAME_ci` as a band of the
-    same colour; displacements in mm. The legend handles, one per level."""
+    same colour; displacements in mm. Parameter sets ([points]: x is `point`) are separate
+    spans, not a curve: markers with error bars, no line between them. The legend handles,
+    one per level."""
     xfactor = _unit(ds[x])[0]
     yfactor = _unit(ds[f"{name}_mean"])[0]
+    sets = x == POINT_DIM
     handles = []
     for i, (part, text) in enumerate(_levels(ds, level)):
         colour = f"C{i % 10}"
         xv = part[x].values.astype(float) * xfactor
         mean = part[f"{name}_mean"].broadcast_like(part[x]).values.astype(float) * yfactor
         line, = ax.plot(xv, mean, color=colour, marker="o", ms=4, lw=1.6, zorder=3,
-                        label=text, gid=f"{name}_mean")
+                        ls="none" if sets else "-", label=text, gid=f"{name}_mean")
         handles.append(line)
         if f"{name}_ci" in part:
             half = part[f"{name}_ci"].broadcast_like(part[x]).values.astype(float) * yfactor
-            ax.fill_between(xv, mean - half, mean + half, color=colour, alpha=_BAND_ALPHA,
-                            lw=0, zorder=2)
+            if sets:
+                ax.errorbar(xv, mean, yerr=half, fmt="none", ecolor=colour, capsize=3,
+                            zorder=2)
+            else:
+                ax.fill_between(xv, mean - half, mean + half, color=colour,
+                                alpha=_BAND_ALPHA, lw=0, zorder=2)
     if f"{name}_ci" in ds and np.isfinite(ds[f"{name}_ci"].values).any():
         handles.append(Patch(facecolor="0.5", alpha=_BAND_ALPHA * 2,
                              label=f"95 % interval of the mean of {_records(ds)}"))
@@ -116,6 +123,8 @@ def _finish(ax: Axes, ds: xr.Dataset, x: str, yname: str, ylabel: str, what: str
     ax.set_title(_title(ds, what), fontsize="medium")
     ax.grid(True, color="0.92", zorder=0)
     _plain_ticks(ax)
+    if x == POINT_DIM:
+        point_ticks(ax, ds, "x")
     _legend(ax, handles)
     return ax.figure
 
@@ -135,7 +144,9 @@ def plot_rms(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
         for i, (part, _text) in enumerate(_levels(ds, level)):
             ax.plot(part[x].values.astype(float) * xfactor,
                     part["linear_rms"].broadcast_like(part[x]).values.astype(float) * yfactor,
-                    color=f"C{i % 10}", ls="--", lw=1.2, zorder=2, gid="linear_rms")
+                    color=f"C{i % 10}", ls="none" if x == POINT_DIM else "--",
+                    marker="_" if x == POINT_DIM else None, ms=12, lw=1.2, zorder=2,
+                    gid="linear_rms")
         handles.append(Line2D([], [], color="0.3", ls="--", lw=1.2, label=_LINEAR_LABEL))
     ax.set_ylim(bottom=0.0)
     return _finish(ax, ds, x, "rms_deflection_mean", "RMS midspan deflection", "RMS midspan "
@@ -187,8 +198,8 @@ def plot_exceedance(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
             ls, marker = _LEVEL_STYLES[j % len(_LEVEL_STYLES)]
             y = part["exceedance_mean"].isel({CLEARANCE_DIM: k}).broadcast_like(part[x])
             ax.plot(part[x].values.astype(float) * xfactor, y.values.astype(float),
-                    color=colour, ls=ls, marker=marker, ms=4, lw=1.4, zorder=3,
-                    gid="exceedance")
+                    color=colour, ls="none" if x == POINT_DIM else ls, marker=marker, ms=4,
+                    lw=1.4, zorder=3, gid="exceedance")
         handles.append(Line2D([], [], color=colour, lw=2.0,
                               label=f"clearance {value * cfactor:.4g} {cunits}"))
     if level is not None:
