@@ -188,15 +188,20 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _summary(ds, seconds: float) -> str:
+    """The run's one line: title, points, time, and the count of each state (a time-domain
+    run's `state`, a stability chart's `stability`, both where the run made both)."""
     import numpy as np
-    name = "state" if "state" in ds else "stability"    # a stability-only result has no state
-    flags = ds[name].attrs          # CF flag_values / flag_meanings (not 0..n-1 for every kind)
-    values = ds[name].values.ravel()
-    counts = [(int(np.count_nonzero(values == v)), m)
-              for v, m in zip(np.atleast_1d(flags["flag_values"]), flags["flag_meanings"].split())]
-    states = ", ".join(f"{c} {m}" for c, m in counts if c)
+
+    def counted(name: str) -> str:
+        flags = ds[name].attrs      # CF flag_values / flag_meanings (not 0..n-1 for every kind)
+        values = ds[name].values.ravel()
+        counts = [(int(np.count_nonzero(values == v)), m) for v, m in
+                  zip(np.atleast_1d(flags["flag_values"]), flags["flag_meanings"].split())]
+        return ", ".join(f"{c} {m}" for c, m in counts if c)
+    names = [n for n in ("state", "stability") if n in ds]
+    states = "; ".join((f"{n}: " if len(names) > 1 else "") + counted(n) for n in names)
     n = int(ds.attrs["n_points"])
-    ways = (f" ({n // 2} x 2 directions: up, down)" if "direction" in ds[name].dims else "")
+    ways = (f" ({n // 2} x 2 directions: up, down)" if "direction" in ds[names[0]].dims else "")
     from .errors import escape
     return (f"{escape(str(ds.attrs['title']))}: {n} point{'' if n == 1 else 's'}{ways} in "
             f"{seconds:.2f} s ({states})")

@@ -194,6 +194,21 @@ def test_summary_counts_states_by_their_flag_values():
     assert _summary(ds, 1.0).endswith("(1 completed)")
 
 
+def test_summary_counts_both_a_time_domain_runs_and_its_charts_states():
+    """A stability chart run beside a time-domain run (base excitation on a stability scene):
+    the line counts both (a reviewer saw only the time domain's)."""
+    import xarray as xr
+    from sweep.cli import _summary
+    flags = {"flag_values": np.array([0, 2], np.int8), "flag_meanings": "decayed steady"}
+    stab = {"flag_values": np.array([0, 1], np.int8), "flag_meanings": "stable unstable"}
+    ds = xr.Dataset({"state": ("x", np.array([0, 2, 2], np.int8), flags),
+                     "stability": ("x", np.array([1, 0, 1], np.int8), stab)},
+                    attrs={"title": "t", "n_points": 3})
+    assert _summary(ds, 1.0).endswith("(state: 1 decayed, 2 steady; stability: 1 stable, "
+                                      "2 unstable)")
+    assert _summary(ds.drop_vars("state"), 1.0).endswith("(1 stable, 2 unstable)")
+
+
 
 def test_the_umask_is_read_without_setting_it(monkeypatch):
     """Setting the umask to read it would change it for every thread for an instant: where the
