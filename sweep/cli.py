@@ -71,6 +71,30 @@ def _hertz(text: str) -> float:
     return _with_unit(text, "Hz", "'100 Hz'")
 
 
+STRAIN_UNITS = {"%": 1e-2, "percent": 1e-2, "microstrain": 1e-6, "ustrain": 1e-6,
+                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
+"""What a strain limit may be written in besides a plain number (1, m/m)."""
+
+
+def _strain(text: str) -> float:
+    """An argparse value: a strain, a plain number (1, m/m) or one with a unit of
+    STRAIN_UNITS ('300 microstrain', '0.03 %'); ArgumentTypeError, one line, otherwise."""
+    import re
+    match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
+    unit = match.group(2).lower() if match else ""
+    factor = 1.0 if not unit else STRAIN_UNITS.get(unit)
+    try:
+        value = float(match.group(1)) if match else None
+    except ValueError:
+        value = None
+    if value is None or factor is None:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: not a strain (a plain number is in m/m, e.g. 0.0003, or write it with "
+            f"one of {', '.join(repr(u) for u in ('%', 'microstrain', 'ppm'))}: '300 "
+            "microstrain', '0.03 %')")
+    return value * factor
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="sweep", description="Parameter sweeps of nonlinear cable vibration.")
     parser.add_argument("--version", action="version",
@@ -143,8 +167,9 @@ def _parser() -> argparse.ArgumentParser:
     design.add_argument("--max-deflection", type=_metres, default=None, metavar="M",
                         help="largest deflection anywhere on the span at most this (m): "
                              "max_deflection (one mode: its midspan amplitude)")
-    design.add_argument("--max-strain", type=float, default=None, metavar="S",
-                        help="largest outer-fibre strain at most this (1, e.g. 0.001): "
+    design.add_argument("--max-strain", type=_strain, default=None, metavar="S",
+                        help="largest outer-fibre strain at most this (1, e.g. 0.001, or "
+                             "'1000 microstrain', '0.1 %%'): "
                              "max_strain, bending at the clamp or midspan plus stretching")
     design.add_argument("--max-rms", type=_metres, default=None, metavar="M",
                         help="random result: RMS midspan deflection, the mean over the "

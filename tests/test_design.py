@@ -307,6 +307,24 @@ def test_cli_design_limits_take_units(results, tmp_path, capsys):
     assert err.count("\n") == 1 and "--max-amplitude" in err and "a frequency" in err
 
 
+@pytest.mark.parametrize("text, strain", [("3e-4", 3e-4), ("300 microstrain", 3e-4),
+                                          ("0.03 %", 3e-4), ("0.03%", 3e-4), ("300 ppm", 3e-4)])
+def test_a_strain_limit_takes_the_units_strain_is_given_in(text, strain):
+    """--max-strain as a data sheet or a fatigue curve gives it: plain (m/m), in microstrain or
+    ppm, or in per cent."""
+    from sweep.cli import _strain
+    assert _strain(text) == pytest.approx(strain, rel=1e-12)
+
+
+@pytest.mark.parametrize("text", ["abc", "3 mm", "0.03 % x", "1.2.3"])
+def test_a_strain_limit_in_another_unit_is_one_line(text, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["design", "x.nc", "--max-strain", text])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--max-strain" in err and "microstrain" in err
+
+
 def test_cli_design_over_an_axis_prints_a_line_per_value(results, tmp_path, capsys):
     from test_cf import cf_problems
     ds, _ = results["coarse"]
