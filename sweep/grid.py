@@ -69,6 +69,9 @@ def parameters(scene: Scene, coords: dict[str, xr.DataArray]) -> dict[str, Any]:
     params.update(random_parameters(scene.values, coords))
     if params["load_type"] == "constant":      # no frequency axis: refused by load_scene
         params["frequency"] = None
+    if params.get("load_ratio") is not None:    # P0 as a multiple of the span's own Pcr
+        from .models.modal import load_from_ratio
+        load_from_ratio(params)
     return params
 
 

@@ -147,6 +147,13 @@ KEYS: tuple[Key, ...] = (
         long_name="end load amplitude P0 (positive = compression)", axis="load_amplitude",
         help="end load amplitude P0 (positive = compression); default 0: no end load unless "
         "the scene gives one (the paper scenes give 4 N)"),
+    Key("load", "amplitude_ratio", "float", None, units="1",
+        long_name="end load amplitude over the span's buckling load, P0/Pcr (Pcr of its own "
+                  "ends, buckling_load)", axis="load_ratio",
+        help="end load amplitude P0 as a multiple of the span's own buckling load (Pcr: EI "
+        "(pi/l)^2 pinned, 4 pi^2 EI/l^2 clamped, between them for elastic clamps), so that a "
+        "stability chart or a parametric map reads the same for any span and clamps; instead "
+        "of load.amplitude (N), which the result then holds per point"),
     Key("load", "frequency_ratio", "float", None, units="1", minimum=0.0,
         long_name="load frequency over the span's first natural frequency, W/w1",
         axis="frequency_ratio",

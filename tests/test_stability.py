@@ -151,3 +151,89 @@ def test_points_without_a_floquet_answer_are_warned_with_the_reason():
         ds = sweep.run(scene, progress=False)
     kinds = ds.stability.transpose("frequency_ratio", ...).values
     assert np.all(kinds[0] == -1) and np.all(kinds[1] >= 0)
+
+
+# ------------------------------------------------------- the load as a multiple of Pcr
+
+RATIO_CHART = CHART.replace("load_amplitude = [0.5, 2.0, 4.0]", "load_ratio = [0.1, 0.4, 0.8]")
+
+
+def test_a_load_ratio_axis_is_p0_over_the_spans_own_pcr():
+    """load.amplitude_ratio (axis load_ratio): P0 = ratio x Pcr, Pcr = EI (pi/l)^2 written
+    here for pinned ends: every multiplier against the SciPy monodromy of the Mathieu equation
+    at that load, and load_amplitude (N) stored beside the axis."""
+    ds = sweep.run(sweep.load_scene_text(RATIO_CHART.format(zeta=0.01)), progress=False)
+    assert "load_ratio" in ds.dims and "load_ratio" in ds.coords
+    pcr = E * INERTIA * (math.pi / 0.8) ** 2
+    assert ds["load_amplitude"].attrs["units"] == "N"
+    np.testing.assert_allclose(ds["load_amplitude"].values, [0.1 * pcr, 0.4 * pcr, 0.8 * pcr],
+                               rtol=1e-13)
+    for r in ds["frequency_ratio"].values:
+        for s in ds["load_ratio"].values:
+            top, _ = reference(float(r), float(s) * pcr, 0.01, 0.8)
+            got = float(ds["floquet_multiplier"].sel(frequency_ratio=r, load_ratio=s))
+            assert got == pytest.approx(top, rel=1e-8), (r, s)
+
+
+@pytest.mark.parametrize("rotation, extra", [("clamped", ""),
+                                             ("elastic", "rotational_stiffness = 3.0")])
+def test_a_load_ratio_reads_the_same_whatever_the_clamps(rotation, extra):
+    """With other ends Pcr is theirs (buckling_load: 4 pi^2 EI/l^2 clamped): the chart at
+    load_ratio s is the chart at load_amplitude s x buckling_load, to round-off, and the
+    clamped buckling load is the exact one to 2e-4."""
+    clamps = f'\n[clamps]\nrotation = "{rotation}"\n{extra}\n'
+    by_ratio = sweep.run(sweep.load_scene_text(RATIO_CHART.format(zeta=0.01) + clamps),
+                         progress=False)
+    pcr = float(by_ratio["buckling_load"])
+    if rotation == "clamped":
+        assert pcr == pytest.approx(4.0 * math.pi ** 2 * E * INERTIA / 0.8 ** 2, rel=2e-4)
+    loads = [0.1 * pcr, 0.4 * pcr, 0.8 * pcr]
+    by_load = sweep.run(sweep.load_scene_text(CHART.format(zeta=0.01).replace(
+        "load_amplitude = [0.5, 2.0, 4.0]", f"load_amplitude = {loads!r}") + clamps),
+        progress=False)
+    np.testing.assert_allclose(by_ratio["floquet_multiplier"].values,
+                               by_load["floquet_multiplier"].values, rtol=1e-12)
+    assert int((by_ratio["stability"] != 0).sum()) > 0           # some zone is crossed
+
+
+def test_a_load_ratio_drives_the_time_domain_as_its_load():
+    """A time-domain run with load.amplitude_ratio is the run with load.amplitude = ratio x
+    buckling_load (clamped, three modes), bit for bit."""
+    base = """
+[model]
+modes = 3
+[clamps]
+rotation = "clamped"
+[cable]
+damping_ratio = 0.01
+length = 0.6
+[load]
+{load}
+frequency_ratio = 1.9
+[initial]
+modal_displacement = [1e-4, 0.0, 0.0]
+[solver]
+t_end = 0.5
+"""
+    by_ratio = sweep.run(sweep.load_scene_text(base.format(load="amplitude_ratio = 0.3")),
+                         progress=False)
+    load = 0.3 * float(by_ratio["buckling_load"])
+    by_load = sweep.run(sweep.load_scene_text(base.format(load=f"amplitude = {load!r}")),
+                        progress=False)
+    assert float(by_ratio["load_amplitude"]) == load
+    for name in ("amplitude", "peak_amplitude", "max_deflection", "state"):
+        np.testing.assert_array_equal(by_ratio[name].values, by_load[name].values)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("[load]\namplitude = 2.0\namplitude_ratio = 0.5\n", ["load.amplitude", "not both"]),
+    ("[load]\namplitude = 2.0\n[axes]\nload_ratio = [0.1, 0.2]\n", ["load_ratio", "not both"]),
+    ('[model]\nkind = "longitudinal"\n[load]\ntype = "constant"\namplitude_ratio = 0.5\n',
+     ["load.amplitude_ratio", "transverse"]),
+    ("[load]\namplitude_ratio = 0.0\n[outputs]\nstability = true\n", ["outputs.stability"]),
+])
+def test_bad_load_ratios_are_one_line(text, words):
+    with pytest.raises(sweep.errors.UserError) as err:
+        sweep.load_scene_text(text)
+    message = str(err.value)
+    assert "\n" not in message and all(w in message for w in words), message

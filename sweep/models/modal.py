@@ -102,6 +102,23 @@ def consistent(p: Mapping[str, Any], ends: Mapping[str, Any] | None = None) -> d
     }
 
 
+def buckling_load(p: Mapping[str, Any]) -> Any:
+    """The span's buckling load Pcr (N; a number or an array over the points): the
+    `buckling_load` of its coefficients (`consistent` for its ends, or Eq.32's own under the
+    paper preset), which no end load changes."""
+    unloaded = {**p, "load_amplitude": 0.0}
+    if p["coefficients"] != "consistent":
+        return paper(unloaded)["buckling_load"]
+    return consistent(unloaded)["buckling_load"]
+
+
+def load_from_ratio(p: dict[str, Any]) -> None:
+    """In place: p's load_amplitude (N) from its load_ratio (P0/Pcr, load.amplitude_ratio)
+    times the span's own `buckling_load`, where the scene gives the load so."""
+    if p.get("load_ratio") is not None:
+        p["load_amplitude"] = p["load_ratio"] * buckling_load(p)
+
+
 def energy_bending(p: Mapping[str, Any]) -> bool:
     """Whether p's bending nonlinearity comes from the span's energy (docs/model.md sec. 7):
     the weak form of (EI / 2) int w_xx^2 (1 - 3 w_x^2 + 6 w_x^4) dx, the exact curvature's
@@ -278,6 +295,8 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
         "load_ratio": p["load_amplitude"] / c["buckling_load"],
         **stiffness,
     }
+    if p.get("load_ratio") is not None:  # given as a ratio: the load in N beside it
+        out["load_amplitude"] = p["load_amplitude"]
     if p["load_type"] == "harmonic":
         if p.get("frequency") is not None:
             omega = 2.0 * np.pi * p["frequency"]

@@ -88,7 +88,7 @@ from .. import schema
 from ..errors import CableSweepWarning
 from ..scene.messages import _fail, _show
 from . import cable, random_scene
-from .modal import oscillator
+from .modal import load_from_ratio, oscillator
 from .wave import wave_parameters
 
 PAPER_VELOCITY = 0.0321
@@ -115,6 +115,7 @@ PAPER_CABLE: dict[str, tuple[float, ...]] = {
 """The cable data Eq.32 was derived from (Table 1, docs/model.md sec. 1): under
 ``model.coefficients = "paper"`` a scalar key may only repeat one of these values."""
 
+LOAD_KEYS: tuple[str, str] = ("load.amplitude", "load.amplitude_ratio")
 FREQUENCY_KEYS: tuple[str, str] = ("load.frequency", "load.frequency_ratio")
 DEFAULT_FREQUENCY_RATIO = 1.0
 """load.frequency_ratio of a scene that gives neither load frequency key."""
@@ -127,9 +128,12 @@ BASE_KEYS: tuple[str, ...] = (BASE_LEVEL_KEYS + (BASE_TABLE_KEY,) + BASE_FREQUEN
 BASE_FIX = ("add a [base] table with acceleration, acceleration_g or levels_g and frequency, "
             "frequency_ratio or sweep")
 """How to fix a base key or axis given without the rest of the base excitation."""
-PAIRS: tuple[tuple[str, str], ...] = (FREQUENCY_KEYS, BASE_LEVEL_KEYS, BASE_FREQUENCY_KEYS)
+PAIRS: tuple[tuple[str, str], ...] = (LOAD_KEYS, FREQUENCY_KEYS, BASE_LEVEL_KEYS,
+                                      BASE_FREQUENCY_KEYS)
 """Either-or keys: two spellings of one quantity (as scalars or axes), never both."""
 _PAIR_UNITS: dict[str, str] = {
+    "load.amplitude": "amplitude is in N, amplitude_ratio in multiples of the span's buckling "
+                      "load",
     "load.frequency": "load.frequency is in Hz, load.frequency_ratio in multiples of w1",
     "base.acceleration": "acceleration is in m/s^2, acceleration_g in g = "
                          f"{schema.STANDARD_GRAVITY:g} m/s^2",
@@ -543,9 +547,12 @@ def _where(dotted: str, axes: dict[str, np.ndarray]) -> str:
 def _has_end_load(given: dict[str, Any], axes: dict[str, np.ndarray]) -> bool:
     """Whether the scene loads the span axially anywhere: load.amplitude (N, default 0), as a
     key or its axis, other than 0 at some point."""
-    amplitude = axes["load_amplitude"] if "load_amplitude" in axes \
-        else given.get("load.amplitude", schema.BY_DOTTED["load.amplitude"].default)
-    return bool(np.any(np.asarray(amplitude, dtype=float) != 0.0))
+    for dotted in LOAD_KEYS:
+        axis = schema.BY_DOTTED[dotted].axis
+        amplitude = axes[axis] if axis in axes else given.get(dotted)
+        if amplitude is not None and np.any(np.asarray(amplitude, dtype=float) != 0.0):
+            return True
+    return False
 
 
 def _refuse_frequency(given: dict[str, Any], problem: str, fix: str) -> None:
@@ -666,6 +673,7 @@ def _check_paper_cable(given: dict[str, Any]) -> None:
 
 
 TRANSVERSE_ONLY = ("cable.damping_ratio", "initial.displacement", "initial.velocity",
+                   "load.amplitude_ratio",
                    "initial.modal_displacement", "initial.modal_velocity",
                    "model.coefficients", "model.membrane", "model.paper_parametric", "solver.rtol", "solver.atol", "solver.method",
                    "solver.controller", "solver.driver", "solver.max_step", "solver.min_step",
@@ -807,8 +815,7 @@ def _warn_zero_solution(values: dict[str, Any], axes: dict[str, np.ndarray],
         what = (f"the scene sets no keys, so it runs one point of the defaults (a "
                 f"{values['cable.length']:g} m span, {values['load.amplitude']:g} N "
                 f"{values['load.type']} end load, {values['solver.t_end']:g} s): ")
-    loaded = (_extreme(values, axes, "load.amplitude", np.min) != 0.0
-              or _extreme(values, axes, "load.amplitude", np.max) != 0.0)
+    loaded = _has_end_load({k: values[k] for k in LOAD_KEYS}, axes)
     why = ("the end load only changes the stiffness" if loaded
            else "nothing drives the span (no end load, no base excitation)")
     warnings.warn(f"{what}initial.displacement = initial.velocity = 0 at every point, and "
@@ -890,6 +897,8 @@ def _check_coefficients(values: dict[str, Any], axes: dict[str, np.ndarray]) -> 
     if params["load_type"] == "constant":
         params["frequency"] = None
     with np.errstate(all="ignore"):
+        if kind != "longitudinal":
+            load_from_ratio(params)
         if kind == "longitudinal":
             derived = wave_parameters(params, values["solver.t_end"], values["solver.transits"])
         else:
@@ -1023,10 +1032,13 @@ def _check_stability_frequency(values: dict[str, Any], axes: dict[str, np.ndarra
 
 
 def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
-    """Defaults of every kind: load.frequency_ratio 1.0 without a load frequency, and
-    cable.inertia (m^4) from a scalar area."""
+    """Defaults of every kind: load.frequency_ratio 1.0 without a load frequency, no
+    load.amplitude (N) where load.amplitude_ratio gives the load, and cable.inertia (m^4)
+    from a scalar area."""
     if not any(d in mentioned for d in FREQUENCY_KEYS):
         values["load.frequency_ratio"] = DEFAULT_FREQUENCY_RATIO
+    if "load.amplitude_ratio" in mentioned:         # the load in N comes from the ratio
+        values["load.amplitude"] = None
     cable.defaults(values, mentioned)
     if "cable.inertia" not in mentioned and values["cable.area"] is not None:
         values["cable.inertia"] = default_inertia(values["cable.area"])

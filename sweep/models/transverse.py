@@ -70,6 +70,8 @@ _DERIVED = {
     "natural_frequency": ("Hz", "first linear natural frequency of the unloaded span"),
     "buckling_load": ("N", "Euler buckling load of the span (paper: implied by Eq.32)"),
     "load_ratio": ("1", "load amplitude over buckling load, P0/Pcr"),
+    "load_amplitude": ("N", "end load amplitude P0 (positive = compression), from "
+                            "load.amplitude_ratio times buckling_load"),
     "load_frequency": ("Hz", "load frequency W/(2 pi)"),
     "escape_barrier": ("m", "|q| beyond which the softening quintic lets the span escape, "
                             "for the mean (harmonic) or constant load; NaN: no barrier, or one "

@@ -110,8 +110,10 @@ def footer(ds: xr.Dataset) -> str:
     load = doc.get("load", {})
     kind = doc.get("model", {}).get("kind", ds.attrs.get("model_kind", "transverse"))
     p0 = get("load", "amplitude")
-    text = f"{load.get('type', 'harmonic')} end load" + ("" if p0 is None else
-                                                        f" P0 = {num(p0)} N")
+    p0_ratio = get("load", "amplitude_ratio")
+    text = f"{load.get('type', 'harmonic')} end load" + (
+        f" P0 = {num(p0)} N" if p0 is not None else
+        "" if p0_ratio is None else f" P0 = {num(p0_ratio)} Pcr")
     if p0 is not None and float(p0) == 0.0 and kind != "longitudinal":
         text = "no end load"
     elif load.get("type", "harmonic") == "harmonic" and kind != "longitudinal":
