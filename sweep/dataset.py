@@ -6,6 +6,7 @@ with these."""
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -37,8 +38,17 @@ def elapsed_time(values: np.ndarray) -> xr.DataArray:
 
     Not CF's `time`: a CF time coordinate (standard_name time, and the name `time` to the IOOS
     compliance checker) needs units "s since <date>", and these are durations from the
-    simulation's t = 0, which has no date.
+    simulation's t = 0, which has no date. The times (k dt) are rounded to 15 significant
+    digits of the largest, so that `.sel(elapsed_time=0.35)` finds the sample 7 x 0.05 s
+    (0.35000000000000003 as computed), as the axes' values are found as typed.
     """
+    values = np.asarray(values, dtype=np.float64)
+    top = float(np.max(np.abs(values))) if values.size else 0.0
+    if math.isfinite(top) and top > 0.0:
+        digits = 15 - math.ceil(math.log10(top))
+        rounded = np.round(values, digits) if digits <= 22 else values
+        if values.size < 2 or np.all(np.diff(rounded) > 0.0):
+            values = rounded
     return xr.DataArray(values, dims=TIME_DIM, attrs={
         "units": "s", "long_name": "simulated time since t = 0 (the initial state)"})
 

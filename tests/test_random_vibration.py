@@ -340,12 +340,21 @@ def test_a_span_whose_start_up_outlasts_the_record_is_flagged_the_others_run():
     from sweep.errors import CableSweepWarning
     with pytest.warns(CableSweepWarning, match=r"1 of 2 span settings start up for longer "
                       r"than 90% of the 1 s run .* flagged invalid_input, the others run"):
-        ds = sweep.run(scene({"base.realisations": 1},
+        ds = sweep.run(scene({"base.realisations": 1, "outputs.clearance": [1e-5]},
                              axes={"damping_ratio": [0.001, 0.05]}), progress=False)
     states = ds.state.transpose("damping_ratio", ...).values.reshape(2, -1)
     assert np.all(states[0] == 0) and np.all(states[1] == 8)      # invalid_input, completed
     rms = ds.rms_deflection.transpose("damping_ratio", ...).values.reshape(2, -1)
     assert np.all(np.isnan(rms[0])) and np.all(rms[1] > 0.0)
+    # what never ran has no verdict: not "no escape", not "no crossing" (a reviewer's filter
+    # on escape_probability == 0 kept a span that was never simulated)
+    for name in ("escape_probability", "clearance_upcrossings", "expected_exceedances",
+                 "exceedance_probability", "exceedance_probability_upper"):
+        if name in ds:
+            values = ds[name].transpose("damping_ratio", ...).values.reshape(2, -1)
+            assert np.all(np.isnan(values[0])) and np.all(np.isfinite(values[1])), name
+    assert "clearance_upcrossings" in ds
+    assert float(ds.escape_probability.sel(damping_ratio=0.05)) == 0.0
 
 
 def test_a_softening_oscillator_escapes_and_has_no_rms():

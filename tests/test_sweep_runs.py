@@ -183,3 +183,16 @@ def test_a_stepped_run_stopped_mid_line_resumes_each_line_from_its_last_dwell(tm
     _same(ds, whole)
     warned = [line for line in capsys.readouterr().err.splitlines() if "not used" in line]
     assert len(warned) == 1 and progress.name in warned[0]
+
+
+def test_stored_times_are_found_as_typed():
+    """The time-series coordinate holds the sample times k dt as the decimals they are
+    (7 x 0.05 s is 0.35, not 0.35000000000000003): `.sel(elapsed_time=0.35)` finds the sample,
+    as an axis value is found as typed (a reviewer found 282 of 2001 times unreachable)."""
+    ds = sweep.run(sweep.load_scene("paper-fig5", {
+        "axes.length": [0.5], "solver.t_end": 15.0, "outputs.sample_interval": 0.05}),
+        progress=False)
+    times = ds["elapsed_time"].values
+    np.testing.assert_array_equal(times, np.arange(times.size) / 20.0)
+    for t in (0.35, 0.7, 14.95, 15.0):
+        assert float(ds["elapsed_time"].sel(elapsed_time=t)) == t

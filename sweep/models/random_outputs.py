@@ -359,11 +359,13 @@ def pooled_crossings(rate: xr.DataArray, window: xr.DataArray, kept: xr.DataArra
     windows' total. Their ratio is the rate of the stationary response over every record
     at once: a level that few records cross is estimated from all of them, where each
     record's own 1 - exp(-rate T) (0 where its window saw no crossing) averaged over the
-    records underestimates the probability of a rare exceedance (Jensen's inequality)."""
+    records underestimates the probability of a rare exceedance (Jensen's inequality). The
+    count is NaN where no record observed anything (a point that never ran, or every record
+    escaped or failed): not a count of 0."""
     usable = kept & np.isfinite(rate) & np.isfinite(window)
-    counted = np.rint(rate * window).where(usable, 0.0).sum(REALISATION_DIM)
     observed = window.where(usable, 0.0).sum(REALISATION_DIM)
-    return counted, observed
+    counted = np.rint(rate * window).where(usable, 0.0).sum(REALISATION_DIM)
+    return counted.where(observed > 0.0), observed     # NaN: no record observed the level
 
 
 def _warn_startup_escapes(escaped: xr.DataArray, failed_at: xr.DataArray,
@@ -430,11 +432,14 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
             units=source.attrs["units"], long_name=f"half-width of the {CONFIDENCE:.0%} "
             f"confidence interval (Student's t) of {name}_mean")
     escaped = xr.DataArray((states == km.DIVERGED).reshape(shape), dims=dims)
-    data["escape_probability"] = escaped.mean(REALISATION_DIM).assign_attrs(
+    # a record with a verdict ran to its end or escaped (not one that never ran, or failed)
+    decided = escaped | xr.DataArray((states == km.COMPLETED).reshape(shape), dims=dims)
+    data["escape_probability"] = escaped.where(decided).mean(REALISATION_DIM).assign_attrs(
         units="1", long_name="fraction of the realisations in which the span escaped within "
         "the run: |q| reached the divergence bound (the span length unless "
         "metrics.divergence_bound says otherwise; a crossing of escape_barrier that comes "
-        "back does not count): a softening span's measure, where an RMS means nothing")
+        "back does not count), of those that ran to their end or escaped (NaN where none "
+        "did): a softening span's measure, where an RMS means nothing")
     failed_at = xr.DataArray(reals[:, tk.FAILURE_TIME].reshape(shape), dims=dims)
     startup = random_scene.transient_time(
         2.0 * math.pi * derived(coeffs["natural_frequency"], coords),
