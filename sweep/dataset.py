@@ -117,3 +117,50 @@ def flag_attrs(flags: tuple[int, ...]) -> dict[str, Any]:
         "flag_values": np.array(flags, dtype=np.int8),
         "flag_meanings": " ".join(km.STATE_MEANINGS[f] for f in flags),
     }
+
+
+LABEL_LENGTH = 100
+"""The longest `long_name` a result keeps (xarray's plots make their axis labels of it); a
+longer one is cut to its longest leading clause within this length, the whole text kept as
+`comment` (`short_long_names`)."""
+
+_CLAUSE_ENDS = (": ", " (", "; ", ", ")
+
+
+def short_long_names(ds: xr.Dataset) -> xr.Dataset:
+    """`ds` with every variable's and coordinate's long_name of more than LABEL_LENGTH
+    characters cut to its longest leading clause within LABEL_LENGTH (up to a ': ', ' (',
+    '; ' or ', ' outside parentheses, not leaving a formula or a colon open), or to its
+    words within it and '...'; the whole explanation moved to `comment` (before any comment
+    it had). In place; returns `ds`."""
+    for name in list(ds.variables):
+        attrs = ds[name].attrs
+        text = attrs.get("long_name")
+        if not isinstance(text, str) or len(text) <= LABEL_LENGTH:
+            continue
+        ends = [i for mark in _CLAUSE_ENDS for i in _positions(text, mark)
+                if 20 <= i <= LABEL_LENGTH and _closes_a_clause(text[:i])]
+        if ends:
+            short = text[:max(ends)]
+        else:
+            short = text[:LABEL_LENGTH - 3].rsplit(" ", 1)[0] + "..."
+        comment = attrs.get("comment")
+        attrs["comment"] = text + (f". {comment}" if comment else "")
+        attrs["long_name"] = short
+    return ds
+
+
+def _closes_a_clause(head: str) -> bool:
+    """Whether `head` may stand as a label: its parentheses closed, and not ending in the
+    middle of a formula or on a colon."""
+    return (head.count("(") == head.count(")") and head.count("[") == head.count("]")
+            and head.rstrip()[-1:] not in tuple(":=+-*/,("))
+
+
+def _positions(text: str, mark: str) -> list[int]:
+    """Where `mark` starts in `text`, every place."""
+    found, i = [], text.find(mark)
+    while i >= 0:
+        found.append(i)
+        i = text.find(mark, i + 1)
+    return found

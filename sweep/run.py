@@ -15,6 +15,7 @@ import numpy as np
 
 from . import models
 from .errors import UserError
+from .dataset import short_long_names
 from .io import check_output_path, remove_stale_temporaries, write_netcdf
 from .scene import Scene
 
@@ -83,7 +84,7 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     try:
         options = run_options(scene, threads=threads, progress=progress, announce=announce,
                               **persist)
-        ds = models.model_for(scene.get("model.kind")).run(scene, options)
+        ds = short_long_names(models.model_for(scene.get("model.kind")).run(scene, options))
         if output is not None:
             _write_whole(ds, output, overwrite)
     finally:

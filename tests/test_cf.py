@@ -88,11 +88,38 @@ def test_builtin_scene_output_passes_the_cf_checker_and_round_trips(name, tmp_pa
                 assert "units" not in ds[var].attrs and ds[var].attrs["long_name"], var
                 continue
             assert back[var].attrs["units"] == ds[var].attrs["units"], var
+            assert len(back[var].attrs.get("long_name", "")) <= 100, var   # a plot's label
         for coord in back.coords:
             assert "_FillValue" not in back[coord].encoding or \
                 back[coord].encoding["_FillValue"] is None, coord
     finally:
         back.close()
+
+
+@pytest.mark.parametrize("text, label", [
+    ("transverse reaction at the clamp: max |V| at either clamp over the tail window, V = -EI "
+     "w_xxx + (N - P) w_x (the shear, the stretching tension's transverse part and the end "
+     "load's, P compression positive)",
+     "transverse reaction at the clamp: max |V| at either clamp over the tail window"),
+    ("bending strain of the outer fibre at the clamp: (d / 2) max |w_xx| at either clamp over "
+     "the tail window (d the cable's diameter)", "bending strain of the outer fibre at the clamp"),
+    ("largest outer-fibre strain reported: max(clamp_bending_strain, midspan_bending_strain) + "
+     "axial_strain (their peaks added)", "largest outer-fibre strain reported"),
+    ("up-crossings of the clearance level by the midspan deflection counted over the statistics "
+     "windows of the realisations that did not escape",
+     "up-crossings of the clearance level by the midspan deflection counted over the "
+     "statistics..."),
+    ("short enough", "short enough"),
+])
+def test_long_names_are_labels_and_the_explanation_a_comment(text, label):
+    """xarray's plots label an axis with long_name: one over 100 characters is cut to its
+    longest closed clause (or its words and '...'), the whole text kept in `comment`, before a
+    comment it had."""
+    from sweep.dataset import short_long_names
+    ds = xr.Dataset({"v": ("x", [1.0], {"long_name": text, "comment": "old"})})
+    short_long_names(ds)
+    assert ds["v"].attrs["long_name"] == label
+    assert ds["v"].attrs["comment"] == ("old" if text == label else f"{text}. old")
 
 
 def test_the_checker_sees_what_was_wrong_before(tmp_path):
