@@ -15,7 +15,6 @@ import numpy as np
 
 from . import models
 from .errors import UserError
-from .dataset import short_long_names
 from .io import check_output_path, remove_stale_temporaries, write_netcdf
 from .scene import Scene
 
@@ -80,6 +79,7 @@ def run(scene: Scene, output: str | os.PathLike | None = None, *, overwrite: boo
     persist = dict(output=output, resume=resume, overwrite=overwrite, scheduler=scheduler)
     if output is not None:
         remove_stale_temporaries(output)            # of a write that was killed
+    from .dataset import short_long_names
     from .store import ChunkStore
     try:
         options = run_options(scene, threads=threads, progress=progress, announce=announce,

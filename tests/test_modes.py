@@ -580,3 +580,29 @@ def test_one_modes_modal_lists_are_its_initial_state():
     assert float(listed.peak_amplitude) > 1e-3
     for name in ("peak_amplitude", "amplitude", "state"):
         assert float(listed[name]) == float(single[name])
+
+
+def test_a_sweep_up_and_down_keeps_each_directions_largest_deflection():
+    """direction = "both": max_deflection and its place are each direction's (a reviewer found
+    the place of the up sweep stored for both)."""
+    s = SWEPT_T
+    ds = sweep.run(sweep.load_scene_text(f"""name = "both-ways"
+[model]
+modes = 3
+membrane = 0.375
+[cable]
+inertia = {INERTIA!r}
+length = {LENGTH!r}
+damping_ratio = 0.01
+[load]
+amplitude = 0.0
+[base]
+acceleration_g = 2.0
+sweep = {{ start = {s['start']!r}, stop = {s['stop']!r}, rate = {s['rate']!r}, direction = "both" }}
+[solver]
+rtol = 1e-8
+"""), progress=False)
+    for name in ("max_deflection", "max_deflection_position"):
+        assert ds[name].dims[0] == "direction", name
+    up, down = (float(ds["max_deflection"].sel(direction=d)) for d in ("up", "down"))
+    assert up != down

@@ -397,6 +397,10 @@ def derived_variables(coeffs: dict[str, Any], coords: dict[str, xr.DataArray],
     return out
 
 
+SPAN_NAMES = ("max_deflection", "max_deflection_position")
+"""`span_outputs`' variables: each point's, solved by the kernels."""
+
+
 def span_outputs(reals: np.ndarray, dims: tuple[str, ...], shape: tuple[int, ...],
                  swept: bool, length: xr.DataArray) -> dict[str, xr.DataArray]:
     """Several modes: the largest deflection anywhere on the span (`max_deflection`, m, over
@@ -738,8 +742,8 @@ def _both_directions(results: list[xr.Dataset], dims: tuple[str, ...], direction
     direction coordinate's (default: a stepped sweep's)."""
     from . import continuation as ct
     first = results[0]
-    solved = {"state", "jump", "modal_amplitude", "max_deflection", "peak_frequency", "envelope",
-              *_REALS, *_COUNTS, *BASE_OUTPUTS, *loads.NAMES}
+    solved = {"state", "jump", "modal_amplitude", "peak_frequency", "envelope",
+              *_REALS, *_COUNTS, *BASE_OUTPUTS, *loads.NAMES, *SPAN_NAMES}
     per_point = [name for name in first.data_vars if name in solved]
     stacked = xr.concat([r[per_point] for r in results], dim=ct.DIRECTION_DIM)
     ds = first.drop_vars(per_point).merge(stacked)
