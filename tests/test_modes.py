@@ -436,6 +436,32 @@ def test_max_deflection_is_the_largest_over_span_and_tail(name, method):
 SWEPT_T = dict(start=100.0, stop=180.0, rate=60.0, ramp_cycles=10.0)   # Hz, Hz, oct/min, 1
 
 
+def swept_scene(zeta: float, level: str, direction: str = "", rtol: float = 1e-10
+                ) -> sweep.Scene:
+    """A log sweep (SWEPT_T) of three modes of the Table 1 span at damping ratio zeta, the
+    [base] level line `level`, `direction` ('direction = "both", ' or nothing)."""
+    s = SWEPT_T
+    return sweep.load_scene_text(f"""name = "swept-span"
+[model]
+modes = 3
+membrane = 0.375
+[cable]
+youngs_modulus = {E!r}
+density = {RHO!r}
+area = {AREA!r}
+inertia = {INERTIA!r}
+length = {LENGTH!r}
+damping_ratio = {zeta!r}
+[load]
+amplitude = 0.0
+[base]
+{level}
+sweep = {{ start = {s['start']!r}, stop = {s['stop']!r}, rate = {s['rate']!r}, {direction}ramp_cycles = {s['ramp_cycles']!r} }}
+[solver]
+rtol = {rtol!r}
+""")
+
+
 def test_a_sine_sweeps_largest_deflection_over_the_span():
     """A log sweep of three modes through mode 3's resonance (9 f1 = 137 Hz, the clamps at
     2 g): max_deflection over the whole sweep and its place against tests/galerkin.py's
@@ -463,26 +489,7 @@ def test_a_sine_sweeps_largest_deflection_over_the_span():
                     atol=np.r_[np.full(3, 1e-15), np.full(3, 1e-12)], dense_output=True)
     assert sol.success
     ref, place = span_tail_argmax(sol.sol, 3, duration, 1.0, fastest_hz=s["stop"])
-    ds = sweep.load_scene_text(f"""name = "swept-span"
-[model]
-modes = 3
-membrane = 0.375
-[cable]
-youngs_modulus = {E!r}
-density = {RHO!r}
-area = {AREA!r}
-inertia = {INERTIA!r}
-length = {LENGTH!r}
-damping_ratio = {zeta!r}
-[load]
-amplitude = 0.0
-[base]
-acceleration = {accel!r}
-sweep = {{ start = {s['start']!r}, stop = {s['stop']!r}, rate = {s['rate']!r}, ramp_cycles = {s['ramp_cycles']!r} }}
-[solver]
-rtol = 1e-10
-""")
-    ds = sweep.run(ds)
+    ds = sweep.run(swept_scene(zeta, f"acceleration = {accel!r}"), progress=False)
     largest = float(ds["max_deflection"])
     assert "whole sweep" in ds["max_deflection"].attrs["long_name"]
     assert abs(largest / ref - 1.0) < 1e-6, (largest, ref)
@@ -585,23 +592,8 @@ def test_one_modes_modal_lists_are_its_initial_state():
 def test_a_sweep_up_and_down_keeps_each_directions_largest_deflection():
     """direction = "both": max_deflection and its place are each direction's (a reviewer found
     the place of the up sweep stored for both)."""
-    s = SWEPT_T
-    ds = sweep.run(sweep.load_scene_text(f"""name = "both-ways"
-[model]
-modes = 3
-membrane = 0.375
-[cable]
-inertia = {INERTIA!r}
-length = {LENGTH!r}
-damping_ratio = 0.01
-[load]
-amplitude = 0.0
-[base]
-acceleration_g = 2.0
-sweep = {{ start = {s['start']!r}, stop = {s['stop']!r}, rate = {s['rate']!r}, direction = "both" }}
-[solver]
-rtol = 1e-8
-"""), progress=False)
+    ds = sweep.run(swept_scene(0.01, "acceleration_g = 2.0", 'direction = "both", ',
+                               rtol=1e-8), progress=False)
     for name in ("max_deflection", "max_deflection_position"):
         assert ds[name].dims[0] == "direction", name
     up, down = (float(ds["max_deflection"].sel(direction=d)) for d in ("up", "down"))
