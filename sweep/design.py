@@ -459,7 +459,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                "source_title": title,
                "criteria": criteria,
                "length_grid": f"{lengths.size} lengths, {lengths[0]:g} to {lengths[-1]:g} m"})
-    return result
+    from .dataset import short_long_names
+    return short_long_names(result)
 
 
 def _worst(var: xr.DataArray, how: str) -> xr.DataArray:
