@@ -115,11 +115,12 @@ def flatten(values: dict[str, Any], names: tuple[str, ...], dims: tuple[str, ...
 def point_values(params: dict[str, Any], dims: tuple[str, ...], shape: tuple[int, ...],
                  points: np.ndarray) -> dict[str, Any]:
     """The parameters at grid points `points` (flat C-order indices): each axis coordinate
-    replaced by its values at those points, scalars kept."""
+    (or a parameter over several axes, as a load given as a ratio of each span's buckling
+    load) replaced by its values at those points, scalars kept."""
     if not shape:
         return dict(params)                      # no axes: one point, all scalars
     index = np.unravel_index(points, shape)
-    return {name: value.values[index[dims.index(value.dims[0])]]
+    return {name: value.values[tuple(index[dims.index(d)] for d in value.dims)]
             if isinstance(value, xr.DataArray) else value
             for name, value in params.items()}
 

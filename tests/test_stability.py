@@ -237,3 +237,39 @@ def test_bad_load_ratios_are_one_line(text, words):
         sweep.load_scene_text(text)
     message = str(err.value)
     assert "\n" not in message and all(w in message for w in words), message
+
+
+@pytest.mark.parametrize("modes", [1, 3])
+def test_a_load_ratio_over_a_length_axis_loads_each_span_by_its_own_pcr(modes):
+    """load_ratio x length (Pcr changes along length, the load in N over both axes): every
+    point is the run of its own load in N (the time-domain rows crashed on a parameter over
+    two axes)."""
+    base = """
+[model]
+modes = {modes}
+[cable]
+damping_ratio = 0.01
+[load]
+{load}
+frequency_ratio = 1.9
+[initial]
+modal_displacement = {q0}
+[solver]
+t_end = 0.3
+[axes]
+{axes}
+"""
+    q0 = [1e-4] + [0.0] * (modes - 1)
+    ds = sweep.run(sweep.load_scene_text(base.format(
+        modes=modes, q0=q0, load="", axes="load_ratio = [0.2, 0.35]\nlength = [0.5, 0.7]")),
+        progress=False)
+    assert ds["load_amplitude"].dims == ("load_ratio", "length")
+    np.testing.assert_allclose(ds["load_amplitude"], ds["load_ratio"] * ds["buckling_load"],
+                               rtol=1e-15)
+    one = ds.sel(load_ratio=0.35, length=0.7)
+    alone = sweep.run(sweep.load_scene_text(base.format(
+        modes=modes, q0=q0, load=f"amplitude = {float(one.load_amplitude)!r}",
+        axes="length = [0.7]")), progress=False)
+    # (the grid runs on the lanes, the single point on the scalar driver: round-off apart)
+    assert float(one["amplitude"]) == pytest.approx(float(alone["amplitude"].squeeze()),
+                                                    rel=1e-9)
