@@ -318,7 +318,8 @@ def test_the_file_says_what_the_clamps_hold_and_how_the_span_stretches(tmp_path)
             for word in stretching:
                 assert word in ds.attrs["stretching"], ds.attrs["stretching"]
             if modes > 1:
-                assert "clamped-clamped" in ds["mode"].attrs["long_name"]
+                full = ds["mode"].attrs["long_name"] + ds["mode"].attrs.get("comment", "")
+                assert "clamped-clamped" in full       # the label, or the whole text in comment
     paper = sweep.run(sweep.load_scene_text(scene_text("pinned", t_end=0.2).replace(
         "[model]", "[model]\nmembrane = 0.375")), progress=False)
     assert "local membrane" in paper.attrs["stretching"] and "0.375" in paper.attrs["stretching"]
