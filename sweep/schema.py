@@ -153,7 +153,8 @@ KEYS: tuple[Key, ...] = (
         help="end load amplitude P0 as a multiple of the span's own buckling load (Pcr: EI "
         "(pi/l)^2 pinned, 4 pi^2 EI/l^2 clamped, between them for elastic clamps), so that a "
         "stability chart or a parametric map reads the same for any span and clamps; instead "
-        "of load.amplitude (N), which the result then holds per point"),
+        "of load.amplitude (N), which the result then holds per point; negative: a tension, "
+        "as a negative load.amplitude"),
     Key("load", "frequency_ratio", "float", None, units="1", minimum=0.0,
         long_name="load frequency over the span's first natural frequency, W/w1",
         axis="frequency_ratio",
