@@ -154,7 +154,7 @@ def _closes_a_clause(head: str) -> bool:
     """Whether `head` may stand as a label: its parentheses closed, and not ending in the
     middle of a formula or on a colon."""
     return (head.count("(") == head.count(")") and head.count("[") == head.count("]")
-            and head.rstrip()[-1:] not in tuple(":=+-*/,("))
+            and not head.rstrip().endswith(tuple(":=+-*/,(")))
 
 
 def _positions(text: str, mark: str) -> list[int]:

@@ -567,7 +567,7 @@ def _warn_off_midspan(ds: xr.Dataset, limits: Limits, like: xr.DataArray, passed
                   f"midspan moved (e.g. {at}: {share[i, j]:.1%} of the midspan's amplitude, "
                   "modal_amplitude), which the midspan criteria ("
                   + ", ".join(midspan) + ") do not see: the largest deflection along the span "
-                  "can be larger (a fixed-frequency run's max_deflection holds it: "
+                  "can be larger (a run of several modes holds it in max_deflection: "
                   "--max-deflection)")
 
 
