@@ -109,8 +109,9 @@ def _mean_with_band(ax: Axes, ds: xr.Dataset, x: str, level: str | None, name: s
                 ax.fill_between(xv, mean - half, mean + half, color=colour,
                                 alpha=_BAND_ALPHA, lw=0, zorder=2)
     if f"{name}_ci" in ds and np.isfinite(ds[f"{name}_ci"].values).any():
-        handles.append(Patch(facecolor="0.5", alpha=_BAND_ALPHA * 2,
-                             label=f"95 % interval of the mean of {_records(ds)}"))
+        what = f"95 % interval of the mean of {_records(ds)}"
+        handles.append(Line2D([], [], color="0.3", ls="none", marker="|", ms=10, label=what)
+                       if sets else Patch(facecolor="0.5", alpha=_BAND_ALPHA * 2, label=what))
     return handles
 
 
@@ -147,7 +148,9 @@ def plot_rms(ds: xr.Dataset, *, select: Mapping[str, Any] | None = None,
                     color=f"C{i % 10}", ls="none" if x == POINT_DIM else "--",
                     marker="_" if x == POINT_DIM else None, ms=12, lw=1.2, zorder=2,
                     gid="linear_rms")
-        handles.append(Line2D([], [], color="0.3", ls="--", lw=1.2, label=_LINEAR_LABEL))
+        sets = x == POINT_DIM                 # as drawn: a tick per set, or a dashed line
+        handles.append(Line2D([], [], color="0.3", ls="none" if sets else "--",
+                              marker="_" if sets else None, ms=12, lw=1.2, label=_LINEAR_LABEL))
     ax.set_ylim(bottom=0.0)
     return _finish(ax, ds, x, "rms_deflection_mean", "RMS midspan deflection", "RMS midspan "
                    f"deflection, mean of {_records(ds)}", handles)
