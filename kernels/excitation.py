@@ -165,8 +165,10 @@ def _record_interval(t, p, o, s, records):
     x = t * fs
     kf = math.floor(x)
     u = x - kf
-    k = int(kf) % n
-    k1 = k + 1 if k + 1 < n else 0
+    k = int(kf)
+    k = k - n if k >= n else k     # t in [0, 2 N / fs): a run never passes the period N / fs
+    k1 = k + 1 if k + 1 < n else 0  # (not `% n`: an integer division per stage and lane, which
+                                    # took half a one-mode record's run on the lanes)
     return (records[r, 0, k], records[r, 1, k], records[r, 0, k1], records[r, 1, k1], u,
             1.0 / fs, p[o + RECORD_SCALE * s])
 
