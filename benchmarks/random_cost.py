@@ -73,6 +73,8 @@ from sweep.models.random import hermite  # noqa: E402
 from sweep.models.random_outputs import RandomInputs  # noqa: E402
 
 SCENE = "launch-random-gevs"
+_SHIPPED = sweep.load_scene(SCENE).values
+DEFAULT = (_SHIPPED["solver.method"], float(_SHIPPED["solver.rtol"]))   # the scene as shipped
 ATOL_SCALE = 0.01          # sweep/models/transverse.py: the engine's default atol fraction
 MAP = (20, 20, 60.0)       # spans, realisations, seconds: the issue's map
 
@@ -257,11 +259,15 @@ def best(fn, repeats: int) -> float:
 
 
 def engine_cost(length: float, level_db: float, realisations: int, modes: int,
-                repeats: int, rtol: float | None = None) -> tuple[float, float]:
+                repeats: int, rtol: float | None = None,
+                method: str | None = None) -> tuple[float, float]:
     """(wall s per realisation-second, the solve's own share: the dataset's run_seconds, the
     kernels' time after the records are made, per realisation-second) of sweep.run on one
-    span, one thread, the scene's records (8 s); solver.rtol the scene's unless given."""
+    span, one thread, the scene's records (8 s); solver.rtol and solver.method the scene's
+    unless given."""
     more = {} if rtol is None else {"solver.rtol": rtol}
+    if method is not None:
+        more["solver.method"] = method
     scene = sweep.load_scene(SCENE, {**overrides(length, level_db, realisations, modes=modes),
                                      **more})
     seconds = realisations * float(scene.values["base.duration"])
@@ -274,10 +280,11 @@ def engine_cost(length: float, level_db: float, realisations: int, modes: int,
     return wall / seconds, min(solve[1:]) / seconds
 
 
-def engine_rms(case: Case, rtol: float) -> tuple[float, float, int]:
-    """(RMS deflection, window start, steps) of realisation 0 by sweep.run at solver.rtol."""
-    ds = sweep.run(sweep.load_scene(SCENE, {**case.overrides, "solver.rtol": rtol}),
-                   progress=False)
+def engine_rms(case: Case, method: str, rtol: float) -> tuple[float, float, int]:
+    """(RMS deflection, window start, steps) of realisation 0 by sweep.run with solver.method
+    and solver.rtol."""
+    ds = sweep.run(sweep.load_scene(SCENE, {**case.overrides, "solver.rtol": rtol,
+                                            "solver.method": method}), progress=False)
     first = {k: ds[k].values.ravel()[0] for k in ("rms_deflection", "statistics_window",
                                                     "n_steps")}
     return (float(first["rms_deflection"]), case.t_end - float(first["statistics_window"]),
@@ -304,7 +311,10 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--accuracy-duration", type=float, default=1.0,
                         help="s: the accuracy record, also SciPy's timed record")
-    parser.add_argument("--engine-rtol", type=float, nargs="+", default=[1e-6, 1e-7, 1e-8])
+    parser.add_argument("--engine-rtol", type=float, nargs="+", default=[1e-6, 1e-7, 1e-8],
+                        help="rtols of the engine's DOP853 rows")
+    parser.add_argument("--rk45-rtol", type=float, nargs="*", default=[1e-5, 1e-6],
+                        help="rtols of the engine's RK45 rows")
     parser.add_argument("--rk4-steps", type=float, nargs="+", default=[0.25, 0.5, 1.0, 2.0],
                         help="m: RK4 steps of 1 / (m fs)")
     parser.add_argument("--no-scene", action="store_true", help="skip the whole scene's run")
@@ -321,8 +331,10 @@ def main() -> None:
         if not np.allclose(got, hermite(acc.records[0], acc.fs, probe), rtol=1e-12,
                            atol=1e-12):
             raise RuntimeError(f"{what} a_b is not sweep.models.random.hermite's")
-    engine = {rtol: engine_rms(acc, rtol) for rtol in args.engine_rtol}
-    t_tail = engine[args.engine_rtol[0]][1]
+    runs = ([("dop853", rtol) for rtol in args.engine_rtol]
+            + [("rk45", rtol) for rtol in args.rk45_rtol])
+    engine = {run: engine_rms(acc, *run) for run in runs}
+    t_tail = engine[runs[0]][1]
     rk4 = {m: rk4_rms(x, dx, acc.fs, acc.coef, acc.t_end, t_tail, m)
            for m in args.rk4_steps + [16.0]}
     starts = sorted({e[1] for e in engine.values()} | {r[1] for r in rk4.values()} | {t_tail})
@@ -346,11 +358,12 @@ def main() -> None:
     rows = []
     label = f"{args.length * 1e3:g} mm, {args.level:g} dB"
     engine_rows = {}
-    for rtol, (rms, t0, steps) in engine.items():
+    for (method, rtol), (rms, t0, steps) in engine.items():
         wall, solve = engine_cost(args.length, args.level, args.realisations, 1, args.repeats,
-                                  rtol)
-        engine_rows[rtol] = (wall, error(rms, t0))
-        rows.append([f"engine, DOP853 rtol {rtol:g}" + (" (default)" if rtol == 1e-6 else ""),
+                                  rtol, method)
+        engine_rows[method, rtol] = (wall, error(rms, t0))
+        rows.append([f"engine, {method.upper()} rtol {rtol:g}"
+                     + (" (default)" if (method, rtol) == DEFAULT else ""),
                      label, f"{wall * 1e3:.2f}", f"{solve * 1e3:.2f}",
                      f"{steps / acc.t_end:.0f}", f"{error(rms, t0):.1e}"])
     rk4_rows = {}
@@ -366,7 +379,7 @@ def main() -> None:
     for length, level in ((args.length, args.level), (0.15, 0.0)):
         for modes in ((1, 3) if (length, level) != (args.length, args.level) else (3,)):
             per_s = engine_cost(length, level, args.realisations, modes, args.repeats)
-            rows.append([f"engine, DOP853 rtol 1e-06 (default), {modes} mode"
+            rows.append([f"engine, {DEFAULT[0].upper()} rtol {DEFAULT[1]:g} (default), {modes} mode"
                          + ("s" if modes > 1 else ""), f"{length * 1e3:g} mm, {level:g} dB",
                          f"{per_s[0] * 1e3:.2f}", f"{per_s[1] * 1e3:.2f}", "", ""])
     print(f"machine: {machine()}\n")
@@ -383,17 +396,17 @@ def main() -> None:
 
     # equal accuracy: the widest RK4 step at least as accurate as each engine run
     equal = None
-    for rtol, (wall, e_engine) in engine_rows.items():
+    for (method, rtol), (wall, e_engine) in engine_rows.items():
         fine = [m for m in args.rk4_steps if rk4_rows[m][1] <= e_engine]
         if not fine:
-            print(f"equal accuracy, engine rtol {rtol:g} (error {e_engine:.1e}): no RK4 step "
+            print(f"equal accuracy, engine {method} rtol {rtol:g} (error {e_engine:.1e}): no RK4 step "
                   "measured is as accurate")
             continue
         m = min(fine)
         per_s, e = rk4_rows[m]
-        if rtol == args.engine_rtol[0]:
+        if (method, rtol) == runs[0]:
             equal = m
-        line = (f"equal accuracy, engine rtol {rtol:g} (error {e_engine:.1e}) / RK4 at h = "
+        line = (f"equal accuracy, engine {method} rtol {rtol:g} (error {e_engine:.1e}) / RK4 at h = "
                 f"1/({m:g} fs) (error {e:.1e}, the widest step at least as accurate): "
                 f"{wall / per_s:.1f}x the cost")
         coarser = [k for k in args.rk4_steps if k < m]
@@ -415,8 +428,8 @@ def main() -> None:
               f"({2.0 * wall / rs * 1e3:.2f} ms of a thread per realisation-second)")
         print(f"{spans} spans x {reals} realisations x {duration:g} s = {mapped:g} "
               f"realisation-s on 2 cores: {mapped * wall / rs:.0f} s at the scene's rate; "
-              f"{mapped * engine_rows[args.engine_rtol[0]][0] / 2.0:.0f} s at the one-span "
-              f"rate above (engine, rtol {args.engine_rtol[0]:g}); "
+              f"{mapped * engine_rows[runs[0]][0] / 2.0:.0f} s at the one-span "
+              f"rate above (engine, {runs[0][0]} rtol {runs[0][1]:g}); "
               + (f"{mapped * rk4_rows[equal][0] / 2.0:.1f} s for the RK4 loop at "
                  f"h = 1/({equal:g} fs), as accurate" if equal is not None else ""))
     print("\n    PYTHONPATH=. python benchmarks/random_cost.py " + " ".join(sys.argv[1:]))

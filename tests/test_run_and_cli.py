@@ -41,6 +41,20 @@ def cli(*args, cwd=None):
                           text=True, cwd=cwd, env=env, timeout=600)
 
 
+def test_python_dash_m_sweep_is_the_console_script(tmp_path):
+    """`python -m sweep` for an environment whose scripts are not on PATH: the same commands
+    and exit codes as `sweep` (a bad scene key: one line, exit 2)."""
+    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    ok = subprocess.run([sys.executable, "-m", "sweep", "--version"], capture_output=True,
+                        text=True, env=env, timeout=600)
+    assert ok.returncode == 0 and ok.stdout.startswith("sweep (cable-sweep) ")
+    bad = subprocess.run([sys.executable, "-m", "sweep", "run", "paper-fig5", "-o", "x.nc",
+                          "--set", "cable.lenght=1"], capture_output=True, text=True, env=env,
+                         timeout=600, cwd=tmp_path)
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "x.nc").exists()
+
+
 def test_paper_fig5_amplitudes():
     """Within 10 % of the paper's 4.1, 3.8, 3.4, 3.0 mm; and docs/model.md's re-run of Eq.32."""
     ds = sweep.run(sweep.load_scene("paper-fig5"), progress=False)
