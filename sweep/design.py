@@ -38,8 +38,9 @@ realisation.
 Interpolation between the last passing grid length l_a and the first failing one l_b:
 frequency in log f against log l (f1 ~ l^-2 unloaded, so the frequency criterion alone is
 exact), amplitude and every other upper limit linearly in l of (quantity - limit), stability
-linearly in l of growth_rate; a state failure (which has no margin) and a missing value give
-l_a. When several criteria fail at l_b the smallest of their spans binds. max_span runs no
+linearly in l of growth_rate; a state failure (which has no margin), a missing value and a
+value that does not cross its limit between l_a and l_b (a stability flag that fails where
+growth_rate is still <= 0) give l_a. When several criteria fail at l_b the smallest of their spans binds. max_span runs no
 analysis: its span is only as good as the grid.
 
 `refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
@@ -671,21 +672,21 @@ def _shown_units(values: xr.DataArray) -> str:
 
 
 def _interpolate(la: float, lb: float, va: float, vb: float, limit: float, how: str) -> float:
-    """Where, between the passing la and failing lb, the criterion's value crosses its limit:
-    `log` (log v against log l), `linear` (v - limit linear in l); la where it cannot be
-    found (no margin, a missing value, no crossing)."""
+    """Where (m), between the passing la and failing lb (m), the criterion's value crosses its
+    limit: `log` (a lower limit, log v against log l: v falls from va >= limit to
+    vb < limit), `linear` (an upper limit, v linear in l: v rises from va <= limit to
+    vb > limit); la where it does not cross there (no margin, a missing value, a value that
+    fails by its flag but not by its limit: an unstable flag with growth_rate <= 0)."""
     if how == "none" or not (np.isfinite(va) and np.isfinite(vb)):
         return float(la)
     if how == "log":
-        if not (va > 0 and vb > 0 and limit > 0) or va == vb:
+        if not (vb > 0 and limit > 0 and va >= limit > vb):
             return float(la)
         t = (math.log(limit) - math.log(va)) / (math.log(vb) - math.log(va))
-        t = min(max(t, 0.0), 1.0)
         return float(math.exp(math.log(la) + t * (math.log(lb) - math.log(la))))
-    if vb == va:
+    if not va <= limit < vb:
         return float(la)
     t = (limit - va) / (vb - va)
-    t = min(max(t, 0.0), 1.0)
     return float(la + t * (lb - la))
 
 

@@ -379,6 +379,35 @@ def test_an_unstable_span_ends_the_walk_at_the_growth_rate_zero():
     assert out["max_span"].dims == ("frequency_ratio", "load_amplitude")
 
 
+def _stability_result(growth: list[float], flags: list[int]) -> xr.Dataset:
+    """A hand-made stability result over length 0.1..0.4 m (as a hand-edited or foreign file
+    may be): its `stability` flags and `growth_rate` (1/s) as given, f1 far above any limit."""
+    lengths = np.array([0.1, 0.2, 0.3, 0.4])
+    stability = xr.DataArray(np.array(flags, np.int8), dims=("length",), attrs={
+        "flag_values": np.array([-1, 0, 1], np.int8),
+        "flag_meanings": "invalid_input stable unstable_period_1"})
+    return xr.Dataset(
+        {"stability": stability,
+         "growth_rate": ("length", np.array(growth, float), {"units": "1/s"}),
+         "natural_frequency": ("length", 1e3 * (0.1 / lengths) ** 2, {"units": "Hz"})},
+        coords={"length": ("length", lengths, {"units": "m"})})
+
+
+@pytest.mark.parametrize("flag", [1, -1])               # unstable_period_1, invalid_input
+def test_a_failing_flag_without_a_positive_growth_rate_gives_the_last_passing_length(flag):
+    """The flag fails 0.3 m while growth_rate is still negative there: the growth rate does
+    not cross zero between 0.2 and 0.3 m, so nothing is interpolated: the span is the last
+    passing grid length, 0.2 m (a clamped interpolation returned the failing 0.3 m)."""
+    ds = _stability_result([-2.0, -1.0, -0.5, 1.0], [0, 0, flag, flag])
+    out = max_span(ds, min_frequency=1.0)
+    assert float(out["max_span"]) == 0.2
+    assert str(out["limited_by"].values) == "stability"
+    # where the growth rate does cross zero in the bracket, its zero is the span
+    crossing = max_span(_stability_result([-2.0, -1.0, 3.0, 4.0], [0, 0, flag, flag]),
+                        min_frequency=1.0)
+    assert float(crossing["max_span"]) == pytest.approx(0.2 + 0.1 * 1.0 / 4.0, rel=1e-12)
+
+
 # --refine: bisection on length with the engine, against the same closed forms
 
 
