@@ -79,6 +79,8 @@ DEFAULT_MAX_PROBABILITY = 0.01
 STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVERGED,
                                                       km.STEP_TOO_SMALL, km.MAX_STEPS))
 """`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "km": 1e3}
+"""The units a result's `length` axis may be in, and their size in metres."""
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance", "state", "stability")
 """The criteria in the order they are named when the shortest span fails several; a failed
@@ -215,7 +217,24 @@ def check_result(ds: xr.Dataset, name: str | None = None) -> tuple[str, ...]:
     if not (np.all(np.isfinite(lengths)) and np.all(lengths > 0)):
         raise UserError(f"design: {which}'s 'length' axis holds values that are not "
                         "positive finite lengths (m); give a result written by 'sweep run'")
+    units = ds[LENGTH].attrs.get("units")
+    if units not in LENGTH_UNITS:
+        said = "no units" if units is None else f"units {units!r}"
+        raise UserError(f"design: {which}'s 'length' axis has {said}, not one of "
+                        f"{', '.join(LENGTH_UNITS)}; give a result whose length coordinate "
+                        "says its unit (a result 'sweep run' wrote is in m)")
     return axes
+
+
+def in_metres(ds: xr.Dataset) -> xr.Dataset:
+    """`ds` with its `length` coordinate in metres (converted from LENGTH_UNITS, its units
+    attribute then "m"); `check_result` refuses any other units first."""
+    units = ds[LENGTH].attrs.get("units")
+    if units == "m":
+        return ds
+    length = ds[LENGTH]
+    metres = np.asarray(length.values, float) * LENGTH_UNITS[units]
+    return ds.assign_coords({LENGTH: (length.dims, metres, {**length.attrs, "units": "m"})})
 
 
 def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
@@ -326,7 +345,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
 
     Parameters
     ----------
-    ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis (m).
+    ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis in m (or
+        mm, cm, km as its units attribute says: converted to m).
     min_frequency : Hz; a length passes when `natural_frequency` >= min_frequency.
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
         `quantity` (a variable in m over the swept axes), by default `peak_amplitude` for a
@@ -367,7 +387,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     span fails). Attributes: `criteria`, the
     source result's `title`.
 
-    Raises UserError (one line) without a criterion, without a `length` axis, for an unknown
+    Raises UserError (one line) without a criterion, without a `length` axis or one whose
+    units are not LENGTH_UNITS, for an unknown
     quantity or one whose units are not m, a non-positive limit, a result without the
     variable a criterion reads (a random one's for max_rms, max_peak, clearance), a clearance
     level the result does not hold.
@@ -377,7 +398,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                                 max_strain=max_strain, max_rms=max_rms, max_peak=max_peak,
                                 clearance=clearance, max_probability=max_probability)
     fmin = c["min_frequency"]
-    ds = ds.sortby(LENGTH)
+    ds = in_metres(ds).sortby(LENGTH)
     others = tuple(a for a in axes if a not in (LENGTH, *WORST_OVER))
     template_name = "state" if "state" in ds else "stability"
     like = _like(ds[template_name]).transpose(*others, LENGTH)

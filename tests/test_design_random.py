@@ -15,6 +15,7 @@ import xarray as xr
 import sweep
 from sweep.cli import main
 from sweep.design import CRITERIA, LIMITED_BY, max_span, refine_span
+from sweep.version import package_version
 
 LENGTHS = np.array([0.10, 0.15, 0.20, 0.25, 0.30])        # m
 LEVELS = np.array([0.001, 0.002, 0.005])                   # m, clearance levels
@@ -87,6 +88,39 @@ def test_max_rms_is_the_linear_crossing(limit):
     # rms = 0.01 l crosses the limit at l = 100 limit, inside the grid
     assert float(out["max_span"]) == pytest.approx(100.0 * limit, rel=1e-12)
     assert str(out["limited_by"].values) == "max_rms"
+
+
+def _length_in(ds: xr.Dataset, units: str | None, per_metre: float) -> xr.Dataset:
+    """`ds` with its length coordinate written in `units` (`per_metre` of them to a metre;
+    None: no units attribute), as a hand-edited or foreign file may hold it."""
+    attrs = {} if units is None else {"units": units}
+    return ds.assign_coords(length=("length", ds["length"].values * per_metre, attrs))
+
+
+@pytest.mark.parametrize("units, per_metre", [("mm", 1e3), ("cm", 1e2), ("km", 1e-3)])
+def test_a_length_in_another_length_unit_is_read_in_metres(units, per_metre, capsys, tmp_path):
+    """rms = 0.01 l (l in m) crosses 0.0017 m at 0.17 m whatever unit the file's length is
+    written in (a length in mm was read as metres: a 170 m span, labelled m)."""
+    ds = _length_in(synthetic(), units, per_metre)
+    out = max_span(ds, max_rms=0.0017)
+    assert float(out["max_span"]) == pytest.approx(0.17, rel=1e-12)
+    assert out["max_span"].attrs["units"] == "m"
+    assert out.attrs["length_grid"] == "5 lengths, 0.1 to 0.3 m"
+    path = tmp_path / "r.nc"
+    ds.drop_vars("exceedance_probability").assign_attrs(
+        cable_sweep_version=package_version()).to_netcdf(path)
+    assert main(["design", str(path), "--max-rms", "0.0017"]) == 0
+    assert "170.00" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("units, said", [("inch", "units 'inch'"), ("1", "units '1'"),
+                                         (None, "no units")])
+def test_a_length_in_no_length_unit_is_refused_in_one_line(units, said):
+    with pytest.raises(sweep.UserError) as info:
+        max_span(_length_in(synthetic(), units, 1.0), max_rms=0.0017)
+    message = str(info.value)
+    assert f"'length' axis has {said}" in message and "m, mm, cm, km" in message
+    assert "\n" not in message
 
 
 def test_max_peak_reads_the_mean_peak():
