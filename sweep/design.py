@@ -237,6 +237,28 @@ def in_metres(ds: xr.Dataset) -> xr.Dataset:
     return ds.assign_coords({LENGTH: (length.dims, metres, {**length.attrs, "units": "m"})})
 
 
+SINE_LIMITS = {"max_amplitude": "--max-amplitude", "max_deflection": "--max-deflection",
+               "max_strain": "--max-strain"}
+"""The criteria that limit a deterministic response (a sine or dwell's tail or sweep peak): a
+random result holds the same variables, but as each record's own peak, no statistic of the
+test, so it is asked only its own criteria (--max-rms, --max-peak, --clearance)."""
+
+
+def _refuse_sine_limits_of_a_random_result(ds: xr.Dataset, max_amplitude: float | None,
+                                           max_deflection: float | None,
+                                           max_strain: float | None) -> None:
+    """Refuse (one line) a SINE_LIMITS criterion given for a random result (one with
+    `realisation`)."""
+    given = dict(max_amplitude=max_amplitude, max_deflection=max_deflection,
+                 max_strain=max_strain)
+    flags = [SINE_LIMITS[k] for k, v in given.items() if v is not None]
+    if REALISATION in ds.dims and flags:
+        raise UserError(f"design: {flags[0]} limits a sine or dwell response, and this is a "
+                        "random result, whose records' peaks are no statistic of the test; "
+                        "give --max-peak M (the mean largest |midspan deflection|), --max-rms "
+                        "M or --clearance M for it")
+
+
 def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
            quantity: str | None, max_deflection: float | None = None,
            max_strain: float | None = None, max_rms: float | None = None,
@@ -251,6 +273,7 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
                                max_rms, max_peak, clearance)):
         raise UserError(NO_CRITERION)
     axes = check_result(ds)
+    _refuse_sine_limits_of_a_random_result(ds, max_amplitude, max_deflection, max_strain)
     if min_frequency is not None and "natural_frequency" not in ds:
         raise UserError("design: --min-frequency needs the variable 'natural_frequency' (Hz), "
                         "which this result lacks (a transverse result has it)")
@@ -351,7 +374,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
         `quantity` (a variable in m over the swept axes), by default `peak_amplitude` for a
         swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
-        (largest) value over `direction` and `realisation` counts.
+        (largest) value over `direction` counts. Not for a random result (SINE_LIMITS), nor
+        are max_deflection and max_strain.
     quantity : the variable `max_amplitude` limits (needs max_amplitude).
     max_deflection : m; a length passes when `max_deflection`, the largest deflection anywhere
         on the span, is at most this (one mode: the midspan's, where its largest lies).
@@ -390,8 +414,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     Raises UserError (one line) without a criterion, without a `length` axis or one whose
     units are not LENGTH_UNITS, for an unknown
     quantity or one whose units are not m, a non-positive limit, a result without the
-    variable a criterion reads (a random one's for max_rms, max_peak, clearance), a clearance
-    level the result does not hold.
+    variable a criterion reads (a random one's for max_rms, max_peak, clearance), a sine
+    response's limit (SINE_LIMITS) for a random result, a clearance level the result does not
+    hold.
     """
     c, axes, limits = validated(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
                                 quantity=quantity, max_deflection=max_deflection,

@@ -3,8 +3,8 @@
 A harness span must pass every test of its load case, each its own result (a sine sweep, a
 random test, a resonant dwell). `governing_span(results, **criteria)` asks each result the
 criteria it holds the variables of (`sweep.design.max_span`: --min-frequency of every
-transverse result, --max-rms of a random one, --max-amplitude of a sine one: a sine response's
-limits go to a random result only where no other result answers them), and keeps,
+transverse result, --max-rms, --max-peak and --clearance of a random one, --max-amplitude,
+--max-deflection and --max-strain of a sine one, never of a random one), and keeps,
 for every combination of the results' other axes, the shortest of their spans, `limited_by`
 the criterion that binds there and `limited_in` the result it binds in. Every criterion must
 apply to some result, and every result must have a criterion that applies to it; axes the
@@ -24,14 +24,10 @@ import xarray as xr
 
 from .design import NO_CRITERION, check_result, max_span, validated
 from .errors import UserError
-from .models.random_scene import REALISATION_DIM
 
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance")
 """The criteria a result may or may not hold the variables of (sweep.design's limits)."""
-RESPONSE_LIMITS = ("max_amplitude", "max_deflection", "max_strain")
-"""Limits of a sine response: a random result holds the same variables (each record's tail
-peak), but where a sine result answers them they are the sine test's, not the random one's."""
 
 
 def _criterion(name: str, criteria: dict[str, Any]) -> dict[str, Any]:
@@ -92,22 +88,23 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
     for name, ds in results:
         check_result(ds, name)
     _check_same_span(results)
-    random = [REALISATION_DIM in ds.dims for _, ds in results]
     asked: list[dict[str, Any]] = [{} for _ in results]
+    refused: list[str] = ["" for _ in results]       # each result's first reason, in words
     for c in given:
         one = _criterion(c, criteria)
         reasons = [_applies(ds, one) for _, ds in results]
         if all(r is not None for r in reasons):
             raise UserError(f"{reasons[0]} (nor does any other result given)")
-        sine_answers = any(r is None and not rnd for r, rnd in zip(reasons, random))
         for i, reason in enumerate(reasons):
-            if reason is None and not (c in RESPONSE_LIMITS and random[i] and sine_answers):
+            if reason is None:
                 asked[i].update(one)
+            elif not refused[i]:
+                refused[i] = reason.removeprefix("design: ")
     spans = []
-    for (name, ds), own in zip(results, asked):
+    for (name, ds), own, why in zip(results, asked, refused):
         if not own:
-            raise UserError(f"design: result '{name}': none of the criteria given reads its "
-                            "variables (leave it out, or give one it holds)")
+            raise UserError(f"design: result '{name}': none of the criteria given applies to "
+                            f"it ({why}; or leave it out)")
         spans.append(max_span(ds, **own))
     return _shortest(spans, names)
 

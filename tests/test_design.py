@@ -694,8 +694,9 @@ def test_several_results_refuse_points_whose_sets_differ(results):
 
 def test_a_sine_limit_binds_the_sine_result_not_the_random_one(results):
     """--max-amplitude given with a sine and a random result limits the sine one (the random
-    result's `amplitude`, each record's tail peak, is not the sine test's response); alone, a
-    random result still answers it."""
+    result's `amplitude`, each record's tail peak, is not the sine test's response); a random
+    result is refused it alone too, and together where no other criterion applies to it, in
+    the same words, pointing at its own criteria."""
     from sweep.governing import governing_span
     linear, _ = results["linear"]
     randomlike = linear.expand_dims(realisation=[0, 1])
@@ -704,6 +705,14 @@ def test_a_sine_limit_binds_the_sine_result_not_the_random_one(results):
                          max_amplitude=1e-7, min_frequency=40.0)
     assert float(out["max_span"]) == pytest.approx(_amplitude_reference(1e-7), rel=2e-3)
     assert str(out["limited_in"].values) == "sine.nc"
+    said = "--max-amplitude limits a sine or dwell response, and this is a random result"
+    with pytest.raises(sweep.UserError, match=said) as alone:
+        max_span(randomlike, max_amplitude=1e-7)
+    with pytest.raises(sweep.UserError, match=said) as together:
+        governing_span([("sine.nc", linear), ("random.nc", randomlike)], max_amplitude=1e-7)
+    for info in (alone, together):
+        assert "--max-peak M" in str(info.value) and "\n" not in str(info.value)
+    assert "result 'random.nc'" in str(together.value)
 
 
 def test_several_results_name_every_one_that_fails_at_the_shortest(results):

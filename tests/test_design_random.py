@@ -138,10 +138,8 @@ def test_realisation_is_no_design_axis_and_counts_at_its_worst():
     assert str(out["limited_by"].values[0]) == "grid"
     assert float(out["max_span"].values[0]) == pytest.approx(0.30)
     assert float(out["max_span"].values[1]) == pytest.approx(0.15, rel=1e-12)
-    # a per-realisation quantity counts at its largest realisation (1.2 x the first)
-    amp = max_span(ds, max_amplitude=0.006)
-    assert float(amp["max_span"].values[1]) == pytest.approx(0.006 / (4 * 0.01 * 1.2),
-                                                            rel=1e-12)
+    # (a per-realisation quantity, amplitude, is a sine limit's and refused for a random
+    # result: test_a_sine_response_limit_of_a_random_result_is_refused_in_one_line)
 
 
 def test_a_diverged_realisation_fails_its_length():
@@ -195,6 +193,23 @@ def test_a_non_random_result_is_refused_in_one_line(kwargs, fragment):
     with pytest.raises(sweep.UserError, match=fragment) as info:
         max_span(_sine_result(), **kwargs)
     assert "asd_g2" in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("flag, kwargs", [
+    ("--max-amplitude", dict(max_amplitude=0.002)),
+    ("--max-deflection", dict(max_deflection=0.002)),
+    ("--max-strain", dict(max_strain=1e-3)),
+    ("--max-amplitude", dict(max_amplitude=0.002, max_rms=0.002)),
+])
+def test_a_sine_response_limit_of_a_random_result_is_refused_in_one_line(flag, kwargs):
+    """A random result holds `amplitude` (each record's tail peak), but the README gives it
+    --max-rms, --max-peak and --clearance only: a sine response's limit is refused, pointing at
+    those (it read the records' largest peak alone, and was refused beside a sine result)."""
+    with pytest.raises(sweep.UserError) as info:
+        max_span(synthetic(), **kwargs)
+    message = str(info.value)
+    assert message.startswith(f"design: {flag} limits a sine or dwell response")
+    assert "--max-peak M" in message and "--max-rms M" in message and "\n" not in message
 
 
 @pytest.mark.parametrize("kwargs, fragment", [
