@@ -26,10 +26,13 @@ import signal
 import sys
 import time
 import warnings
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 from .errors import CableSweepWarning, UserError, one_line
 from .version import VERSION, package_version  # noqa: F401  (VERSION: re-exported)
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 
 class _Parser(argparse.ArgumentParser):
@@ -372,12 +375,12 @@ def _design(args: argparse.Namespace) -> int:
                     max_strain=args.max_strain, max_rms=args.max_rms,
                     max_peak=args.max_peak, clearance=args.clearance,
                     max_probability=args.max_probability)
-    if len(args.result) > 1:
+    loaded = [(path, load_result(path)) for path in args.result]
+    if len(loaded) > 1:
         from .governing import governing_span
-        result = governing_span([(path, load_result(path)) for path in args.result],
-                                **criteria)
+        result = governing_span(loaded, **criteria)
     else:
-        ds = load_result(args.result[0])
+        ds = loaded[0][1]
         result = (refine_span(ds, **criteria,
                               tolerance=1e-3 if args.tolerance is None else args.tolerance)
                   if args.refine else max_span(ds, **criteria))
@@ -386,20 +389,34 @@ def _design(args: argparse.Namespace) -> int:
     if args.refine:
         print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
               f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
-    elif interpolated(result, criteria):
-        if len(args.result) > 1:
-            fix = ("--refine runs the engine to bracket it, one sine result at a time; a random "
-                   "result's length axis refined (and base.realisations added) narrows it")
-        elif "realisation" in ds.dims:
-            fix = "refine the scene's length axis (and add base.realisations) to narrow it"
-        else:
-            fix = "--refine runs the engine to bracket it"
-        print("interpolated between the grid's lengths, not run there: a response that peaks "
-              f"between two of them (a resonance) can put the true limit shorter; {fix}")
+    else:
+        _say_interpolated(interpolated(result, dict(loaded)), [ds for _, ds in loaded])
     if args.output is not None:
         write_netcdf(result, args.output, overwrite=args.overwrite)
         print(f"-> {args.output}")
     return 0
+
+
+def _say_interpolated(counts: dict[str, int], results: list[xr.Dataset]) -> None:
+    """The lines that say how many spans `sweep design` interpolated between grid lengths
+    (sweep.design.interpolated's counts) and what would narrow them."""
+    if counts["response"]:
+        if len(results) > 1:
+            fix = ("--refine runs the engine to bracket it, one sine result at a time; a random "
+                   "result's length axis refined (and base.realisations added) narrows it")
+        elif "realisation" in results[0].dims:
+            fix = "refine the scene's length axis (and add base.realisations) to narrow it"
+        else:
+            fix = "--refine runs the engine to bracket it"
+        print(f"{counts['response']} span(s) interpolated between the grid's lengths, not run "
+              "there: a response that peaks between two of them (a resonance) can put the "
+              f"true limit shorter; {fix}")
+    if counts["frequency"]:
+        one = "" if len(results) == 1 else " (on that result alone)"
+        print(f"{counts['frequency']} min_frequency span(s) interpolated as log f against "
+              "log l, which is exact for pinned or clamped ends but not for elastic ones "
+              f"(K = k_t l / EI grows with the span); --refine{one} gives the exact span, "
+              "without an engine run")
 
 
 def _compile(args: argparse.Namespace) -> int:

@@ -30,26 +30,30 @@ margin of the criterion that binds. A length fails when
   (`growth_rate` > 0, or a flag other than stable).
 
 A stepped or swept result's `direction` (up, down) and a random result's `realisation` (its
-Monte Carlo records) count at their worst: the quantity's maximum over them, and a length fails
+Monte Carlo records) count at their worst: a quantity's maximum over them, and a length fails
 on a state or stability failure of any of them (a realisation that escaped, state diverged,
-fails its length). The design is over the result's axes less length, direction and
+fails its length); a random result's criteria read statistics over its records, and the sine
+response limits (SINE_LIMITS) are refused for it. The design is over the result's axes less length, direction and
 realisation.
 
 Interpolation between the last passing grid length l_a and the first failing one l_b:
-frequency in log f against log l (f1 ~ l^-2 unloaded, so the frequency criterion alone is
-exact), amplitude and every other upper limit linearly in l of (quantity - limit), stability
-linearly in l of growth_rate; a state failure (which has no margin), a missing value and a
-value that does not cross its limit between l_a and l_b (a stability flag that fails where
-growth_rate is still <= 0) give l_a. When several criteria fail at l_b the smallest of their spans binds. max_span runs no
-analysis: its span is only as good as the grid.
+frequency in log f against log l (exact for pinned and clamped ends, whose unloaded
+f1 ~ l^-2; not for elastic ends, whose K = k_t l / EI grows with the length: up to 2e-4
+relative on a 50 mm grid near K = 1), amplitude and every other upper limit linearly in l of
+(quantity - limit), stability linearly in l of growth_rate; a state failure (which has no
+margin), a missing value and a value that does not cross its limit between l_a and l_b (a
+stability flag that fails where growth_rate is still <= 0) give l_a. When several criteria
+fail at l_b the smallest of their spans binds. max_span runs no analysis: its span is only as
+good as the grid.
 
 `refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
 bracketed span it bisects on length with one-length engine runs of the result's stored scene,
 the other axes fixed to the combination's values, evaluating the same criteria (`_margins`,
 shared with max_span) until the bracket is below the tolerance (1 mm by default), and reports
 the bracket's passing end (conservative). The frequency criterion needs no run (log f against
-log l is exact for the unloaded f1 ~ l^-2), so a frequency-only refinement costs none; the
-runs made are counted in the attribute `refine_runs`.
+log l is exact for pinned or clamped ends, f1 ~ l^-2; elastic ends bisect on the closed-form
+f1), so a frequency-only refinement costs none; the runs made are counted in the attribute
+`refine_runs`.
 """
 
 from __future__ import annotations
@@ -697,18 +701,38 @@ def _frequency_span(f1: Callable[[float], float], lo: float, hi: float, fmin: fl
     return lo
 
 
-def interpolated(result: xr.Dataset, criteria: dict[str, Any]) -> bool:
-    """Whether some span of `max_span`'s result (criteria: its keyword arguments) lies between
-    two grid lengths, interpolated on a response criterion: a resonance between them can put
-    the true limit shorter (`refine_span` runs the engine there). A frequency's log-log
-    interpolation is exact; the grid's longest length and a failing shortest one are not
-    interpolated."""
-    response = any(v is not None for k, v in criteria.items()
-                   if k not in ("min_frequency", "quantity"))
-    limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
+def elastic_ends(ds: xr.Dataset) -> bool:
+    """Whether result `ds` has elastic clamps (its `clamps` attribute, sweep.models.transverse
+    .span_attrs): K = k_t l / EI grows with the span, so f1 is not ~ l^-2."""
+    return str(ds.attrs.get("clamps", "")).startswith("elastic")
+
+
+def interpolated(result: xr.Dataset, sources: dict[str, xr.Dataset]) -> dict[str, int]:
+    """How many spans of `max_span`'s (or `governing_span`'s) result lie strictly between two
+    grid lengths of the result they bind in (`sources`: name -> result; `limited_in` names
+    it, else the one source), by kind: "response" (a response criterion or the growth rate
+    interpolated linearly in l: a resonance or a tongue between the lengths can put the true
+    limit shorter) and "frequency" (log f against log l with elastic ends, not exact). A
+    span that is a grid length (a state failure, a limit not crossed in the bracket, the
+    grid's longest, a NaN) is not counted, nor is a frequency span of pinned or clamped ends
+    (exact, f1 ~ l^-2)."""
     spans = np.asarray(result["max_span"].values, dtype=float).ravel()
-    return response and bool(np.any((limited != "grid") & (limited != "min_frequency")
-                                    & np.isfinite(spans)))
+    limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
+    where = (np.asarray(result["limited_in"].values, dtype=str).ravel()
+             if "limited_in" in result else np.full(spans.size, next(iter(sources))))
+    counts = {"response": 0, "frequency": 0}
+    for span, by, name in zip(spans, limited, where):
+        source = sources.get(name)
+        if source is None or not np.isfinite(span):
+            continue
+        lengths = np.asarray(in_metres(source)[LENGTH].values, float)
+        if np.any(np.isclose(lengths, span, rtol=1e-12, atol=0.0)):
+            continue
+        if by != "min_frequency":
+            counts["response"] += 1
+        elif elastic_ends(source):
+            counts["frequency"] += 1
+    return counts
 
 
 def _shown_units(values: xr.DataArray) -> str:
@@ -797,10 +821,12 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     passing end (conservative: within `tolerance` below the true span), limited_by the
     criterion its failing end fails.
 
-    The frequency criterion needs no run: natural_frequency is the closed form
-    f1 ~ l^-2 of the unloaded span, so interpolating log f against log l between the grid
-    lengths is exact; where only it fails at l_b the span is that interpolation (no run; with
-    only min_frequency the refinement costs no run at all). Where another criterion fails at
+    The frequency criterion needs no run: natural_frequency is the closed form of the
+    unloaded span, f1 ~ l^-2 with pinned or clamped ends, so interpolating log f against
+    log l between the grid lengths is exact there; with elastic ends (K = k_t l / EI, f1 not
+    ~ l^-2) the length where the closed-form f1 crosses the limit is bisected instead. Where
+    only it fails at l_b the span is that length (no run; with only min_frequency the
+    refinement costs no run at all). Where another criterion fails at
     l_b too and the frequency span l_f lies inside the bracket, one run at l_f decides:
     passing, the span is l_f; failing, the bisection runs on [l_a, l_f].
 
@@ -927,7 +953,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                 l_f = _frequency_span(lambda length: frequency_at(point, length), lo, hi,
                                       fmin, tol)
         others_fail = [k for k in failing if k != "min_frequency"]
-        if not others_fail:                      # the frequency alone: exact, no run
+        if not others_fail:                      # the frequency alone: no run
             spans[flat_i], limited[flat_i] = l_f, "min_frequency"
             continue
         by = others_fail[0]

@@ -16,6 +16,7 @@ import sweep
 from conftest import TABLE1_CABLE
 from sweep.cli import main
 from sweep.design import max_span, refine_span
+from sweep.version import package_version
 
 # Table 1 cable, bending moment of the solid round 6 mm^2 section.
 E, RHO, AREA, INERTIA, ZETA = 1.1e11, 8900.0, 6e-6, 2.865e-12, 0.02
@@ -284,6 +285,39 @@ def test_cli_design_says_when_its_span_is_interpolated(results, capsys):
     assert "--refine" not in capsys.readouterr().out
     assert main(["design", str(path), "--min-frequency", "100"]) == 0
     assert "--refine" not in capsys.readouterr().out
+
+
+def test_cli_design_says_nothing_of_a_span_that_is_a_grid_length(tmp_path, capsys):
+    """A span limited by a failed state is the last passing grid length, not interpolated:
+    no 'interpolated' line (it was printed for any row limited by a response-side name)."""
+    from test_design_random import synthetic
+    path = tmp_path / "diverged.nc"
+    ds = synthetic(diverged=(2, 0)).drop_vars("exceedance_probability")   # fails 0.2 m
+    ds.assign_attrs(cable_sweep_version=package_version()).to_netcdf(path)
+    assert main(["design", str(path), "--max-rms", "0.0024"]) == 0    # rms crosses at 0.24 m
+    out = capsys.readouterr().out
+    assert "150.00  state" in out and "interpolated" not in out
+    assert main(["design", str(path), "--max-rms", "0.0012"]) == 0    # crosses at 0.12 m
+    assert "1 span(s) interpolated between the grid's lengths" in capsys.readouterr().out
+
+
+def test_cli_design_says_an_elastic_frequency_span_is_interpolated(tmp_path, capsys):
+    """With elastic clamps f1 is not ~ l^-2 (K = k_t l / EI grows with the span), so the
+    frequency span interpolated log-log between grid lengths is not exact: the command says so
+    and points at --refine (pinned ends get no such line: test above)."""
+    text = SCENE.format(table1=TABLE1_CABLE, name="elastic", membrane=0.0, cable="",
+                        base=f"acceleration_g = {LEVEL_G}\nfrequency = {BASE_FREQUENCY}",
+                        axes="length = [0.2, 0.3, 0.4]", solver="t_end = 0.05")
+    scene = sweep.load_scene_text(text, overrides={"clamps.rotation": "elastic",
+                                                   "clamps.rotational_stiffness": 1.0})
+    path = tmp_path / "elastic.nc"
+    ds = sweep.run(scene, output=path, progress=False)
+    f = ds["natural_frequency"].values
+    limit = float(np.sqrt(f[0] * f[1]))                  # between the first two lengths
+    assert main(["design", str(path), "--min-frequency", f"{limit:.9g}"]) == 0
+    out = capsys.readouterr().out
+    assert "1 min_frequency span(s) interpolated as log f against log l" in out
+    assert "not for elastic ones" in out and "--refine gives the exact span" in out
 
 
 def test_cli_design_limits_take_units(results, tmp_path, capsys):
