@@ -33,8 +33,8 @@ A stepped or swept result's `direction` (up, down) and a random result's `realis
 Monte Carlo records) count at their worst: a quantity's maximum over them, and a length fails
 on a state or stability failure of any of them (a realisation that escaped, state diverged,
 fails its length); a random result's criteria read statistics over its records, and the sine
-response limits (SINE_LIMITS) are refused for it. The design is over the result's axes less length, direction and
-realisation.
+response limits (SINE_LIMITS) are refused for it. The design is over the result's axes less
+length, direction and realisation.
 
 Interpolation between the last passing grid length l_a and the first failing one l_b:
 frequency in log f against log l (exact for pinned and clamped ends, whose unloaded
@@ -90,6 +90,19 @@ CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "m
 """The criteria in the order they are named when the shortest span fails several; a failed
 solve (`state`) comes first wherever it fails, as its NaN values fail no limit."""
 LIMITED_BY = CRITERIA + ("grid",)
+SPAN_LONG_NAME = "largest span between clamps meeting the criteria"
+NAN_SPAN = "NaN: the shortest grid length already fails (limited_by says which criterion)"
+GRID_SPAN_COMMENT = ("every shorter grid length passes; interpolated between the last passing "
+                     "and the first failing grid length on the binding criterion's margin "
+                     "(sweep.design, docs/model.md sec. 9), the longest grid length where none "
+                     f"fails. {NAN_SPAN}")
+"""max_span's labels: a long_name short and complete (<= 100 characters), how in comment."""
+LIMITED_BY_ATTRS = {
+    "long_name": "criterion that limits the span (see comment)",
+    "comment": "one of " + ", ".join(LIMITED_BY) + "; grid: no grid length fails (max_span is "
+               "the longest grid length, the true one may be longer); with a NaN max_span, the "
+               "criterion the shortest grid length fails"}
+"""limited_by's labels: the criteria it may name listed in full in comment."""
 NO_CRITERION = ("design: no criterion given (give --min-frequency HZ, --max-amplitude M, "
                 "--max-deflection M, --max-strain S, --max-rms M, --max-peak M or "
                 "--clearance M)")
@@ -489,17 +502,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     result = xr.Dataset(
         {"max_span": xr.DataArray(spans.reshape(out_shape), dims=others, attrs={
-            "units": "m",
-            "long_name": "largest span between clamps meeting the criteria, every shorter "
-                         "grid span passing (interpolated between grid lengths)",
-            "comment": "NaN: the shortest grid length already fails (limited_by says which "
-                       "criterion)"}),
+            "units": "m", "long_name": SPAN_LONG_NAME, "comment": GRID_SPAN_COMMENT}),
          "limited_by": xr.DataArray(limited.reshape(out_shape).astype(str).astype(object),
-                                    dims=others, attrs={
-             "long_name": "criterion binding max_span: " + ", ".join(LIMITED_BY),
-             "comment": "grid: no grid length fails (max_span is the longest grid length, "
-                        "the true one may be longer); with a NaN max_span, the criterion "
-                        "the shortest grid length fails"})},
+                                    dims=others, attrs=dict(LIMITED_BY_ATTRS))},
         coords=coords,
         attrs={"title": f"maximum span: {title}" if title else "maximum span",
                "Conventions": "CF-1.11",
@@ -975,8 +980,11 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         spans[flat_i], limited[flat_i] = lo, by
     grid["max_span"].values = spans.reshape(shape)
     grid["limited_by"].values = limited.reshape(shape)
-    grid["max_span"].attrs["long_name"] = ("largest span between clamps meeting the criteria, "
-                                           "refined by bisection with the engine")
+    grid["max_span"].attrs["long_name"] = f"{SPAN_LONG_NAME}, refined by bisection with the engine"
+    grid["max_span"].attrs["comment"] = (
+        f"the passing end of a bracket bisected on length with engine runs of the result's scene "
+        f"to below {tol:g} m (conservative: at most that below the true span; min_frequency "
+        f"without a run), the longest grid length where none fails. {NAN_SPAN}")
     grid.attrs["refine_runs"] = np.int32(runs)
     grid.attrs["refine_tolerance"] = float(tol)
     grid.attrs["refinement"] = (

@@ -22,7 +22,8 @@ from typing import Any, Sequence
 import numpy as np
 import xarray as xr
 
-from .design import NO_CRITERION, check_result, max_span, validated
+from .design import (GRID_SPAN_COMMENT, NO_CRITERION, SPAN_LONG_NAME, check_result, max_span,
+                     validated)
 from .errors import UserError
 
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
@@ -229,9 +230,8 @@ def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
     return xr.Dataset(
         {"max_span": xr.DataArray(span, dims=dims, attrs={
             **first["max_span"].attrs,
-            "long_name": "largest span between clamps meeting the criteria in every result "
-                         "they apply to, every shorter grid span passing (interpolated between "
-                         "grid lengths)"}),
+            "long_name": f"{SPAN_LONG_NAME} in every result they apply to",
+            "comment": f"the shortest of the results' spans, each: {GRID_SPAN_COMMENT}"}),
          "limited_by": xr.DataArray(limited_by.astype(str).astype(object), dims=dims,
                                     attrs=first["limited_by"].attrs),
          "limited_in": xr.DataArray(limited_in.astype(str).astype(object), dims=dims, attrs={

@@ -320,6 +320,31 @@ def test_cli_design_says_an_elastic_frequency_span_is_interpolated(tmp_path, cap
     assert "not for elastic ones" in out and "--refine gives the exact span" in out
 
 
+def test_design_labels_are_short_complete_and_match_how_the_span_was_found(results):
+    """long_name is a plot's label (<= 100 characters) and must read as complete: limited_by's
+    criteria were cut to a list that looked whole (ending at max_rms), so they are all in its
+    comment and none in its label; a refined span's comment says bisection, not interpolation
+    between grid lengths (its long_name said one, its comment the other); several results'
+    span has a label within 100 characters too (it had 146)."""
+    from sweep.design import LIMITED_BY
+    from sweep.governing import governing_span
+    coarse, _ = results["coarse"]
+    grid = max_span(coarse, min_frequency=100.0)
+    label, comment = grid["limited_by"].attrs["long_name"], grid["limited_by"].attrs["comment"]
+    assert len(label) <= 100 and not any(name in label for name in LIMITED_BY)
+    assert all(name in comment for name in LIMITED_BY)
+    assert "interpolated" in grid["max_span"].attrs["comment"]
+    refined = refine_span(coarse, min_frequency=100.0)         # the frequency alone: no run
+    assert "refined by bisection" in refined["max_span"].attrs["long_name"]
+    assert "interpolated" not in refined["max_span"].attrs["comment"]
+    assert "bisected" in refined["max_span"].attrs["comment"]
+    linear, _ = results["linear"]
+    both = governing_span([("linear.nc", linear), ("coarse.nc", _frequency_only(results))],
+                          min_frequency=40.0)
+    for var in ("max_span", "limited_by", "limited_in"):
+        assert len(both[var].attrs["long_name"]) <= 100, var
+
+
 def test_cli_design_limits_take_units(results, tmp_path, capsys):
     """A limit may carry its unit, as a scene key does: '--max-amplitude "2 mm"' is 0.002 m (it
     was refused as an invalid float, and a bare 2 meant 2 m), '--min-frequency "0.1 kHz"' is
