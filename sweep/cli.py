@@ -48,54 +48,28 @@ def _one_line(text: object) -> str:
     return one_line(text)
 
 
-def _with_unit(text: str, units: str, example: str) -> float:
-    """An argparse value: a plain number (SI) or a number with a unit, converted to `units`
-    (sweep.scene.units, the scene keys' rules); ArgumentTypeError, one line, otherwise."""
+def _limit(text: str, units: str) -> float:
+    """An argparse value: a design limit (sweep.design.limit_value: a plain number in `units`
+    or a number with a unit); ArgumentTypeError, one line, otherwise."""
+    from .design import limit_value
     try:
-        return float(text)
-    except ValueError:
-        pass
-    from .errors import SceneError
-    from .scene.units import to_si
-    from .schema import Key
-    try:
-        return to_si("value", Key("design", "limit", "float", None, units=units), text)
-    except SceneError as exc:
-        said = str(exc).removeprefix("value: ").replace("the key takes", "it takes")
-        raise argparse.ArgumentTypeError(f"{said}; a plain number is in {units}, or write "
-                                         f"e.g. {example}") from None
+        return limit_value(text, units)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _metres(text: str) -> float:
-    return _with_unit(text, "m", "'2 mm'")
+    return _limit(text, "m")
 
 
 def _hertz(text: str) -> float:
-    return _with_unit(text, "Hz", "'100 Hz'")
-
-
-STRAIN_UNITS = {"%": 1e-2, "percent": 1e-2, "microstrain": 1e-6, "ustrain": 1e-6,
-                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
-"""What a strain limit may be written in besides a plain number (1, m/m)."""
+    return _limit(text, "Hz")
 
 
 def _strain(text: str) -> float:
-    """An argparse value: a strain, a plain number (1, m/m) or one with a unit of
-    STRAIN_UNITS ('300 microstrain', '0.03 %'); ArgumentTypeError, one line, otherwise."""
-    import re
-    match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
-    unit = match.group(2).lower() if match else ""
-    factor = 1.0 if not unit else STRAIN_UNITS.get(unit)
-    try:
-        value = float(match.group(1)) if match else None
-    except ValueError:
-        value = None
-    if value is None or factor is None:
-        raise argparse.ArgumentTypeError(
-            f"{text!r}: not a strain (a plain number is in m/m, e.g. 0.0003, or write it with "
-            f"one of {', '.join(repr(u) for u in ('%', 'microstrain', 'ppm'))}: '300 "
-            "microstrain', '0.03 %')")
-    return value * factor
+    """An argparse value: a strain, plain (1, m/m) or with a unit ('300 microstrain',
+    '0.03 %'; sweep.design.STRAIN_UNITS)."""
+    return _limit(text, "1")
 
 
 def _parser() -> argparse.ArgumentParser:

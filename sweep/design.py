@@ -108,7 +108,63 @@ NO_CRITERION = ("design: no criterion given (give --min-frequency HZ, --max-ampl
                 "--clearance M)")
 
 
-def _number(value: Any, flag: str, example: str) -> float:
+STRAIN_UNITS = {"%": 1e-2, "percent": 1e-2, "microstrain": 1e-6, "ustrain": 1e-6,
+                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
+"""What a strain limit may be written in besides a plain number (1, m/m)."""
+UNIT_EXAMPLES = {"m": "'2 mm'", "Hz": "'100 Hz'"}
+"""How a limit in these units may be written with its unit (limit_value)."""
+
+
+def limit_value(text: str, units: str) -> float:
+    """A limit written as text, in `units`: "m" or "Hz", a plain number in them or a number
+    with a unit converted as a scene key's ("2 mm", "0.1 kHz": sweep.scene.units); "1", a
+    strain, plain (m/m) or with a unit of STRAIN_UNITS ("300 microstrain", "0.03 %").
+    ValueError, one line (what it takes), otherwise; the sign is checked by the caller."""
+    if units == "1":
+        return _strain_value(text)
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    from .errors import SceneError
+    from .scene.units import to_si
+    from .schema import Key
+    try:
+        return to_si("value", Key("design", "limit", "float", None, units=units), text)
+    except SceneError as exc:
+        said = str(exc).removeprefix("value: ").replace("the key takes", "it takes")
+        raise ValueError(f"{said}; a plain number is in {units}, or write e.g. "
+                         f"{UNIT_EXAMPLES[units]}") from None
+
+
+def _strain_value(text: str) -> float:
+    """A strain (1) written plain (m/m) or with a unit of STRAIN_UNITS; ValueError, one line,
+    otherwise."""
+    import re
+    match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
+    unit = match.group(2).lower() if match else ""
+    factor = 1.0 if not unit else STRAIN_UNITS.get(unit)
+    try:
+        value = float(match.group(1)) if match else None
+    except ValueError:
+        value = None
+    if value is None or factor is None:
+        raise ValueError(f"{text!r}: not a strain (a plain number is in m/m, e.g. 0.0003, or "
+                         "write it with one of '%', 'microstrain', 'ppm': '300 microstrain', "
+                         "'0.03 %')")
+    return value * factor
+
+
+def _number(value: Any, flag: str, example: str, units: str | None = None) -> float:
+    """A criterion's limit as a positive finite float: a number, or (from Python) a string
+    with a unit of `units` (limit_value; None: a plain number only); one-line UserError
+    otherwise, naming `flag` (the command's) and the keyword argument it is."""
+    if isinstance(value, str) and units is not None:
+        keyword = flag.removeprefix("--").replace("-", "_")
+        try:
+            value = limit_value(value, units)
+        except ValueError as exc:
+            raise UserError(f"design: {keyword}={value!r} ({flag}): {exc}") from None
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -136,6 +192,9 @@ def _length_quantities(ds: xr.Dataset, axes: tuple[str, ...]) -> list[str]:
                   and set(v.dims) <= set(axes))
 
 
+Limit = float | str | None
+"""A criterion's limit as max_span takes it: a number in the criterion's units (Hz, m, 1), a
+string with its unit ("2 mm", "0.1 kHz", "300 microstrain": limit_value), or None (not given)."""
 Limits = dict[str, tuple[str, float, float | None]]
 """The upper-limit criteria of a design: criterion -> (the variable it reads, its limit, the
 `clearance` level (m) it is read at, or None)."""
@@ -340,16 +399,16 @@ def _parse(min_frequency: Any, max_amplitude: Any, max_deflection: Any, max_stra
            ) -> dict[str, float | None]:
     """The criteria's limits as positive finite floats (None where not given), refused in one
     line otherwise; max_probability below 1 too."""
-    given = {"min_frequency": (min_frequency, "--min-frequency", "100"),
-             "max_amplitude": (max_amplitude, "--max-amplitude", "0.002"),
-             "max_deflection": (max_deflection, "--max-deflection", "0.002"),
-             "max_strain": (max_strain, "--max-strain", "0.001"),
-             "max_rms": (max_rms, "--max-rms", "0.001"),
-             "max_peak": (max_peak, "--max-peak", "0.004"),
-             "clearance": (clearance, "--clearance", "0.002"),
-             "max_probability": (max_probability, "--max-probability", "0.01")}
-    out = {k: None if v is None else _number(v, flag, example)
-           for k, (v, flag, example) in given.items()}
+    given = {"min_frequency": (min_frequency, "--min-frequency", "100", "Hz"),
+             "max_amplitude": (max_amplitude, "--max-amplitude", "0.002", "m"),
+             "max_deflection": (max_deflection, "--max-deflection", "0.002", "m"),
+             "max_strain": (max_strain, "--max-strain", "0.001", "1"),
+             "max_rms": (max_rms, "--max-rms", "0.001", "m"),
+             "max_peak": (max_peak, "--max-peak", "0.004", "m"),
+             "clearance": (clearance, "--clearance", "0.002", "m"),
+             "max_probability": (max_probability, "--max-probability", "0.01", None)}
+    out = {k: None if v is None else _number(v, flag, example, units)
+           for k, (v, flag, example, units) in given.items()}
     p = out["max_probability"]
     if p is not None and clearance is None:
         raise UserError(f"design: --max-probability {p:g} is the limit of the clearance "
@@ -374,11 +433,11 @@ def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
     return np.asarray(var.broadcast_like(like).transpose(*like.dims).values, float)
 
 
-def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
-             max_amplitude: float | None = None, quantity: str | None = None,
-             max_deflection: float | None = None, max_strain: float | None = None,
-             max_rms: float | None = None, max_peak: float | None = None,
-             clearance: float | None = None, max_probability: float | None = None
+def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
+             max_amplitude: Limit = None, quantity: str | None = None,
+             max_deflection: Limit = None, max_strain: Limit = None,
+             max_rms: Limit = None, max_peak: Limit = None,
+             clearance: Limit = None, max_probability: float | None = None
              ) -> xr.Dataset:
     """The largest span between clamps (m) that meets the criteria, per combination of the
     result's other swept axes.
@@ -408,6 +467,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         most `max_probability`.
     max_probability : 1, below 1; the clearance criterion's limit (needs clearance; default
         0.01, i.e. 1 %).
+
+    Each limit but max_probability may be a string with its unit, as the command takes it
+    ("2 mm", "0.1 kHz", "300 microstrain": limit_value).
 
     Every length must also have a `state` that is not a failure (invalid_input, diverged,
     step_size_too_small, max_steps_reached on either direction or in any realisation) and,
@@ -808,12 +870,12 @@ MAX_BISECTIONS = 64
 """Most halvings of one bracket (a bound whatever the tolerance)."""
 
 
-def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
-                max_amplitude: float | None = None, quantity: str | None = None,
-                max_deflection: float | None = None, max_strain: float | None = None,
-                max_rms: float | None = None, max_peak: float | None = None,
-                clearance: float | None = None, max_probability: float | None = None,
-                tolerance: float = 1e-3) -> xr.Dataset:
+def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
+                max_amplitude: Limit = None, quantity: str | None = None,
+                max_deflection: Limit = None, max_strain: Limit = None,
+                max_rms: Limit = None, max_peak: Limit = None,
+                clearance: Limit = None, max_probability: float | None = None,
+                tolerance: float | str = 1e-3) -> xr.Dataset:
     """`max_span` refined beyond the grid by bisecting on length with the engine itself.
 
     For every combination of the result's other axes whose grid max_span is bracketed (a
@@ -846,7 +908,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     from .run import run
     from .scene import load_scene_text
 
-    tol = _number(tolerance, "--tolerance", "0.001")
+    tol = _number(tolerance, "--tolerance", "0.001", "m")
     if isinstance(ds, xr.Dataset) and REALISATION in ds.dims:
         raise UserError("design: --refine bisects between lengths, and a random result's "
                         "criteria are Monte Carlo means whose scatter from one length to the "

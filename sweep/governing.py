@@ -22,8 +22,8 @@ from typing import Any, Sequence
 import numpy as np
 import xarray as xr
 
-from .design import (GRID_SPAN_COMMENT, NO_CRITERION, SPAN_LONG_NAME, check_result, max_span,
-                     validated)
+from .design import (GRID_SPAN_COMMENT, NO_CRITERION, SPAN_LONG_NAME, Limit, check_result,
+                     max_span, validated)
 from .errors import UserError
 
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
@@ -53,10 +53,10 @@ def _applies(ds: xr.Dataset, one: dict[str, Any]) -> str | None:
 
 
 def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
-                   min_frequency: float | None = None, max_amplitude: float | None = None,
-                   quantity: str | None = None, max_deflection: float | None = None,
-                   max_strain: float | None = None, max_rms: float | None = None,
-                   max_peak: float | None = None, clearance: float | None = None,
+                   min_frequency: Limit = None, max_amplitude: Limit = None,
+                   quantity: str | None = None, max_deflection: Limit = None,
+                   max_strain: Limit = None, max_rms: Limit = None,
+                   max_peak: Limit = None, clearance: Limit = None,
                    max_probability: float | None = None) -> xr.Dataset:
     """The largest span between clamps (m) that meets every criterion in every result it
     applies to: `max_span` of each (name, result) pair with its own criteria, the shortest

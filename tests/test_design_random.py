@@ -123,6 +123,17 @@ def test_a_length_in_no_length_unit_is_refused_in_one_line(units, said):
     assert "\n" not in message
 
 
+def test_limits_from_python_take_units_as_the_command_does():
+    """max_span(ds, min_frequency="0.03 kHz") is 30 Hz, as 'sweep design --min-frequency
+    "0.03 kHz"' (it was refused with the command's words); f1 = 52.6 (0.15 / l)^2 Hz crosses
+    30 Hz at l = 0.15 sqrt(52.6 / 30), rms = 0.01 l crosses 1.7 mm at 0.17 m."""
+    ds = synthetic()
+    frequency = max_span(ds, min_frequency="0.03 kHz")
+    assert float(frequency["max_span"]) == pytest.approx(0.15 * np.sqrt(52.6 / 30.0), rel=1e-12)
+    assert float(max_span(ds, max_rms="1.7 mm")["max_span"]) == pytest.approx(0.17, rel=1e-12)
+    assert str(max_span(ds, max_peak=" 8 mm ")["limited_by"].values) == "max_peak"
+
+
 def test_max_peak_reads_the_mean_peak():
     out = max_span(synthetic(), max_peak=0.008)          # 4 * 0.01 l = 0.008 at l = 0.2
     assert float(out["max_span"]) == pytest.approx(0.2, rel=1e-12)
@@ -217,7 +228,8 @@ def test_a_sine_response_limit_of_a_random_result_is_refused_in_one_line(flag, k
     (dict(max_rms=0.001, max_probability=0.05), "give --clearance M too"),
     (dict(clearance=0.001, max_probability=1.0), "below 1"),
     (dict(max_rms=-1.0), "--max-rms -1"),
-    (dict(max_peak="x"), "--max-peak 'x'"),
+    (dict(max_peak="x"), "max_peak='x' (--max-peak): 'x' does not start with a number"),
+    (dict(min_frequency="3 mm"), "min_frequency='3 mm' (--min-frequency): '3 mm' is a length"),
 ])
 def test_bad_random_criteria_are_one_line(kwargs, fragment):
     with pytest.raises(sweep.UserError) as info:
