@@ -140,7 +140,9 @@ def _parser() -> argparse.ArgumentParser:
                         help="response at most this (m): peak_amplitude of a swept result, "
                              "else amplitude, or --quantity")
     design.add_argument("--quantity", default=None, metavar="NAME",
-                        help="the variable (in m) --max-amplitude limits")
+                        help="the response (in m) --max-amplitude limits: amplitude, "
+                             "peak_amplitude, max_deflection, linear_amplitude, ... (not a "
+                             "position or a threshold)")
     design.add_argument("--max-deflection", type=_metres, default=None, metavar="M",
                         help="largest deflection anywhere on the span at most this (m): "
                              "max_deflection (one mode: its midspan amplitude)")

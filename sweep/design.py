@@ -8,8 +8,8 @@ margin of the criterion that binds. A length fails when
 
 * ``min_frequency``: its first natural frequency `natural_frequency` (Hz) is below the limit;
 * ``max_amplitude``: its response (`peak_amplitude` of a swept result, one with
-  `peak_frequency`; else `amplitude`; or the variable named by ``quantity``, m) is above the
-  limit, or is missing (NaN);
+  `peak_frequency`; else `amplitude`; or the response named by ``quantity``, one of
+  RESPONSES, m) is above the limit, or is missing (NaN);
 * ``max_deflection``: its largest deflection anywhere on the span (`max_deflection`, m; a
   one-mode result's midspan amplitude, where its mode peaks) is above the limit;
 * ``max_strain``: its largest outer-fibre strain (`max_strain`: the bending strain at the
@@ -185,10 +185,22 @@ def _default_quantity(ds: xr.Dataset) -> str:
     return "peak_amplitude" if "peak_frequency" in ds else "amplitude"
 
 
+RESPONSES = ("amplitude", "peak_amplitude", "max_deflection", "linear_amplitude",
+             "peak_end_displacement", "static_end_displacement")
+"""What --quantity may name: the span's responses in m a limit applies to (sweep.models
+.transverse: the midspan's `amplitude` and `peak_amplitude`, `max_deflection` anywhere on the
+span, the linearised span's closed form `linear_amplitude`; sweep.models.longitudinal: the
+loaded end's `peak_end_displacement` and `static_end_displacement`). Not every variable in m
+is one: `max_deflection_position` is where along the span the largest deflection lies, and
+`escape_barrier` the |q| beyond which the span escapes, a threshold (NON_RESPONSES)."""
+NON_RESPONSES = ("max_deflection_position", "escape_barrier")
+"""Variables in m over the swept axes that are no response to limit (RESPONSES)."""
+
+
 def _length_quantities(ds: xr.Dataset, axes: tuple[str, ...]) -> list[str]:
-    """Variables with units m over the swept axes only: what --quantity may name."""
+    """The responses (RESPONSES) in m over the swept axes only: what --quantity may name."""
     return sorted(str(n) for n, v in ds.data_vars.items()
-                  if v.attrs.get("units") == "m" and LENGTH in v.dims
+                  if n in RESPONSES and v.attrs.get("units") == "m" and LENGTH in v.dims
                   and set(v.dims) <= set(axes))
 
 
@@ -364,12 +376,16 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
     choices = ", ".join(_length_quantities(ds, axes)) or "none"
     if name not in ds.data_vars:
         how = "--quantity" if quantity is not None else "the default quantity"
-        raise UserError(f"design: {how} '{name}': no such variable in the result (variables "
+        raise UserError(f"design: {how} '{name}': no such variable in the result (responses "
                         f"in m over its length axis: {choices}; give --quantity NAME)")
     units = ds[name].attrs.get("units")
     if units != "m":
         raise UserError(f"design: --max-amplitude limits '{name}', whose units are "
                         f"{units!r}, not 'm' (give --quantity NAME of one in m: {choices})")
+    if name not in RESPONSES:
+        raise UserError(f"design: --quantity {name}: not a response of the span to limit (a "
+                        "position along it or a threshold, not a deflection); give --quantity "
+                        f"NAME of a response: {choices}")
     extra = [d for d in ds[name].dims if d not in axes]
     if extra:
         raise UserError(f"design: quantity '{name}' lies over {', '.join(map(str, extra))}, "
@@ -448,11 +464,11 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         mm, cm, km as its units attribute says: converted to m).
     min_frequency : Hz; a length passes when `natural_frequency` >= min_frequency.
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
-        `quantity` (a variable in m over the swept axes), by default `peak_amplitude` for a
+        `quantity` (one of RESPONSES, in m over the swept axes), by default `peak_amplitude` for a
         swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
         (largest) value over `direction` counts. Not for a random result (SINE_LIMITS), nor
         are max_deflection and max_strain.
-    quantity : the variable `max_amplitude` limits (needs max_amplitude).
+    quantity : the response `max_amplitude` limits, one of RESPONSES (needs max_amplitude).
     max_deflection : m; a length passes when `max_deflection`, the largest deflection anywhere
         on the span, is at most this (one mode: the midspan's, where its largest lies).
     max_strain : 1; a length passes when `max_strain` (the outer fibre's bending strain at

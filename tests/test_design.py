@@ -250,6 +250,34 @@ def test_bad_criteria_are_one_line(results, kwargs, fragment):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("name", ["escape_barrier", "max_deflection_position"])
+def test_quantity_is_a_response_not_a_position_or_a_threshold(results, name):
+    """--quantity names a response to limit: a barrier (escape_barrier) or the place of the
+    largest deflection (max_deflection_position) is in m over the length axis too, and was
+    taken for one."""
+    ds, _ = results["coarse"]
+    if name not in ds:                             # several modes hold it: one added here
+        ds = ds.assign({name: ds["amplitude"].assign_attrs(units="m")})
+    with pytest.raises(sweep.UserError) as info:
+        max_span(ds, max_amplitude=1e-3, quantity=name)
+    message = str(info.value)
+    assert f"--quantity {name}: not a response" in message and "\n" not in message
+    assert "amplitude" in message.split("a response:")[-1]
+
+
+def test_every_variable_in_m_is_classed_a_response_or_not(results):
+    """Each variable in m over the length axis that a result holds is either a response
+    --quantity may limit (RESPONSES) or no response (NON_RESPONSES): an output added in m
+    must be classed before design reads it."""
+    from sweep.design import NON_RESPONSES, RESPONSES
+    seen = set()
+    for ds, _ in results.values():
+        seen |= {str(n) for n, v in ds.data_vars.items()
+                 if v.attrs.get("units") == "m" and "length" in v.dims}
+    assert seen and seen <= set(RESPONSES) | set(NON_RESPONSES), seen
+    assert not set(RESPONSES) & set(NON_RESPONSES)
+
+
 def test_a_result_without_length_is_refused(results):
     ds, _ = results["no_length"]
     with pytest.raises(sweep.UserError, match="length") as info:
