@@ -26,10 +26,13 @@ import signal
 import sys
 import time
 import warnings
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 from .errors import CableSweepWarning, UserError, one_line
 from .version import VERSION, package_version  # noqa: F401  (VERSION: re-exported)
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 
 class _Parser(argparse.ArgumentParser):
@@ -45,54 +48,28 @@ def _one_line(text: object) -> str:
     return one_line(text)
 
 
-def _with_unit(text: str, units: str, example: str) -> float:
-    """An argparse value: a plain number (SI) or a number with a unit, converted to `units`
-    (sweep.scene.units, the scene keys' rules); ArgumentTypeError, one line, otherwise."""
+def _limit(text: str, units: str) -> float:
+    """An argparse value: a design limit (sweep.design.limit_value: a plain number in `units`
+    or a number with a unit); ArgumentTypeError, one line, otherwise."""
+    from .design import limit_value
     try:
-        return float(text)
-    except ValueError:
-        pass
-    from .errors import SceneError
-    from .scene.units import to_si
-    from .schema import Key
-    try:
-        return to_si("value", Key("design", "limit", "float", None, units=units), text)
-    except SceneError as exc:
-        said = str(exc).removeprefix("value: ").replace("the key takes", "it takes")
-        raise argparse.ArgumentTypeError(f"{said}; a plain number is in {units}, or write "
-                                         f"e.g. {example}") from None
+        return limit_value(text, units)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _metres(text: str) -> float:
-    return _with_unit(text, "m", "'2 mm'")
+    return _limit(text, "m")
 
 
 def _hertz(text: str) -> float:
-    return _with_unit(text, "Hz", "'100 Hz'")
-
-
-STRAIN_UNITS = {"%": 1e-2, "percent": 1e-2, "microstrain": 1e-6, "ustrain": 1e-6,
-                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
-"""What a strain limit may be written in besides a plain number (1, m/m)."""
+    return _limit(text, "Hz")
 
 
 def _strain(text: str) -> float:
-    """An argparse value: a strain, a plain number (1, m/m) or one with a unit of
-    STRAIN_UNITS ('300 microstrain', '0.03 %'); ArgumentTypeError, one line, otherwise."""
-    import re
-    match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
-    unit = match.group(2).lower() if match else ""
-    factor = 1.0 if not unit else STRAIN_UNITS.get(unit)
-    try:
-        value = float(match.group(1)) if match else None
-    except ValueError:
-        value = None
-    if value is None or factor is None:
-        raise argparse.ArgumentTypeError(
-            f"{text!r}: not a strain (a plain number is in m/m, e.g. 0.0003, or write it with "
-            f"one of {', '.join(repr(u) for u in ('%', 'microstrain', 'ppm'))}: '300 "
-            "microstrain', '0.03 %')")
-    return value * factor
+    """An argparse value: a strain, plain (1, m/m) or with a unit ('300 microstrain',
+    '0.03 %'; sweep.design.STRAIN_UNITS)."""
+    return _limit(text, "1")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -163,7 +140,9 @@ def _parser() -> argparse.ArgumentParser:
                         help="response at most this (m): peak_amplitude of a swept result, "
                              "else amplitude, or --quantity")
     design.add_argument("--quantity", default=None, metavar="NAME",
-                        help="the variable (in m) --max-amplitude limits")
+                        help="the response (in m) --max-amplitude limits: amplitude, "
+                             "peak_amplitude, max_deflection, linear_amplitude, ... (not a "
+                             "position or a threshold)")
     design.add_argument("--max-deflection", type=_metres, default=None, metavar="M",
                         help="largest deflection anywhere on the span at most this (m): "
                              "max_deflection (one mode: its midspan amplitude)")
@@ -372,12 +351,12 @@ def _design(args: argparse.Namespace) -> int:
                     max_strain=args.max_strain, max_rms=args.max_rms,
                     max_peak=args.max_peak, clearance=args.clearance,
                     max_probability=args.max_probability)
-    if len(args.result) > 1:
+    loaded = [(path, load_result(path)) for path in args.result]
+    if len(loaded) > 1:
         from .governing import governing_span
-        result = governing_span([(path, load_result(path)) for path in args.result],
-                                **criteria)
+        result = governing_span(loaded, **criteria)
     else:
-        ds = load_result(args.result[0])
+        ds = loaded[0][1]
         result = (refine_span(ds, **criteria,
                               tolerance=1e-3 if args.tolerance is None else args.tolerance)
                   if args.refine else max_span(ds, **criteria))
@@ -386,20 +365,34 @@ def _design(args: argparse.Namespace) -> int:
     if args.refine:
         print(f"refined: {int(result.attrs['refine_runs'])} engine runs, tolerance "
               f"{result.attrs['refine_tolerance']:g} m (max_span the bracket's passing end)")
-    elif interpolated(result, criteria):
-        if len(args.result) > 1:
-            fix = ("--refine runs the engine to bracket it, one sine result at a time; a random "
-                   "result's length axis refined (and base.realisations added) narrows it")
-        elif "realisation" in ds.dims:
-            fix = "refine the scene's length axis (and add base.realisations) to narrow it"
-        else:
-            fix = "--refine runs the engine to bracket it"
-        print("interpolated between the grid's lengths, not run there: a response that peaks "
-              f"between two of them (a resonance) can put the true limit shorter; {fix}")
+    else:
+        _say_interpolated(interpolated(result, dict(loaded)), [ds for _, ds in loaded])
     if args.output is not None:
         write_netcdf(result, args.output, overwrite=args.overwrite)
         print(f"-> {args.output}")
     return 0
+
+
+def _say_interpolated(counts: dict[str, int], results: list[xr.Dataset]) -> None:
+    """The lines that say how many spans `sweep design` interpolated between grid lengths
+    (sweep.design.interpolated's counts) and what would narrow them."""
+    if counts["response"]:
+        if len(results) > 1:
+            fix = ("--refine runs the engine to bracket it, one sine result at a time; a random "
+                   "result's length axis refined (and base.realisations added) narrows it")
+        elif "realisation" in results[0].dims:
+            fix = "refine the scene's length axis (and add base.realisations) to narrow it"
+        else:
+            fix = "--refine runs the engine to bracket it"
+        print(f"{counts['response']} span(s) interpolated between the grid's lengths, not run "
+              "there: a response that peaks between two of them (a resonance) can put the "
+              f"true limit shorter; {fix}")
+    if counts["frequency"]:
+        one = "" if len(results) == 1 else " (on that result alone)"
+        print(f"{counts['frequency']} min_frequency span(s) interpolated as log f against "
+              "log l, which is exact for pinned or clamped ends but not for elastic ones "
+              f"(K = k_t l / EI grows with the span); --refine{one} gives the exact span, "
+              "without an engine run")
 
 
 def _compile(args: argparse.Namespace) -> int:

@@ -8,8 +8,8 @@ margin of the criterion that binds. A length fails when
 
 * ``min_frequency``: its first natural frequency `natural_frequency` (Hz) is below the limit;
 * ``max_amplitude``: its response (`peak_amplitude` of a swept result, one with
-  `peak_frequency`; else `amplitude`; or the variable named by ``quantity``, m) is above the
-  limit, or is missing (NaN);
+  `peak_frequency`; else `amplitude`; or the response named by ``quantity``, one of
+  RESPONSES, m) is above the limit, or is missing (NaN);
 * ``max_deflection``: its largest deflection anywhere on the span (`max_deflection`, m; a
   one-mode result's midspan amplitude, where its mode peaks) is above the limit;
 * ``max_strain``: its largest outer-fibre strain (`max_strain`: the bending strain at the
@@ -30,25 +30,30 @@ margin of the criterion that binds. A length fails when
   (`growth_rate` > 0, or a flag other than stable).
 
 A stepped or swept result's `direction` (up, down) and a random result's `realisation` (its
-Monte Carlo records) count at their worst: the quantity's maximum over them, and a length fails
+Monte Carlo records) count at their worst: a quantity's maximum over them, and a length fails
 on a state or stability failure of any of them (a realisation that escaped, state diverged,
-fails its length). The design is over the result's axes less length, direction and
-realisation.
+fails its length); a random result's criteria read statistics over its records, and the sine
+response limits (SINE_LIMITS) are refused for it. The design is over the result's axes less
+length, direction and realisation.
 
 Interpolation between the last passing grid length l_a and the first failing one l_b:
-frequency in log f against log l (f1 ~ l^-2 unloaded, so the frequency criterion alone is
-exact), amplitude and every other upper limit linearly in l of (quantity - limit), stability
-linearly in l of growth_rate; a state failure (which has no margin) and a missing value give
-l_a. When several criteria fail at l_b the smallest of their spans binds. max_span runs no
-analysis: its span is only as good as the grid.
+frequency in log f against log l (exact for pinned and clamped ends, whose unloaded
+f1 ~ l^-2; not for elastic ends, whose K = k_t l / EI grows with the length: up to 2e-4
+relative on a 50 mm grid near K = 1), amplitude and every other upper limit linearly in l of
+(quantity - limit), stability linearly in l of growth_rate; a state failure (which has no
+margin), a missing value and a value that does not cross its limit between l_a and l_b (a
+stability flag that fails where growth_rate is still <= 0) give l_a. When several criteria
+fail at l_b the smallest of their spans binds. max_span runs no analysis: its span is only as
+good as the grid.
 
 `refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
 bracketed span it bisects on length with one-length engine runs of the result's stored scene,
 the other axes fixed to the combination's values, evaluating the same criteria (`_margins`,
 shared with max_span) until the bracket is below the tolerance (1 mm by default), and reports
 the bracket's passing end (conservative). The frequency criterion needs no run (log f against
-log l is exact for the unloaded f1 ~ l^-2), so a frequency-only refinement costs none; the
-runs made are counted in the attribute `refine_runs`.
+log l is exact for pinned or clamped ends, f1 ~ l^-2; elastic ends bisect on the closed-form
+f1), so a frequency-only refinement costs none; the runs made are counted in the attribute
+`refine_runs`.
 """
 
 from __future__ import annotations
@@ -78,17 +83,88 @@ DEFAULT_MAX_PROBABILITY = 0.01
 STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVERGED,
                                                       km.STEP_TOO_SMALL, km.MAX_STEPS))
 """`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "km": 1e3}
+"""The units a result's `length` axis may be in, and their size in metres."""
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance", "state", "stability")
 """The criteria in the order they are named when the shortest span fails several; a failed
 solve (`state`) comes first wherever it fails, as its NaN values fail no limit."""
 LIMITED_BY = CRITERIA + ("grid",)
+SPAN_LONG_NAME = "largest span between clamps meeting the criteria"
+NAN_SPAN = "NaN: the shortest grid length already fails (limited_by says which criterion)"
+GRID_SPAN_COMMENT = ("every shorter grid length passes; interpolated between the last passing "
+                     "and the first failing grid length on the binding criterion's margin "
+                     "(sweep.design, docs/model.md sec. 9), the longest grid length where none "
+                     f"fails. {NAN_SPAN}")
+"""max_span's labels: a long_name short and complete (<= 100 characters), how in comment."""
+LIMITED_BY_ATTRS = {
+    "long_name": "criterion that limits the span (see comment)",
+    "comment": "one of " + ", ".join(LIMITED_BY) + "; grid: no grid length fails (max_span is "
+               "the longest grid length, the true one may be longer); with a NaN max_span, the "
+               "criterion the shortest grid length fails"}
+"""limited_by's labels: the criteria it may name listed in full in comment."""
 NO_CRITERION = ("design: no criterion given (give --min-frequency HZ, --max-amplitude M, "
                 "--max-deflection M, --max-strain S, --max-rms M, --max-peak M or "
                 "--clearance M)")
 
 
-def _number(value: Any, flag: str, example: str) -> float:
+STRAIN_UNITS = {"%": 1e-2, "percent": 1e-2, "microstrain": 1e-6, "ustrain": 1e-6,
+                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
+"""What a strain limit may be written in besides a plain number (1, m/m)."""
+UNIT_EXAMPLES = {"m": "'2 mm'", "Hz": "'100 Hz'"}
+"""How a limit in these units may be written with its unit (limit_value)."""
+
+
+def limit_value(text: str, units: str) -> float:
+    """A limit written as text, in `units`: "m" or "Hz", a plain number in them or a number
+    with a unit converted as a scene key's ("2 mm", "0.1 kHz": sweep.scene.units); "1", a
+    strain, plain (m/m) or with a unit of STRAIN_UNITS ("300 microstrain", "0.03 %").
+    ValueError, one line (what it takes), otherwise; the sign is checked by the caller."""
+    if units == "1":
+        return _strain_value(text)
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    from .errors import SceneError
+    from .scene.units import to_si
+    from .schema import Key
+    try:
+        return to_si("value", Key("design", "limit", "float", None, units=units), text)
+    except SceneError as exc:
+        said = str(exc).removeprefix("value: ").replace("the key takes", "it takes")
+        raise ValueError(f"{said}; a plain number is in {units}, or write e.g. "
+                         f"{UNIT_EXAMPLES[units]}") from None
+
+
+def _strain_value(text: str) -> float:
+    """A strain (1) written plain (m/m) or with a unit of STRAIN_UNITS; ValueError, one line,
+    otherwise."""
+    import re
+    match = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*", text)
+    unit = match.group(2).lower() if match else ""
+    factor = 1.0 if not unit else STRAIN_UNITS.get(unit)
+    try:
+        value = float(match.group(1)) if match else None
+    except ValueError:
+        value = None
+    if value is None or factor is None:
+        raise ValueError(f"{text!r}: not a strain (a plain number is in m/m, e.g. 0.0003, or "
+                         "write it with one of '%', 'microstrain', 'ppm': '300 microstrain', "
+                         "'0.03 %')")
+    return value * factor
+
+
+def _number(value: Any, flag: str, example: str, units: str | None = None) -> float:
+    """A criterion's limit as a positive finite float: a number, or (from Python) a string
+    with a unit of `units` (limit_value; None: a plain number only); one-line UserError
+    otherwise, naming `flag` (the command's) and the keyword argument it is."""
+    if isinstance(value, str) and units is not None:
+        keyword = flag.removeprefix("--").replace("-", "_")
+        try:
+            value = limit_value(value, units)
+        except ValueError as exc:
+            raise UserError(f"design: {keyword}={value!r} ({flag}): {exc}") from None
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -109,13 +185,28 @@ def _default_quantity(ds: xr.Dataset) -> str:
     return "peak_amplitude" if "peak_frequency" in ds else "amplitude"
 
 
+RESPONSES = ("amplitude", "peak_amplitude", "max_deflection", "linear_amplitude",
+             "peak_end_displacement", "static_end_displacement")
+"""What --quantity may name: the span's responses in m a limit applies to (sweep.models
+.transverse: the midspan's `amplitude` and `peak_amplitude`, `max_deflection` anywhere on the
+span, the linearised span's closed form `linear_amplitude`; sweep.models.longitudinal: the
+loaded end's `peak_end_displacement` and `static_end_displacement`). Not every variable in m
+is one: `max_deflection_position` is where along the span the largest deflection lies, and
+`escape_barrier` the |q| beyond which the span escapes, a threshold (NON_RESPONSES)."""
+NON_RESPONSES = ("max_deflection_position", "escape_barrier")
+"""Variables in m over the swept axes that are no response to limit (RESPONSES)."""
+
+
 def _length_quantities(ds: xr.Dataset, axes: tuple[str, ...]) -> list[str]:
-    """Variables with units m over the swept axes only: what --quantity may name."""
+    """The responses (RESPONSES) in m over the swept axes only: what --quantity may name."""
     return sorted(str(n) for n, v in ds.data_vars.items()
-                  if v.attrs.get("units") == "m" and LENGTH in v.dims
+                  if n in RESPONSES and v.attrs.get("units") == "m" and LENGTH in v.dims
                   and set(v.dims) <= set(axes))
 
 
+Limit = float | str | None
+"""A criterion's limit as max_span takes it: a number in the criterion's units (Hz, m, 1), a
+string with its unit ("2 mm", "0.1 kHz", "300 microstrain": limit_value), or None (not given)."""
 Limits = dict[str, tuple[str, float, float | None]]
 """The upper-limit criteria of a design: criterion -> (the variable it reads, its limit, the
 `clearance` level (m) it is read at, or None)."""
@@ -214,7 +305,46 @@ def check_result(ds: xr.Dataset, name: str | None = None) -> tuple[str, ...]:
     if not (np.all(np.isfinite(lengths)) and np.all(lengths > 0)):
         raise UserError(f"design: {which}'s 'length' axis holds values that are not "
                         "positive finite lengths (m); give a result written by 'sweep run'")
+    units = ds[LENGTH].attrs.get("units")
+    if units not in LENGTH_UNITS:
+        said = "no units" if units is None else f"units {units!r}"
+        raise UserError(f"design: {which}'s 'length' axis has {said}, not one of "
+                        f"{', '.join(LENGTH_UNITS)}; give a result whose length coordinate "
+                        "says its unit (a result 'sweep run' wrote is in m)")
     return axes
+
+
+def in_metres(ds: xr.Dataset) -> xr.Dataset:
+    """`ds` with its `length` coordinate in metres (converted from LENGTH_UNITS, its units
+    attribute then "m"); `check_result` refuses any other units first."""
+    units = ds[LENGTH].attrs.get("units")
+    if units == "m":
+        return ds
+    length = ds[LENGTH]
+    metres = np.asarray(length.values, float) * LENGTH_UNITS[units]
+    return ds.assign_coords({LENGTH: (length.dims, metres, {**length.attrs, "units": "m"})})
+
+
+SINE_LIMITS = {"max_amplitude": "--max-amplitude", "max_deflection": "--max-deflection",
+               "max_strain": "--max-strain"}
+"""The criteria that limit a deterministic response (a sine or dwell's tail or sweep peak): a
+random result holds the same variables, but as each record's own peak, no statistic of the
+test, so it is asked only its own criteria (--max-rms, --max-peak, --clearance)."""
+
+
+def _refuse_sine_limits_of_a_random_result(ds: xr.Dataset, max_amplitude: float | None,
+                                           max_deflection: float | None,
+                                           max_strain: float | None) -> None:
+    """Refuse (one line) a SINE_LIMITS criterion given for a random result (one with
+    `realisation`)."""
+    given = dict(max_amplitude=max_amplitude, max_deflection=max_deflection,
+                 max_strain=max_strain)
+    flags = [SINE_LIMITS[k] for k, v in given.items() if v is not None]
+    if REALISATION in ds.dims and flags:
+        raise UserError(f"design: {flags[0]} limits a sine or dwell response, and this is a "
+                        "random result, whose records' peaks are no statistic of the test; "
+                        "give --max-peak M (the mean largest |midspan deflection|), --max-rms "
+                        "M or --clearance M for it")
 
 
 def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | None,
@@ -231,6 +361,7 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
                                max_rms, max_peak, clearance)):
         raise UserError(NO_CRITERION)
     axes = check_result(ds)
+    _refuse_sine_limits_of_a_random_result(ds, max_amplitude, max_deflection, max_strain)
     if min_frequency is not None and "natural_frequency" not in ds:
         raise UserError("design: --min-frequency needs the variable 'natural_frequency' (Hz), "
                         "which this result lacks (a transverse result has it)")
@@ -245,12 +376,16 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
     choices = ", ".join(_length_quantities(ds, axes)) or "none"
     if name not in ds.data_vars:
         how = "--quantity" if quantity is not None else "the default quantity"
-        raise UserError(f"design: {how} '{name}': no such variable in the result (variables "
+        raise UserError(f"design: {how} '{name}': no such variable in the result (responses "
                         f"in m over its length axis: {choices}; give --quantity NAME)")
     units = ds[name].attrs.get("units")
     if units != "m":
         raise UserError(f"design: --max-amplitude limits '{name}', whose units are "
                         f"{units!r}, not 'm' (give --quantity NAME of one in m: {choices})")
+    if name not in RESPONSES:
+        raise UserError(f"design: --quantity {name}: not a response of the span to limit (a "
+                        "position along it or a threshold, not a deflection); give --quantity "
+                        f"NAME of a response: {choices}")
     extra = [d for d in ds[name].dims if d not in axes]
     if extra:
         raise UserError(f"design: quantity '{name}' lies over {', '.join(map(str, extra))}, "
@@ -280,16 +415,16 @@ def _parse(min_frequency: Any, max_amplitude: Any, max_deflection: Any, max_stra
            ) -> dict[str, float | None]:
     """The criteria's limits as positive finite floats (None where not given), refused in one
     line otherwise; max_probability below 1 too."""
-    given = {"min_frequency": (min_frequency, "--min-frequency", "100"),
-             "max_amplitude": (max_amplitude, "--max-amplitude", "0.002"),
-             "max_deflection": (max_deflection, "--max-deflection", "0.002"),
-             "max_strain": (max_strain, "--max-strain", "0.001"),
-             "max_rms": (max_rms, "--max-rms", "0.001"),
-             "max_peak": (max_peak, "--max-peak", "0.004"),
-             "clearance": (clearance, "--clearance", "0.002"),
-             "max_probability": (max_probability, "--max-probability", "0.01")}
-    out = {k: None if v is None else _number(v, flag, example)
-           for k, (v, flag, example) in given.items()}
+    given = {"min_frequency": (min_frequency, "--min-frequency", "100", "Hz"),
+             "max_amplitude": (max_amplitude, "--max-amplitude", "0.002", "m"),
+             "max_deflection": (max_deflection, "--max-deflection", "0.002", "m"),
+             "max_strain": (max_strain, "--max-strain", "0.001", "1"),
+             "max_rms": (max_rms, "--max-rms", "0.001", "m"),
+             "max_peak": (max_peak, "--max-peak", "0.004", "m"),
+             "clearance": (clearance, "--clearance", "0.002", "m"),
+             "max_probability": (max_probability, "--max-probability", "0.01", None)}
+    out = {k: None if v is None else _number(v, flag, example, units)
+           for k, (v, flag, example, units) in given.items()}
     p = out["max_probability"]
     if p is not None and clearance is None:
         raise UserError(f"design: --max-probability {p:g} is the limit of the clearance "
@@ -314,24 +449,26 @@ def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
     return np.asarray(var.broadcast_like(like).transpose(*like.dims).values, float)
 
 
-def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
-             max_amplitude: float | None = None, quantity: str | None = None,
-             max_deflection: float | None = None, max_strain: float | None = None,
-             max_rms: float | None = None, max_peak: float | None = None,
-             clearance: float | None = None, max_probability: float | None = None
+def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
+             max_amplitude: Limit = None, quantity: str | None = None,
+             max_deflection: Limit = None, max_strain: Limit = None,
+             max_rms: Limit = None, max_peak: Limit = None,
+             clearance: Limit = None, max_probability: float | None = None
              ) -> xr.Dataset:
     """The largest span between clamps (m) that meets the criteria, per combination of the
     result's other swept axes.
 
     Parameters
     ----------
-    ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis (m).
+    ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis in m (or
+        mm, cm, km as its units attribute says: converted to m).
     min_frequency : Hz; a length passes when `natural_frequency` >= min_frequency.
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
-        `quantity` (a variable in m over the swept axes), by default `peak_amplitude` for a
+        `quantity` (one of RESPONSES, in m over the swept axes), by default `peak_amplitude` for a
         swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
-        (largest) value over `direction` and `realisation` counts.
-    quantity : the variable `max_amplitude` limits (needs max_amplitude).
+        (largest) value over `direction` counts. Not for a random result (SINE_LIMITS), nor
+        are max_deflection and max_strain.
+    quantity : the response `max_amplitude` limits, one of RESPONSES (needs max_amplitude).
     max_deflection : m; a length passes when `max_deflection`, the largest deflection anywhere
         on the span, is at most this (one mode: the midspan's, where its largest lies).
     max_strain : 1; a length passes when `max_strain` (the outer fibre's bending strain at
@@ -346,6 +483,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         most `max_probability`.
     max_probability : 1, below 1; the clearance criterion's limit (needs clearance; default
         0.01, i.e. 1 %).
+
+    Each limit but max_probability may be a string with its unit, as the command takes it
+    ("2 mm", "0.1 kHz", "300 microstrain": limit_value).
 
     Every length must also have a `state` that is not a failure (invalid_input, diverged,
     step_size_too_small, max_steps_reached on either direction or in any realisation) and,
@@ -366,17 +506,19 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     span fails). Attributes: `criteria`, the
     source result's `title`.
 
-    Raises UserError (one line) without a criterion, without a `length` axis, for an unknown
+    Raises UserError (one line) without a criterion, without a `length` axis or one whose
+    units are not LENGTH_UNITS, for an unknown
     quantity or one whose units are not m, a non-positive limit, a result without the
-    variable a criterion reads (a random one's for max_rms, max_peak, clearance), a clearance
-    level the result does not hold.
+    variable a criterion reads (a random one's for max_rms, max_peak, clearance), a sine
+    response's limit (SINE_LIMITS) for a random result, a clearance level the result does not
+    hold.
     """
     c, axes, limits = validated(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
                                 quantity=quantity, max_deflection=max_deflection,
                                 max_strain=max_strain, max_rms=max_rms, max_peak=max_peak,
                                 clearance=clearance, max_probability=max_probability)
     fmin = c["min_frequency"]
-    ds = ds.sortby(LENGTH)
+    ds = in_metres(ds).sortby(LENGTH)
     others = tuple(a for a in axes if a not in (LENGTH, *WORST_OVER))
     template_name = "state" if "state" in ds else "stability"
     like = _like(ds[template_name]).transpose(*others, LENGTH)
@@ -438,17 +580,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     result = xr.Dataset(
         {"max_span": xr.DataArray(spans.reshape(out_shape), dims=others, attrs={
-            "units": "m",
-            "long_name": "largest span between clamps meeting the criteria, every shorter "
-                         "grid span passing (interpolated between grid lengths)",
-            "comment": "NaN: the shortest grid length already fails (limited_by says which "
-                       "criterion)"}),
+            "units": "m", "long_name": SPAN_LONG_NAME, "comment": GRID_SPAN_COMMENT}),
          "limited_by": xr.DataArray(limited.reshape(out_shape).astype(str).astype(object),
-                                    dims=others, attrs={
-             "long_name": "criterion binding max_span: " + ", ".join(LIMITED_BY),
-             "comment": "grid: no grid length fails (max_span is the longest grid length, "
-                        "the true one may be longer); with a NaN max_span, the criterion "
-                        "the shortest grid length fails"})},
+                                    dims=others, attrs=dict(LIMITED_BY_ATTRS))},
         coords=coords,
         attrs={"title": f"maximum span: {title}" if title else "maximum span",
                "Conventions": "CF-1.11",
@@ -650,18 +784,38 @@ def _frequency_span(f1: Callable[[float], float], lo: float, hi: float, fmin: fl
     return lo
 
 
-def interpolated(result: xr.Dataset, criteria: dict[str, Any]) -> bool:
-    """Whether some span of `max_span`'s result (criteria: its keyword arguments) lies between
-    two grid lengths, interpolated on a response criterion: a resonance between them can put
-    the true limit shorter (`refine_span` runs the engine there). A frequency's log-log
-    interpolation is exact; the grid's longest length and a failing shortest one are not
-    interpolated."""
-    response = any(v is not None for k, v in criteria.items()
-                   if k not in ("min_frequency", "quantity"))
-    limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
+def elastic_ends(ds: xr.Dataset) -> bool:
+    """Whether result `ds` has elastic clamps (its `clamps` attribute, sweep.models.transverse
+    .span_attrs): K = k_t l / EI grows with the span, so f1 is not ~ l^-2."""
+    return str(ds.attrs.get("clamps", "")).startswith("elastic")
+
+
+def interpolated(result: xr.Dataset, sources: dict[str, xr.Dataset]) -> dict[str, int]:
+    """How many spans of `max_span`'s (or `governing_span`'s) result lie strictly between two
+    grid lengths of the result they bind in (`sources`: name -> result; `limited_in` names
+    it, else the one source), by kind: "response" (a response criterion or the growth rate
+    interpolated linearly in l: a resonance or a tongue between the lengths can put the true
+    limit shorter) and "frequency" (log f against log l with elastic ends, not exact). A
+    span that is a grid length (a state failure, a limit not crossed in the bracket, the
+    grid's longest, a NaN) is not counted, nor is a frequency span of pinned or clamped ends
+    (exact, f1 ~ l^-2)."""
     spans = np.asarray(result["max_span"].values, dtype=float).ravel()
-    return response and bool(np.any((limited != "grid") & (limited != "min_frequency")
-                                    & np.isfinite(spans)))
+    limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
+    where = (np.asarray(result["limited_in"].values, dtype=str).ravel()
+             if "limited_in" in result else np.full(spans.size, next(iter(sources))))
+    counts = {"response": 0, "frequency": 0}
+    for span, by, name in zip(spans, limited, where):
+        source = sources.get(name)
+        if source is None or not np.isfinite(span):
+            continue
+        lengths = np.asarray(in_metres(source)[LENGTH].values, float)
+        if np.any(np.isclose(lengths, span, rtol=1e-12, atol=0.0)):
+            continue
+        if by != "min_frequency":
+            counts["response"] += 1
+        elif elastic_ends(source):
+            counts["frequency"] += 1
+    return counts
 
 
 def _shown_units(values: xr.DataArray) -> str:
@@ -671,21 +825,21 @@ def _shown_units(values: xr.DataArray) -> str:
 
 
 def _interpolate(la: float, lb: float, va: float, vb: float, limit: float, how: str) -> float:
-    """Where, between the passing la and failing lb, the criterion's value crosses its limit:
-    `log` (log v against log l), `linear` (v - limit linear in l); la where it cannot be
-    found (no margin, a missing value, no crossing)."""
+    """Where (m), between the passing la and failing lb (m), the criterion's value crosses its
+    limit: `log` (a lower limit, log v against log l: v falls from va >= limit to
+    vb < limit), `linear` (an upper limit, v linear in l: v rises from va <= limit to
+    vb > limit); la where it does not cross there (no margin, a missing value, a value that
+    fails by its flag but not by its limit: an unstable flag with growth_rate <= 0)."""
     if how == "none" or not (np.isfinite(va) and np.isfinite(vb)):
         return float(la)
     if how == "log":
-        if not (va > 0 and vb > 0 and limit > 0) or va == vb:
+        if not (vb > 0 and limit > 0 and va >= limit > vb):
             return float(la)
         t = (math.log(limit) - math.log(va)) / (math.log(vb) - math.log(va))
-        t = min(max(t, 0.0), 1.0)
         return float(math.exp(math.log(la) + t * (math.log(lb) - math.log(la))))
-    if vb == va:
+    if not va <= limit < vb:
         return float(la)
     t = (limit - va) / (vb - va)
-    t = min(max(t, 0.0), 1.0)
     return float(la + t * (lb - la))
 
 
@@ -732,12 +886,12 @@ MAX_BISECTIONS = 64
 """Most halvings of one bracket (a bound whatever the tolerance)."""
 
 
-def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
-                max_amplitude: float | None = None, quantity: str | None = None,
-                max_deflection: float | None = None, max_strain: float | None = None,
-                max_rms: float | None = None, max_peak: float | None = None,
-                clearance: float | None = None, max_probability: float | None = None,
-                tolerance: float = 1e-3) -> xr.Dataset:
+def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
+                max_amplitude: Limit = None, quantity: str | None = None,
+                max_deflection: Limit = None, max_strain: Limit = None,
+                max_rms: Limit = None, max_peak: Limit = None,
+                clearance: Limit = None, max_probability: float | None = None,
+                tolerance: float | str = 1e-3) -> xr.Dataset:
     """`max_span` refined beyond the grid by bisecting on length with the engine itself.
 
     For every combination of the result's other axes whose grid max_span is bracketed (a
@@ -750,10 +904,12 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     passing end (conservative: within `tolerance` below the true span), limited_by the
     criterion its failing end fails.
 
-    The frequency criterion needs no run: natural_frequency is the closed form
-    f1 ~ l^-2 of the unloaded span, so interpolating log f against log l between the grid
-    lengths is exact; where only it fails at l_b the span is that interpolation (no run; with
-    only min_frequency the refinement costs no run at all). Where another criterion fails at
+    The frequency criterion needs no run: natural_frequency is the closed form of the
+    unloaded span, f1 ~ l^-2 with pinned or clamped ends, so interpolating log f against
+    log l between the grid lengths is exact there; with elastic ends (K = k_t l / EI, f1 not
+    ~ l^-2) the length where the closed-form f1 crosses the limit is bisected instead. Where
+    only it fails at l_b the span is that length (no run; with only min_frequency the
+    refinement costs no run at all). Where another criterion fails at
     l_b too and the frequency span l_f lies inside the bracket, one run at l_f decides:
     passing, the span is l_f; failing, the bisection runs on [l_a, l_f].
 
@@ -768,7 +924,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
     from .run import run
     from .scene import load_scene_text
 
-    tol = _number(tolerance, "--tolerance", "0.001")
+    tol = _number(tolerance, "--tolerance", "0.001", "m")
     if isinstance(ds, xr.Dataset) and REALISATION in ds.dims:
         raise UserError("design: --refine bisects between lengths, and a random result's "
                         "criteria are Monte Carlo means whose scatter from one length to the "
@@ -880,7 +1036,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
                 l_f = _frequency_span(lambda length: frequency_at(point, length), lo, hi,
                                       fmin, tol)
         others_fail = [k for k in failing if k != "min_frequency"]
-        if not others_fail:                      # the frequency alone: exact, no run
+        if not others_fail:                      # the frequency alone: no run
             spans[flat_i], limited[flat_i] = l_f, "min_frequency"
             continue
         by = others_fail[0]
@@ -902,8 +1058,11 @@ def refine_span(ds: xr.Dataset, *, min_frequency: float | None = None,
         spans[flat_i], limited[flat_i] = lo, by
     grid["max_span"].values = spans.reshape(shape)
     grid["limited_by"].values = limited.reshape(shape)
-    grid["max_span"].attrs["long_name"] = ("largest span between clamps meeting the criteria, "
-                                           "refined by bisection with the engine")
+    grid["max_span"].attrs["long_name"] = f"{SPAN_LONG_NAME}, refined by bisection with the engine"
+    grid["max_span"].attrs["comment"] = (
+        f"the passing end of a bracket bisected on length with engine runs of the result's scene "
+        f"to below {tol:g} m (conservative: at most that below the true span; min_frequency "
+        f"without a run), the longest grid length where none fails. {NAN_SPAN}")
     grid.attrs["refine_runs"] = np.int32(runs)
     grid.attrs["refine_tolerance"] = float(tol)
     grid.attrs["refinement"] = (

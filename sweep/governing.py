@@ -3,8 +3,8 @@
 A harness span must pass every test of its load case, each its own result (a sine sweep, a
 random test, a resonant dwell). `governing_span(results, **criteria)` asks each result the
 criteria it holds the variables of (`sweep.design.max_span`: --min-frequency of every
-transverse result, --max-rms of a random one, --max-amplitude of a sine one: a sine response's
-limits go to a random result only where no other result answers them), and keeps,
+transverse result, --max-rms, --max-peak and --clearance of a random one, --max-amplitude,
+--max-deflection and --max-strain of a sine one, never of a random one), and keeps,
 for every combination of the results' other axes, the shortest of their spans, `limited_by`
 the criterion that binds there and `limited_in` the result it binds in. Every criterion must
 apply to some result, and every result must have a criterion that applies to it; axes the
@@ -22,16 +22,13 @@ from typing import Any, Sequence
 import numpy as np
 import xarray as xr
 
-from .design import NO_CRITERION, check_result, max_span, validated
+from .design import (GRID_SPAN_COMMENT, NO_CRITERION, SPAN_LONG_NAME, Limit, check_result,
+                     max_span, validated)
 from .errors import UserError
-from .models.random_scene import REALISATION_DIM
 
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance")
 """The criteria a result may or may not hold the variables of (sweep.design's limits)."""
-RESPONSE_LIMITS = ("max_amplitude", "max_deflection", "max_strain")
-"""Limits of a sine response: a random result holds the same variables (each record's tail
-peak), but where a sine result answers them they are the sine test's, not the random one's."""
 
 
 def _criterion(name: str, criteria: dict[str, Any]) -> dict[str, Any]:
@@ -56,10 +53,10 @@ def _applies(ds: xr.Dataset, one: dict[str, Any]) -> str | None:
 
 
 def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
-                   min_frequency: float | None = None, max_amplitude: float | None = None,
-                   quantity: str | None = None, max_deflection: float | None = None,
-                   max_strain: float | None = None, max_rms: float | None = None,
-                   max_peak: float | None = None, clearance: float | None = None,
+                   min_frequency: Limit = None, max_amplitude: Limit = None,
+                   quantity: str | None = None, max_deflection: Limit = None,
+                   max_strain: Limit = None, max_rms: Limit = None,
+                   max_peak: Limit = None, clearance: Limit = None,
                    max_probability: float | None = None) -> xr.Dataset:
     """The largest span between clamps (m) that meets every criterion in every result it
     applies to: `max_span` of each (name, result) pair with its own criteria, the shortest
@@ -92,22 +89,23 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
     for name, ds in results:
         check_result(ds, name)
     _check_same_span(results)
-    random = [REALISATION_DIM in ds.dims for _, ds in results]
     asked: list[dict[str, Any]] = [{} for _ in results]
+    refused: list[str] = ["" for _ in results]       # each result's first reason, in words
     for c in given:
         one = _criterion(c, criteria)
         reasons = [_applies(ds, one) for _, ds in results]
         if all(r is not None for r in reasons):
             raise UserError(f"{reasons[0]} (nor does any other result given)")
-        sine_answers = any(r is None and not rnd for r, rnd in zip(reasons, random))
         for i, reason in enumerate(reasons):
-            if reason is None and not (c in RESPONSE_LIMITS and random[i] and sine_answers):
+            if reason is None:
                 asked[i].update(one)
+            elif not refused[i]:
+                refused[i] = reason.removeprefix("design: ")
     spans = []
-    for (name, ds), own in zip(results, asked):
+    for (name, ds), own, why in zip(results, asked, refused):
         if not own:
-            raise UserError(f"design: result '{name}': none of the criteria given reads its "
-                            "variables (leave it out, or give one it holds)")
+            raise UserError(f"design: result '{name}': none of the criteria given applies to "
+                            f"it ({why}; or leave it out)")
         spans.append(max_span(ds, **own))
     return _shortest(spans, names)
 
@@ -232,9 +230,8 @@ def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
     return xr.Dataset(
         {"max_span": xr.DataArray(span, dims=dims, attrs={
             **first["max_span"].attrs,
-            "long_name": "largest span between clamps meeting the criteria in every result "
-                         "they apply to, every shorter grid span passing (interpolated between "
-                         "grid lengths)"}),
+            "long_name": f"{SPAN_LONG_NAME} in every result they apply to",
+            "comment": f"the shortest of the results' spans, each: {GRID_SPAN_COMMENT}"}),
          "limited_by": xr.DataArray(limited_by.astype(str).astype(object), dims=dims,
                                     attrs=first["limited_by"].attrs),
          "limited_in": xr.DataArray(limited_in.astype(str).astype(object), dims=dims, attrs={

@@ -16,6 +16,7 @@ import sweep
 from conftest import TABLE1_CABLE
 from sweep.cli import main
 from sweep.design import max_span, refine_span
+from sweep.version import package_version
 
 # Table 1 cable, bending moment of the solid round 6 mm^2 section.
 E, RHO, AREA, INERTIA, ZETA = 1.1e11, 8900.0, 6e-6, 2.865e-12, 0.02
@@ -249,6 +250,34 @@ def test_bad_criteria_are_one_line(results, kwargs, fragment):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("name", ["escape_barrier", "max_deflection_position"])
+def test_quantity_is_a_response_not_a_position_or_a_threshold(results, name):
+    """--quantity names a response to limit: a barrier (escape_barrier) or the place of the
+    largest deflection (max_deflection_position) is in m over the length axis too, and was
+    taken for one."""
+    ds, _ = results["coarse"]
+    if name not in ds:                             # several modes hold it: one added here
+        ds = ds.assign({name: ds["amplitude"].assign_attrs(units="m")})
+    with pytest.raises(sweep.UserError) as info:
+        max_span(ds, max_amplitude=1e-3, quantity=name)
+    message = str(info.value)
+    assert f"--quantity {name}: not a response" in message and "\n" not in message
+    assert "amplitude" in message.split("a response:")[-1]
+
+
+def test_every_variable_in_m_is_classed_a_response_or_not(results):
+    """Each variable in m over the length axis that a result holds is either a response
+    --quantity may limit (RESPONSES) or no response (NON_RESPONSES): an output added in m
+    must be classed before design reads it."""
+    from sweep.design import NON_RESPONSES, RESPONSES
+    seen = set()
+    for ds, _ in results.values():
+        seen |= {str(n) for n, v in ds.data_vars.items()
+                 if v.attrs.get("units") == "m" and "length" in v.dims}
+    assert seen and seen <= set(RESPONSES) | set(NON_RESPONSES), seen
+    assert not set(RESPONSES) & set(NON_RESPONSES)
+
+
 def test_a_result_without_length_is_refused(results):
     ds, _ = results["no_length"]
     with pytest.raises(sweep.UserError, match="length") as info:
@@ -284,6 +313,64 @@ def test_cli_design_says_when_its_span_is_interpolated(results, capsys):
     assert "--refine" not in capsys.readouterr().out
     assert main(["design", str(path), "--min-frequency", "100"]) == 0
     assert "--refine" not in capsys.readouterr().out
+
+
+def test_cli_design_says_nothing_of_a_span_that_is_a_grid_length(tmp_path, capsys):
+    """A span limited by a failed state is the last passing grid length, not interpolated:
+    no 'interpolated' line (it was printed for any row limited by a response-side name)."""
+    from test_design_random import synthetic
+    path = tmp_path / "diverged.nc"
+    ds = synthetic(diverged=(2, 0)).drop_vars("exceedance_probability")   # fails 0.2 m
+    ds.assign_attrs(cable_sweep_version=package_version()).to_netcdf(path)
+    assert main(["design", str(path), "--max-rms", "0.0024"]) == 0    # rms crosses at 0.24 m
+    out = capsys.readouterr().out
+    assert "150.00  state" in out and "interpolated" not in out
+    assert main(["design", str(path), "--max-rms", "0.0012"]) == 0    # crosses at 0.12 m
+    assert "1 span(s) interpolated between the grid's lengths" in capsys.readouterr().out
+
+
+def test_cli_design_says_an_elastic_frequency_span_is_interpolated(tmp_path, capsys):
+    """With elastic clamps f1 is not ~ l^-2 (K = k_t l / EI grows with the span), so the
+    frequency span interpolated log-log between grid lengths is not exact: the command says so
+    and points at --refine (pinned ends get no such line: test above)."""
+    text = SCENE.format(table1=TABLE1_CABLE, name="elastic", membrane=0.0, cable="",
+                        base=f"acceleration_g = {LEVEL_G}\nfrequency = {BASE_FREQUENCY}",
+                        axes="length = [0.2, 0.3, 0.4]", solver="t_end = 0.05")
+    scene = sweep.load_scene_text(text, overrides={"clamps.rotation": "elastic",
+                                                   "clamps.rotational_stiffness": 1.0})
+    path = tmp_path / "elastic.nc"
+    ds = sweep.run(scene, output=path, progress=False)
+    f = ds["natural_frequency"].values
+    limit = float(np.sqrt(f[0] * f[1]))                  # between the first two lengths
+    assert main(["design", str(path), "--min-frequency", f"{limit:.9g}"]) == 0
+    out = capsys.readouterr().out
+    assert "1 min_frequency span(s) interpolated as log f against log l" in out
+    assert "not for elastic ones" in out and "--refine gives the exact span" in out
+
+
+def test_design_labels_are_short_complete_and_match_how_the_span_was_found(results):
+    """long_name is a plot's label (<= 100 characters) and must read as complete: limited_by's
+    criteria were cut to a list that looked whole (ending at max_rms), so they are all in its
+    comment and none in its label; a refined span's comment says bisection, not interpolation
+    between grid lengths (its long_name said one, its comment the other); several results'
+    span has a label within 100 characters too (it had 146)."""
+    from sweep.design import LIMITED_BY
+    from sweep.governing import governing_span
+    coarse, _ = results["coarse"]
+    grid = max_span(coarse, min_frequency=100.0)
+    label, comment = grid["limited_by"].attrs["long_name"], grid["limited_by"].attrs["comment"]
+    assert len(label) <= 100 and not any(name in label for name in LIMITED_BY)
+    assert all(name in comment for name in LIMITED_BY)
+    assert "interpolated" in grid["max_span"].attrs["comment"]
+    refined = refine_span(coarse, min_frequency=100.0)         # the frequency alone: no run
+    assert "refined by bisection" in refined["max_span"].attrs["long_name"]
+    assert "interpolated" not in refined["max_span"].attrs["comment"]
+    assert "bisected" in refined["max_span"].attrs["comment"]
+    linear, _ = results["linear"]
+    both = governing_span([("linear.nc", linear), ("coarse.nc", _frequency_only(results))],
+                          min_frequency=40.0)
+    for var in ("max_span", "limited_by", "limited_in"):
+        assert len(both[var].attrs["long_name"]) <= 100, var
 
 
 def test_cli_design_limits_take_units(results, tmp_path, capsys):
@@ -377,6 +464,35 @@ def test_an_unstable_span_ends_the_walk_at_the_growth_rate_zero():
                                 / (g[b] - g[b - 1]), rel=1e-9)
     assert str(out["limited_by"].squeeze().values) == "stability"
     assert out["max_span"].dims == ("frequency_ratio", "load_amplitude")
+
+
+def _stability_result(growth: list[float], flags: list[int]) -> xr.Dataset:
+    """A hand-made stability result over length 0.1..0.4 m (as a hand-edited or foreign file
+    may be): its `stability` flags and `growth_rate` (1/s) as given, f1 far above any limit."""
+    lengths = np.array([0.1, 0.2, 0.3, 0.4])
+    stability = xr.DataArray(np.array(flags, np.int8), dims=("length",), attrs={
+        "flag_values": np.array([-1, 0, 1], np.int8),
+        "flag_meanings": "invalid_input stable unstable_period_1"})
+    return xr.Dataset(
+        {"stability": stability,
+         "growth_rate": ("length", np.array(growth, float), {"units": "1/s"}),
+         "natural_frequency": ("length", 1e3 * (0.1 / lengths) ** 2, {"units": "Hz"})},
+        coords={"length": ("length", lengths, {"units": "m"})})
+
+
+@pytest.mark.parametrize("flag", [1, -1])               # unstable_period_1, invalid_input
+def test_a_failing_flag_without_a_positive_growth_rate_gives_the_last_passing_length(flag):
+    """The flag fails 0.3 m while growth_rate is still negative there: the growth rate does
+    not cross zero between 0.2 and 0.3 m, so nothing is interpolated: the span is the last
+    passing grid length, 0.2 m (a clamped interpolation returned the failing 0.3 m)."""
+    ds = _stability_result([-2.0, -1.0, -0.5, 1.0], [0, 0, flag, flag])
+    out = max_span(ds, min_frequency=1.0)
+    assert float(out["max_span"]) == 0.2
+    assert str(out["limited_by"].values) == "stability"
+    # where the growth rate does cross zero in the bracket, its zero is the span
+    crossing = max_span(_stability_result([-2.0, -1.0, 3.0, 4.0], [0, 0, flag, flag]),
+                        min_frequency=1.0)
+    assert float(crossing["max_span"]) == pytest.approx(0.2 + 0.1 * 1.0 / 4.0, rel=1e-12)
 
 
 # --refine: bisection on length with the engine, against the same closed forms
@@ -665,8 +781,9 @@ def test_several_results_refuse_points_whose_sets_differ(results):
 
 def test_a_sine_limit_binds_the_sine_result_not_the_random_one(results):
     """--max-amplitude given with a sine and a random result limits the sine one (the random
-    result's `amplitude`, each record's tail peak, is not the sine test's response); alone, a
-    random result still answers it."""
+    result's `amplitude`, each record's tail peak, is not the sine test's response); a random
+    result is refused it alone too, and together where no other criterion applies to it, in
+    the same words, pointing at its own criteria."""
     from sweep.governing import governing_span
     linear, _ = results["linear"]
     randomlike = linear.expand_dims(realisation=[0, 1])
@@ -675,6 +792,14 @@ def test_a_sine_limit_binds_the_sine_result_not_the_random_one(results):
                          max_amplitude=1e-7, min_frequency=40.0)
     assert float(out["max_span"]) == pytest.approx(_amplitude_reference(1e-7), rel=2e-3)
     assert str(out["limited_in"].values) == "sine.nc"
+    said = "--max-amplitude limits a sine or dwell response, and this is a random result"
+    with pytest.raises(sweep.UserError, match=said) as alone:
+        max_span(randomlike, max_amplitude=1e-7)
+    with pytest.raises(sweep.UserError, match=said) as together:
+        governing_span([("sine.nc", linear), ("random.nc", randomlike)], max_amplitude=1e-7)
+    for info in (alone, together):
+        assert "--max-peak M" in str(info.value) and "\n" not in str(info.value)
+    assert "result 'random.nc'" in str(together.value)
 
 
 def test_several_results_name_every_one_that_fails_at_the_shortest(results):

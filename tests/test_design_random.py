@@ -15,6 +15,7 @@ import xarray as xr
 import sweep
 from sweep.cli import main
 from sweep.design import CRITERIA, LIMITED_BY, max_span, refine_span
+from sweep.version import package_version
 
 LENGTHS = np.array([0.10, 0.15, 0.20, 0.25, 0.30])        # m
 LEVELS = np.array([0.001, 0.002, 0.005])                   # m, clearance levels
@@ -89,6 +90,50 @@ def test_max_rms_is_the_linear_crossing(limit):
     assert str(out["limited_by"].values) == "max_rms"
 
 
+def _length_in(ds: xr.Dataset, units: str | None, per_metre: float) -> xr.Dataset:
+    """`ds` with its length coordinate written in `units` (`per_metre` of them to a metre;
+    None: no units attribute), as a hand-edited or foreign file may hold it."""
+    attrs = {} if units is None else {"units": units}
+    return ds.assign_coords(length=("length", ds["length"].values * per_metre, attrs))
+
+
+@pytest.mark.parametrize("units, per_metre", [("mm", 1e3), ("cm", 1e2), ("km", 1e-3)])
+def test_a_length_in_another_length_unit_is_read_in_metres(units, per_metre, capsys, tmp_path):
+    """rms = 0.01 l (l in m) crosses 0.0017 m at 0.17 m whatever unit the file's length is
+    written in (a length in mm was read as metres: a 170 m span, labelled m)."""
+    ds = _length_in(synthetic(), units, per_metre)
+    out = max_span(ds, max_rms=0.0017)
+    assert float(out["max_span"]) == pytest.approx(0.17, rel=1e-12)
+    assert out["max_span"].attrs["units"] == "m"
+    assert out.attrs["length_grid"] == "5 lengths, 0.1 to 0.3 m"
+    path = tmp_path / "r.nc"
+    ds.drop_vars("exceedance_probability").assign_attrs(
+        cable_sweep_version=package_version()).to_netcdf(path)
+    assert main(["design", str(path), "--max-rms", "0.0017"]) == 0
+    assert "170.00" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("units, said", [("inch", "units 'inch'"), ("1", "units '1'"),
+                                         (None, "no units")])
+def test_a_length_in_no_length_unit_is_refused_in_one_line(units, said):
+    with pytest.raises(sweep.UserError) as info:
+        max_span(_length_in(synthetic(), units, 1.0), max_rms=0.0017)
+    message = str(info.value)
+    assert f"'length' axis has {said}" in message and "m, mm, cm, km" in message
+    assert "\n" not in message
+
+
+def test_limits_from_python_take_units_as_the_command_does():
+    """max_span(ds, min_frequency="0.03 kHz") is 30 Hz, as 'sweep design --min-frequency
+    "0.03 kHz"' (it was refused with the command's words); f1 = 52.6 (0.15 / l)^2 Hz crosses
+    30 Hz at l = 0.15 sqrt(52.6 / 30), rms = 0.01 l crosses 1.7 mm at 0.17 m."""
+    ds = synthetic()
+    frequency = max_span(ds, min_frequency="0.03 kHz")
+    assert float(frequency["max_span"]) == pytest.approx(0.15 * np.sqrt(52.6 / 30.0), rel=1e-12)
+    assert float(max_span(ds, max_rms="1.7 mm")["max_span"]) == pytest.approx(0.17, rel=1e-12)
+    assert str(max_span(ds, max_peak=" 8 mm ")["limited_by"].values) == "max_peak"
+
+
 def test_max_peak_reads_the_mean_peak():
     out = max_span(synthetic(), max_peak=0.008)          # 4 * 0.01 l = 0.008 at l = 0.2
     assert float(out["max_span"]) == pytest.approx(0.2, rel=1e-12)
@@ -104,10 +149,8 @@ def test_realisation_is_no_design_axis_and_counts_at_its_worst():
     assert str(out["limited_by"].values[0]) == "grid"
     assert float(out["max_span"].values[0]) == pytest.approx(0.30)
     assert float(out["max_span"].values[1]) == pytest.approx(0.15, rel=1e-12)
-    # a per-realisation quantity counts at its largest realisation (1.2 x the first)
-    amp = max_span(ds, max_amplitude=0.006)
-    assert float(amp["max_span"].values[1]) == pytest.approx(0.006 / (4 * 0.01 * 1.2),
-                                                            rel=1e-12)
+    # (a per-realisation quantity, amplitude, is a sine limit's and refused for a random
+    # result: test_a_sine_response_limit_of_a_random_result_is_refused_in_one_line)
 
 
 def test_a_diverged_realisation_fails_its_length():
@@ -163,12 +206,30 @@ def test_a_non_random_result_is_refused_in_one_line(kwargs, fragment):
     assert "asd_g2" in str(info.value) and "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("flag, kwargs", [
+    ("--max-amplitude", dict(max_amplitude=0.002)),
+    ("--max-deflection", dict(max_deflection=0.002)),
+    ("--max-strain", dict(max_strain=1e-3)),
+    ("--max-amplitude", dict(max_amplitude=0.002, max_rms=0.002)),
+])
+def test_a_sine_response_limit_of_a_random_result_is_refused_in_one_line(flag, kwargs):
+    """A random result holds `amplitude` (each record's tail peak), but the README gives it
+    --max-rms, --max-peak and --clearance only: a sine response's limit is refused, pointing at
+    those (it read the records' largest peak alone, and was refused beside a sine result)."""
+    with pytest.raises(sweep.UserError) as info:
+        max_span(synthetic(), **kwargs)
+    message = str(info.value)
+    assert message.startswith(f"design: {flag} limits a sine or dwell response")
+    assert "--max-peak M" in message and "--max-rms M" in message and "\n" not in message
+
+
 @pytest.mark.parametrize("kwargs, fragment", [
     (dict(clearance=0.003), "not one of the result's clearance levels (0.001, 0.002, 0.005 m)"),
     (dict(max_rms=0.001, max_probability=0.05), "give --clearance M too"),
     (dict(clearance=0.001, max_probability=1.0), "below 1"),
     (dict(max_rms=-1.0), "--max-rms -1"),
-    (dict(max_peak="x"), "--max-peak 'x'"),
+    (dict(max_peak="x"), "max_peak='x' (--max-peak): 'x' does not start with a number"),
+    (dict(min_frequency="3 mm"), "min_frequency='3 mm' (--min-frequency): '3 mm' is a length"),
 ])
 def test_bad_random_criteria_are_one_line(kwargs, fragment):
     with pytest.raises(sweep.UserError) as info:
