@@ -149,17 +149,24 @@ WHOLE_RUN = 2.0
 """LOADS: over the whole run, a sine sweep's (kernels.modal_driver.WHOLE_RUN)."""
 
 
+def peak_switch(swept: bool) -> str:
+    """The outputs.* switch of the peaks over the tail window (a sine sweep's: over the whole
+    sweep): outputs.amplitude, or outputs.peak_amplitude for a sweep. It governs the midspan's
+    peak and every peak that goes with it: each mode's (modal_amplitude), the span's largest
+    deflection (max_deflection and its position) and the loads (sweep.models.loads)."""
+    return "outputs.peak_amplitude" if swept else "outputs.amplitude"
+
+
 def observation(scene: Any, swept: bool) -> float:
     """kernels/layout.py's LOADS setting for `scene`: where it gets these outputs (`wanted`)
-    and the deflection's peak they go with, their peaks over the tail window (TAIL_WINDOW:
-    with outputs.amplitude) or, swept, over the whole sweep (WHOLE_RUN: with
+    and the deflection's peak they go with (`peak_switch`), their peaks over the tail window
+    (TAIL_WINDOW: with outputs.amplitude) or, swept, over the whole sweep (WHOLE_RUN: with
     outputs.peak_amplitude, the peak a sweep reports); else 0.0, and the kernels skip that
     work."""
     membrane = (scene.get("model.membrane") is not None or "membrane" in scene.axes
                 or "membrane" in (scene.points or {})
                 or scene.get("model.coefficients") == "paper")
-    deflection = "outputs.peak_amplitude" if swept else "outputs.amplitude"
-    if not (scene.get(deflection) and _wanted(scene.get("clamps.rotation"), membrane)):
+    if not (scene.get(peak_switch(swept)) and _wanted(scene.get("clamps.rotation"), membrane)):
         return 0.0
     return WHOLE_RUN if swept else TAIL_WINDOW
 
