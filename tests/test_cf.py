@@ -175,3 +175,30 @@ def test_one_state_table_across_kinds(tmp_path):
             assert km.STATE_MEANINGS[value] == meaning
     assert len(set(seen.values())) == len(seen)            # no meaning under two integers
     assert {"completed", "steady", "diverged"} <= set(seen.values())
+
+
+def _readme_unitless() -> set[str]:
+    """The names the README's "What the output holds" lists as labels without units (its
+    parenthesis after "but for labels"), in backticks."""
+    import re
+    text = (Path(__file__).parents[1] / "README.md").read_text()
+    section = text[text.index("## What the output holds"):]
+    labels = section[section.index("but for labels"):section.index("global attributes")]
+    return set(re.findall(r"`([A-Za-z_]+)`", labels))
+
+
+def test_the_readme_names_every_design_variable_without_units():
+    """A design result's string variables (`limited_by`, and `limited_in` of several results)
+    carry no units, as CF allows a label; the README's list of what has none named only the
+    `direction` coordinate and band bounds (a reviewer's finding)."""
+    from sweep.design import max_span
+    from sweep.governing import governing_span
+    text = ('name = "spans"\n[cable]\ndamping_ratio = 0.02\n[base]\nacceleration_g = 0.1\n'
+            "frequency_ratio = 0.5\n[solver]\nt_end = 0.05\n[axes]\nlength = [0.2, 0.3, 0.4]\n")
+    ds = sweep.run(sweep.load_scene_text(text), progress=False)
+    outputs = [max_span(ds, min_frequency=60.0),
+               governing_span([("a", ds), ("b", ds)], min_frequency=60.0)]
+    unitless = {name for out in outputs for name in out.variables
+                if "units" not in out[name].attrs}
+    assert {"limited_by", "limited_in"} <= unitless
+    assert unitless <= _readme_unitless(), unitless - _readme_unitless()
