@@ -420,3 +420,32 @@ solver_stats = true
     ds = sweep.run(sweep.load_scene_text(text), progress=False)
     assert "stability" in ds and "n_steps" in ds
     assert "modal_amplitude" not in ds and "amplitude" not in ds
+
+
+@pytest.mark.parametrize("rotation, quoted, not_quoted", [
+    ("pinned", "exact beam", "five modes"), ("clamped", "five modes", "exact beam"),
+    ("elastic", "tens of per cent", "%")])
+def test_one_modes_clamp_force_warning_reads_cleanly_for_its_ends(rotation, quoted, not_quoted):
+    """The warning named a base_acceleration_g axis value as '0.3 9.80665 m s-2' (its units
+    attribute after the number) and quoted the clamped span's measured miss on a pinned span:
+    it gives the excitation over the span's first frequency in words, a level in g, and the
+    measured miss of the span's own ends only (none for elastic ends, which were not
+    measured)."""
+    import warnings
+
+    from sweep.errors import CableSweepWarning
+    extra = "rotational_stiffness = 1.0" if rotation == "elastic" else ""
+    text = scene_text(rotation, level_g=0.3, t_end=0.3, extra=extra).replace(
+        "frequency_ratio = 1.0", "frequency = 400.0").replace(
+        "[axes]", "[axes]\nbase_acceleration_g = [0.3]").replace("acceleration_g = 0.3\n", "")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = sweep.run(sweep.load_scene_text(text), progress=False)
+    said = [str(w.message) for w in caught if issubclass(w.category, CableSweepWarning)
+            and "clamp_force of one mode" in str(w.message)]
+    assert len(said) == 1, said
+    ratio = 400.0 / _one(ds, "natural_frequency")
+    assert ratio > 1.6
+    assert f"at {ratio:.2g} times the span's first natural frequency" in said[0]
+    assert "base_acceleration_g 0.3 g" in said[0] and "9.80665" not in said[0]
+    assert quoted in said[0] and not_quoted not in said[0]
