@@ -89,6 +89,7 @@ def test_builtin_scene_output_passes_the_cf_checker_and_round_trips(name, tmp_pa
                 continue
             assert back[var].attrs["units"] == ds[var].attrs["units"], var
             assert len(back[var].attrs.get("long_name", "")) <= 100, var   # a plot's label
+            assert not back[var].attrs.get("long_name", "").endswith("..."), var  # a whole one
         for coord in back.coords:
             assert "_FillValue" not in back[coord].encoding or \
                 back[coord].encoding["_FillValue"] is None, coord
@@ -202,3 +203,16 @@ def test_the_readme_names_every_design_variable_without_units():
                 if "units" not in out[name].attrs}
     assert {"limited_by", "limited_in"} <= unitless
     assert unitless <= _readme_unitless(), unitless - _readme_unitless()
+
+
+def test_the_jump_flag_has_a_whole_label_and_its_explanation_a_comment():
+    """`jump`'s long_name was over 100 characters and cut to its words and '...': it is now a
+    whole label on any axis, the ratio and what a flag means in its comment."""
+    from sweep import schema
+    from sweep.models.continuation import jump_attrs
+    longest = max(schema.BY_AXIS, key=len)
+    for both, words in ((True, "different branches"), (False, "run both ways")):
+        attrs = jump_attrs(longest, 1.5, both)
+        assert len(attrs["long_name"]) <= 100 and not attrs["long_name"].endswith("...")
+        assert longest in attrs["long_name"]
+        assert "factor 1.5" in attrs["comment"] and words in attrs["comment"]

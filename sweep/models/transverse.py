@@ -825,8 +825,10 @@ def sweep_outputs(result: KernelResult, inputs: Inputs,
         n = inputs.bands[2]
         out["envelope"] = xr.DataArray(
             result.envelope.reshape(shape + (result.envelope.shape[1],)), dims=dims + (BAND_DIM,),
-            attrs={"units": "m", "long_name": f"response envelope: the largest |q| at the "
-                   f"extrema of q while the sweep's frequency lay in the 1/{n}-octave band",
+            attrs={"units": "m", "long_name": f"response envelope: the largest midspan |q| in "
+                   f"each 1/{n}-octave band of the excitation frequency",
+                   "comment": f"response envelope: the largest |q| at the extrema of q while "
+                   f"the sweep's frequency lay in the 1/{n}-octave band",
                    "cell_methods": f"{BAND_DIM}: maximum"})
         from .excitation import band_centres, table_level
         centres = xr.DataArray(band_centres(*inputs.bands), dims=BAND_DIM)
