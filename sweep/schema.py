@@ -301,8 +301,14 @@ KEYS: tuple[Key, ...] = (
     Key("metrics", "divergence_bound", "float", None, units="m", minimum=0.0,
         exclusive_min=True, long_name="|q| beyond which a point is diverged (default: the span length)"),
     # [outputs]
-    Key("outputs", "amplitude", "bool", True, long_name="store the tail amplitude"),
-    Key("outputs", "peak_amplitude", "bool", True, long_name="store the global max |q|"),
+    Key("outputs", "amplitude", "bool", True,
+        long_name="store the tail amplitude (the midspan's max |q| over the tail window) and the "
+                  "tail-window peaks that go with it: modal_amplitude, max_deflection and its "
+                  "position, and the clamp and stretching loads and strains (false: none of "
+                  "them)"),
+    Key("outputs", "peak_amplitude", "bool", True,
+        long_name="store the global max |q| (a sine sweep's: with the whole sweep's peaks that "
+                  "go with it, as outputs.amplitude's with a fixed frequency)"),
     Key("outputs", "settling_time", "bool", True, long_name="compute and store the settling time"),
     Key("outputs", "response_period", "bool", True, long_name="store the response period"),
     Key("outputs", "solver_stats", "bool", True, long_name="store step and evaluation counts"),

@@ -108,6 +108,45 @@ def test_an_angle_per_time_on_a_frequency_key_is_read_in_cycles(text, hertz):
     assert to_si("scene key 'base.frequency'", key, text) == pytest.approx(hertz, rel=1e-14)
 
 
+@pytest.mark.parametrize("dotted, text, expected", [
+    ("base.acceleration", "0.5 G", 0.5 * G0), ("base.acceleration_g", "1.5 G", 1.5),
+    ("base.levels_g", "2 G", 2.0), ("base.asd_g2", "0.16 G^2/Hz", 0.16),
+    ("base.asd", "0.16 G^2/Hz", 0.16 * G0 ** 2), ("base.asd_g2", "0.04 G2 Hz-1", 0.04)])
+def test_a_capital_g_is_standard_gravity_on_the_acceleration_keys(dotted, text, expected):
+    """Test specifications write "G^2/Hz" and "G": pint read the gauss, and "0.16 G^2/Hz" was
+    refused as "of dimension [mass] / [length] / [time]" (a reviewer's finding)."""
+    key = schema.BY_DOTTED[dotted]
+    assert to_si(f"scene key '{dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
+
+
+@pytest.mark.parametrize("dotted, text", [("cable.linear_mass", "33 G/m"),
+                                          ("base.frequency", "20 G")])
+def test_a_capital_g_elsewhere_is_one_line_saying_where_it_means_gravity(dotted, text):
+    with pytest.raises(sweep.SceneError) as info:
+        to_si(f"scene key '{dotted}'", schema.BY_DOTTED[dotted], text)
+    message = str(info.value)
+    assert "\n" not in message and f"scene key '{dotted}'" in message
+    assert "'G'" in message and "base.acceleration_g" in message and "dimension" not in message
+
+
+@pytest.mark.parametrize("dotted, text, expected", [
+    ("base.frequency", "20 1/s", 20.0), ("base.frequency", "120 1/min", 2.0),
+    ("base.sweep.rate", "2 1/min", 2.0), ("base.sweep.rate", "2 1 / min", 2.0),
+    ("base.sweep.rate", "0.05 1/s", 3.0), ("base.frequency", "2 1/ms", 2000.0)])
+def test_a_reciprocal_unit_may_keep_its_one(dotted, text, expected):
+    """"20 1/s" and "2 1/min" were refused as a number inside the unit; the 1 of a reciprocal
+    unit is read as "/s" is."""
+    key = schema.BY_DOTTED[dotted]
+    assert to_si(f"scene key '{dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
+
+
+def test_a_g_in_a_scene_file_reads_on_the_acceleration_keys():
+    scene = load('[base]\nacceleration = "0.5 G"\nfrequency = "20 1/s"\n[cable]\n'
+                 "length = 0.4\n")
+    assert scene.get("base.acceleration") == pytest.approx(0.5 * G0, rel=1e-14)
+    assert scene.get("base.frequency") == pytest.approx(20.0, rel=1e-14)
+
+
 def test_an_angle_where_the_key_has_none_is_refused_and_data_sheet_spellings_read():
     """An octave rate given in rpm is refused in one line; "oct/min" (a sweep rate as a test
     specification writes it) and "Nm" (pint's "number metre") read as meant."""

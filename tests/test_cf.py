@@ -89,6 +89,7 @@ def test_builtin_scene_output_passes_the_cf_checker_and_round_trips(name, tmp_pa
                 continue
             assert back[var].attrs["units"] == ds[var].attrs["units"], var
             assert len(back[var].attrs.get("long_name", "")) <= 100, var   # a plot's label
+            assert not back[var].attrs.get("long_name", "").endswith("..."), var  # a whole one
         for coord in back.coords:
             assert "_FillValue" not in back[coord].encoding or \
                 back[coord].encoding["_FillValue"] is None, coord
@@ -175,3 +176,43 @@ def test_one_state_table_across_kinds(tmp_path):
             assert km.STATE_MEANINGS[value] == meaning
     assert len(set(seen.values())) == len(seen)            # no meaning under two integers
     assert {"completed", "steady", "diverged"} <= set(seen.values())
+
+
+def _readme_unitless() -> set[str]:
+    """The names the README's "What the output holds" lists as labels without units (its
+    parenthesis after "but for labels"), in backticks."""
+    import re
+    text = (Path(__file__).parents[1] / "README.md").read_text()
+    section = text[text.index("## What the output holds"):]
+    labels = section[section.index("but for labels"):section.index("global attributes")]
+    return set(re.findall(r"`([A-Za-z_]+)`", labels))
+
+
+def test_the_readme_names_every_design_variable_without_units():
+    """A design result's string variables (`limited_by`, and `limited_in` of several results)
+    carry no units, as CF allows a label; the README's list of what has none named only the
+    `direction` coordinate and band bounds (a reviewer's finding)."""
+    from sweep.design import max_span
+    from sweep.governing import governing_span
+    text = ('name = "spans"\n[cable]\ndamping_ratio = 0.02\n[base]\nacceleration_g = 0.1\n'
+            "frequency_ratio = 0.5\n[solver]\nt_end = 0.05\n[axes]\nlength = [0.2, 0.3, 0.4]\n")
+    ds = sweep.run(sweep.load_scene_text(text), progress=False)
+    outputs = [max_span(ds, min_frequency=60.0),
+               governing_span([("a", ds), ("b", ds)], min_frequency=60.0)]
+    unitless = {name for out in outputs for name in out.variables
+                if "units" not in out[name].attrs}
+    assert {"limited_by", "limited_in"} <= unitless
+    assert unitless <= _readme_unitless(), unitless - _readme_unitless()
+
+
+def test_the_jump_flag_has_a_whole_label_and_its_explanation_a_comment():
+    """`jump`'s long_name was over 100 characters and cut to its words and '...': it is now a
+    whole label on any axis, the ratio and what a flag means in its comment."""
+    from sweep import schema
+    from sweep.models.continuation import jump_attrs
+    longest = max(schema.BY_AXIS, key=len)
+    for both, words in ((True, "different branches"), (False, "run both ways")):
+        attrs = jump_attrs(longest, 1.5, both)
+        assert len(attrs["long_name"]) <= 100 and not attrs["long_name"].endswith("...")
+        assert longest in attrs["long_name"]
+        assert "factor 1.5" in attrs["comment"] and words in attrs["comment"]

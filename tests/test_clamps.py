@@ -364,3 +364,88 @@ def test_one_modes_clamp_force_is_warned_of_above_its_resonance(ratio, warned):
     if warned:
         assert "\n" not in said[0] and "model.modes = 3" in said[0]
         assert "1 point(s)" in said[0]
+
+
+PEAKS_BESIDE_THE_AMPLITUDE = ("amplitude", "modal_amplitude", "max_deflection",
+                              "max_deflection_position", "clamp_bending_strain", "clamp_moment",
+                              "clamp_force", "midspan_bending_strain", "axial_tension",
+                              "axial_strain", "max_strain")
+
+
+@pytest.mark.parametrize("modes", [1, 2])
+def test_outputs_amplitude_governs_every_tail_window_peak(modes):
+    """outputs.amplitude is the switch of the tail window's peaks, as its key says: on, a span
+    whose clamps hold rotation gets the midspan's amplitude and every peak beside it (each
+    mode's, the span's largest deflection, the loads; one mode: no modal or span variables);
+    off, none of them, modal_amplitude included (it was stored alone, beside the loads dropped),
+    while the other outputs stay."""
+    text = scene_text("elastic", modes=modes, level_g=0.5, t_end=0.4,
+                      extra="rotational_stiffness = 1.0")
+    multi = {"modal_amplitude", "max_deflection", "max_deflection_position"}
+    expected = {n for n in PEAKS_BESIDE_THE_AMPLITUDE if modes > 1 or n not in multi}
+    on = sweep.run(sweep.load_scene_text(text), progress=False)
+    assert expected <= set(on.data_vars), expected - set(on.data_vars)
+    off = sweep.run(sweep.load_scene_text(text, overrides={"outputs.amplitude": False}),
+                    progress=False)
+    assert not set(PEAKS_BESIDE_THE_AMPLITUDE) & set(off.data_vars)
+    for name in ("peak_amplitude", "settling_time", "natural_frequency", "state"):
+        assert name in off, name
+    if modes > 1:
+        assert "modal_frequency" in off      # a closed form of the span, not a peak
+
+
+def test_a_stability_run_with_solver_stats_stores_no_modal_amplitude():
+    """outputs.stability with the tail amplitude off and only the solver's counters asked of
+    the time domain: no modal_amplitude (it was stored as zeros beside state = decayed, as one
+    mode stores no amplitude), the Floquet outputs and counters are."""
+    text = """
+name = "stability-stats"
+[model]
+modes = 2
+[cable]
+damping_ratio = 0.02
+length = 1.0
+[load]
+type = "harmonic"
+amplitude = 2.0
+[solver]
+t_end = 0.5
+[axes]
+frequency_ratio = [1.0, 2.0]
+[outputs]
+stability = true
+amplitude = false
+solver_stats = true
+"""
+    ds = sweep.run(sweep.load_scene_text(text), progress=False)
+    assert "stability" in ds and "n_steps" in ds
+    assert "modal_amplitude" not in ds and "amplitude" not in ds
+
+
+@pytest.mark.parametrize("rotation, quoted, not_quoted", [
+    ("pinned", "exact beam", "five modes"), ("clamped", "five modes", "exact beam"),
+    ("elastic", "tens of per cent", "%")])
+def test_one_modes_clamp_force_warning_reads_cleanly_for_its_ends(rotation, quoted, not_quoted):
+    """The warning named a base_acceleration_g axis value as '0.3 9.80665 m s-2' (its units
+    attribute after the number) and quoted the clamped span's measured miss on a pinned span:
+    it gives the excitation over the span's first frequency in words, a level in g, and the
+    measured miss of the span's own ends only (none for elastic ends, which were not
+    measured)."""
+    import warnings
+
+    from sweep.errors import CableSweepWarning
+    extra = "rotational_stiffness = 1.0" if rotation == "elastic" else ""
+    text = scene_text(rotation, level_g=0.3, t_end=0.3, extra=extra).replace(
+        "frequency_ratio = 1.0", "frequency = 400.0").replace(
+        "[axes]", "[axes]\nbase_acceleration_g = [0.3]").replace("acceleration_g = 0.3\n", "")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ds = sweep.run(sweep.load_scene_text(text), progress=False)
+    said = [str(w.message) for w in caught if issubclass(w.category, CableSweepWarning)
+            and "clamp_force of one mode" in str(w.message)]
+    assert len(said) == 1, said
+    ratio = 400.0 / _one(ds, "natural_frequency")
+    assert ratio > 1.6
+    assert f"at {ratio:.2g} times the span's first natural frequency" in said[0]
+    assert "base_acceleration_g 0.3 g" in said[0] and "9.80665" not in said[0]
+    assert quoted in said[0] and not_quoted not in said[0]

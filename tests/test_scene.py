@@ -965,6 +965,22 @@ def test_a_table_override_of_a_section_merges_key_by_key():
         assert scene.get("cable.damping_ratio") == 0.02
 
 
+def test_a_nested_table_override_merges_as_its_section_form_does():
+    """--set 'base.sweep={start=80.0, stop=20.0}' on a sweep of 20 to 80 Hz at 60 oct/min
+    sets start and stop and keeps the rate, as 'base={sweep={...}}' did (it replaced the
+    table and was refused: 'missing rate'); a key the table does not have is still one line
+    naming it."""
+    from sweep.scene import parse_override
+    text = ('name = "down"\n[cable]\nlength = 0.4\n[base]\nacceleration_g = 0.5\n'
+            "sweep = {start = 20.0, stop = 80.0, rate = 60.0}\n")
+    for item in ("base.sweep={start=80.0, stop=20.0}", "base={sweep={start=80.0, stop=20.0}}"):
+        scene = sweep.load_scene_text(text, overrides=dict([parse_override(item)]))
+        assert (scene.get("base.sweep.start"), scene.get("base.sweep.stop"),
+                scene.get("base.sweep.rate")) == (80.0, 20.0, 60.0), item
+    with pytest.raises(SceneError, match="'base.sweep.rat'.*did you mean 'base.sweep.rate'"):
+        sweep.load_scene_text(text, overrides=dict([parse_override("base.sweep={rat=1}")]))
+
+
 def test_a_section_table_override_flattens_nested_tables_and_keeps_the_pair_rules():
     """base={sweep={rate=1}} sets base.sweep.rate alone (it replaced the sweep's table,
     dropping start and stop); points={length=[...]} replaces the length axis as

@@ -249,8 +249,9 @@ def jump_attrs(axis_name: str, ratio: float, both: bool) -> dict[str, object]:
              "(run both ways to tell a jump from a steep slope)")
     return {"units": "1", "flag_values": np.array([NO_JUMP, JUMP_UP, JUMP_DOWN], np.int8),
             "flag_meanings": JUMP_MEANINGS,
-            "long_name": f"jump of the tail amplitude from the previous step along {axis_name} "
-                         f"in the sweep's direction (by more than a factor {ratio:g}) {where}"}
+            "long_name": f"jump of the tail amplitude from the previous step along {axis_name}",
+            "comment": f"jump of the tail amplitude from the previous step along {axis_name} "
+                       f"in the sweep's direction (by more than a factor {ratio:g}) {where}"}
 
 
 def direction_coordinate(directions: list[str], long_name: str = "direction of the stepped "

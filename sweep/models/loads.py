@@ -149,17 +149,24 @@ WHOLE_RUN = 2.0
 """LOADS: over the whole run, a sine sweep's (kernels.modal_driver.WHOLE_RUN)."""
 
 
+def peak_switch(swept: bool) -> str:
+    """The outputs.* switch of the peaks over the tail window (a sine sweep's: over the whole
+    sweep): outputs.amplitude, or outputs.peak_amplitude for a sweep. It governs the midspan's
+    peak and every peak that goes with it: each mode's (modal_amplitude), the span's largest
+    deflection (max_deflection and its position) and the loads (sweep.models.loads)."""
+    return "outputs.peak_amplitude" if swept else "outputs.amplitude"
+
+
 def observation(scene: Any, swept: bool) -> float:
     """kernels/layout.py's LOADS setting for `scene`: where it gets these outputs (`wanted`)
-    and the deflection's peak they go with, their peaks over the tail window (TAIL_WINDOW:
-    with outputs.amplitude) or, swept, over the whole sweep (WHOLE_RUN: with
+    and the deflection's peak they go with (`peak_switch`), their peaks over the tail window
+    (TAIL_WINDOW: with outputs.amplitude) or, swept, over the whole sweep (WHOLE_RUN: with
     outputs.peak_amplitude, the peak a sweep reports); else 0.0, and the kernels skip that
     work."""
     membrane = (scene.get("model.membrane") is not None or "membrane" in scene.axes
                 or "membrane" in (scene.points or {})
                 or scene.get("model.coefficients") == "paper")
-    deflection = "outputs.peak_amplitude" if swept else "outputs.amplitude"
-    if not (scene.get(deflection) and _wanted(scene.get("clamps.rotation"), membrane)):
+    if not (scene.get(peak_switch(swept)) and _wanted(scene.get("clamps.rotation"), membrane)):
         return 0.0
     return WHOLE_RUN if swept else TAIL_WINDOW
 
@@ -214,7 +221,7 @@ def _one_mode_peaks(params: dict[str, Any], amplitude: xr.DataArray,
     shear = xr.where(inertia_part == 0.0, modes_part, shear)
     if p.get("load_type") == "harmonic":
         shear = shear.where(load == 0.0)
-    _warn_above_resonance(shear, mode, coords)
+    _warn_above_resonance(shear, mode, coords, p.get("clamps_rotation") or "pinned")
     return Peaks(q * ends["clamp_curvature"], q * ends["midspan_curvature"], stretch, shear)
 
 
@@ -223,16 +230,24 @@ ONE_MODE_REACTION_LIMIT = 1.6
 mode's own linear frequency."""
 
 
+# What one mode's reaction was measured to miss above ONE_MODE_REACTION_LIMIT, by the span's
+# ends (`_warn_above_resonance`); elastic ends, between the two, were not measured.
+_MEASURED_MISS = {"clamped": "-18 to -63 % at 1.7-3 f1 against five modes",
+                  "pinned": "7-22 % near 2 f1 against the exact beam"}
+
+
 def _warn_above_resonance(shear: xr.DataArray, mode: OneMode,
-                          coords: dict[str, xr.DataArray]) -> None:
+                          coords: dict[str, xr.DataArray], rotation: str = "pinned") -> None:
     """Warn (one line) where one mode's clamp reaction was computed at an excitation frequency
-    above ONE_MODE_REACTION_LIMIT times the mode's linear one (sqrt(k0)). There the clamps'
-    inertia opposes the span's shear, and the modes left out, which the static correction
-    carries as if they did not move, are driven closer to their own resonances: measured
-    against five modes on a clamped span, within 5 % up to 1.5 f1, then -18 to -63 % at
-    1.7-3 f1 (the reaction's two parts nearly cancel near 1.8 f1), and 7-22 % near 2 f1 pinned
-    against the exact beam."""
-    with np.errstate(invalid="ignore"):
+    above ONE_MODE_REACTION_LIMIT times the mode's linear one (sqrt(k0), rad/s). There the
+    clamps' inertia opposes the span's shear, and the modes left out, which the static
+    correction carries as if they did not move, are driven closer to their own resonances:
+    measured against five modes on a clamped span, within 5 % up to 1.5 f1, then -18 to
+    -63 % at 1.7-3 f1 (the reaction's two parts nearly cancel near 1.8 f1), and 7-22 % near
+    2 f1 pinned against the exact beam. The line gives the frequency ratio in words and quotes
+    the measured miss only for the span's own ends (`rotation`: clamps.rotation)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = (mode.omega / np.sqrt(mode.k0)) * xr.ones_like(shear)
         above = np.isfinite(shear) & (mode.omega * mode.omega
                                       > ONE_MODE_REACTION_LIMIT ** 2 * mode.k0)
     above = np.asarray(above.broadcast_like(shear).transpose(*shear.dims))
@@ -241,17 +256,31 @@ def _warn_above_resonance(shear: xr.DataArray, mode: OneMode,
     import warnings
 
     from ..errors import CableSweepWarning
+    ratios = np.asarray(ratio.transpose(*shear.dims))[above]
+    ratios = ratios[np.isfinite(ratios)]
+    low, high = (f"{r:.2g}" for r in (ratios.min(), ratios.max())) if ratios.size else ("", "")
+    at = ("at " + (low if low == high else f"{low} to {high}") + " times"
+          if ratios.size else f"above {ONE_MODE_REACTION_LIMIT:g} times")
     index = np.unravel_index(int(np.argmax(above)), above.shape)
-    at = ", ".join(f"{d} {float(coords[d].values[i]):.4g}"
-                   + (f" {coords[d].attrs['units']}" if coords[d].attrs.get("units", "1")
-                      != "1" else "") for d, i in zip(shear.dims, index) if d in coords)
-    warnings.warn(f"clamp_force of one mode: {int(above.sum())} point(s) are shaken above "
-                  f"{ONE_MODE_REACTION_LIMIT:g} times the span's own frequency"
-                  f"{' (e.g. ' + at + ')' if at else ''}, where the clamps' inertia opposes "
-                  "the span's shear and the modes left out move: one mode's reaction is off "
-                  "by tens of per cent there (-18 to -63 % at 1.7-3 f1 against five modes on a "
-                  "clamped span); run model.modes = 3 for clamp_force there",
+    example = ", ".join(f"{d} {float(coords[d].values[i]):.4g}{_unit_words(coords[d])}"
+                        for d, i in zip(shear.dims, index) if d in coords)
+    miss = _MEASURED_MISS.get(rotation)
+    off = (f"(on a {rotation} span {miss})" if miss else "by up to tens of per cent")
+    warnings.warn(f"clamp_force of one mode: {int(above.sum())} point(s) are shaken {at} the "
+                  f"span's first natural frequency, past the {ONE_MODE_REACTION_LIMIT:g} times "
+                  "one mode's reaction holds to"
+                  f"{' (e.g. ' + example + ')' if example else ''}: the clamps' inertia opposes "
+                  "the span's shear and the modes left out move, so one mode's reaction is off "
+                  f"there {off}; run model.modes = 3 for clamp_force there",
                   CableSweepWarning, stacklevel=6)
+
+
+def _unit_words(coord: xr.DataArray) -> str:
+    """A coordinate's units as a number's suffix: ' m', ' g' for the keys in g, '' for 1."""
+    from ..schema import G2_UNITS, G_UNITS
+    units = coord.attrs.get("units", "1")
+    units = {G_UNITS: "g", G2_UNITS: "g^2/Hz"}.get(units, units)
+    return "" if units == "1" else f" {units}"
 
 
 def outer_diameter(params: dict[str, Any], coords: dict[str, xr.DataArray]) -> Any:

@@ -463,6 +463,8 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
         counted, observed = pooled_crossings(rate, data["statistics_window"], ~escaped)
         data["clearance_upcrossings"] = counted.assign_attrs(
             units="1", long_name="up-crossings of the clearance level by |midspan deflection| "
+            "in the realisations that did not escape",
+            comment="up-crossings of the clearance level by |midspan deflection| "
             "counted over the statistics windows of the realisations that did not escape (the "
             "count behind expected_exceedances: its relative standard error is at least "
             "1 / sqrt(count), and several times that where crossings come in clumps, as a "

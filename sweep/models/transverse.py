@@ -825,8 +825,10 @@ def sweep_outputs(result: KernelResult, inputs: Inputs,
         n = inputs.bands[2]
         out["envelope"] = xr.DataArray(
             result.envelope.reshape(shape + (result.envelope.shape[1],)), dims=dims + (BAND_DIM,),
-            attrs={"units": "m", "long_name": f"response envelope: the largest |q| at the "
-                   f"extrema of q while the sweep's frequency lay in the 1/{n}-octave band",
+            attrs={"units": "m", "long_name": f"response envelope: the largest midspan |q| in "
+                   f"each 1/{n}-octave band of the excitation frequency",
+                   "comment": f"response envelope: the largest |q| at the extrema of q while "
+                   f"the sweep's frequency lay in the 1/{n}-octave band",
                    "cell_methods": f"{BAND_DIM}: maximum"})
         from .excitation import band_centres, table_level
         centres = xr.DataArray(band_centres(*inputs.bands), dims=BAND_DIM)
@@ -908,14 +910,19 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                                              "long_name": long_name.format(method=short)})
     data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
     if result.modal is not None:
-        data.update(modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis,
-                                  inputs.params))
+        modes = modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis,
+                              inputs.params)
         if inputs.swept:                 # a sweep's tail window is the whole sweep
-            attrs = data["modal_amplitude"].attrs
+            attrs = modes["modal_amplitude"].attrs
             attrs["long_name"] = attrs["long_name"].replace("over the tail window",
                                                             "over the whole sweep")
-        midspan = "outputs.peak_amplitude" if inputs.swept else "outputs.amplitude"
-        if midspan in inputs.wanted:                 # the span's beside the midspan's
+        # the peaks of the tail window (a sweep's: of the whole sweep) go with the midspan's
+        # own switch (loads.peak_switch): the modes' and the span's beside the midspan's
+        peaks = loads.peak_switch(inputs.swept) in inputs.wanted
+        if not peaks:
+            del modes["modal_amplitude"]
+        data.update(modes)
+        if peaks:
             data.update(span_outputs(result.reals, dims, shape, inputs.swept,
                                      derived(inputs.params["length"], coords)))
     if inputs.settings[tk.LOADS] != 0.0:

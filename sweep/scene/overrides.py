@@ -1,13 +1,15 @@
 """``--set KEY=VALUE`` overrides: parsed as TOML values and written into the parsed document
 before validation.
 
-An override that sets a sweepable key as a scalar removes that key's axis (or [points]
-entry), one that sets an axis removes the key's [points] entry and the other way round
-(``--set points.length=[0.3, 0.5]``); an override of one
-key of an either-or pair (`sweep.models.rules.PAIRS`: the load frequency, the base level, the
-base frequency; as a scalar or an axis) removes its partner, and one of the end-time keys
-(solver.t_end, solver.transits) the other; so ``--set`` can always replace what the scene file
-says. Overrides of both keys of a pair are refused.
+A table sets the keys it names and keeps the others, for a section
+(``--set 'cable={length=0.3}'``) as for a table inside one (``--set 'base.sweep={start=80.0}'``).
+An override that sets a sweepable key as a scalar removes that key's axis (or [points] entry),
+one that sets an axis removes the key's [points] entry and the other way round
+(``--set points.length=[0.3, 0.5]``); an override of one key of an either-or pair
+(`sweep.models.rules.PAIRS`: the load frequency, the base level, the base frequency; as a
+scalar or an axis) removes its partner, and one of the end-time keys (solver.t_end,
+solver.transits) the other; so ``--set`` can always replace what the scene file says.
+Overrides of both keys of a pair are refused.
 """
 
 from __future__ import annotations
@@ -86,9 +88,10 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
                   "write KEY=VALUE with a dotted scene key, e.g. solver.rtol=1e-9")
         key = key.strip()
         value = _override_value(key, value)
-        if "." not in key and isinstance(value, Mapping):
-            # a table for a whole section sets the keys it names, as `section.key` overrides
-            # do (replacing the section would drop its other keys to their defaults unsaid)
+        if isinstance(value, Mapping) and ("." not in key or key in schema.TABLES):
+            # a table for a whole section, or for a table in one (base.sweep), sets the keys
+            # it names, as `section.key` overrides do (replacing the table would drop its
+            # other keys to their defaults unsaid)
             parsed.update(_section_keys(key, value))
         else:
             parsed[key] = value
@@ -103,7 +106,7 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
 
 
 def _section_keys(prefix: str, table: Mapping[str, Any]) -> dict[str, Any]:
-    """A section's table as dotted overrides: nested tables flattened (base={sweep={rate=1}}
+    """A section's table (or a nested table's, prefix 'base.sweep') as dotted overrides: nested tables flattened (base={sweep={rate=1}}
     is base.sweep.rate) down to a key the schema knows or an entry of [axes] or [points],
     whose value a table may be ({start, stop, num})."""
     out: dict[str, Any] = {}

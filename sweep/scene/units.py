@@ -14,10 +14,12 @@ frequency, Hz), the values of [axes] lists and ranges (start, stop) and of [poin
 A string on a dimensionless key, a unit of the wrong dimension or an unknown unit is one
 SceneError line. pint parses the strings, and is imported only when a scene holds one.
 
-"g" means grams to pint. On an acceleration key (base.acceleration in m/s^2, the keys in g:
-base.acceleration_g, base.levels_g) a "g" written alone is read as standard gravity
-(schema.STANDARD_GRAVITY, 9.80665 m/s^2), so "0.5 g" is half of it there; everywhere else g
-is the gram ("33.3 g/m").
+"g" means grams to pint, "G" the gauss. On an acceleration key (base.acceleration in m/s^2,
+the keys in g: base.acceleration_g, base.levels_g) and an acceleration spectral density
+(base.asd, base.asd_g2) a "g" or "G" written alone (as test specifications write "G^2/Hz") is read as
+standard gravity (schema.STANDARD_GRAVITY, 9.80665 m/s^2), so "0.5 g" is half of it there;
+everywhere else g is the gram ("33.3 g/m"), and a G is refused with a line saying where it
+means gravity. A reciprocal unit may be written with its 1: "20 1/s" is "20 /s".
 """
 
 from __future__ import annotations
@@ -30,9 +32,11 @@ from .. import schema
 from .messages import _fail, _show
 
 ACCELERATION_UNITS = ("m s-2", schema.G_UNITS, "m2 s-4 Hz-1", schema.G2_UNITS)
-"""Schema units of the keys on which "g" means standard gravity."""
+"""Schema units of the keys on which "g" (or "G") means standard gravity."""
 _UNIT_POWER = re.compile(r"(?<![\w.])([A-Za-z]+)(-?\d+)(?![\w.])")   # m2, s-2 (UDUNITS)
-_LONE_G = re.compile(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])")
+_LONE_G = re.compile(r"(?<![A-Za-z_])[gG](?![A-Za-z_0-9])")    # "0.5 g", "0.16 G^2/Hz"
+_GRAVITY_G = re.compile(r"(?<![A-Za-z_])G(?![A-Za-z_0-9])")    # G alone: gravity, not gauss
+_RECIPROCAL = re.compile(r"^1\s*/")          # a unit written "1/s", "1/min": pint's "/s"
 
 _DIMENSION_NAMES: dict[str, str] = {
     "[length]": "a length", "[mass]": "a mass", "[time]": "a time",
@@ -45,7 +49,8 @@ _DIMENSION_NAMES: dict[str, str] = {
     "[mass] * [length] ** 2 / [time] ** 2": "a moment (force x length)",
     "[mass] / [time] ** 2": "a stiffness (force per length)",
     "[length] ** 2 / [time] ** 3": "an acceleration spectral density",
-    "1 / [time] ** 2": "an acceleration per length ('g' is standard gravity on this key)",
+    "1 / [time] ** 2": "an acceleration per length ('g' or 'G' is standard gravity on this "
+                       "key)",
     "dimensionless": "a pure number",
 }
 _EXAMPLES: dict[str, str] = {
@@ -74,7 +79,7 @@ def accepted(key: schema.Key) -> str:
     if key.units in ("", "1") or key.kind not in ("float", "floats", "pairs"):
         return ""
     quantity = _QUANTITIES.get(key.units, key.units)
-    gravity = " ('g': standard gravity)" if key.units in ACCELERATION_UNITS else ""
+    gravity = " ('g' or 'G': standard gravity)" if key.units in ACCELERATION_UNITS else ""
     shown = {schema.G_UNITS: "g", schema.G2_UNITS: "g^2/Hz"}.get(key.units, key.units)
     return (f"a number in {shown}, or a string with "
             f"any {quantity} unit, e.g. {_EXAMPLES.get(key.units, key.units)}{gravity}")
@@ -154,7 +159,7 @@ def _unit_text(where: str, text: str, example: str) -> str:
     number = _LEADING_NUMBER.match(text)
     if number is None:                   # pint would read a unit alone as 1 of it ('a': a year)
         _fail(where, f"{_show(text)} does not start with a number", fix)
-    unit = _powers(" ".join(text[number.end():].split()))
+    unit = _RECIPROCAL.sub("/", _powers(" ".join(text[number.end():].split())))
     unit = _MIL.sub("thou", unit)        # a data sheet's mil, 1/1000 inch (pint's is an angle)
     unit = _NEWTON_METRE.sub("N m", unit)    # pint's Nm is a "number metre"
     if re.search(r"[\d+-]", _EXPONENT.sub("", unit)):
@@ -175,10 +180,14 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     target = _pint_units(key.units)
     example = _EXAMPLES.get(key.units, f"a number with a unit of {key.units}")
     parsed_text = _unit_text(where, text, example)
+    if not acceleration and _GRAVITY_G.search(parsed_text):
+        keys = ", ".join(k.dotted for k in schema.KEYS if k.units in ACCELERATION_UNITS)
+        _fail(where, f"{_show(text)} has a 'G': standard gravity, which only the acceleration "
+              f"keys take ({keys})", f"give e.g. {example}")
     parsed_text = _LONE_G.sub("g_0", parsed_text) if acceleration else parsed_text
     if key.units == "min-1":             # a sweep rate in octaves per minute: "2 oct/min"
         parsed_text = _OCTAVES.sub("", parsed_text)
-    gravity = " ('g' is standard gravity on this key)" if acceleration else ""
+    gravity = " ('g' or 'G' is standard gravity on this key)" if acceleration else ""
     try:
         quantity = registry.Quantity(parsed_text.strip())
     except (pint.errors.UndefinedUnitError, AttributeError) as exc:
