@@ -235,6 +235,23 @@ def test_points_get_their_own_spectra():
     assert np.all(np.abs(peaks - f1) <= float(ds.asd_frequency[1]))    # each its own resonance
 
 
+@pytest.mark.parametrize("lengths", [[0.2, 0.25, 0.3], [0.12, 0.3]])
+def test_the_segment_fits_the_shortest_window_of_a_length_by_damping_grid(lengths):
+    """A damping axis beside a length axis: the Welch segment fits SEGMENTS half-overlapping
+    in the shortest statistics window over the whole product grid, read from the result's own
+    per-point windows (a reviewer: with 3 lengths and 2 dampings the run failed with a
+    traceback; with 2 and 2 the two axes were paired point by point, so the grid's shortest
+    window, at the longest span's lowest damping, was missed and the segment was 2.2 times too
+    long for it)."""
+    ds = sweep.run(scene({"base.duration": 4.0},
+                         axes={"length": lengths, "damping_ratio": [0.015, 0.05]}),
+                   progress=False)
+    shortest = float(ds.statistics_window.min())
+    segment = 1.0 / float(ds.asd_frequency[1] - ds.asd_frequency[0])      # s
+    assert segment <= 2.0 * shortest / (response_asd.SEGMENTS + 1)
+    assert segment >= 0.99 * shortest / (response_asd.SEGMENTS + 1)       # the longest that fits
+
+
 def test_an_end_loads_frequency_axis_and_the_spectra_are_two_dimensions():
     """A harmonic end load swept in `frequency` (Hz) beside the spectra's `asd_frequency`."""
     sc = scene({"load.type": "harmonic", "load.amplitude": 1.0},

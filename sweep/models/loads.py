@@ -245,11 +245,14 @@ def _warn_above_resonance(shear: xr.DataArray, mode: OneMode,
     measured against five modes on a clamped span, within 5 % up to 1.5 f1, then -18 to
     -63 % at 1.7-3 f1 (the reaction's two parts nearly cancel near 1.8 f1), and 7-22 % near
     2 f1 pinned against the exact beam. The line gives the frequency ratio in words and quotes
-    the measured miss only for the span's own ends (`rotation`: clamps.rotation)."""
+    the measured miss only for the span's own ends (`rotation`: clamps.rotation). Only where
+    the base shakes the span (a level A != 0) below its buckling load (k0 > 0): a span at
+    rest under an end load past buckling has no frequency to be above, and its reaction is
+    the static one."""
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = (mode.omega / np.sqrt(mode.k0)) * xr.ones_like(shear)
-        above = np.isfinite(shear) & (mode.omega * mode.omega
-                                      > ONE_MODE_REACTION_LIMIT ** 2 * mode.k0)
+        above = (np.isfinite(shear) & (mode.level != 0.0) & (mode.k0 > 0.0)
+                 & (mode.omega * mode.omega > ONE_MODE_REACTION_LIMIT ** 2 * mode.k0))
     above = np.asarray(above.broadcast_like(shear).transpose(*shear.dims))
     if not above.any():
         return

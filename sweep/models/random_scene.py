@@ -253,6 +253,21 @@ def required_realisations(accuracy: float, omega_1: Any, damping_ratio: Any,
     return int(np.max(np.ceil(np.asarray(need, float) - 1e-9)))
 
 
+def _on_one_grid(natural_frequency: Any, damping_ratio: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(w1, zeta) (rad/s, 1) as arrays of one shape, point by point: DataArrays (a run's
+    coefficients, each over the axes it varies on) broadcast by their dimensions, so a length
+    axis and a damping axis make their product; plain arrays (the rules' aligned corners of
+    the grid) by NumPy's rules."""
+    import xarray as xr
+    if isinstance(natural_frequency, xr.DataArray) or isinstance(damping_ratio, xr.DataArray):
+        f1, zeta = xr.broadcast(xr.DataArray(natural_frequency), xr.DataArray(damping_ratio))
+        natural_frequency, damping_ratio = f1.values, zeta.transpose(*f1.dims).values
+    omega, zeta = np.broadcast_arrays(
+        2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
+        np.atleast_1d(np.asarray(damping_ratio, float)))
+    return omega, zeta
+
+
 def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
                    damping_ratio: Any) -> None:
     """Refuse (one line) base.realisations too few for base.rms_accuracy at some point of
@@ -262,9 +277,7 @@ def check_accuracy(values: Mapping[str, Any], natural_frequency: Any,
     accuracy = values.get("base.rms_accuracy")
     if accuracy is None:
         return
-    omega, zeta = np.broadcast_arrays(
-        2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
-        np.atleast_1d(np.asarray(damping_ratio, float)))
+    omega, zeta = _on_one_grid(natural_frequency, damping_ratio)
     with np.errstate(divide="ignore", invalid="ignore"):
         window = statistics_window(float(values["solver.t_end"]),
                                    float(values["metrics.tail"]),
@@ -320,9 +333,7 @@ def shortest_window(t_end: float, tail: float, tolerance: float, natural_frequen
     t_end s (tail: metrics.tail; tolerance: metrics.tolerance, for the start-up transient):
     natural_frequency f1 (Hz) and damping_ratio on the grid, or at its corners, where zeta w1
     takes its extremes."""
-    omega, zeta = np.broadcast_arrays(
-        2.0 * math.pi * np.atleast_1d(np.asarray(natural_frequency, float)),
-        np.atleast_1d(np.asarray(damping_ratio, float)))
+    omega, zeta = _on_one_grid(natural_frequency, damping_ratio)
     with np.errstate(divide="ignore", invalid="ignore"):
         start = transient_time(omega, zeta, tolerance, ramp)
         window = statistics_window(t_end, tail, start)
@@ -363,4 +374,6 @@ def check_duration(t_end: float, startup: float, ramp: float = 0.0) -> None:
               f"of it after the start-up transient has decayed ({startup:.3g} s = "
               + (f"base.ramp {ramp:g} s + " if ramp > 0.0 else "")
               + "ln(1/metrics.tolerance) / (zeta w1) at the best-damped point)",
-              f"give base.duration of at least {10.0 * startup:.3g} s, or more damping")
+              f"give base.duration above {startup / STARTUP_SHARE:.3g} s (the statistics then "
+              f"start after the transient; {10.0 * startup:.3g} s keeps 90 % of the record for "
+              "them), or more damping")
