@@ -83,7 +83,10 @@ DEFAULT_MAX_PROBABILITY = 0.01
 STATE_FAILURES = tuple(km.STATE_MEANINGS[f] for f in (km.INVALID_INPUT, km.DIVERGED,
                                                       km.STEP_TOO_SMALL, km.MAX_STEPS))
 """`state` flag meanings that fail a length (the one state table, kernels/states.py)."""
-LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "km": 1e3}
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "km": 1e3,
+                "metre": 1.0, "meter": 1.0, "metres": 1.0, "meters": 1.0,
+                "millimetre": 1e-3, "millimeter": 1e-3, "millimetres": 1e-3,
+                "millimeters": 1e-3}
 """The units a result's `length` axis may be in, and their size in metres."""
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
             "max_peak", "clearance", "state", "stability")
@@ -241,8 +244,9 @@ def _limits(ds: xr.Dataset, axes: tuple[str, ...], max_deflection: float | None,
         else:
             raise UserError("design: --max-deflection needs the variable 'max_deflection' "
                             "(m, the largest deflection over the span), which this result "
-                            "lacks (a sine sweep of several modes written before 2026-12-05 "
-                            "has none: run it again, or use --max-amplitude)")
+                            "lacks (a run with outputs.amplitude = false, or a sine sweep of "
+                            "several modes written before 2026-12-05, has none: run it with "
+                            "the tail amplitude on, or use --max-amplitude)")
     if max_strain is not None:
         if "max_strain" not in ds:
             raise UserError("design: --max-strain needs the variable 'max_strain' (bending "
@@ -461,7 +465,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     Parameters
     ----------
     ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis in m (or
-        mm, cm, km as its units attribute says: converted to m).
+        mm, cm, km or their spelled-out names, as its units attribute says: converted to m).
     min_frequency : Hz; a length passes when `natural_frequency` >= min_frequency.
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
         `quantity` (one of RESPONSES, in m over the swept axes), by default `peak_amplitude` for a

@@ -97,7 +97,8 @@ def _length_in(ds: xr.Dataset, units: str | None, per_metre: float) -> xr.Datase
     return ds.assign_coords(length=("length", ds["length"].values * per_metre, attrs))
 
 
-@pytest.mark.parametrize("units, per_metre", [("mm", 1e3), ("cm", 1e2), ("km", 1e-3)])
+@pytest.mark.parametrize("units, per_metre", [("mm", 1e3), ("cm", 1e2), ("km", 1e-3), ("metre", 1.0),
+                                              ("millimeters", 1e3)])
 def test_a_length_in_another_length_unit_is_read_in_metres(units, per_metre, capsys, tmp_path):
     """rms = 0.01 l (l in m) crosses 0.0017 m at 0.17 m whatever unit the file's length is
     written in (a length in mm was read as metres: a 170 m span, labelled m)."""

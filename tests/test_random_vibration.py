@@ -30,6 +30,7 @@ from sweep.execute import transverse_chunk
 from sweep.kernels import layout as tk
 from sweep.kernels import oscillator as osc
 from sweep.models import random as rnd
+from sweep.models import random_scene
 from sweep.models.random_outputs import RandomInputs
 from sweep.schema import STANDARD_GRAVITY as G
 
@@ -336,8 +337,13 @@ def test_a_record_shorter_than_the_start_up_is_refused():
     # start-up, which a record a ninth of that long already meets), worked out here by hand
     startup = (math.log(1.0 / float(sc.values["metrics.tolerance"]))
                / (0.001 * 2.0 * math.pi * 42.4))                     # f1 = 42.4 Hz, 3 digits
-    advised = float(re.search(r"base\.duration above ([0-9.e+]+) s", str(caught.value)).group(1))
+    advised = float(re.search(r"base\.duration of at least ([0-9.e+]+) s", str(caught.value)).group(1))
     assert advised == pytest.approx(startup / 0.9, rel=1e-2)
+    for startup_s in (0.9031, 1.0481, 0.01):    # a reviewer's: 3 digits rounded down below it
+        with pytest.raises(SceneError) as short:
+            random_scene.check_duration(0.5 * startup_s, startup_s)
+        given = float(re.search(r"at least ([0-9.e+]+) s", str(short.value)).group(1))
+        random_scene.check_duration(given, startup_s)          # the advice runs
 
 
 def test_a_span_whose_start_up_outlasts_the_record_is_flagged_the_others_run():

@@ -218,7 +218,7 @@ def warn_long_startups(t_end: float, startups: Any) -> None:
     if not long.any() or long.all():
         return
     worst = float(np.max(starts))
-    fix = (f"give base.duration of at least {worst / STARTUP_SHARE:.3g} s to run them too"
+    fix = (f"give base.duration of at least {_above(worst / STARTUP_SHARE)} s to run them too"
            if math.isfinite(worst) else "give them damping (cable.damping_ratio > 0)")
     warnings.warn(f"{int(long.sum())} of {starts.size} span settings start up for longer than "
                   f"{STARTUP_SHARE:.0%} of the {t_end:g} s run (up to {worst:.3g} s: "
@@ -359,6 +359,16 @@ def check_spectra_window(values: Mapping[str, Any], natural_frequency: Any,
     segment_length(window, spectra_rate(values), values.get("outputs.asd_resolution"))
 
 
+def _above(threshold: float) -> str:
+    """`threshold` (s) rounded up to 3 significant digits and past it, as advice: a duration
+    read off the line then passes the strict test (`runs_after_startup`)."""
+    if not (math.isfinite(threshold) and threshold > 0.0):
+        return f"{threshold:.3g}"
+    step = 10.0 ** (math.floor(math.log10(threshold)) - 2)
+    value = (math.floor(threshold / step) + 1) * step
+    return f"{value:.3g}"
+
+
 def check_duration(t_end: float, startup: float, ramp: float = 0.0) -> None:
     """Refuse (one line) a run that leaves less than a tenth of itself after the start-up
     of its best-damped point (`startup`, s: the shortest over the grid), so that no point has
@@ -374,6 +384,6 @@ def check_duration(t_end: float, startup: float, ramp: float = 0.0) -> None:
               f"of it after the start-up transient has decayed ({startup:.3g} s = "
               + (f"base.ramp {ramp:g} s + " if ramp > 0.0 else "")
               + "ln(1/metrics.tolerance) / (zeta w1) at the best-damped point)",
-              f"give base.duration above {startup / STARTUP_SHARE:.3g} s (the statistics then "
-              f"start after the transient; {10.0 * startup:.3g} s keeps 90 % of the record for "
-              "them), or more damping")
+              f"give base.duration of at least {_above(startup / STARTUP_SHARE)} s (the "
+              f"statistics then start after the transient; {_above(10.0 * startup)} s keeps 90 % "
+              "of the record for them), or more damping")

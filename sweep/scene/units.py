@@ -49,8 +49,7 @@ _DIMENSION_NAMES: dict[str, str] = {
     "[mass] * [length] ** 2 / [time] ** 2": "a moment (force x length)",
     "[mass] / [time] ** 2": "a stiffness (force per length)",
     "[length] ** 2 / [time] ** 3": "an acceleration spectral density",
-    "1 / [time] ** 2": "an acceleration per length ('g' or 'G' is standard gravity on this "
-                       "key)",
+    "1 / [time] ** 2": "an acceleration per length",
     "dimensionless": "a pure number",
 }
 _EXAMPLES: dict[str, str] = {
