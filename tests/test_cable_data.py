@@ -89,6 +89,18 @@ def test_udunits_exponents_after_a_slash():
                                                                                 rel=1e-14)
 
 
+@pytest.mark.parametrize("key, text", [("cable.linear_mass", "0a176 kg/m"),
+                                       ("base.sweep.rate", "2 a300/min")])
+def test_a_unit_whose_size_overflows_is_one_line(key, text):
+    """The fuzz test's '0a176 kg/m' (a character edit of '0.176 kg/m'): pint reads a^176, years
+    to the 176th power, whose size overflows a float while the angle check reduced it to root
+    units (OverflowError, a traceback); now one line naming the key."""
+    from sweep.errors import SceneError
+    with pytest.raises(SceneError) as caught:
+        sweep.load_scene("launch-sine-qualification", {key: text})
+    assert key in str(caught.value) and "\n" not in str(caught.value)
+
+
 def test_mil_is_a_thousandth_of_an_inch():
     key = schema.BY_DOTTED["cable.diameter"]
     assert to_si("scene key 'cable.diameter'", key, "109 mil") == pytest.approx(109e-3 * INCH,

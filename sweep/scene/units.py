@@ -200,7 +200,11 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
               f"give a number and a unit of {key.units}, e.g. {example}{gravity}")
     if not isinstance(quantity, registry.Quantity):    # a bare number parses as a float
         quantity = registry.Quantity(quantity)
-    quantity = _cycles(where, key, text, quantity, target, registry)
+    try:
+        quantity = _cycles(where, key, text, quantity, target, registry)
+    except ArithmeticError:                      # "0a176 kg/m": pint reads a^176 (years)
+        _fail(where, f"{_show(text)} is not a number with a unit",
+              f"give a number and a unit of {key.units}, e.g. {example}{gravity}")
     try:
         value = float(quantity.to(target).magnitude)
     except pint.errors.DimensionalityError:
