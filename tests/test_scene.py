@@ -163,6 +163,29 @@ def test_override_frequency_replaces_frequency_ratio():
     assert scene.get("load.frequency_ratio") is None
 
 
+@pytest.mark.parametrize("name, override, value, gone", [
+    ("launch-sine-qualification", {"base.acceleration_g": 0.5}, 0.5, ("base.levels_g",)),
+    ("launch-sine-qualification", {"axes.base_acceleration_g": [0.5, 1.0]}, None,
+     ("base.levels_g",)),
+    ("harness-base-sine", {"base.levels_g": [[5.0, 0.5], [100.0, 0.6]]},
+     ((5.0, 0.5), (100.0, 0.6)), ("base.acceleration_g", "base.acceleration")),
+    ("launch-random-gevs", {"base.asd": [[20.0, 1.0], [2000.0, 1.0]]},
+     ((20.0, 1.0), (2000.0, 1.0)), ("base.asd_g2",))])
+def test_override_replaces_another_way_to_give_the_same_quantity(name, override, value, gone):
+    """A level as a table in g and a spectrum in g^2/Hz or (m/s^2)^2/Hz are other ways to give
+    one quantity, beside the either-or pairs: --set of one replaces what the scene gave (a
+    reviewer: refused "give one level, not both", while the README says --set can always
+    replace what the scene file says)."""
+    scene = load_scene(name, overrides=override)
+    (key, given), = override.items()
+    if value is not None:
+        assert scene.get(key) == value
+    else:
+        assert list(scene.axes["base_acceleration_g"]) == given
+    for other in gone:
+        assert scene.get(other) is None, other
+
+
 def test_override_both_frequencies_refused():
     message = scene_error(BASE, {"load.frequency": 10.0, "axes.frequency_ratio": [1.0, 2.0]})
     assert "give one, not both" in message

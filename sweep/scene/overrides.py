@@ -7,8 +7,10 @@ An override that sets a sweepable key as a scalar removes that key's axis (or [p
 one that sets an axis removes the key's [points] entry and the other way round
 (``--set points.length=[0.3, 0.5]``); an override of one key of an either-or pair
 (`sweep.models.rules.PAIRS`: the load frequency, the base level, the base frequency; as a
-scalar or an axis) removes its partner, and one of the end-time keys (solver.t_end,
-solver.transits) the other; so ``--set`` can always replace what the scene file says.
+scalar or an axis) removes its partner, one of the other ways to give one quantity
+(`ALTERNATIVES`: the base level as a table in g, a spectrum in g^2/Hz or in (m/s^2)^2/Hz)
+the others, and one of the end-time keys (solver.t_end, solver.transits) the other; so
+``--set`` can always replace what the scene file says.
 Overrides of both keys of a pair are refused.
 """
 
@@ -21,9 +23,17 @@ from typing import Any
 import numpy as np
 
 from .. import schema
-from ..models.rules import END_TIME_KEYS, PAIRS
+from ..models.rules import BASE_LEVEL_KEYS, BASE_TABLE_KEY, END_TIME_KEYS, PAIRS
 from .axes import _axis_or_none
 from .messages import _fail, _section_not_table
+
+
+ALTERNATIVES: tuple[tuple[str, ...], ...] = (
+    BASE_LEVEL_KEYS + (BASE_TABLE_KEY,),         # a base level: m/s^2, g, or (Hz, g) table
+    ("base.asd_g2", "base.asd"),                 # a spectrum: g^2/Hz or (m/s^2)^2/Hz
+)
+"""Groups of keys that give one quantity different ways, beside the either-or PAIRS: a
+``--set`` of one removes the others the scene gives (scalars and axes)."""
 
 
 def parse_override(item: str) -> tuple[str, Any]:
@@ -164,6 +174,7 @@ def _override_axis(doc: dict[str, Any], name: str, value: Any, section: str = "a
     other = next(s for s in schema.SWEPT_SECTIONS if s != section)
     _drop_axis(doc, axis, (other,))
     _drop_frequency_partner(doc, schema.BY_AXIS[axis].dotted)
+    _drop_alternatives(doc, schema.BY_AXIS[axis].dotted)
     replaced = {(axis if _axis_or_none(k) == axis else k): v for k, v in axes.items()}
     replaced[axis] = value
     axes.clear()
@@ -181,6 +192,24 @@ def _override_scalar(doc: dict[str, Any], section: str, name: str, value: Any) -
     if key is not None and key.axis is not None:
         _drop_axis(doc, key.axis)
         _drop_frequency_partner(doc, key.dotted)
+    _drop_alternatives(doc, dotted)
+
+
+def _drop_alternatives(doc: dict[str, Any], dotted: str) -> None:
+    """When a key of an `ALTERNATIVES` group is set, remove the group's other keys (scalar and
+    axis) from the document."""
+    for group in ALTERNATIVES:
+        if dotted not in group:
+            continue
+        for other in group:
+            if other == dotted:
+                continue
+            key = schema.BY_DOTTED[other]
+            table = doc.get(key.section)
+            if isinstance(table, dict):
+                table.pop(key.name, None)
+            if key.axis is not None:
+                _drop_axis(doc, key.axis)
 
 
 def _drop_axis(doc: dict[str, Any], axis: str,
