@@ -272,7 +272,8 @@ def test_the_dataset_has_a_realisation_dimension_and_means():
     ({"solver.t_end": 2.0}, "longer than the record"),
     ({"base.sample_rate": 900.0}, "cannot carry the spectrum"),
     ({"outputs.clearance": [1e-3] * 5}, "1 to 4 levels"),
-    ({"base.asd": [[10.0, 1.0], [500.0, 1.0]]}, "give one, not both"),
+    ({"base.asd": [[10.0, 1.0], [500.0, 1.0]], "base.asd_g2": [[10.0, 0.1], [500.0, 0.1]]},
+     "give one, not both"),
     ({"solver.stop_when_steady": True}, "never steady"),
 ])
 def test_bad_random_scenes_are_one_line(overrides, words):

@@ -105,9 +105,10 @@ def _parse_overrides(overrides: Mapping[str, Any] | None) -> dict[str, Any]:
             parsed.update(_section_keys(key, value))
         else:
             parsed[key] = value
-    for pair in PAIRS:
-        if len({_pair_target(k, pair) for k in parsed} - {None}) == 2:
-            _fail(f"overrides '{pair[0]}' and '{pair[1]}'", "give one, not both",
+    for group in PAIRS + ALTERNATIVES:
+        given = sorted({_pair_target(k, group) for k in parsed} - {None}, key=group.index)
+        if len(given) >= 2:
+            _fail(f"overrides '{given[0]}' and '{given[1]}'", "give one, not both",
                   "remove one of the two overrides")
     if all(k in parsed for k in END_TIME_KEYS):
         _fail("overrides 'solver.t_end' and 'solver.transits'", "give one, not both",
@@ -130,8 +131,9 @@ def _section_keys(prefix: str, table: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _pair_target(dotted: str, pair: tuple[str, str]) -> str | None:
-    """The key of an either-or `pair` an override sets (as scalar or axis), or None."""
+def _pair_target(dotted: str, pair: tuple[str, ...]) -> str | None:
+    """The key of an either-or `pair` (or `ALTERNATIVES` group) an override sets (as scalar or
+    axis), or None."""
     if dotted in pair:
         return dotted
     section, _, name = dotted.partition(".")
