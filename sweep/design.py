@@ -807,17 +807,17 @@ def interpolated(result: xr.Dataset, sources: dict[str, xr.Dataset]) -> dict[str
     limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
     where = (np.asarray(result["limited_in"].values, dtype=str).ravel()
              if "limited_in" in result else np.full(spans.size, next(iter(sources))))
+    grids = {name: np.asarray(in_metres(ds)[LENGTH].values, float)
+             for name, ds in sources.items()}           # each source's lengths, m
     counts = {"response": 0, "frequency": 0}
     for span, by, name in zip(spans, limited, where):
-        source = sources.get(name)
-        if source is None or not np.isfinite(span):
+        if name not in sources or not np.isfinite(span):
             continue
-        lengths = np.asarray(in_metres(source)[LENGTH].values, float)
-        if np.any(np.isclose(lengths, span, rtol=1e-12, atol=0.0)):
+        if np.any(np.isclose(grids[name], span, rtol=1e-12, atol=0.0)):
             continue
         if by != "min_frequency":
             counts["response"] += 1
-        elif elastic_ends(source):
+        elif elastic_ends(sources[name]):
             counts["frequency"] += 1
     return counts
 

@@ -175,8 +175,7 @@ def _override_axis(doc: dict[str, Any], name: str, value: Any, section: str = "a
         return
     other = next(s for s in schema.SWEPT_SECTIONS if s != section)
     _drop_axis(doc, axis, (other,))
-    _drop_frequency_partner(doc, schema.BY_AXIS[axis].dotted)
-    _drop_alternatives(doc, schema.BY_AXIS[axis].dotted)
+    _drop_partners(doc, schema.BY_AXIS[axis].dotted)
     replaced = {(axis if _axis_or_none(k) == axis else k): v for k, v in axes.items()}
     replaced[axis] = value
     axes.clear()
@@ -193,25 +192,7 @@ def _override_scalar(doc: dict[str, Any], section: str, name: str, value: Any) -
     key = schema.BY_DOTTED.get(dotted)
     if key is not None and key.axis is not None:
         _drop_axis(doc, key.axis)
-        _drop_frequency_partner(doc, key.dotted)
-    _drop_alternatives(doc, dotted)
-
-
-def _drop_alternatives(doc: dict[str, Any], dotted: str) -> None:
-    """When a key of an `ALTERNATIVES` group is set, remove the group's other keys (scalar and
-    axis) from the document."""
-    for group in ALTERNATIVES:
-        if dotted not in group:
-            continue
-        for other in group:
-            if other == dotted:
-                continue
-            key = schema.BY_DOTTED[other]
-            table = doc.get(key.section)
-            if isinstance(table, dict):
-                table.pop(key.name, None)
-            if key.axis is not None:
-                _drop_axis(doc, key.axis)
+    _drop_partners(doc, dotted)
 
 
 def _drop_axis(doc: dict[str, Any], axis: str,
@@ -224,14 +205,18 @@ def _drop_axis(doc: dict[str, Any], axis: str,
                 del table[entry]
 
 
-def _drop_frequency_partner(doc: dict[str, Any], dotted: str) -> None:
-    """When one key of an either-or pair (PAIRS: the load frequency, the base level, the base
-    frequency) is set, remove the other (scalar and axis)."""
-    pair = next((p for p in PAIRS if dotted in p), None)
-    if pair is None:
-        return
-    partner = schema.BY_DOTTED[pair[1 - pair.index(dotted)]]
-    table = doc.get(partner.section)
-    if isinstance(table, dict):
-        table.pop(partner.name, None)
-    _drop_axis(doc, partner.axis or "")
+def _drop_partners(doc: dict[str, Any], dotted: str) -> None:
+    """When a key of an either-or pair (PAIRS: the load frequency, the base level, the base
+    frequency) or of an `ALTERNATIVES` group is set, remove the others (scalar and axis)."""
+    for group in PAIRS + ALTERNATIVES:
+        if dotted not in group:
+            continue
+        for other in group:
+            if other == dotted:
+                continue
+            partner = schema.BY_DOTTED[other]
+            table = doc.get(partner.section)
+            if isinstance(table, dict):
+                table.pop(partner.name, None)
+            if partner.axis is not None:
+                _drop_axis(doc, partner.axis)
