@@ -142,6 +142,76 @@ def test_a_capital_g_elsewhere_is_one_line_saying_where_it_means_gravity(dotted,
 
 
 @pytest.mark.parametrize("dotted, text, expected", [
+    ("base.acceleration", "0.5 g0", 0.5 * G0), ("base.acceleration", "0.5 gn", 0.5 * G0),
+    ("base.acceleration", "0.5 g_0", 0.5 * G0), ("base.acceleration", "0.5g0", 0.5 * G0),
+    ("base.acceleration", "500 mG", 0.5 * G0), ("base.acceleration_g", "0.5 g0", 0.5),
+    ("base.acceleration_g", "0.5 gn", 0.5), ("base.acceleration_g", "500 mG", 0.5),
+    ("base.acceleration_g", "25 mG", 0.025), ("base.levels_g", "1875 mG", 1.875),
+    ("base.asd_g2", "0.16 g0^2/Hz", 0.16), ("base.asd_g2", "160 mG^2/Hz", 160e-6),
+    ("base.asd", "0.16 gn^2/Hz", 0.16 * G0 ** 2), ("base.asd", "400 mG^2/Hz", 0.4e-3 * G0 ** 2)])
+def test_g0_gn_and_milli_g_are_standard_gravity_on_the_acceleration_keys(dotted, text, expected):
+    """"0.5 g0" was read as g to the power 0 (a pure number, refused), "0.5 gn" and "500 mG"
+    (pint's milligauss) as unknown or of a wrong dimension; on the acceleration keys they are
+    standard gravity and a thousandth of it (9.80665 m/s^2 per g, by hand)."""
+    key = schema.BY_DOTTED[dotted]
+    assert to_si(f"scene key '{dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
+
+
+@pytest.mark.parametrize("dotted, text, words", [
+    ("base.acceleration", "500 mg", ["'500 mG'", "'0.5 g'"]),
+    ("base.acceleration_g", "500 mg", ["'500 mG'", "'0.5 g'"]),
+    ("base.levels_g", "250 mg", ["'250 mG'", "'0.25 g'"]),
+    ("base.asd_g2", "0.16 mg^2/Hz", ["'0.16 mG^2/Hz'", "'1.6e-07 g^2/Hz'"])])
+def test_a_milligram_on_an_acceleration_key_is_one_line_suggesting_milli_g(dotted, text, words):
+    """"500 mg" is 500 milligrams: refused, in one line that says it is a mass and gives the
+    level in mG and in g."""
+    with pytest.raises(sweep.SceneError) as info:
+        to_si(f"scene key '{dotted}'", schema.BY_DOTTED[dotted], text)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(f"scene key '{dotted}': ")
+    assert "is a mass" in message and "milligram" in message, message
+    for word in words:
+        assert word in message, message
+
+
+@pytest.mark.parametrize("dotted, text", [
+    ("base.acceleration_g", "14.1 grms"), ("base.acceleration_g", "14.1 Grms"),
+    ("base.acceleration", "1 g rms"), ("base.levels_g", "2 GRMS")])
+def test_an_rms_level_on_a_sine_level_key_is_one_line_asking_for_the_peak(dotted, text):
+    """A sine's level is its peak: "14.1 grms" was "unknown unit 'grms'"; now one line that
+    says what the key takes."""
+    with pytest.raises(sweep.SceneError) as info:
+        to_si(f"scene key '{dotted}'", schema.BY_DOTTED[dotted], text)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(f"scene key '{dotted}': ")
+    assert "RMS" in message and "peak" in message and "g or m/s^2" in message, message
+    assert "unknown unit" not in message
+
+
+@pytest.mark.parametrize("dotted, text, named", [
+    ("cable.linear_mass", "0.5 g0", "'g0'"), ("load.amplitude", "2 gn", "'gn'"),
+    ("base.frequency", "500 mG", "'mG'")])
+def test_gravity_spelled_otherwise_elsewhere_is_one_line_saying_where_it_means_gravity(
+        dotted, text, named):
+    """"0.5 g0" on a mass per length was read as g^0, "a pure number"; g0, gn and mG are
+    standard gravity, which only the acceleration keys take."""
+    with pytest.raises(sweep.SceneError) as info:
+        to_si(f"scene key '{dotted}'", schema.BY_DOTTED[dotted], text)
+    message = str(info.value)
+    assert "\n" not in message and named in message and "base.acceleration_g" in message
+
+
+def test_gravity_units_through_a_scene_file_and_an_override():
+    """The same spellings in a scene file and in --set, to SI once (9.80665 m/s^2 per g)."""
+    text = ('[cable]\nlength = 0.4\n[base]\nacceleration_g = "750 mG"\nfrequency = 20.0\n'
+            "[solver]\nt_end = 0.5\n")
+    assert load(text).get("base.acceleration_g") == pytest.approx(0.75, rel=1e-14)
+    scene = load(text, **{"base.acceleration": "0.25 gn"})
+    assert scene.get("base.acceleration") == pytest.approx(0.25 * G0, rel=1e-14)
+    assert scene.get("base.acceleration_g") is None
+
+
+@pytest.mark.parametrize("dotted, text, expected", [
     ("base.frequency", "20 1/s", 20.0), ("base.frequency", "120 1/min", 2.0),
     ("base.sweep.rate", "2 1/min", 2.0), ("base.sweep.rate", "2 1 / min", 2.0),
     ("base.sweep.rate", "0.05 1/s", 3.0), ("base.frequency", "2 1/ms", 2000.0)])

@@ -186,6 +186,93 @@ def test_override_replaces_another_way_to_give_the_same_quantity(name, override,
         assert scene.get(other) is None, other
 
 
+@pytest.mark.parametrize("override, frequency, axis", [
+    ({"base.frequency": 20.0}, 20.0, None),
+    ({"base.frequency_ratio": 0.5}, None, None),
+    ({"axes.base_frequency": [10.0, 20.0]}, None, "base_frequency")])
+def test_a_fixed_base_frequency_override_replaces_the_scenes_sweep(override, frequency, axis):
+    """--set base.frequency=20 on a sweep scene was refused "give one frequency, not both",
+    while the README says --set can always replace what the scene says: a fixed frequency (key
+    or axis) replaces the sweep table whole, and the envelope outputs only a sweep has (the
+    scene file gives outputs.envelope = true; a fixed frequency stores none)."""
+    scene = load_scene("launch-sine-qualification", overrides={**override, "solver.t_end": 3.0})
+    assert scene.get("base.frequency") == frequency
+    if "base.frequency_ratio" in override:
+        assert scene.get("base.frequency_ratio") == 0.5
+    for name in ("start", "stop", "rate", "ramp_cycles", "direction"):
+        assert scene.get(f"base.sweep.{name}") is None, name
+    assert scene.get("outputs.envelope") is False
+    assert scene.get("solver.t_end") == 3.0
+    assert list(scene.axes) == ["length"] + ([axis] if axis else [])
+    if axis:
+        assert list(scene.axes[axis]) == [10.0, 20.0]
+    # the rest of the scene stays as its file says
+    assert scene.get("base.levels_g") == ((5.0, 1.875), (45.0, 1.875), (50.0, 2.5), (100.0, 2.5))
+    assert scene.get("cable.damping_ratio") == 0.02
+
+
+def test_a_fixed_frequency_override_of_a_sweep_without_t_end_asks_for_one():
+    """The launch scene's run ends with its sweep (it gives no solver.t_end): a fixed frequency
+    in its place has no end time anyone chose, so one line asks for solver.t_end."""
+    for override in ({"base.frequency": 20.0}, {"axes.base_frequency": [10.0, 20.0]}):
+        with pytest.raises(SceneError) as info:
+            load_scene("launch-sine-qualification", overrides=override)
+        message = str(info.value)
+        (key,) = override
+        assert "\n" not in message and message.startswith(f"override '{key}': "), message
+        assert "replaces the scene's sweep" in message and "solver.t_end=" in message
+
+
+def test_a_sweep_override_replaces_the_scenes_fixed_frequency():
+    """--set base.sweep={...} on a scene with a base_frequency axis ran into "give one
+    frequency, not both": the sweep replaces the frequency (key or axis), and a stepped sweep's
+    [continuation] (which a continuous sweep cannot have); the scene's other keys stay."""
+    sweep_table = {"base.sweep": {"start": 5.0, "stop": 100.0, "rate": 2.0},
+                   "solver.t_end": 200.0}
+    scene = load_scene("harness-base-sine", overrides=sweep_table)
+    assert list(scene.axes) == ["length"]
+    assert (scene.get("base.sweep.start"), scene.get("base.sweep.stop"),
+            scene.get("base.sweep.rate")) == (5.0, 100.0, 2.0)
+    assert scene.get("base.frequency") is None and scene.get("base.acceleration_g") == 1.0
+    scene = load_scene("harness-stepped-sine", overrides=sweep_table)
+    assert list(scene.axes) == ["length"] and scene.get("continuation.axis") is None
+    assert scene.get("base.frequency_ratio") is None and scene.get("base.sweep.rate") == 2.0
+
+
+@pytest.mark.parametrize("overrides, words", [
+    ({"base.frequency": 20.0, "base.sweep.rate": 3.0},
+     "overrides 'base.frequency' and 'base.sweep': give one, not both"),
+    ({"axes.base_sweep_rate": [2.0, 4.0], "base.frequency_ratio": 1.0},
+     "overrides 'base.frequency_ratio' and 'base.sweep': give one, not both"),
+    ({"base.frequency": 20.0, "solver.t_end": 3.0, "outputs.envelope": True},
+     "scene key 'outputs.envelope': needs a swept base frequency")])
+def test_a_fixed_frequency_and_a_sweep_both_overridden_are_refused(overrides, words):
+    """Two overrides that give the base frequency two ways are refused, as a pair's are; an
+    override of a sweep-only output beside a fixed frequency stays, and is refused."""
+    with pytest.raises(SceneError) as info:
+        load_scene("launch-sine-qualification", overrides=overrides)
+    assert words in str(info.value), str(info.value)
+
+
+def test_cli_runs_a_sweep_scene_at_a_fixed_frequency(tmp_path, monkeypatch):
+    """`sweep run launch-sine-qualification --set base.frequency=20` runs (one span, 0.2 s):
+    a fixed-frequency result at 20 Hz and the table's level there (1.875 g, flat from 5 to
+    45 Hz), no sweep direction, no envelope."""
+    import xarray as xr
+    from sweep.cli import main
+    monkeypatch.chdir(tmp_path)
+    argv = ["run", "launch-sine-qualification", "--set", "base.frequency=20.0", "--set",
+            "solver.t_end=0.2", "--set", "axes.length=[0.3]", "-o", "out.nc", "--quiet"]
+    assert main(argv) == 0
+    with xr.open_dataset(tmp_path / "out.nc") as ds:
+        assert "direction" not in ds.dims and "band_frequency" not in ds.dims
+        assert "envelope" not in ds and "amplitude" in ds     # a fixed frequency's tail amplitude
+        assert ds["length"].values.tolist() == [0.3]
+        assert float(ds["base_frequency"].squeeze()) == 20.0
+        assert float(ds["base_acceleration_g"].squeeze()) == pytest.approx(1.875, rel=1e-12)
+        assert np.all(np.isfinite(ds["peak_amplitude"].values))
+
+
 def test_override_both_frequencies_refused():
     message = scene_error(BASE, {"load.frequency": 10.0, "axes.frequency_ratio": [1.0, 2.0]})
     assert "give one, not both" in message

@@ -8,10 +8,16 @@ one that sets an axis removes the key's [points] entry and the other way round
 (``--set points.length=[0.3, 0.5]``); an override of one key of an either-or pair
 (`sweep.models.rules.PAIRS`: the load frequency, the base level, the base frequency; as a
 scalar or an axis) removes its partner, one of the other ways to give one quantity
-(`ALTERNATIVES`: the base level as a table in g, a spectrum in g^2/Hz or in (m/s^2)^2/Hz)
-the others, and one of the end-time keys (solver.t_end, solver.transits) the other; so
-``--set`` can always replace what the scene file says.
-Overrides of both keys of a pair are refused.
+(`ALTERNATIVES`: the base level as a table in g, a spectrum in g^2/Hz or in (m/s^2)^2/Hz,
+the base frequency as a sweep table) the others, and one of the end-time keys (solver.t_end,
+solver.transits) the other; so ``--set`` can always replace what the scene file says. A fixed
+base frequency (key or axis) replaces the scene's whole sweep table, and with it the envelope
+outputs that only a sweep has (outputs.envelope, outputs.bands_per_octave); a scene whose run
+ended with its sweep (no solver.t_end) then needs a solver.t_end override, refused in one line
+without one. A sweep's start, stop or rate (key or axis) replaces the scene's base.frequency
+or frequency_ratio (key or axis) and a stepped sweep's [continuation], and keeps the sweep's
+other keys.
+Overrides of two ways to give one quantity are refused.
 """
 
 from __future__ import annotations
@@ -23,17 +29,26 @@ from typing import Any
 import numpy as np
 
 from .. import schema
-from ..models.rules import BASE_LEVEL_KEYS, BASE_TABLE_KEY, END_TIME_KEYS, PAIRS
+from ..models.excitation import SWEEP_KEYS
+from ..models.rules import (BASE_FREQUENCY_KEYS, BASE_LEVEL_KEYS, BASE_TABLE_KEY, END_TIME_KEYS,
+                            PAIRS)
 from .axes import _axis_or_none
 from .messages import _fail, _section_not_table
 
 
+SWEEP_TABLE = "base.sweep"
+"""A continuous sine sweep, as one way to give the base frequency: set by its start, stop or
+rate (`SWEEP_KEYS`, keys or axes); replaced whole (every base.sweep key and axis)."""
+SWEEP_OUTPUTS: tuple[str, ...] = ("outputs.envelope", "outputs.bands_per_octave")
+"""Outputs only a sweep has: a fixed frequency that replaces the scene's sweep removes the
+scene's (an override of one of them stays, and the rules refuse it without a sweep)."""
 ALTERNATIVES: tuple[tuple[str, ...], ...] = (
     BASE_LEVEL_KEYS + (BASE_TABLE_KEY,),         # a base level: m/s^2, g, or (Hz, g) table
     ("base.asd_g2", "base.asd"),                 # a spectrum: g^2/Hz or (m/s^2)^2/Hz
+    BASE_FREQUENCY_KEYS + (SWEEP_TABLE,),        # a base frequency: Hz, f/f1, or a sweep
 )
-"""Groups of keys that give one quantity different ways, beside the either-or PAIRS: a
-``--set`` of one removes the others the scene gives (scalars and axes)."""
+"""Groups of ways to give one quantity, beside the either-or PAIRS: a ``--set`` of one
+removes the others the scene gives (scalars and axes). A member is a key, or `SWEEP_TABLE`."""
 
 
 def parse_override(item: str) -> tuple[str, Any]:
@@ -132,20 +147,39 @@ def _section_keys(prefix: str, table: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _pair_target(dotted: str, pair: tuple[str, ...]) -> str | None:
-    """The key of an either-or `pair` (or `ALTERNATIVES` group) an override sets (as scalar or
-    axis), or None."""
-    if dotted in pair:
-        return dotted
+    """The member of an either-or `pair` (or `ALTERNATIVES` group) an override sets (as scalar
+    or axis), or None."""
+    return _member(_target(dotted), pair)
+
+
+def _target(dotted: str) -> str:
+    """The scene key an override sets: an [axes] or [points] entry's key, else `dotted`."""
     section, _, name = dotted.partition(".")
     if section in schema.SWEPT_SECTIONS:
         axis = _axis_or_none(name)
-        if axis is not None and schema.BY_AXIS[axis].dotted in pair:
+        if axis is not None:
             return schema.BY_AXIS[axis].dotted
+    return dotted
+
+
+def _member(dotted: str, group: tuple[str, ...]) -> str | None:
+    """The member of `group` that setting key `dotted` gives: the key itself, or
+    `SWEEP_TABLE` for a sweep's start, stop or rate; None if neither is in the group."""
+    if dotted in group:
+        return dotted
+    if dotted in SWEEP_KEYS and SWEEP_TABLE in group:
+        return SWEEP_TABLE
     return None
 
 
 def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
-    """Write overrides into the parsed document (in place), before validation."""
+    """Write overrides into the parsed document (in place), before validation: first remove
+    what they replace (`_drop_partners`), then write them, so that no override removes
+    another."""
+    for dotted in overrides:
+        lost = _drop_partners(doc, _target(dotted))
+        if SWEEP_TABLE in lost:
+            _check_end_time(doc, overrides, dotted)
     for dotted, value in overrides.items():
         section, _, name = dotted.partition(".")
         if not name:
@@ -154,6 +188,20 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
             _override_axis(doc, name, value, section)
         else:
             _override_scalar(doc, section, name, value)
+
+
+def _check_end_time(doc: dict[str, Any], overrides: Mapping[str, Any], dotted: str) -> None:
+    """A fixed frequency (override `dotted`) replaced the scene's sweep: the run's end time was
+    the sweep's own unless the scene or an override gives solver.t_end; refuse without one
+    (the 5 s default of a fixed frequency is nobody's choice here, and may end before the
+    start-up transient has decayed)."""
+    solver = doc.get("solver")
+    if "solver.t_end" in overrides or (isinstance(solver, dict) and "t_end" in solver):
+        return
+    _fail(f"override '{dotted}'", "replaces the scene's sweep, whose run ended with the sweep; "
+          "the scene gives no solver.t_end for a fixed frequency",
+          "add the override solver.t_end=20.0 (s: the tail window, the last half, should start "
+          "several decay times 1/(zeta w1) in, once the start-up transient has died away)")
 
 
 def _override_table(doc: dict[str, Any], section: str) -> dict[str, Any]:
@@ -166,8 +214,7 @@ def _override_table(doc: dict[str, Any], section: str) -> dict[str, Any]:
 
 def _override_axis(doc: dict[str, Any], name: str, value: Any, section: str = "axes") -> None:
     """Set or replace an axis or a [points] entry (`section`; keeping its place); drop the
-    same key from the other section, and the other key of its either-or pair (load or base
-    frequency, base level)."""
+    same key from the other section."""
     axes = _override_table(doc, section)
     axis = _axis_or_none(name)
     if axis is None:
@@ -175,7 +222,6 @@ def _override_axis(doc: dict[str, Any], name: str, value: Any, section: str = "a
         return
     other = next(s for s in schema.SWEPT_SECTIONS if s != section)
     _drop_axis(doc, axis, (other,))
-    _drop_partners(doc, schema.BY_AXIS[axis].dotted)
     replaced = {(axis if _axis_or_none(k) == axis else k): v for k, v in axes.items()}
     replaced[axis] = value
     axes.clear()
@@ -192,31 +238,59 @@ def _override_scalar(doc: dict[str, Any], section: str, name: str, value: Any) -
     key = schema.BY_DOTTED.get(dotted)
     if key is not None and key.axis is not None:
         _drop_axis(doc, key.axis)
-    _drop_partners(doc, dotted)
 
 
 def _drop_axis(doc: dict[str, Any], axis: str,
-               sections: tuple[str, ...] = schema.SWEPT_SECTIONS) -> None:
-    """Remove every ``[axes]`` and ``[points]`` entry (of `sections`) that names ``axis``."""
+               sections: tuple[str, ...] = schema.SWEPT_SECTIONS) -> bool:
+    """Remove every ``[axes]`` and ``[points]`` entry (of `sections`) that names ``axis``;
+    whether there was one."""
+    had = False
     for section in sections:
         table = doc.get(section)
         if isinstance(table, dict):
             for entry in [k for k in table if _axis_or_none(k) == axis]:
                 del table[entry]
+                had = True
+    return had
 
 
-def _drop_partners(doc: dict[str, Any], dotted: str) -> None:
+def _drop_partners(doc: dict[str, Any], dotted: str) -> list[str]:
     """When a key of an either-or pair (PAIRS: the load frequency, the base level, the base
-    frequency) or of an `ALTERNATIVES` group is set, remove the others (scalar and axis)."""
+    frequency) or a member of an `ALTERNATIVES` group is set (key `dotted`), remove the others
+    (scalar and axis; the sweep table whole, with the outputs only a sweep has; a sweep also
+    removes a stepped sweep's [continuation]). Returns the members the scene gave and lost."""
+    lost = []
     for group in PAIRS + ALTERNATIVES:
-        if dotted not in group:
+        member = _member(dotted, group)
+        if member is None:
             continue
-        for other in group:
-            if other == dotted:
-                continue
-            partner = schema.BY_DOTTED[other]
-            table = doc.get(partner.section)
-            if isinstance(table, dict):
-                table.pop(partner.name, None)
-            if partner.axis is not None:
-                _drop_axis(doc, partner.axis)
+        for other in (o for o in group if o != member):
+            if _drop_keys(doc, _member_keys(other)):
+                lost.append(other)
+            if other == SWEEP_TABLE:
+                _drop_keys(doc, [schema.BY_DOTTED[d] for d in SWEEP_OUTPUTS])
+        if member == SWEEP_TABLE:
+            _drop_keys(doc, [k for k in schema.KEYS if k.section == "continuation"])
+    return lost
+
+
+def _member_keys(member: str) -> list[schema.Key]:
+    """The keys a member of an `ALTERNATIVES` group stands for: the key, or every base.sweep
+    key for `SWEEP_TABLE`."""
+    if member != SWEEP_TABLE:
+        return [schema.BY_DOTTED[member]]
+    return [k for k in schema.KEYS if k.dotted.startswith(SWEEP_TABLE + ".")]
+
+
+def _drop_keys(doc: dict[str, Any], keys: list[schema.Key]) -> bool:
+    """Remove `keys` from the document, as scalars and as axes or [points] entries; whether
+    the document had any of them."""
+    had = False
+    for key in keys:
+        table = doc.get(key.section)
+        if isinstance(table, dict) and key.name in table:
+            del table[key.name]
+            had = True
+        if key.axis is not None:
+            had = _drop_axis(doc, key.axis) or had
+    return had

@@ -17,9 +17,12 @@ SceneError line. pint parses the strings, and is imported only when a scene hold
 "g" means grams to pint, "G" the gauss. On an acceleration key (base.acceleration in m/s^2,
 the keys in g: base.acceleration_g, base.levels_g) and an acceleration spectral density
 (base.asd, base.asd_g2) a "g" or "G" written alone (as test specifications write "G^2/Hz") is read as
-standard gravity (schema.STANDARD_GRAVITY, 9.80665 m/s^2), so "0.5 g" is half of it there;
-everywhere else g is the gram ("33.3 g/m"), and a G is refused with a line saying where it
-means gravity. A reciprocal unit may be written with its 1: "20 1/s" is "20 /s".
+standard gravity (schema.STANDARD_GRAVITY, 9.80665 m/s^2), so "0.5 g" is half of it there, as
+are "g0", "gn", "g_0" and "g_n"; "mG" is a thousandth of it ("500 mG" is 0.5 g). There "mg", a
+milligram, is refused with a line suggesting mG, and an RMS level ("14.1 grms") on a sine's
+level key with a line saying that the key takes the peak. Everywhere else g is the gram
+("33.3 g/m"), and a G, mG, g0 or gn is refused with a line saying where it means gravity.
+A reciprocal unit may be written with its 1: "20 1/s" is "20 /s".
 """
 
 from __future__ import annotations
@@ -29,13 +32,21 @@ from functools import lru_cache
 from typing import Any
 
 from .. import schema
+from ..errors import SceneError
 from .messages import _fail, _show
 
 ACCELERATION_UNITS = ("m s-2", schema.G_UNITS, "m2 s-4 Hz-1", schema.G2_UNITS)
 """Schema units of the keys on which "g" (or "G") means standard gravity."""
 _UNIT_POWER = re.compile(r"(?<![\w.])([A-Za-z]+)(-?\d+)(?![\w.])")   # m2, s-2 (UDUNITS)
 _LONE_G = re.compile(r"(?<![A-Za-z_])[gG](?![A-Za-z_0-9])")    # "0.5 g", "0.16 G^2/Hz"
-_GRAVITY_G = re.compile(r"(?<![A-Za-z_])G(?![A-Za-z_0-9])")    # G alone: gravity, not gauss
+_GRAVITY_G = re.compile(r"(?<![A-Za-z_])(?:m?G|g_?0|gn)(?![A-Za-z_])")   # G, mG, g0, gn: gravity
+_GRAVITY_NAMES = re.compile(r"(?<![A-Za-z_])g_?[0n](?![A-Za-z_0-9])")    # g0, g_0, gn, g_n
+_MILLI_G = re.compile(r"(?<![A-Za-z_])mG(?![A-Za-z_0-9])")      # a thousandth of gravity
+_MILLIGRAM = re.compile(r"(?<![A-Za-z_])mg(?![A-Za-z_0-9])")    # "500 mg": a mass
+_RMS = re.compile(r"(?<![A-Za-z])(?:[gG]_?)?(?:rms|RMS)(?![A-Za-z])")  # "14.1 grms", "1 g rms"
+LEVEL_UNITS = ("m s-2", schema.G_UNITS)
+"""Schema units of a sine's level keys (a peak acceleration)."""
+GRAVITY_WORDS = "'g', 'G', 'g0' or 'gn' is standard gravity and 'mG' a thousandth of it"
 _RECIPROCAL = re.compile(r"^1\s*/")          # a unit written "1/s", "1/min": pint's "/s"
 
 _DIMENSION_NAMES: dict[str, str] = {
@@ -78,7 +89,7 @@ def accepted(key: schema.Key) -> str:
     if key.units in ("", "1") or key.kind not in ("float", "floats", "pairs"):
         return ""
     quantity = _QUANTITIES.get(key.units, key.units)
-    gravity = " ('g' or 'G': standard gravity)" if key.units in ACCELERATION_UNITS else ""
+    gravity = f" ({GRAVITY_WORDS})" if key.units in ACCELERATION_UNITS else ""
     shown = {schema.G_UNITS: "g", schema.G2_UNITS: "g^2/Hz"}.get(key.units, key.units)
     return (f"a number in {shown}, or a string with "
             f"any {quantity} unit, e.g. {_EXAMPLES.get(key.units, key.units)}{gravity}")
@@ -146,11 +157,13 @@ _OCTAVES = re.compile(r"(?<![A-Za-z_])oct(?:ave)?s?(?![A-Za-z_])")
 _EXPONENT = re.compile(r"(?:\^|\*\*)\s*\(?\s*[+-]?\d+(?:\.\d+)?\s*\)?")
 
 
-def _unit_text(where: str, text: str, example: str) -> str:
+def _unit_text(where: str, text: str, example: str, gravity: bool = False) -> str:
     """`text` as pint should read it: one number, then its unit, UDUNITS' exponents ("N m2",
-    "m s-2") written as powers. Refused in one line: a comma (a decimal comma or a thousands
-    separator, which pint would drop: '53,4 g/m' read as 534 g/m), and any number or sign in
-    the unit other than an exponent ('g/m 2', 'g/m + 1 g/m': pint would compute them)."""
+    "m s-2") written as powers; with `gravity` (an acceleration key), "g0", "g_0", "gn" and
+    "g_n" read as standard gravity (not g to the power 0). Refused in one line: a comma (a
+    decimal comma or a thousands separator, which pint would drop: '53,4 g/m' read as 534 g/m),
+    and any number or sign in the unit other than an exponent ('g/m 2', 'g/m + 1 g/m': pint
+    would compute them)."""
     fix = f"give one number with a point for decimals, then the unit, e.g. {example}"
     if "," in text:
         _fail(where, f"{_show(text)} has a comma (a decimal comma or a thousands separator "
@@ -158,7 +171,10 @@ def _unit_text(where: str, text: str, example: str) -> str:
     number = _LEADING_NUMBER.match(text)
     if number is None:                   # pint would read a unit alone as 1 of it ('a': a year)
         _fail(where, f"{_show(text)} does not start with a number", fix)
-    unit = _RECIPROCAL.sub("/", _powers(" ".join(text[number.end():].split())))
+    unit = " ".join(text[number.end():].split())
+    if gravity:
+        unit = _GRAVITY_NAMES.sub("gravity", unit)
+    unit = _RECIPROCAL.sub("/", _powers(unit))
     unit = _MIL.sub("thou", unit)        # a data sheet's mil, 1/1000 inch (pint's is an angle)
     unit = _NEWTON_METRE.sub("N m", unit)    # pint's Nm is a "number metre"
     if re.search(r"[\d+-]", _EXPONENT.sub("", unit)):
@@ -178,15 +194,22 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     acceleration = key.units in ACCELERATION_UNITS
     target = _pint_units(key.units)
     example = _EXAMPLES.get(key.units, f"a number with a unit of {key.units}")
-    parsed_text = _unit_text(where, text, example)
-    if not acceleration and _GRAVITY_G.search(parsed_text):
+    parsed_text = _unit_text(where, text, example, gravity=acceleration)
+    named = _GRAVITY_G.search(text[_LEADING_NUMBER.match(text).end():])
+    if not acceleration and named:
         keys = ", ".join(k.dotted for k in schema.KEYS if k.units in ACCELERATION_UNITS)
-        _fail(where, f"{_show(text)} has a 'G': standard gravity, which only the acceleration "
-              f"keys take ({keys})", f"give e.g. {example}")
-    parsed_text = _LONE_G.sub("g_0", parsed_text) if acceleration else parsed_text
+        _fail(where, f"{_show(text)} has a '{named.group(0)}': standard gravity, which only the "
+              f"acceleration keys take ({keys})", f"give e.g. {example}")
+    if key.units in LEVEL_UNITS and _RMS.search(text):
+        _fail(where, f"{_show(text)} is an RMS level; the key takes the sine's peak "
+              "acceleration, in g or m/s^2", "give the peak, e.g. '0.5 g' or '4.9 m/s^2' (a "
+              "sine's peak is sqrt(2) x its RMS); a random environment's grms comes from its "
+              "spectrum, base.asd_g2 in g^2/Hz")
+    if acceleration:
+        parsed_text = _MILLI_G.sub("milligravity", _LONE_G.sub("g_0", parsed_text))
     if key.units == "min-1":             # a sweep rate in octaves per minute: "2 oct/min"
         parsed_text = _OCTAVES.sub("", parsed_text)
-    gravity = " ('g' or 'G' is standard gravity on this key)" if acceleration else ""
+    gravity = f" (on this key {GRAVITY_WORDS})" if acceleration else ""
     try:
         quantity = registry.Quantity(parsed_text.strip())
     except (pint.errors.UndefinedUnitError, AttributeError) as exc:
@@ -208,6 +231,8 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     try:
         value = float(quantity.to(target).magnitude)
     except pint.errors.DimensionalityError:
+        if acceleration and _MILLIGRAM.search(text):
+            _milligram(where, key, text)
         got = _dimension_name(quantity.dimensionality)
         want = _dimension_name(registry.Quantity(1.0, target).dimensionality)
         _fail(where, f"{_show(text)} is {got}, the key takes {want} ({key.units})",
@@ -217,6 +242,24 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
               f"give e.g. {example}")
     # 15 significant digits: '33.3 g/m' is 0.0333, not 33.3 x 0.001 = 0.033299999999999996
     return float(f"{value:.15g}")
+
+
+def _milligram(where: str, key: schema.Key, text: str) -> None:
+    """Refuse a milligram written for a thousandth of gravity ("500 mg" on an acceleration
+    key) in one line that gives the text in mG and in g; return if mG would not fit either."""
+    fixed = _MILLIGRAM.sub("mG", text)
+    try:
+        value = to_si(where, key, fixed)
+    except SceneError:
+        return
+    power = 2 if key.units in ("m2 s-4 Hz-1", schema.G2_UNITS) else 1
+    in_g = value if key.units in (schema.G_UNITS, schema.G2_UNITS) else (
+        value / schema.STANDARD_GRAVITY ** power)
+    unit = "g^2/Hz" if power == 2 else "g"
+    _fail(where, f"{_show(text)} is a mass (mg: a milligram), the key takes "
+          f"{'an acceleration spectral density' if power == 2 else 'an acceleration'}",
+          f"write {_show(fixed)} (mG: a thousandth of standard gravity) or "
+          f"'{in_g:.6g} {unit}'")
 
 
 def _cycles(where: str, key: schema.Key, text: str, quantity: Any, target: str,
