@@ -80,6 +80,14 @@ def _design(**criteria: float) -> Callable[[xr.Dataset], str]:
     return phrase
 
 
+def _stepped_over(ds: xr.Dataset) -> str:
+    """`sweep design --max-amplitude "1 mm" --over base_frequency_ratio direction`: its row."""
+    from sweep.design import max_span
+    out = max_span(ds, max_amplitude=1e-3, over=("base_frequency_ratio", "direction"))
+    return (f"{float(out['max_span']) * 1e3:.2f} {out['limited_by'].values} "
+            f"{float(out['binding_base_frequency_ratio']):g} {out['binding_direction'].values}")
+
+
 def _stepped(ds: xr.Dataset) -> str:
     def jumps(direction: str, flag: int) -> list[str]:
         out = []
@@ -115,6 +123,8 @@ FIGURES: tuple[Figure, ...] = (
     Figure("launch-sine-qualification", "sweep design --max-amplitude 0.002 --min-frequency 40",
            _design(max_amplitude=0.002, min_frequency=40.0)),
     Figure("harness-stepped-sine", "where the up and down sweeps jump", _stepped),
+    Figure("harness-stepped-sine", "sweep design --max-amplitude '1 mm' --over "
+           "base_frequency_ratio direction", _stepped_over),
     Figure("harness-base-sine", "worst accelerations and deflections", _base_sine),
 )
 """Every quoted figure, in README order within each scene."""

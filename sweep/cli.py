@@ -6,7 +6,7 @@
     sweep design RESULT.nc [RESULT.nc ...] [--min-frequency HZ] [--max-amplitude M]
                  [--quantity NAME] [--max-deflection M] [--max-strain S] [--max-rms M]
                  [--max-peak M] [--clearance M [--max-probability P]] [--refine [--tolerance M]]
-                 [-o OUT.nc]
+                 [--over AXIS [AXIS ...]] [-o OUT.nc]
     sweep scenes
     sweep keys [SECTION | KEY] [--markdown]
     sweep --version
@@ -171,6 +171,11 @@ def _parser() -> argparse.ArgumentParser:
     design.add_argument("--tolerance", type=float, default=None, metavar="M",
                         help="--refine: bisect until the bracket is below this (m, default "
                              "0.001)")
+    design.add_argument("--over", nargs="+", action="extend", default=None, metavar="AXIS",
+                        help="one span for every value of these axes together (a stepped "
+                             "test's base_frequency_ratio and direction, an uncertain "
+                             "damping_ratio): the shortest of their spans, binding_AXIS naming "
+                             "the value it binds at (not length, not realisation)")
     design.add_argument("-o", "--output", metavar="OUT.nc",
                         help="netCDF file to write the spans to (atomically)")
     design.add_argument("--overwrite", action="store_true", help="replace an existing output file")
@@ -351,15 +356,16 @@ def _design(args: argparse.Namespace) -> int:
                     max_strain=args.max_strain, max_rms=args.max_rms,
                     max_peak=args.max_peak, clearance=args.clearance,
                     max_probability=args.max_probability)
+    over = tuple(args.over or ())
     loaded = [(path, load_result(path)) for path in args.result]
     if len(loaded) > 1:
         from .governing import governing_span
-        result = governing_span(loaded, **criteria)
+        result = governing_span(loaded, **criteria, over=over)
     else:
         ds = loaded[0][1]
-        result = (refine_span(ds, **criteria,
+        result = (refine_span(ds, **criteria, over=over,
                               tolerance=1e-3 if args.tolerance is None else args.tolerance)
-                  if args.refine else max_span(ds, **criteria))
+                  if args.refine else max_span(ds, **criteria, over=over))
     print(f"{result.attrs['title']} ({result.attrs['criteria']})")
     print(table(result))
     if args.refine:

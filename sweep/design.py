@@ -46,6 +46,19 @@ stability flag that fails where growth_rate is still <= 0) give l_a. When severa
 fail at l_b the smallest of their spans binds. max_span runs no analysis: its span is only as
 good as the grid.
 
+`over` (`sweep design --over AXIS [AXIS ...]`) asks one span for every value of some axes
+together (a stepped sine test covers every frequency of its continuation axis and both
+directions; an uncertain damping ratio or load level must pass at each value): `max_span` is
+the minimum over those axes of each value's span, a NaN (no span at some value) first,
+`limited_by` the criterion binding there, and `binding_<axis>` (in the axis's units, its
+comment quoting the axis's long_name; `binding_<coordinate>` too for a coordinate along it, a
+[points] set's values) names the value it binds at: the first in the axis's order where several give the same span,
+NaN (or empty, for a string axis) where every value's longest grid length passes.
+`direction` already counts at its worst at each length, so --over direction leaves max_span
+as it is and adds `binding_direction`, the direction whose own span is the shorter. length
+and realisation cannot be given (the axis the span is found along; a random result's
+criteria are statistics over its realisations already).
+
 `refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
 bracketed span it bisects on length with one-length engine runs of the result's stored scene,
 the other axes fixed to the combination's values, evaluating the same criteria (`_margins`,
@@ -60,7 +73,7 @@ from __future__ import annotations
 
 import datetime
 import math
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import xarray as xr
@@ -457,10 +470,10 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
              max_amplitude: Limit = None, quantity: str | None = None,
              max_deflection: Limit = None, max_strain: Limit = None,
              max_rms: Limit = None, max_peak: Limit = None,
-             clearance: Limit = None, max_probability: float | None = None
-             ) -> xr.Dataset:
+             clearance: Limit = None, max_probability: float | None = None,
+             over: str | Sequence[str] = ()) -> xr.Dataset:
     """The largest span between clamps (m) that meets the criteria, per combination of the
-    result's other swept axes.
+    result's other swept axes (less those of `over`).
 
     Parameters
     ----------
@@ -487,6 +500,12 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         most `max_probability`.
     max_probability : 1, below 1; the clearance criterion's limit (needs clearance; default
         0.01, i.e. 1 %).
+
+    over : an axis of the result, or several (not length, not realisation), whose values the
+        span must pass at all together (`reduce_over`): max_span is the minimum over them of
+        each value's span (a NaN first), and `binding_<axis>` names the value it binds at.
+        `direction` counts at its worst already: over it, max_span stays as it is and
+        `binding_direction` names the direction whose own span is the shorter.
 
     Each limit but max_probability may be a string with its unit, as the command takes it
     ("2 mm", "0.1 kHz", "300 microstrain": limit_value).
@@ -515,12 +534,14 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     quantity or one whose units are not m, a non-positive limit, a result without the
     variable a criterion reads (a random one's for max_rms, max_peak, clearance), a sine
     response's limit (SINE_LIMITS) for a random result, a clearance level the result does not
-    hold.
+    hold, and an `over` axis the result lacks, length or realisation.
     """
-    c, axes, limits = validated(ds, min_frequency=min_frequency, max_amplitude=max_amplitude,
-                                quantity=quantity, max_deflection=max_deflection,
-                                max_strain=max_strain, max_rms=max_rms, max_peak=max_peak,
-                                clearance=clearance, max_probability=max_probability)
+    asked = dict(min_frequency=min_frequency, max_amplitude=max_amplitude,
+                 quantity=quantity, max_deflection=max_deflection, max_strain=max_strain,
+                 max_rms=max_rms, max_peak=max_peak, clearance=clearance,
+                 max_probability=max_probability)
+    c, axes, limits = validated(ds, **asked)
+    over = over_axes(over, axes)
     fmin = c["min_frequency"]
     ds = in_metres(ds).sortby(LENGTH)
     others = tuple(a for a in axes if a not in (LENGTH, *WORST_OVER))
@@ -598,7 +619,154 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
                "criteria": criteria,
                "length_grid": f"{lengths.size} lengths, {lengths[0]:g} to {lengths[-1]:g} m"})
     from .dataset import short_long_names
-    return short_long_names(result)
+    result = short_long_names(result)
+    if DIRECTION in over:
+        result = with_binding_direction(ds, result, asked)
+    return reduce_over(result, over) if over else result
+
+
+OVER_REFUSED = {
+    LENGTH: "length is the axis the span is found along, not one to take the shortest span "
+            "over",
+    REALISATION: "a random result's criteria are statistics over its realisations already "
+                 "(means, a pooled probability), not one value per realisation"}
+"""The axes --over cannot take, and why."""
+BINDING = "binding_"
+"""The prefix of the variables that name where a span taken over axes binds (reduce_over)."""
+
+
+def over_axes(over: str | Sequence[str] | None, axes: Sequence[str],
+              which: str = "the result") -> tuple[str, ...]:
+    """The axes `over` names (one name or a sequence; each once, in the order given), each
+    one of `axes` (a result's swept axes, direction included) other than OVER_REFUSED; a
+    one-line UserError, saying which axes may be given, otherwise. () for none."""
+    if over is None:
+        return ()
+    names = (over,) if isinstance(over, str) else over
+    if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
+        raise UserError(f"design: over={over!r}: give an axis name or a list of them, e.g. "
+                        "over=('base_frequency_ratio', 'direction')")
+    choices = [str(a) for a in axes if a not in OVER_REFUSED]
+    can = (f"--over takes {', '.join(choices)}" if choices else
+           f"{which} has no axis but length to take the shortest span over")
+    for name in names:
+        if name in OVER_REFUSED:
+            raise UserError(f"design: --over {name}: {OVER_REFUSED[name]} ({can})")
+        if name not in choices:
+            raise UserError(f"design: --over {name}: not an axis of {which} ({can})")
+    return tuple(dict.fromkeys(names))
+
+
+def _first_shortest(spans: np.ndarray) -> np.ndarray:
+    """Along the last axis of `spans` (m), the index of the shortest, a NaN (no span) before
+    any number, the first of equals."""
+    return np.argmin(np.where(np.isnan(spans), -np.inf, spans), axis=-1)
+
+
+def with_binding_direction(ds: xr.Dataset, result: xr.Dataset,
+                           criteria: dict[str, Any]) -> xr.Dataset:
+    """`result` (max_span of `ds` with `criteria`, over the axes less direction) with
+    `binding_direction`: at each combination, the direction whose own span (max_span of that
+    direction alone) is the shorter, a NaN first, the first of equals; empty where result's
+    limited_by is grid (no direction fails). max_span stays the worst of both directions at
+    each length: at most the shorter direction's own span, which fails at the same first
+    grid length."""
+    import warnings
+
+    from .errors import CableSweepWarning
+    span = result["max_span"]
+    names = [str(v) for v in np.asarray(ds[DIRECTION].values)]
+    with warnings.catch_warnings():        # each direction alone: max_span warned already
+        warnings.simplefilter("ignore", CableSweepWarning)
+        own = [max_span(ds.isel({DIRECTION: k}), **criteria)["max_span"]
+               .transpose(*span.dims).values for k in range(len(names))]
+    pick = _first_shortest(np.stack(own, axis=-1))
+    binding = np.asarray(names, dtype=object)[pick]
+    binding = np.where(np.asarray(result["limited_by"].values) == "grid", "", binding)
+    attrs = {"long_name": f"{DIRECTION} at which the span binds",
+             "comment": f"the {DIRECTION} ({', '.join(names)}) whose own span is the "
+                        "shorter (the first where they are equal); empty where no length fails "
+                        "(limited_by grid). "
+                        "max_span is the worst of both directions at each length, as without "
+                        "--over: at most that direction's own span"}
+    return result.assign({BINDING + DIRECTION: xr.DataArray(
+        np.asarray(binding, dtype=object).astype(str).astype(object), dims=span.dims,
+        attrs=attrs)})
+
+
+def reduce_over(result: xr.Dataset, over: Sequence[str]) -> xr.Dataset:
+    """A span result (max_span's, refine_span's or governing_span's) taken over the axes
+    `over`: at each combination of its other axes, the value of `over` whose max_span is the
+    shortest (`_first_shortest`: a NaN, no span there, first; the first in order of equals),
+    and every variable there (limited_by, limited_in, binding_direction). Adds
+    `binding_<axis>` for each of them in the axis's units, its long_name naming the axis and
+    its comment quoting the axis's long_name (and `binding_<coordinate>` for a coordinate
+    along it, a [points] set's values): the value the span binds at, NaN (a string axis:
+    empty) where every value's grid passes (limited_by grid). max_span lists them in its
+    `ancillary_variables`; the attribute `over_axes` names `over`. `over` may name direction,
+    which is no dimension of max_span (with_binding_direction gives its binding_direction):
+    only the labels and the order of the variables name it."""
+    span = result["max_span"]
+    dims = [str(d) for d in span.dims if d in over]
+    kept = [str(d) for d in span.dims if d not in over]
+    sizes = [span.sizes[d] for d in dims]
+
+    def rows(var: xr.DataArray) -> np.ndarray:
+        """`var` shaped (the kept axes..., the `over` combinations)."""
+        v = np.asarray(var.broadcast_like(span).transpose(*kept, *dims).values)
+        return v.reshape(v.shape[:len(kept)] + (-1,))
+
+    pick = _first_shortest(rows(span))
+
+    def at_pick(values: np.ndarray) -> np.ndarray:
+        return np.take_along_axis(values, pick[..., None], axis=-1)[..., 0]
+
+    grid = np.all(rows(result["limited_by"]).astype(str) == "grid", axis=-1)
+    data = {name: xr.DataArray(at_pick(rows(var)), dims=kept, attrs=dict(var.attrs))
+            for name, var in result.data_vars.items()}
+    named = ", ".join(over)
+    where = ("the first in the axes' order where several values give the same span (a "
+             "criterion these axes do not move binds at every value)")
+    axis_of: dict[str, str] = {}
+    for dim, index in zip(dims, np.unravel_index(pick, sizes) if dims else ()):
+        along = [dim] + [str(c) for c in result.coords if c != dim and result[c].dims == (dim,)]
+        for name in along:
+            coord = result[name]
+            values = np.asarray(coord.values)[index]
+            attrs = {"long_name": f"{name} at which the span binds"}
+            if values.dtype.kind in "fiub":
+                values = np.where(grid, np.nan, values.astype(float))
+                attrs["units"] = coord.attrs.get("units", "1")
+                missing = "NaN"
+            else:
+                values = np.where(grid, "", values.astype(str)).astype(object)
+                missing = "empty"
+            attrs["comment"] = (f"the value of {name} ({coord.attrs.get('long_name', name)}) "
+                                f"at which max_span, the shortest over {named}, binds: "
+                                f"{where}; with a NaN max_span, the first "
+                                f"whose shortest grid length fails; {missing} where every "
+                                "value's longest grid length passes (limited_by grid)")
+            data[BINDING + name] = xr.DataArray(values, dims=kept, attrs=attrs)
+            axis_of[BINDING + name] = dim
+    coords = {c: result[c] for c in result.coords if not set(result[c].dims) & set(dims)}
+    # the span's variables first, then where each axis binds in the order `over` names them
+    axis_of.update({BINDING + DIRECTION: DIRECTION})
+    data = {name: data[name] for name in sorted(
+        data, key=lambda n: list(over).index(axis_of[n]) if n in axis_of else -1)}
+    out = xr.Dataset(data, coords=coords, attrs=dict(result.attrs))
+    binding = [n for n in out.data_vars if str(n).startswith(BINDING)]
+    label = f"{SPAN_LONG_NAME} at every {named}"
+    out["max_span"].attrs.update({
+        "long_name": label if len(label) <= 100 else
+        f"{SPAN_LONG_NAME}, the shortest over the axes over_axes names",
+        "comment": f"the shortest over {named} of each value's span (a NaN, no span at some "
+                   f"value, first), {', '.join(binding)} naming where it binds; each value's: "
+                   + str(out["max_span"].attrs.get("comment", "")),
+        "ancillary_variables": " ".join(binding)})
+    out.attrs["over_axes"] = named
+    out.attrs["history"] = f"{out.attrs.get('history', '')}; the shortest over {named}"
+    from .dataset import short_long_names
+    return short_long_names(out)
 
 
 def _worst(var: xr.DataArray, how: str) -> xr.DataArray:
@@ -860,13 +1028,23 @@ def _coordinate(ds: xr.Dataset, dim: str) -> xr.DataArray:
 
 def table(result: xr.Dataset) -> str:
     """A short text table of `max_span`: one line per combination of the other axes, their
-    values (a parameter set's [points] values too), max_span in mm and limited_by."""
+    values (a parameter set's [points] values too), max_span in mm, limited_by and, for a span
+    taken over axes (reduce_over), the binding_<axis> values ('-' where none binds)."""
     span = result["max_span"]
     dims = list(span.dims)
     on_points = [c for c in result.coords if c != POINT_DIM and result[c].dims == (POINT_DIM,)]
     columns = [(d, d) for d in dims] + [(c, POINT_DIM) for c in on_points]
     where = "limited_in" in result          # several results (sweep.governing)
-    head = [c for c, _ in columns] + ["max_span_mm", "limited_by"] + (["in"] if where else [])
+    binding = [str(n) for n in result.data_vars if str(n).startswith(BINDING)]
+    head = ([c for c, _ in columns] + ["max_span_mm", "limited_by"] + binding
+            + (["in"] if where else []))
+
+    def shown(value: Any) -> str:
+        if isinstance(value, (float, np.floating)) and not np.isfinite(value):
+            return "-"
+        return f"{value:g}" if isinstance(value, (int, float, np.number)) else \
+            (str(value) or "-")
+
     rows = []
     for index in np.ndindex(*span.shape):
         at = dict(zip(dims, index))
@@ -876,6 +1054,7 @@ def table(result: xr.Dataset) -> str:
         by = str(result["limited_by"].values[index])
         rows.append([*values, f"{s * 1e3:.2f}" if np.isfinite(s) else "nan",
                      by if np.isfinite(s) else f"{by} (shortest span fails)"]
+                    + [shown(result[b].values[index]) for b in binding]
                     + ([str(result["limited_in"].values[index])] if where else []))
     widths = [max(len(r[j]) for r in [head, *rows]) for j in range(len(head))]
     lines = ["  ".join(c.rjust(w) if j < len(head) - 1 else c
@@ -895,7 +1074,8 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
                 max_deflection: Limit = None, max_strain: Limit = None,
                 max_rms: Limit = None, max_peak: Limit = None,
                 clearance: Limit = None, max_probability: float | None = None,
-                tolerance: float | str = 1e-3) -> xr.Dataset:
+                tolerance: float | str = 1e-3, over: str | Sequence[str] = ()
+                ) -> xr.Dataset:
     """`max_span` refined beyond the grid by bisecting on length with the engine itself.
 
     For every combination of the result's other axes whose grid max_span is bracketed (a
@@ -917,10 +1097,14 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     l_b too and the frequency span l_f lies inside the bracket, one run at l_f decides:
     passing, the span is l_f; failing, the bisection runs on [l_a, l_f].
 
+    `over` (axes, not direction) takes the refined spans over those axes as max_span does
+    (`reduce_over`): every combination is refined, then the shortest binds.
+
     Returns max_span's Dataset with the refined spans; attributes `refine_runs` (engine runs
     made), `refine_tolerance` (m) and `refinement` (how). Raises UserError (one line) as
-    max_span, for a result without its scene, a non-positive tolerance, an axis the stored
-    scene lacks, a stepped result stepped along length (its branch depends on the path), and a
+    max_span, for direction in `over` (the bisection reads the worst of both directions and
+    cannot say which binds), for a result without its scene, a non-positive tolerance, an
+    axis the stored scene lacks, a stepped result stepped along length (its branch depends on the path), and a
     random result (one with `realisation`: its criteria are Monte Carlo means of a few
     records, whose scatter from one length to the next is more than a bisection resolves;
     refine the scene's length axis, and add records).
@@ -937,8 +1121,14 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     criteria = dict(min_frequency=min_frequency, max_amplitude=max_amplitude,
                     max_deflection=max_deflection, max_strain=max_strain, max_rms=max_rms,
                     max_peak=max_peak, clearance=clearance, max_probability=max_probability)
-    grid = max_span(ds, quantity=quantity, **criteria)
     c, axes, limits = validated(ds, quantity=quantity, **criteria)
+    over = over_axes(over, axes)
+    if DIRECTION in over:
+        raise UserError("design --refine: --over direction: the bisection reads the worse of "
+                        "both directions at each length and cannot say which of them binds; "
+                        "leave direction out of --over (max_span is the worse direction's "
+                        "already), or leave --refine out")
+    grid = max_span(ds, quantity=quantity, **criteria)
     fmin = c["min_frequency"]
     text = ds.attrs.get("scene")
     if not isinstance(text, str) or not text.strip():
@@ -1075,4 +1265,4 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         f"log f vs log l interpolation, exact for the unloaded f1 ~ l^-2 (elastic clamps: "
         f"bisection on the closed-form f1), no run")
     grid.attrs["history"] += f"; refined by bisection ({runs} engine runs, tolerance {tol:g} m)"
-    return grid
+    return reduce_over(grid, over) if over else grid

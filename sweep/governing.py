@@ -22,8 +22,9 @@ from typing import Any, Sequence
 import numpy as np
 import xarray as xr
 
-from .design import (GRID_SPAN_COMMENT, NO_CRITERION, SPAN_LONG_NAME, Limit, check_result,
-                     max_span, validated)
+from .design import (BINDING, DIRECTION, GRID_SPAN_COMMENT, NO_CRITERION, SPAN_LONG_NAME,
+                     Limit, check_result, max_span, over_axes, reduce_over, validated,
+                     with_binding_direction)
 from .errors import UserError
 
 CRITERIA = ("min_frequency", "max_amplitude", "max_deflection", "max_strain", "max_rms",
@@ -57,13 +58,17 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
                    quantity: str | None = None, max_deflection: Limit = None,
                    max_strain: Limit = None, max_rms: Limit = None,
                    max_peak: Limit = None, clearance: Limit = None,
-                   max_probability: float | None = None) -> xr.Dataset:
+                   max_probability: float | None = None,
+                   over: str | Sequence[str] = ()) -> xr.Dataset:
     """The largest span between clamps (m) that meets every criterion in every result it
     applies to: `max_span` of each (name, result) pair with its own criteria, the shortest
     over the results at each combination of their other axes. Returns a Dataset with
     `max_span`, `limited_by` (sweep.design.LIMITED_BY) and `limited_in` (the binding
     result's name); attributes `criteria` (each result's) and `results`. A NaN span (a
-    result's shortest length fails) wins over any other.
+    result's shortest length fails) wins over any other. `over` (axes of any of the results,
+    direction too) takes the governing span over them as sweep.design.max_span does
+    (`reduce_over`), binding_<axis> naming where it binds (binding_direction: in the result
+    it binds in, empty where that one has no direction).
 
     Raises UserError (one line): no criterion, a criterion no result holds the variables of
     (its reason in the first result), a result no criterion applies to, axes the results
@@ -86,8 +91,9 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise UserError(f"design: result '{twice[0]}' given twice (give each result once)")
-    for name, ds in results:
-        check_result(ds, name)
+    axes = [check_result(ds, name) for name, ds in results]
+    over = over_axes(over, list(dict.fromkeys(a for each in axes for a in each)),
+                     "any of the results")
     _check_same_span(results)
     asked: list[dict[str, Any]] = [{} for _ in results]
     refused: list[str] = ["" for _ in results]       # each result's first reason, in words
@@ -106,8 +112,12 @@ def governing_span(results: Sequence[tuple[str, xr.Dataset]], *,
         if not own:
             raise UserError(f"design: result '{name}': none of the criteria given applies to "
                             f"it ({why}; or leave it out)")
-        spans.append(max_span(ds, **own))
-    return _shortest(spans, names)
+        span = max_span(ds, **own)
+        if DIRECTION in over and DIRECTION in ds.dims:
+            span = with_binding_direction(ds, span, own)
+        spans.append(span)
+    shortest = _shortest(spans, names)
+    return reduce_over(shortest, over) if over else shortest
 
 
 SPAN = (("linear_mass", "kg/m"), ("bending_rigidity", "N m^2"), ("axial_rigidity", "N"),
@@ -209,6 +219,15 @@ def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
     span = np.take_along_axis(stack, pick[None], axis=0)[0]
     limited_by = np.asarray(np.take_along_axis(by, pick[None], axis=0)[0], dtype=object)
     grid = np.all(by == "grid", axis=0)
+    carried: dict[str, xr.DataArray] = {}     # each result's binding_direction, if it has one
+    name = BINDING + DIRECTION
+    if any(name in s for s in spans):
+        own = xr.broadcast(*[s[name] if name in s else s["max_span"].copy(
+            data=np.full(s["max_span"].shape, "", dtype=object)) for s in spans])
+        stacked = np.stack([b.transpose(*dims).values for b in own])
+        carried[name] = xr.DataArray(
+            np.asarray(np.take_along_axis(stacked, pick[None], axis=0)[0]).astype(str)
+            .astype(object), dims=dims, attrs=next(s[name].attrs for s in spans if name in s))
     limited_in = np.asarray(np.where(grid, "", np.asarray(names, dtype=object)[pick]),
                             dtype=object)
     nan = np.isnan(span)                  # the shortest length fails: name every result
@@ -236,7 +255,7 @@ def _shortest(spans: list[xr.Dataset], names: list[str]) -> xr.Dataset:
                                     attrs=first["limited_by"].attrs),
          "limited_in": xr.DataArray(limited_in.astype(str).astype(object), dims=dims, attrs={
              "long_name": "the result the binding criterion holds in (empty: every result's "
-                          "grid passes)"})},
+                          "grid passes)"}), **carried},
         coords=coords,
         attrs={"title": "maximum span: " + " + ".join(str(s.attrs.get("source_title") or n)
                                                       for n, s in zip(names, spans)),

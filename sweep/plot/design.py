@@ -64,11 +64,16 @@ def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Fig
         ax.bar([0], [height], color=colour, width=0.5, **kwargs)
         note = (f"{v * factor:.4g} {units}\nlimited by {b}" if np.isfinite(v)
                 else f"none: the shortest length\nfails {b}")
+        for name in [n for n in ds.data_vars if str(n).startswith("binding_")]:
+            at = ds[name].values[()]         # 'sweep design --over': where the span binds
+            shown = f"{at:g}" if isinstance(at, (float, np.number)) else str(at)
+            if shown not in ("", "nan"):
+                note += f"\nat {str(name).removeprefix('binding_')} {shown}"
         ax.annotate(note, (0, height), xytext=(0, 4), textcoords="offset points",
                     ha="center", va="bottom")
         ax.set_xticks([0], ["max_span"])
         ax.set_xlim(-1, 1)
-        ax.set_ylim(0, max(height, 1e-12) * 1.25)
+        ax.set_ylim(0, max(height, 1e-12) * (1.25 + 0.08 * max(note.count("\n") - 1, 0)))
     else:
         dim = span.dims[0]
         x = _coord(ds, dim)
