@@ -205,6 +205,55 @@ def record_and_rate(t, p, o, s, records):
     return _ramped(t, p[o + RAMP * s], scale * _hermite(y0, d0, y1, d1, u, dt), scale * slope)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def level_bound(t0, t1, p, o, s, base):
+    """An upper bound (m/s^2) of |a_b(t)| over [t0, t1] (s) for the sine kinds: the constant
+    level |ACCEL|, or the level table's largest A over the stretch of ln w that [t0, t1]
+    sweeps (ln A is linear on each segment, so its largest value lies at an end of the stretch
+    a segment covers; the ramp's rise is at most 1). `base` is the kind switch (`by_kind`)."""
+    n = int(p[o + SEGMENTS * s])
+    if n == 0:
+        return abs(p[o + ACCEL * s])
+    u0 = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t0
+    u1 = p[o + LOG_OMEGA * s] + p[o + RATE * s] * t1
+    lo = min(u0, u1)
+    hi = max(u0, u1)
+    top = 0.0
+    for k in range(n):
+        edge = p[o + (EDGE + k) * s]
+        a = lo if k == 0 else max(lo, edge)                           # segment 0 reaches down
+        b = hi if k + 1 == n else min(hi, p[o + (EDGE + k + 1) * s])  # and the last one up
+        if a > b:
+            continue
+        log_level = p[o + (LOG_LEVEL + k) * s]
+        slope = p[o + (SLOPE + k) * s]
+        top = max(top, math.exp(log_level + slope * (a - edge)),
+                  math.exp(log_level + slope * (b - edge)))
+    return top
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def record_bound(t0, t1, p, o, s, records):
+    """An upper bound (m/s^2) of |a_b(t)| over [t0, t1] (s) for the record kind: on each
+    sample interval the span touches, the cubic Hermite through (y0, d0) and (y1, d1) is at
+    most max(|y0|, |y1|) + 4/27 dt (|d0| + |d1|) (its value weights are >= 0 and sum to 1, its
+    slope weights u (1 - u)^2 and u^2 (1 - u) are at most 4/27), times the level factor (the
+    ramp's rise is at most 1)."""
+    n = records.shape[2]
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    dt = 1.0 / fs
+    first = int(math.floor(min(t0, t1) * fs))
+    last = int(math.floor(max(t0, t1) * fs))
+    top = 0.0
+    for k in range(first, last + 1):
+        k0 = k - n if k >= n else k          # t < 2 N / fs, as `_record_interval`
+        k1 = k0 + 1 if k0 + 1 < n else 0
+        top = max(top, max(abs(records[r, 0, k0]), abs(records[r, 0, k1]))
+                  + 4.0 / 27.0 * dt * (abs(records[r, 1, k0]) + abs(records[r, 1, k1])))
+    return abs(p[o + RECORD_SCALE * s]) * top
+
+
 def signal_and_rate(t, p, o, s, base):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the excitation block for the scene's `base` switch,
     as `signal` chooses."""
@@ -276,6 +325,11 @@ def _is_record(base):
 def _true(base):
     return True
 
+
+peak_bound = by_kind(level_bound, record_bound)
+peak_bound.__doc__ = """peak_bound(t0, t1, p, o, s, base): an upper bound (m/s^2) of |a_b(t)|
+over [t0, t1] (s) for the scene's kind (`level_bound`, `record_bound`): what lets an observer
+skip a search for a peak that cannot exceed the largest so far."""
 
 record_switch = by_kind(None, _true)
 record_switch.__doc__ = """None for the sine kinds, True for the record kind (an array of

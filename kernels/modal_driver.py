@@ -627,10 +627,37 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
         g_lo = _load_rises(a, k)
         g_hi = _load_rises(b, k)
         if g_lo > 0.0 and g_hi <= 0.0:
+            if _load_bound(t, t_new, y, h, QA, n, basis, modal, qv, p1, base, k) <= modal[slot + k]:
+                continue          # no instant of the step can beat the largest so far
             peak = _load_peak(t, y, h, QA, n, basis, modal, qv, m, p1, base, k, g_lo, g_hi,
                               (t_tail - t) / h)
             modal[slot + k] = max(modal[slot + k], peak)
     return located
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
+    """An upper bound of |L_k| (kernels.modes.span_loads' load k) over the accepted step
+    [t, t_new] (s), on every mode's interpolant (QA, as `_span_bound`: |q_c| <= |y_c| + |h|
+    sum_k |QA[c, 0, k]| for x in [0, 1]), the end load's largest size (its mean and
+    amplitude) and the base inertia's (kernels.excitation.peak_bound over the step): where it
+    is no larger than the largest |L_k| so far, `_observe_loads` skips the search for the
+    step's peak (on a random record the shears turn at nearly every step, and that search took
+    two thirds of a three-mode run). q_max (N): scratch."""
+    for c in range(n):
+        reach = 0.0
+        for j in range(QA.shape[2]):
+            reach += abs(QA[c, 0, j])
+        q_max[c] = abs(y[c]) + abs(h) * reach
+    s = end_load_slot(n)
+    inertia = 0.0
+    if base is not None and k > 0:
+        factor = modal[inertia_slot(n)]
+        if factor != 0.0:
+            inertia = abs(factor) * ex.peak_bound(t, t_new, p1, osc.EXCITATION, 1, base)
+    return md.span_load_bound(basis[md.CLAMPS], basis[md.COUPLING], q_max, n,
+                              modal[factor_slot(n)], abs(modal[s]) + abs(modal[s + 1]),
+                              inertia, k)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

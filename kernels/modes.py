@@ -163,6 +163,28 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, i
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
+def span_load_bound(rows, coupling, q_max, n_modes, kappa, load_max, inertia_max, k):
+    """An upper bound of |L_k| (`span_loads`' load k: 0 the stretch E, 1 and 2 the shears F_0
+    and F_1, m^2 and m) over states whose modes are within |q_n| <= q_max[n] (m), with the end
+    load's |P l^2 / EI| <= load_max and the inertia's |r a_b| <= inertia_max (m): |E| <=
+    sum |C_ij| q_max_i q_max_j, |F_e| <= sum |s3_e,i| q_max_i + (|kappa| |E|max + load_max)
+    sum |s1_e,i| q_max_i + inertia_max, term by term from span_loads' sums."""
+    e = 0.0
+    for i in range(n_modes):
+        for j in range(n_modes):
+            e += abs(coupling[i, j]) * q_max[i] * q_max[j]
+    if k == 0:
+        return e
+    end = k - 1
+    s3 = 0.0
+    s1 = 0.0
+    for i in range(n_modes):
+        s3 += abs(rows[SHEAR_0 + end, i]) * q_max[i]
+        s1 += abs(rows[AXIAL_0 + end, i]) * q_max[i]
+    return s3 + (abs(kappa) * e + load_max) * s1 + inertia_max
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def inertia_factor(row, n_modes, rows):
     """r (rho A l^4 / EI) (s^2) of a raw row, times a_b(t) (m/s^2) the `span_loads` inertia
     (m): r = 1/2 - sum_n rows[INERTIA, n], the share of a uniform load's reaction at a clamp
