@@ -43,9 +43,10 @@ REALISATION_DIM = "realisation"
 DEFAULT_RTOL = 1e-5
 """solver.rtol of a random scene that gives none. Its RMS is a statistic whose error over a
 record is about 1 % or more (docs/model.md sec. 11, "How long a record"); at 1e-5 DOP853
-integrates each record's RMS to 5e-4 or better (2e-4 with one mode) in every case of the
-work-precision table whose trajectories converge (benchmarks/RESULTS.md, "The random scene's
-tolerance"), and runs the built-in scene 1.4x (one mode) to 1.5x (three) faster than at 1e-6."""
+integrates each record's RMS to 5e-4 or better in every case of the work-precision table
+whose trajectories converge (benchmarks/RESULTS.md, "The random scene's tolerance"; 7.4e-4
+against SciPy on benchmarks/random_cost.py's 1 s record), and runs the built-in scene 1.4x
+(one mode) to 1.5x (three) faster than at 1e-6."""
 
 
 def spectrum_key(values: Mapping[str, Any]) -> str | None:
