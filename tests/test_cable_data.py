@@ -157,6 +157,17 @@ def test_g0_gn_and_milli_g_are_standard_gravity_on_the_acceleration_keys(dotted,
     assert to_si(f"scene key '{dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
 
 
+@pytest.mark.parametrize("dotted, text, expected", [
+    ("base.asd_g2", "0.16 gn2/Hz", 0.16), ("base.asd_g2", "0.16 g_n2 Hz-1", 0.16),
+    ("base.asd", "0.16 gn2/Hz", 0.16 * G0 ** 2), ("base.asd", "0.16 gn^2/Hz", 0.16 * G0 ** 2)])
+def test_gn_takes_a_udunits_exponent_as_g_and_mg_do(dotted, text, expected):
+    """"0.16 gn2/Hz" (UDUNITS' exponent, as "G2/Hz" and "mG2/Hz" are read) was "unknown unit
+    'gn'", in a line that said gn is standard gravity on the key: it is (g0 keeps no exponent
+    written so: "g02" would read as g to the power 02); by hand, 9.80665 m/s^2 per g."""
+    key = schema.BY_DOTTED[dotted]
+    assert to_si(f"scene key '{dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
+
+
 @pytest.mark.parametrize("dotted, text, words", [
     ("base.acceleration", "500 mg", ["'500 mG'", "'0.5 g'"]),
     ("base.acceleration_g", "500 mg", ["'500 mG'", "'0.5 g'"]),

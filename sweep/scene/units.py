@@ -40,7 +40,8 @@ ACCELERATION_UNITS = ("m s-2", schema.G_UNITS, "m2 s-4 Hz-1", schema.G2_UNITS)
 _UNIT_POWER = re.compile(r"(?<![\w.])([A-Za-z]+)(-?\d+)(?![\w.])")   # m2, s-2 (UDUNITS)
 _LONE_G = re.compile(r"(?<![A-Za-z_])[gG](?![A-Za-z_0-9])")    # "0.5 g", "0.16 G^2/Hz"
 _GRAVITY_G = re.compile(r"(?<![A-Za-z_])(?:m?G|g_?0|gn)(?![A-Za-z_])")   # G, mG, g0, gn: gravity
-_GRAVITY_NAMES = re.compile(r"(?<![A-Za-z_])g_?[0n](?![A-Za-z_0-9])")    # g0, g_0, gn, g_n
+_GRAVITY_NAMES = re.compile(r"(?<![A-Za-z_])(?:g_?n(?![A-Za-z_])|g_?0(?![A-Za-z_0-9]))")
+"""g0, g_0, gn, g_n: standard gravity; gn and g_n also with a UDUNITS exponent ("gn2/Hz")."""
 _MILLI_G = re.compile(r"(?<![A-Za-z_])mG(?![A-Za-z_0-9])")      # a thousandth of gravity
 _MILLIGRAM = re.compile(r"(?<![A-Za-z_])mg(?![A-Za-z_0-9])")    # "500 mg": a mass
 _RMS = re.compile(r"(?<![A-Za-z])(?:[gG]_?)?(?:rms|RMS)(?![A-Za-z])")  # "14.1 grms", "1 g rms"
