@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -237,6 +239,37 @@ def test_a_sweep_override_replaces_the_scenes_fixed_frequency():
     scene = load_scene("harness-stepped-sine", overrides=sweep_table)
     assert list(scene.axes) == ["length"] and scene.get("continuation.axis") is None
     assert scene.get("base.frequency_ratio") is None and scene.get("base.sweep.rate") == 2.0
+
+
+def test_a_sweep_override_drops_the_dwells_end_time_unless_one_is_given():
+    """A reviewer: every built-in fixed-frequency scene gives its dwell a solver.t_end (20, 4,
+    3 s), which refused any longer sweep ('remove solver.t_end', which --set cannot do): a
+    sweep that replaces the fixed frequency takes its own duration, ln(f_e / f_s) / (r ln 2 /
+    60) s, unless an override gives t_end."""
+    sweep_table = {"base.sweep.start": 5.0, "base.sweep.stop": 100.0, "base.sweep.rate": 8.0}
+    duration = math.log(100.0 / 5.0) / (8.0 * math.log(2.0) / 60.0)          # 32.41 s
+    for name in ("harness-clamps", "harness-base-sine", "harness-stepped-sine"):
+        scene = load_scene(name, overrides=sweep_table)
+        assert scene.get("solver.t_end") is None, name      # the sweep's own end
+        assert scene.get("base.sweep.rate") == 8.0 and scene.get("base.frequency") is None
+        assert duration == pytest.approx(32.4145, abs=1e-4)
+    scene = load_scene("harness-clamps", overrides={**sweep_table, "solver.t_end": 40.0})
+    assert scene.get("solver.t_end") == 40.0
+    scene = load_scene("harness-clamps", overrides={"base.acceleration_g": 2.0})
+    assert scene.get("solver.t_end") == 3.0                  # no sweep: the dwell's end stays
+
+
+def test_a_fixed_frequency_on_a_stepped_scene_drops_the_continuation_it_orphans():
+    """A reviewer: --set base.frequency=30 on harness-stepped-sine left [continuation] naming
+    the base_frequency_ratio axis the override removed (refused, and --set cannot remove a
+    table): the continuation goes with its axis; one that still has its axis stays."""
+    for override in ({"base.frequency": 30.0}, {"axes.base_frequency": [20.0, 30.0]},
+                     {"base.frequency_ratio": 1.2}):
+        scene = load_scene("harness-stepped-sine", overrides=override)
+        assert scene.get("continuation.axis") is None, override
+        assert "base_frequency_ratio" not in scene.axes
+    scene = load_scene("harness-stepped-sine", overrides={"axes.length": [0.3, 0.4]})
+    assert scene.get("continuation.axis") == "base_frequency_ratio"
 
 
 @pytest.mark.parametrize("overrides, words", [

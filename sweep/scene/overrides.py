@@ -15,8 +15,9 @@ base frequency (key or axis) replaces the scene's whole sweep table, and with it
 outputs that only a sweep has (outputs.envelope, outputs.bands_per_octave); a scene whose run
 ended with its sweep (no solver.t_end) then needs a solver.t_end override, refused in one line
 without one. A sweep's start, stop or rate (key or axis) replaces the scene's base.frequency
-or frequency_ratio (key or axis) and a stepped sweep's [continuation], and keeps the sweep's
-other keys.
+or frequency_ratio (key or axis), that dwell's solver.t_end (unless an override gives one)
+and a stepped sweep's [continuation], and keeps the sweep's other keys. A [continuation] whose
+axis an override removes goes with it.
 Overrides of two ways to give one quantity are refused.
 """
 
@@ -176,10 +177,14 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
     """Write overrides into the parsed document (in place), before validation: first remove
     what they replace (`_drop_partners`), then write them, so that no override removes
     another."""
+    stepped = _continuation_axis_present(doc)
     for dotted in overrides:
-        lost = _drop_partners(doc, _target(dotted))
+        target = _target(dotted)
+        lost = _drop_partners(doc, target)
         if SWEEP_TABLE in lost:
             _check_end_time(doc, overrides, dotted)
+        elif lost and _member(target, (SWEEP_TABLE,)) == SWEEP_TABLE:
+            _drop_dwell_end(doc, overrides)
     for dotted, value in overrides.items():
         section, _, name = dotted.partition(".")
         if not name:
@@ -188,6 +193,8 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
             _override_axis(doc, name, value, section)
         else:
             _override_scalar(doc, section, name, value)
+    if stepped and not _continuation_axis_present(doc):
+        del doc["continuation"]     # an override removed the stepped axis: nothing to step along
 
 
 def _check_end_time(doc: dict[str, Any], overrides: Mapping[str, Any], dotted: str) -> None:
@@ -202,6 +209,29 @@ def _check_end_time(doc: dict[str, Any], overrides: Mapping[str, Any], dotted: s
           "the scene gives no solver.t_end for a fixed frequency",
           "add the override solver.t_end=20.0 (s: the tail window, the last half, should start "
           "several decay times 1/(zeta w1) in, once the start-up transient has died away)")
+
+
+def _drop_dwell_end(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
+    """A sweep replaced the scene's fixed frequency: the scene's solver.t_end was that dwell's
+    (a sweep's run ends with the sweep by default, and a dwell's t_end refuses a longer
+    sweep), so it goes unless an override gives one."""
+    solver = doc.get("solver")
+    if "solver.t_end" not in overrides and isinstance(solver, dict):
+        solver.pop("t_end", None)
+
+
+def _continuation_axis_present(doc: dict[str, Any]) -> bool:
+    """Whether the document has a stepped sweep's [continuation] whose axis is among its
+    [axes] or [points]: `_apply_overrides` removes a [continuation] whose axis the overrides
+    removed (a fixed frequency replaced the stepped frequency axis), as nothing is left to
+    step along; one whose axis the scene never had is left for the rules' own message."""
+    continuation = doc.get("continuation")
+    if not isinstance(continuation, dict):
+        return False
+    axis = _axis_or_none(str(continuation.get("axis", "")))
+    return axis is not None and any(
+        _axis_or_none(k) == axis for section in schema.SWEPT_SECTIONS
+        if isinstance(doc.get(section), dict) for k in doc[section])
 
 
 def _override_table(doc: dict[str, Any], section: str) -> dict[str, Any]:
