@@ -26,6 +26,7 @@ import signal
 import sys
 import time
 import warnings
+from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 from .errors import CableSweepWarning, UserError, one_line
@@ -130,7 +131,8 @@ def _parser() -> argparse.ArgumentParser:
     design = sub.add_parser("design", help="the largest span between clamps meeting the "
                                            "criteria, from a result with a length axis (limits "
                                            "in SI, or with a unit: --max-amplitude '2 mm')")
-    design.add_argument("result", metavar="RESULT.nc", nargs="+",
+    design.add_argument("result", metavar="RESULT.nc", nargs="*",   # "*": `_design` takes a
+                                                                    # file --over swallowed
                         help="a netCDF file written by 'sweep run' with a length axis; several "
                              "(a launch's sine and random results): each is asked the criteria "
                              "it holds, and the shortest span binds")
@@ -334,10 +336,26 @@ def _refuse_writing_over_an_input(output: str, inputs: list[str]) -> None:
                             "replace the result with its design: give another file name")
 
 
+def _take_files_from_over(args: argparse.Namespace) -> None:
+    """`sweep design --over AXIS RESULT.nc`: argparse gives --over every word after it, the
+    result file too; a word that names a .nc file or an existing path is a result, not an
+    axis. Without any result, one line asks for one."""
+    over = list(args.over or ())
+    files = [w for w in over if w.lower().endswith(".nc") or Path(w).exists()]
+    if files:
+        args.over = [w for w in over if w not in files] or None
+        args.result = list(args.result) + files
+    if not args.result:
+        raise UserError("design: give the result to design from: sweep design RESULT.nc "
+                        "[--min-frequency HZ] [--max-amplitude M] ... (a netCDF file that "
+                        "'sweep run' wrote, with a length axis)")
+
+
 def _design(args: argparse.Namespace) -> int:
     from .design import NO_CRITERION, interpolated, max_span, refine_span, table
     from .io import check_output_path, write_netcdf
     from .plot import load_result
+    _take_files_from_over(args)
     if all(v is None for v in (args.min_frequency, args.max_amplitude, args.max_deflection,
                                args.max_strain, args.max_rms, args.max_peak, args.clearance,
                                args.max_probability)):

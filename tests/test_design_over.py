@@ -324,6 +324,20 @@ def test_cli_design_over_refusals_are_one_line_exit_2(real_stepped, capsys):
         assert fragment in err and len(err.splitlines()) == 1, err
 
 
+def test_cli_design_over_before_the_file_takes_the_file_as_the_result(real_stepped, capsys):
+    """A reviewer: `sweep design --over AXIS RESULT.nc` gave the file to --over and answered
+    'the following arguments are required: RESULT.nc'; the same answer as with the file
+    first, and no file at all is one line."""
+    _, path = real_stepped
+    first = main(["design", str(path), "--max-amplitude", "1e-3", "--over", "direction"])
+    text_first = capsys.readouterr().out
+    after = main(["design", "--max-amplitude", "1e-3", "--over", "direction", str(path)])
+    assert (first, after) == (0, 0) and capsys.readouterr().out == text_first
+    assert main(["design", "--max-amplitude", "1e-3", "--over", "direction"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "give the result to design from" in err and len(err.splitlines()) == 1
+
+
 def test_refine_over_an_axis_takes_the_refined_spans_shortest(real_stepped):
     """--refine with --over: each combination refined, then the shortest; the frequency
     criterion alone needs no run and does not move with the step, so every step gives the
