@@ -11,8 +11,9 @@ Runge-Kutta stage, solution and dense output is linear in the state, so the step
 derivatives projected on q_mid (K_mid) are exactly the stages of q_mid, and its interpolants
 (RK45's quartic, DOP853's quintic Hermite) are exactly those of q_mid. On top, each mode's
 tail amplitude max |q_n| (step ends, the tail's start and every extremum of q_n located on its
-own interpolant) and a divergence test on every mode (a mode with no midspan deflection, an
-even one, can grow unseen at midspan).
+own interpolant), the span's largest deflection max |w(x, t)| (every step of the tail window
+that can hold a larger one searched in time and place: `observe_span`) and a divergence test
+on every mode (a mode with no midspan deflection, an even one, can grow unseen at midspan).
 
 Units: t in s, q in m, q' in m/s.
 """
@@ -186,8 +187,8 @@ def modal_size(n_modes):
     """Length of the modes' accumulator `modal` of both multi-mode drivers: each mode's tail
     amplitude max |q_n| over the tail window (slots 0..N-1, m), each mode's peak max |q_n| at
     the accepted steps' ends over the whole run (N..2N-1, m), the largest deflection over
-    the span in the tail window (slot 2N, m; `_observe_span`), the mode shapes at its
-    place x*, phi_n(x* / l) (2N + 1..3N; the midspan's until the tail window starts), the
+    the span in the tail window (slot 2N, m; `observe_span`), N unused slots (2N + 1..3N,
+    0; they held the mode shapes at the place of slot 2N's deflection), the
     largest |sum phi_n''(s) q_n| at each clamp s = 0, 1 and at midspan s = 1/2 in the tail
     window (clamp_slot(N) + 0, 1, 2, m: the curvature there times l^2; `_observe_bends`),
     the largest stretch E and clamp shears |F_0|, |F_1| there (load_slot(N) + 0, 1, 2;
@@ -207,8 +208,9 @@ def modal_size(n_modes):
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def observer_scratch(n_modes):
     """Length of the observers' scratch qx: the modes' values at an instant (0..N-1, for
-    `_observe_span`), then `_observe_loads`' (N..3N-1: q and its rate there; then three
-    blocks of 6: kernels.modes.span_loads at the step's start, end and inside)."""
+    `observe_span`; N..N+7: its `_span_spread`'s), then `_observe_loads`' (N..3N-1: q and
+    its rate there; then three blocks of 6: kernels.modes.span_loads at the step's start,
+    end and inside)."""
     return 3 * n_modes + 18
 
 
@@ -351,27 +353,17 @@ def curvature_moments(modal, n, acc, reals):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _project_rate(y, y_new, QA, modal, n_modes, Qp):
-    """The rate of the deflection at x* (modal's mode shapes there, `modal_size`) at the
-    step's ends, (r0, r1) (m/s), and its interpolant into Qp[1]."""
-    n = n_modes
-    r0 = 0.0
-    r1 = 0.0
-    for j in range(Qp.shape[1]):
-        Qp[1, j] = 0.0
-    for c in range(n):
-        phi = modal[2 * n + 1 + c]
-        r0 += phi * y[n + c]
-        r1 += phi * y_new[n + c]
-        for j in range(Qp.shape[1]):
-            Qp[1, j] += phi * QA[c, 1, j]
-    return r0, r1
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _turns(r0, r1):
     """Whether a rate going from r0 to r1 over a step changes sign (an extremum)."""
     return (r0 > 0.0 and r1 <= 0.0) or (r0 < 0.0 and r1 >= 0.0)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def shape_size(shapes, c):
+    """An upper bound of max |phi_c| over the span for mode c's beam-function row
+    (`modes.shape_at`: A cos + B sin + C e^- + D e^+): sqrt(A^2 + B^2) + |C| + |D|."""
+    return (math.sqrt(shapes[c, 1] * shapes[c, 1] + shapes[c, 2] * shapes[c, 2])
+            + abs(shapes[c, 3]) + abs(shapes[c, 4]))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -386,48 +378,237 @@ def _span_bound(y, h, QA, n_modes, shapes):
         reach = 0.0
         for k in range(QA.shape[2]):
             reach += abs(QA[c, 0, k])
-        size = (math.sqrt(shapes[c, 1] * shapes[c, 1] + shapes[c, 2] * shapes[c, 2])
-                + abs(shapes[c, 3]) + abs(shapes[c, 4]))
-        bound += (abs(y[c]) + abs(h) * reach) * size
+        bound += (abs(y[c]) + abs(h) * reach) * shape_size(shapes, c)
     return bound
 
 
+SPAN_SAMPLES = 4
+"""Intervals of an accepted step at whose ends `observe_span` takes the span's maximum: a
+crest in time of the largest deflection shows as its rate turning from rising to falling
+between two of them, and is then located (`_span_crest`)."""
+SPAN_ITERATIONS = 60
+"""Most evaluations that locate a crest inside an interval (`_span_crest`)."""
+SPAN_WIDTH = 2.0 ** -30
+"""The bracket (a fraction of the step) at which `_span_crest` stops: the crest's height is
+then exact to about (1e-9)^2 of the step's curvature in time, far below round-off."""
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _observe_span(y, y_new, h, QA, x, n_modes, qx, modal, basis, Qp):
-    """The largest deflection over the span near the fraction x of the accepted step (every
-    mode's interpolant in QA), into modal[2N] (m), and its place x* into modal's mode
-    shapes: the span's maximum at x, at its place (modes.span_argmax), then at the instant
-    inside the step where the deflection there turns (the root of its interpolated rate),
-    twice. qx (N), Qp (2, terms): scratch. Skipped where no instant of the step can exceed the
-    largest so far (`_span_bound`)."""
-    n = n_modes
-    if _span_bound(y, h, QA, n, basis[md.SHAPES]) <= modal[2 * n]:
-        return
+def _span_sample(y, h, QA, s, n, qx, basis):
+    """(max over the span of |w| (m), its place x* / l, the rate of |w(x*)| (m per unit s))
+    at the fraction s of the accepted step, on every mode's interpolant (QA): the maximum by
+    kernels.modes.span_argmax; the rate is that of the interpolants themselves (their
+    polynomials' derivatives), so by the envelope theorem it is the rate of the span's
+    maximum, which rises where it is > 0 and falls where it is < 0. qx (N): scratch."""
     for c in range(n):
-        qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
-    top, where = md.span_argmax(qx, n, basis)
-    best = where
-    for _ in range(2):
+        qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], s)
+    value, place = md.span_argmax(qx, n, basis)
+    w = 0.0
+    rate = 0.0
+    for c in range(n):
+        phi = md.shape_at(basis[md.SHAPES], c, place)[0]
+        slope = 0.0
+        for k in range(QA.shape[2] - 1, -1, -1):
+            slope = slope * s + (k + 1) * QA[c, 0, k]
+        w += phi * qx[c]
+        rate += phi * slope
+    return value, place, (rate if w >= 0.0 else -rate)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _interpolant_terms(y_c, h, c, s):
+    """(q, dq/ds, d2q/ds^2) (m) of one mode's interpolant q = y_c + h sum_k c[k] s^(k+1) at
+    the fraction s of the step (Horner's scheme with its derivatives)."""
+    p = 0.0
+    d1 = 0.0
+    d2 = 0.0
+    for k in range(c.shape[0] - 1, -1, -1):
+        d2 = d2 * s + d1
+        d1 = d1 * s + p
+        p = p * s + c[k]
+    return y_c + h * s * p, h * (p + s * d1), h * (2.0 * d1 + 2.0 * s * d2)
+
+
+CREST_NEWTON = 12
+"""Most Newton iterations of `_crest_newton`."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _crest_newton(y, h, QA, n, qx, basis, lo, hi, s, x):
+    """(max |w| (m), its place x* / l, whether found) at the crest of the span's maximum in
+    (time, place) between the fractions lo and hi of the step, by Newton's method on
+    grad w = 0 in (s, x) from (s, x), w = sum_c phi_c(x) q_c(s) on the interpolants (QA);
+    not found where an iterate leaves the bracket or the span, where w is not curved as at a
+    crest of |w| (the Hessian definite, negative where w > 0), where it has not converged,
+    or where the span holds a larger deflection elsewhere at that instant
+    (kernels.modes.span_argmax: the crest is then another hump's). qx (N): scratch."""
+    shapes = basis[md.SHAPES]
+    done = False
+    for _ in range(CREST_NEWTON):
+        w = 0.0
+        w_x = 0.0
+        w_s = 0.0
+        w_xx = 0.0
+        w_xs = 0.0
+        w_ss = 0.0
         for c in range(n):
-            modal[2 * n + 1 + c] = md.shape_at(basis[md.SHAPES], c, where)[0]
-        r0, r1 = _project_rate(y, y_new, QA, modal, n, Qp)
-        if not _turns(r0, r1):
+            q, q_s, q_ss = _interpolant_terms(y[c], h, QA[c, 0], s)
+            phi, p1, p2 = md.shape_at(shapes, c, x)
+            w += phi * q
+            w_x += p1 * q
+            w_s += phi * q_s
+            w_xx += p2 * q
+            w_xs += p1 * q_s
+            w_ss += phi * q_ss
+        det = w_xx * w_ss - w_xs * w_xs
+        if not (det > 0.0 and w * w_xx < 0.0):        # a crest of |w|: w's extremum, w's way
+            return 0.0, x, False
+        dx = (w_xs * w_s - w_ss * w_x) / det
+        ds = (w_xs * w_x - w_xx * w_s) / det
+        x += dx
+        s += ds
+        if not (lo <= s <= hi and 0.0 <= x <= 1.0):
+            return 0.0, x, False
+        if abs(dx) <= 1e-13 and abs(ds) <= 1e-13:
+            done = True
             break
-        x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
-        for c in range(n):
-            qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], x)
-        value, where = md.span_argmax(qx, n, basis)
+    if not done:
+        return 0.0, x, False
+    w = 0.0
+    for c in range(n):
+        qx[c] = dopri5.dense_value(y[c], h, QA[c, 0], s)
+        w += md.shape_at(shapes, c, x)[0] * qx[c]
+    top, place = md.span_argmax(qx, n, basis)
+    if top > abs(w) * (1.0 + 1e-12):
+        return top, place, False
+    return abs(w), x, True
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _span_crest(y, h, QA, n, qx, basis, lo, hi, g_lo, g_hi, x_lo, x_hi):
+    """(the largest span maximum found (m), its place x* / l) at the crest in time of the
+    span's maximum between the fractions lo < hi of the step, where its rate
+    (`_span_sample`) is g_lo >= 0 at lo and g_hi < 0 at hi, and its place x_lo at lo, x_hi
+    at hi: Newton's method in time and place (`_crest_newton`) from the regula falsi's
+    instant at x_lo, and at x_hi too where that is another hump (more than a station apart:
+    the first hump's crest and, after the second took over, the second's may both lie in
+    the interval); where neither finds a crest, the Illinois method on the rate (regula falsi
+    that halves the end kept twice), a bisection wherever the bracket failed to halve, until
+    it is SPAN_WIDTH of the step wide. The rate jumps where the maximum moves to another hump
+    of w, but only upwards (where two humps' heights cross, the one taking over rises the
+    faster): the bracket closes on a smooth crest."""
+    s = lo + (hi - lo) * g_lo / (g_lo - g_hi)
+    top, where, found = _crest_newton(y, h, QA, n, qx, basis, lo, hi, s, x_lo)
+    if abs(x_hi - x_lo) * (basis[md.STATIONS].shape[0] - 1) > 1.0:
+        other, place, also = _crest_newton(y, h, QA, n, qx, basis, lo, hi, s, x_hi)
+        if other > top:
+            top = other
+            where = place
+        found = found or also
+    if found:
+        return top, where
+    kept = 0                       # the end kept last: -1 lo, +1 hi, 0 none
+    width = hi - lo
+    bisect = False
+    for _ in range(SPAN_ITERATIONS):
+        if bisect or not g_lo > g_hi:
+            s = 0.5 * (lo + hi)
+        else:
+            s = lo + (hi - lo) * g_lo / (g_lo - g_hi)
+            if not (lo < s < hi):
+                s = 0.5 * (lo + hi)
+        value, place, g = _span_sample(y, h, QA, s, n, qx, basis)
         if value > top:
             top = value
-            best = where
-    if top > modal[2 * n]:
-        modal[2 * n] = top
-        modal[place_slot(n)] = best
-    else:
-        best = -1.0
-    if best >= 0.0:
-        for c in range(n):
-            modal[2 * n + 1 + c] = md.shape_at(basis[md.SHAPES], c, best)[0]
+            where = place
+        if g > 0.0:
+            lo, g_lo = s, g
+            if kept == 1:
+                g_hi *= 0.5
+            kept = 1
+        else:
+            hi, g_hi = s, g
+            if kept == -1:
+                g_lo *= 0.5
+            kept = -1
+        if hi - lo <= SPAN_WIDTH or g == 0.0:
+            break
+        bisect = hi - lo > 0.5 * width
+        width = hi - lo
+    return top, where
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _span_spread(h, QA, n, shapes, s_m, r, a):
+    """An upper bound (m) of |w(x, s) - w(x, s_m)| over the span and |s - s_m| <= r (fractions
+    of the step): sum_c max |phi_c| sum_k |a_k| r^k, a_k the Taylor coefficients at s_m of
+    mode c's interpolant q_c(s) - y_c = h sum_j QA[c, 0, j] s^(j+1) (its coefficients
+    shifted to s_m by Horner's scheme). a (terms + 1): scratch."""
+    terms = QA.shape[2]
+    total = 0.0
+    for c in range(n):
+        a[0] = 0.0
+        for j in range(terms):
+            a[j + 1] = h * QA[c, 0, j]
+        for i in range(terms):
+            for j in range(terms - 1, i - 1, -1):
+                a[j] += s_m * a[j + 1]
+        spread = 0.0
+        power = 1.0
+        for k in range(1, terms + 1):
+            power *= r
+            spread += abs(a[k]) * power
+        total += spread * shape_size(shapes, c)
+    return total
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def observe_span(y, h, QA, s_lo, n_modes, qx, modal, basis):
+    """The largest deflection over the span and over the fractions s_lo..1 of the accepted
+    step (every mode's interpolant in QA) into modal[2N] (m) and its place x* / l into
+    modal[place_slot(N)], where it exceeds the largest so far. Nothing where `_span_bound`
+    leaves no room above the largest so far, nor where the span's maximum
+    (kernels.modes.span_argmax) at the middle of s_lo..1 plus `_span_spread` over the rest
+    leaves none; else the span's maximum at the ends of SPAN_SAMPLES equal intervals, and in
+    each interval where it rises (or is level) at the start and falls at the end, at its
+    crest (`_span_crest`). qx (observer_scratch(N)): scratch. Both multi-mode drivers call
+    it: `_observe_modes`, and kernels.modal_lanes for a lane's ordinary step."""
+    n = n_modes
+    top = modal[2 * n]
+    if _span_bound(y, h, QA, n, basis[md.SHAPES]) <= top:
+        return
+    half = SPAN_SAMPLES // 2
+    s_mid = s_lo + (1.0 - s_lo) * half / SPAN_SAMPLES
+    v_mid, x_mid, g_mid = _span_sample(y, h, QA, s_mid, n, qx, basis)
+    place = modal[place_slot(n)]
+    if v_mid > top:
+        top = v_mid
+        place = x_mid
+    spread = _span_spread(h, QA, n, basis[md.SHAPES], s_mid, 1.0 - s_mid, qx[n:])
+    if v_mid + spread > top:
+        s_prev = s_lo
+        g_prev = 0.0
+        x_prev = 0.5
+        for j in range(SPAN_SAMPLES + 1):
+            s = 1.0 if j == SPAN_SAMPLES else s_lo + (1.0 - s_lo) * j / SPAN_SAMPLES
+            if j == half:
+                value, where, g = v_mid, x_mid, g_mid
+            else:
+                value, where, g = _span_sample(y, h, QA, s, n, qx, basis)
+            if value > top:
+                top = value
+                place = where
+            if j > 0 and g_prev >= 0.0 and g < 0.0:    # (g = 0: the crest is this sample)
+                crest, at = _span_crest(y, h, QA, n, qx, basis, s_prev, s, g_prev, g, x_prev,
+                                        where)
+                if crest > top:
+                    top = crest
+                    place = at
+            s_prev = s
+            g_prev = g
+            x_prev = where
+    modal[2 * n] = top
+    modal[place_slot(n)] = place
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -447,16 +628,13 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
     """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each mode's
     peak at the step's end; in the tail window each mode's tail amplitude max |q_i| (the step's
     end, the tail's start inside the step, and an extremum of q_i inside the step, on its own
-    interpolant, unless the mode is `negligible`) and the span's largest deflection at those
-    instants (the tail's start and every mode's extremum: where the span's maximum in time lies,
-    to second order in the small modes, then refined: `_observe_span`). QA (N, 2, terms): every
-    mode's interpolant, scratch; qx (N), Qp (2, terms): scratch; basis: the span's
-    (kernels.modes). And where the deflection at the place x* of the largest so far turns inside
-    the step (a crest there that no mode's extremum marks), the span there too. The loads
-    (`_observe_bends`, `_observe_loads`) over the tail window, or over the whole run where
-    `start` marked it so (a sine sweep: their peak over the whole sweep). p1, base: the
-    Observer row and the excitation switch, for the base inertia's part of the clamp shear
-    (`inertia_at`)."""
+    interpolant, unless the mode is `negligible`) and the span's largest deflection over the
+    step's part in the window (`observe_span`). QA (N, 2, terms): every mode's interpolant,
+    scratch; qx (`observer_scratch`), Qp (2, terms): scratch; basis: the span's
+    (kernels.modes). The loads (`_observe_bends`, `_observe_loads`) over the tail window, or
+    over the whole run where `start` marked it so (a sine sweep: their peak over the whole
+    sweep). p1, base: the Observer row and the excitation switch, for the base inertia's part
+    of the clamp shear (`inertia_at`)."""
     n = n_modes
     largest = 0.0
     for i in range(n):
@@ -473,40 +651,22 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
                                  basis, located, qx, p1, base)
     if t_new < t_tail:
         return
-    r0 = 0.0
-    r1 = 0.0
-    for c in range(n):
-        r0 += modal[2 * n + 1 + c] * y[n + c]
-        r1 += modal[2 * n + 1 + c] * y_new[n + c]
-    crest = _turns(r0, r1)                           # at x*, as it stands at the step's start
-    if crest:                                        # first: x* may move below
+    if not located:
         for c in range(n):
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
-        located = True
-        _project_rate(y, y_new, QA, modal, n, Qp)    # the rate's interpolant at x*
-        x = dopri5.dense_root(r0, h, Qp[1], 0.0, 0.0, 1.0)
-        if t + x * h >= t_tail:
-            _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
+    located = True
+    s_lo = 0.0
     if t < t_tail:                                   # the tail starts inside the step
-        if not located:
-            for c in range(n):
-                _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
-        located = True
-        x = (t_tail - t) / h
+        s_lo = (t_tail - t) / h
         for c in range(n):
-            modal[c] = max(modal[c], abs(dopri5.dense_value(y[c], h, QA[c, 0], x)))
-        _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
+            modal[c] = max(modal[c], abs(dopri5.dense_value(y[c], h, QA[c, 0], s_lo)))
+    observe_span(y, h, QA, s_lo, n, qx, modal, basis)
     for i in range(n):
         if not _turns(y[n + i], y_new[n + i]) or negligible(modal[n + i], largest):
             continue
-        if not located:
-            for c in range(n):
-                _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
-            located = True
         x = dopri5.dense_root(y[n + i], h, QA[i, 1], 0.0, 0.0, 1.0)   # q_i' = 0
         if t + x * h >= t_tail:
             modal[i] = max(modal[i], abs(dopri5.dense_value(y[i], h, QA[i, 0], x)))
-            _observe_span(y, y_new, h, QA, x, n, qx, modal, basis, Qp)
     if modal[factor_slot(n) + 1] != TAIL_WINDOW:    # none, or over the whole run (above)
         return
     located = _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
@@ -866,9 +1026,8 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     for k in range(6):
         modal[square_slot(n) + k] = 0.0
-    midspan = basis[md.MIDSPAN]
     for i in range(n):
-        modal[2 * n + 1 + i] = midspan[i]
+        modal[2 * n + 1 + i] = 0.0
     for i in range(n):
         if not abs(y[i]) <= row[md.BOUND]:
             acc[tj.STATUS] = mt.DIVERGED

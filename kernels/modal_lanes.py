@@ -20,10 +20,11 @@ compile to packed AVX-512 FMAs on zmm registers):
 - `_control`: accept/reject and the step-size update, err^(-1/5) by vecmath.inv_fifth_root
   (kernels.lanes._step_factor);
 - trajectory.next_attempts: trajectory.next_attempt for the lanes whose step needs no special care;
-- `_midspan`, `_mode_events`, `_finish`, `_tail_modes`, `_advance`: the accepted step's
-  stages projected on the midspan deflection (K_mid), the test for anything unusual, the
-  Observer's step-end metrics of an ordinary step (trajectory.observe_step_end), each mode's
-  tail amplitude at the step's end, and the move to the step's end.
+- `_midspan`, `_mode_events`, `_finish`, `_tail_modes`, `_span_events`, `_advance`: the
+  accepted step's stages projected on the midspan deflection (K_mid), the test for anything
+  unusual, the Observer's step-end metrics of an ordinary step (trajectory.observe_step_end),
+  each mode's tail amplitude at the step's end, the test for room above the span's largest
+  deflection so far, and the move to the step's end.
 
 An accepted step with anything to locate on a dense output (an extremum of the midspan
 deflection or of any mode, the tail's start, a time-series sample, a threshold crossing) or a
@@ -31,9 +32,11 @@ divergence goes to the scalar path for that lane alone (`_flagged_lane`): the sc
 own functions on copies of the lane's columns (the divergence test on every mode,
 modal_driver._observe_modes, trajectory.record_step on the lane's accumulator W[j::LANES]
 and its Observer row, with the scalar driver's types, so that they compile once for both).
-So do a lane's unusual steps to try (trajectory.next_attempt). A lane whose trajectory ends is
-classified as modal_driver.solve_point does and takes the next point of the block. Set-up
-(f(0), SciPy's initial step) is the scalar driver's arithmetic.
+So do a lane's unusual steps to try (trajectory.next_attempt). An ordinary step whose bound
+leaves room above the span's largest deflection so far has just that searched, by the scalar
+driver's modal_driver.observe_span on copies of the lane's columns (`_span_lane`). A lane whose
+trajectory ends is classified as modal_driver.solve_point does and takes the next point of the
+block. Set-up (f(0), SciPy's initial step) is the scalar driver's arithmetic.
 
 A random base acceleration (the record kind, kernels.excitation) runs here too: the right-hand
 side reads each lane's record, and every accepted step goes to the scalar path, whose
@@ -229,14 +232,76 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base):
+    """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
+    the tail window and modal_driver._span_bound over the step (on each mode's interpolant:
+    DOP853's quintic Hermite through the state and its rates at both ends, RK45's quartic from
+    the stages, as modal_driver._mode_interpolant builds them) exceeds the span's largest
+    deflection so far (MOD's slot 2N), else 0: the step may hold a larger one, which
+    `_span_lane` searches for (a step on the scalar path searches in
+    modal_driver._observe_modes). K: the stages; eighth: the method switch; SHAPES: the basis'
+    mode shapes; base: the excitation switch (excitation.by_kind, `_sine_span_events`: a
+    record's steps are all the scalar path's)."""
+    L = LANES
+    last = K.shape[0] - 1                   # f(t + h, y_new)
+    for l in range(n_run):
+        SPAN[l] = 0.0                       # the bound, until the test below
+    for c in range(n):
+        size = drv.shape_size(SHAPES, c)
+        for l in range(n_run):
+            h = H[l]
+            if eighth:
+                c3, c4, c5 = dop853.hermite_terms(Y[c, l], Y[n + c, l], K[0, n + c, l],
+                                                  YN[c, l], YN[n + c, l], K[last, n + c, l], h)
+                reach = (abs(h * Y[n + c, l]) + abs(0.5 * h * h * K[0, n + c, l]) + abs(c3)
+                         + abs(c4) + abs(c5))
+            else:
+                reach = 0.0
+                for k in range(dopri5.QUARTIC_TERMS):
+                    term = 0.0
+                    for j in range(dopri5.N_STAGES + 1):
+                        term += K[j, c, l] * dopri5.P[j, k]
+                    reach += abs(term)
+                reach *= abs(h)
+            SPAN[l] += (abs(Y[c, l]) + reach) * size
+    for l in range(n_run):
+        ordinary = (MOVE[l] != 0.0) & (FLAG[l] == 0.0)
+        tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
+        SPAN[l] = 1.0 if ordinary & tail & (SPAN[l] > MOD[2 * n, l]) else 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis):
+    """Lane j's ordinary step that `_span_events` marked: the span's largest deflection over
+    it by the scalar driver's modal_driver.observe_span, on copies of the lane's state columns
+    and every mode's interpolant built from them as the scalar path builds it
+    (modal_driver._mode_interpolant), with the scalar driver's types (Kl, yl, ynl, ml, Km,
+    QA, qx: `_flagged_lane`'s scratch)."""
+    for s in range(K.shape[0]):
+        for c in range(2 * n):
+            Kl[s, c] = K[s, c, j]
+    for c in range(2 * n):
+        yl[c] = Y[c, j]
+        ynl[c] = YN[c, j]
+    h = H[j]
+    for c in range(n):
+        drv._mode_interpolant(yl, ynl, Kl, h, c, n, eighth, Km, QA[c])
+    place = drv.place_slot(n)
+    ml[2 * n] = MOD[2 * n, j]
+    ml[place] = MOD[place, j]
+    drv.observe_span(yl, h, QA, 0.0, n, qx, ml, basis)
+    MOD[2 * n, j] = ml[2 * n]
+    MOD[place, j] = ml[place]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, an extremum of q_n in a mode not negligible
     beside the largest (modal_driver.negligible; BIG: scratch, the largest mode's peak) or a
-    crest of the deflection at the place x* of the span's largest (its mode shapes in MOD, as
-    modal_driver._observe_modes tests it) or of the curvature at a clamp or at midspan (CV: the
-    basis' kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest), or a maximum
-    of the stretch or of a clamp's shear (kernels.modes.span_loads, CP: the basis' coupling;
+    crest of the curvature at a clamp or at midspan (CV: the basis' kernels.modes.CLAMPS rows;
+    a pinned clamp's are all 0: never a crest), or a maximum of the stretch or of a clamp's
+    shear (kernels.modes.span_loads, CP: the basis' coupling;
     MOD's shear factor; LD (2, 6): scratch; P1L: the lanes' Observer rows, for the base
     inertia's part of the shear, modal_driver.inertia_at), where the scene observes the loads
     (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch
@@ -258,15 +323,6 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
             EV[l] = 1.0 if (turns & tail) | bad else EV[l]
-    for l in range(n_run):
-        r0 = 0.0
-        r1 = 0.0
-        for i in range(n):
-            r0 += MOD[2 * n + 1 + i, l] * Y[n + i, l]
-            r1 += MOD[2 * n + 1 + i, l] * YN[n + i, l]
-        crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
-        tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
-        EV[l] = 1.0 if crest & tail else EV[l]
     if not observe:
         return
     for e in range(md.N_BENDS):
@@ -548,6 +604,7 @@ def _refine_marked(W, P1L, n_run, base):
 # path): compiled for the sine kinds or none only (excitation.by_kind)
 _sine_mode_events = ex.by_kind(_mode_events, None)
 _sine_tail_modes = ex.by_kind(_tail_modes, None)
+_sine_span_events = ex.by_kind(_span_events, None)
 _sine_refine_marked = ex.by_kind(_refine_marked, None)
 
 
@@ -600,6 +657,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     H = np.zeros(L)
     ERR = np.zeros(L)
     EV = np.zeros(L)
+    SPAN = np.zeros(L)
     FLAG = np.zeros(L)
     MOVE = np.zeros(L)
     BOUNDS = np.zeros(L)
@@ -679,6 +737,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                             n_run, base)
         _sine_tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
                          basis[md.COUPLING], LD, P1L, base)
+        _sine_span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth,
+                          basis[md.SHAPES], base)
+        for j in range(n_run):
+            if SPAN[j] != 0.0:          # (a record's: never; its steps are the scalar path's)
+                _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis)
         if base is not None:
             _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema
         if n_flagged > 0:

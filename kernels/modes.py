@@ -323,13 +323,16 @@ def span_argmax(q, n_modes, basis):
             best = abs(w)
             where = k / m
     top = best
+    w = 0.0                       # w_prev, w, w_next: w at stations k - 1, k, k + 1
+    w_next = 0.0
+    for i in range(n_modes):
+        w += q[i] * stations[0, i]
+        w_next += q[i] * stations[1, i]
     for k in range(1, m):
-        w_prev = 0.0
-        w = 0.0
+        w_prev = w
+        w = w_next
         w_next = 0.0
         for i in range(n_modes):
-            w_prev += q[i] * stations[k - 1, i]
-            w += q[i] * stations[k, i]
             w_next += q[i] * stations[k + 1, i]
         if not (abs(w) >= abs(w_prev) and abs(w) >= abs(w_next) and abs(w) >= 0.9 * best):
             continue
