@@ -366,6 +366,16 @@ def shape_size(shapes, c):
             + abs(shapes[c, 3]) + abs(shapes[c, 4]))
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def mode_reach(y, h, QA, c):
+    """An upper bound (m) of |q_c| over the accepted step, on mode c's interpolant
+    q_c = y_c + h sum_k QA[c, 0, k] s^(k+1), s in [0, 1]: |y_c| + |h| sum_k |QA[c, 0, k]|."""
+    reach = 0.0
+    for k in range(QA.shape[2]):
+        reach += abs(QA[c, 0, k])
+    return abs(y[c]) + abs(h) * reach
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _span_bound(y, h, QA, n_modes, shapes):
     """An upper bound (m) of |w(x, t)| over the span and over the accepted step (every mode's
@@ -375,10 +385,7 @@ def _span_bound(y, h, QA, n_modes, shapes):
     (`modes.shape_at`; 1 for a pinned sine)."""
     bound = 0.0
     for c in range(n_modes):
-        reach = 0.0
-        for k in range(QA.shape[2]):
-            reach += abs(QA[c, 0, k])
-        bound += (abs(y[c]) + abs(h) * reach) * shape_size(shapes, c)
+        bound += mode_reach(y, h, QA, c) * shape_size(shapes, c)
     return bound
 
 
@@ -798,17 +805,13 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
     """An upper bound of |L_k| (kernels.modes.span_loads' load k) over the accepted step
-    [t, t_new] (s), on every mode's interpolant (QA, as `_span_bound`: |q_c| <= |y_c| + |h|
-    sum_k |QA[c, 0, k]| for x in [0, 1]), the end load's largest size (its mean and
-    amplitude) and the base inertia's (kernels.excitation.peak_bound over the step): where it
-    is no larger than the largest |L_k| so far, `_observe_loads` skips the search for the
-    step's peak (on a random record the shears turn at nearly every step, and that search took
-    two thirds of a three-mode run). q_max (N): scratch."""
+    [t, t_new] (s), on every mode's interpolant (QA, `mode_reach`), the end load's largest
+    size (its mean and amplitude) and the base inertia's (kernels.excitation.peak_bound over
+    the step): where it is no larger than the largest |L_k| so far, `_observe_loads` skips the
+    search for the step's peak (on a random record the shears turn at nearly every step, and
+    that search took two thirds of a three-mode run). q_max (N): scratch."""
     for c in range(n):
-        reach = 0.0
-        for j in range(QA.shape[2]):
-            reach += abs(QA[c, 0, j])
-        q_max[c] = abs(y[c]) + abs(h) * reach
+        q_max[c] = mode_reach(y, h, QA, c)
     s = end_load_slot(n)
     inertia = 0.0
     if base is not None and k > 0:
