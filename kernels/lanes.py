@@ -37,8 +37,10 @@ driver).
 A random base acceleration (kernels.excitation's record kind: `base` is the records) runs here
 too, on stage chains of its own (`_chain5_r`, `_chain8_r`: each lane reads its row's record
 through a call, so that loop is not vectorised, but the chain is still written out from the
-tableau), and every accepted step of a record goes to record_step, whose statistics are the
-scalar driver's: 1.8-1.9x the scalar driver's speed from a few records (benchmarks/RESULTS.md).
+tableau). A record's accepted step with anything to locate inside it (an extremum of q, the
+tail's start, a sample) goes to record_step as above; its ordinary steps get the record's
+statistics (trajectory.record_statistics, the scalar driver's arithmetic) in
+`_record_statistics`, on the lane's own accumulator, without the scalar path's copies.
 """
 
 import math
@@ -85,7 +87,9 @@ W_QE = W_QN + 5                   # q there (m)
 W_FACTOR = W_QN + 6               # the PI controller's step-size factor for the attempt
 W_AB = W_QN + 7                   # base excitation a_b(t + h) at the attempt's end (m/s^2)
 W_K8 = W_QN + 8                   # DOP853's stage s = 1..11, component c: W_K8 + 2 (s - 1) + c
-W_ROWS = W_K8 + 2 * (dop853.N_STAGES - 1)
+W_START = W_K8 + 2 * (dop853.N_STAGES - 1)   # a record's attempt starts at (t s, q m, q' m/s,
+                                             # q'' m/s^2) in rows W_START + 0..3 (`_keep_start`)
+W_ROWS = W_START + 4
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -309,7 +313,6 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     n_flagged = 0
     n_extrema = 0
     n_near = 0
-    record = ex.is_record(base)     # a random record's statistics: every step's (record_step)
     for j in range(n_run):
         t_tail = W[tj.T_TAIL * L + j]         # the lane's own tail window start
         h = W[W_H * L + j]
@@ -331,8 +334,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
         sample = W[tj.SAMPLE * L + j]
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
-        event = active & accepted & (extremum | (not bounded) | straddles | due | crosses
-                                     | record)
+        event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
         done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
         if pi is None:
@@ -391,8 +393,51 @@ def _sine_acceleration(W, settings, n_run, n_near, base):
             tj.refine_marked_lanes(W, LANES, W, W_P * LANES, n_run)
 
 
-# A record's steps are all the scalar path's (`_finish`): this compiles for the sine kinds only.
-_ordinary_acceleration = ex.by_kind(_sine_acceleration, None)
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _keep_start(W, n_run, base):
+    """A record's attempts: each lane's state at the attempt's start (t, q, q', q'') into rows
+    W_START + 0..3, for the statistics of an ordinary step (`_record_statistics`), which
+    `_finish` moves to its end."""
+    L = LANES
+    for j in range(n_run):
+        W[W_START * L + j] = W[tj.T * L + j]
+        W[(W_START + 1) * L + j] = W[tj.Q * L + j]
+        W[(W_START + 2) * L + j] = W[tj.V * L + j]
+        W[(W_START + 3) * L + j] = W[tj.FV * L + j]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_statistics(W, settings, n_run, n_near, base):
+    """A record's ordinary accepted steps (`_finish` moved them to their ends; the others go to
+    trajectory.record_step): what record_step adds for a record's step with nothing to locate
+    inside it, the absolute acceleration's step-end samples (trajectory.observe_acceleration,
+    with the attempt's own a_b at its end, W_AB) and the record's statistics over the step
+    (trajectory.record_statistics: the quintic Hermite's squares, Simpson's rule on the
+    absolute acceleration, the crossings), on the lane's accumulator W[j::LANES]. Not a
+    vector loop (the record is read at the step's middle), but 5-10x cheaper a step than the
+    scalar path's copies and calls (benchmarks/RESULTS.md)."""
+    L = LANES
+    for j in range(n_run):
+        done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
+                & (W[W_FLAG * L + j] == ORDINARY))
+        if not done:
+            continue
+        acc = W[j::L]
+        t_new = W[tj.T * L + j]
+        q_new = W[tj.Q * L + j]
+        v_new = W[tj.V * L + j]
+        fv_new = W[tj.FV * L + j]
+        tj.observe_acceleration(acc, 0, 1, t_new, q_new, v_new, fv_new,
+                                fv_new + W[W_AB * L + j], W[tj.T_TAIL * L + j], True)
+        tj.record_statistics(settings, acc, W, W_P * L + j, L, W[W_START * L + j], t_new,
+                             W[(W_START + 1) * L + j], W[(W_START + 2) * L + j],
+                             W[(W_START + 3) * L + j], q_new, v_new, fv_new, False, 0.0, base)
+
+
+# The ordinary steps' base-excitation metric and statistics, each compiled for its own kind
+# only: a sine's acceleration peak, a record's statistics.
+_ordinary_acceleration = ex.by_kind(_sine_acceleration, _record_statistics)
+_keep_record_start = ex.by_kind(None, _keep_start)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -593,6 +638,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             _attempt8(W, rtol, n_run, parametric, base, record)
         if pi is not None:
             _pi_factors(W, n_run)
+        _keep_record_start(W, n_run, base)
         n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth,
                                                parametric, base)
         _ordinary_acceleration(W, settings, n_run, n_near, base)

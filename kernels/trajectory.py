@@ -977,11 +977,13 @@ def _count_crossings(settings, acc, a, b):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _record_step_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
+def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
                             v_new, fv_new, has_ext, qe, base):
-    """`observe_random` for record_step's accepted step, with the absolute acceleration at
-    both ends (the newest sample's at t_new, the step before's end at t, evaluated here where
-    there is none) and at its middle (q'' on the quintic Hermite, plus a_b there)."""
+    """`observe_random` for a record's accepted step [t, t_new] (s) (record_step's, and the
+    one-mode lanes' ordinary steps', kernels.lanes), with the absolute acceleration at both
+    ends (the newest sample's at t_new, the step before's end at t, evaluated here where there
+    is none) and at its middle (q'' on the quintic Hermite, plus a_b there). Call it after
+    `observe_acceleration` has taken the step's end as its newest sample."""
     if t < acc[T_TAIL]:
         return
     a_new = acc[ACC_SAMPLES + S_A]
@@ -998,7 +1000,7 @@ def _record_step_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_o
 # record_step's kind-specific parts, each compiled only for its own kind (excitation.by_kind):
 # a sine's acceleration peak refined, a record's statistics.
 _refine_sine_peak = ex.by_kind(refine_acceleration_peak, None)
-_observe_record_step = ex.by_kind(None, _record_step_statistics)
+_observe_record_step = ex.by_kind(None, record_statistics)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
