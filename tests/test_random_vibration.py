@@ -151,27 +151,29 @@ def _rows(omega: float, zeta: float, k3: float, realisations: int, fs: float) ->
 
 
 def _run(rows: np.ndarray, records: rnd.Records, t_end: float, t_tail: float,
-         levels: tuple = ()) -> dict[str, np.ndarray]:
-    """The one-mode scalar kernel with DOP853 at rtol 1e-7 over [0, t_end], statistics from
-    t_tail (s)."""
+         levels: tuple = (), driver: str = "scalar") -> dict[str, np.ndarray]:
+    """The one-mode kernel (driver: "scalar" or "lanes") with DOP853 at rtol 1e-7 over
+    [0, t_end], statistics from t_tail (s)."""
     s = np.zeros(tk.N_SETTINGS)
     s[tk.RTOL], s[tk.T_END], s[tk.MAX_STEPS] = 1e-7, t_end, 1e9
     s[tk.MAX_STEP], s[tk.TAIL], s[tk.TOL] = math.inf, (t_end - t_tail) / t_end, 0.02
     s[tk.ATOL_SCALE], s[tk.BASE], s[tk.CONSTANT_STIFFNESS], s[tk.METHOD] = 0.01, 1, 1, 1
     s[tk.N_LEVELS] = len(levels)
     s[tk.LEVEL_0:tk.LEVEL_0 + len(levels)] = levels
-    return transverse_chunk(rows, s, 0, "scalar", -1, False, records.values)
+    return transverse_chunk(rows, s, 0, driver, -1, False, records.values)
 
 
-def test_linear_oscillator_rms_matches_the_exact_integral():
+@pytest.mark.parametrize("driver", ["scalar", "lanes"])
+def test_linear_oscillator_rms_matches_the_exact_integral(driver):
     """A linear 60 Hz oscillator (zeta = 0.05) under FLAT: the mean over 12 records of 10 s of
     the RMS deflection, velocity and absolute acceleration against the exact integrals of
     |H|^2 W, |w H|^2 W and |1 + w^2 H|^2 W, within 4 standard errors of the ensemble (about
-    1 %); the zero up-crossing rate against Rice's sqrt(m2/m0) / 2 pi."""
+    1 %); the zero up-crossing rate against Rice's sqrt(m2/m0) / 2 pi. Both one-mode drivers
+    (the lanes keep a record's ordinary steps' statistics in their own loop)."""
     f, w = rnd.spectrum(FLAT)
     records = rnd.synthesise(f, w, 10.0, 5000.0, 12, 11)
     omega, zeta = 2 * math.pi * 60.0, 0.05
-    out = _run(_rows(omega, zeta, 0.0, 12, 5000.0), records, 10.0, 1.0)
+    out = _run(_rows(omega, zeta, 0.0, 12, 5000.0), records, 10.0, 1.0, driver=driver)
     assert np.all(out["states"] == 8)
     for column, what in ((tk.RMS_DEFLECTION, "deflection"), (tk.RMS_VELOCITY, "velocity"),
                          (tk.RMS_ACCELERATION, "absolute_acceleration")):
@@ -200,14 +202,15 @@ def _fokker_planck(s0: float, omega: float, k3: float) -> tuple[float, callable]
     return var / norm, lambda q: weight(q) / norm
 
 
-def test_hardening_oscillator_matches_the_fokker_planck_density():
+@pytest.mark.parametrize("driver", ["scalar", "lanes"])
+def test_hardening_oscillator_matches_the_fokker_planck_density(driver):
     """A 100 Hz oscillator (zeta = 0.02) with k3 such that eps = k3 s0^2 / w^2 = 1 under a flat
     spectrum (white over its response): the RMS deflection over 16 records of 16 s against the
     exact stationary value (sigma^2 / s0^2 = 0.4679 at eps = 1, by quadrature here), the RMS
     velocity against the linear Gamma^2 W / (8 zeta w) (the density's q' is Gaussian and
     linear), and the up-crossing rates of |q| at 1 and 2 sigma against Rice's 2 sigma_v p(u) /
     sqrt(2 pi). Gaussian equivalent linearisation, (sqrt(1 + 12 eps) - 1) / (6 eps), is 3.7 %
-    low on the RMS: outside the tolerance the engine meets."""
+    low on the RMS: outside the tolerance the engine meets. Both one-mode drivers."""
     flat = [[5.0, 0.02], [1000.0, 0.02]]
     f, w = rnd.spectrum(flat)
     omega, zeta = 2 * math.pi * 100.0, 0.02
@@ -219,7 +222,7 @@ def test_hardening_oscillator_matches_the_fokker_planck_density():
     sigma_v = math.sqrt(w[0] / (8 * zeta * omega))
     records = rnd.synthesise(f, w, 16.0, 10_000.0, 16, 5)
     out = _run(_rows(omega, zeta, k3, 16, 10_000.0), records, 16.0, 1.0,
-               levels=(sigma, 2 * sigma))
+               levels=(sigma, 2 * sigma), driver=driver)
     assert np.all(out["states"] == 8)
     ms = out["reals"][:, tk.RMS_DEFLECTION] ** 2
     error = ms.std(ddof=1) / math.sqrt(ms.size)
