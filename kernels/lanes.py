@@ -313,6 +313,9 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     n_flagged = 0
     n_extrema = 0
     n_near = 0
+    # a record's samples on DOP853's quintic Hermite are `_record_statistics`' (RK45's are its
+    # quartic from the stages: record_step's)
+    sampled_here = ex.is_record(base) & (eighth is not None)
     for j in range(n_run):
         t_tail = W[tj.T_TAIL * L + j]         # the lane's own tail window start
         h = W[W_H * L + j]
@@ -334,7 +337,8 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
         sample = W[tj.SAMPLE * L + j]
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
-        event = active & accepted & (extremum | (not bounded) | straddles | due | crosses)
+        event = active & accepted & (extremum | (not bounded) | straddles
+                                     | (due & (not sampled_here)) | crosses)
         done = active & accepted & (not event)
         rejected_before = W[tj.REJECTED_NOW * L + j] != 0.0
         if pi is None:
@@ -384,7 +388,7 @@ def _observe_acceleration(W, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _sine_acceleration(W, settings, n_run, n_near, base):
+def _sine_acceleration(W, settings, n_run, n_near, series, point, Qc, base):
     """With a sine base excitation (`base` True), and ordinary steps near or in the tail
     window (n_near of them, `_finish`): `_observe_acceleration`, and the acceleration's peaks
     refined where it marked some (trajectory.refine_marked_lanes)."""
@@ -407,16 +411,20 @@ def _keep_start(W, n_run, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _record_statistics(W, settings, n_run, n_near, base):
+def _record_statistics(W, settings, n_run, n_near, series, point, Qc, base):
     """A record's ordinary accepted steps (`_finish` moved them to their ends; the others go to
-    trajectory.record_step): what record_step adds for a record's step with nothing to locate
-    inside it, the absolute acceleration's step-end samples (trajectory.observe_acceleration,
-    with the attempt's own a_b at its end, W_AB) and the record's statistics over the step
-    (trajectory.record_statistics: the quintic Hermite's squares, Simpson's rule on the
-    absolute acceleration, the crossings), on the lane's accumulator W[j::LANES]. Not a
-    vector loop (the record is read at the step's middle), but 5-10x cheaper a step than the
-    scalar path's copies and calls (benchmarks/RESULTS.md)."""
+    trajectory.record_step): what record_step adds for a record's step with no extremum or
+    tail start inside it, the absolute acceleration's step-end samples
+    (trajectory.observe_acceleration, with the attempt's own a_b at its end, W_AB), the
+    record's statistics over the step (trajectory.record_statistics: the quintic Hermite's
+    squares, Simpson's rule on the absolute acceleration, the crossings), on the lane's
+    accumulator W[j::LANES], and with DOP853 the time series' samples in the step (for the
+    spectra) on the quintic Hermite, as record_step takes them (trajectory.take_samples into
+    series[point[j]]; Qc: scratch). Not a vector loop (the record is read at the step's
+    middle), but cheaper than the scalar path's copies and calls (benchmarks/RESULTS.md)."""
     L = LANES
+    dt_sample = settings[SAMPLE_DT]
+    n_samples = series.shape[1]
     for j in range(n_run):
         done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
                 & (W[W_FLAG * L + j] == ORDINARY))
@@ -432,6 +440,14 @@ def _record_statistics(W, settings, n_run, n_near, base):
         tj.record_statistics(settings, acc, W, W_P * L + j, L, W[W_START * L + j], t_new,
                              W[(W_START + 1) * L + j], W[(W_START + 2) * L + j],
                              W[(W_START + 3) * L + j], q_new, v_new, fv_new, False, 0.0, base)
+        k = W[tj.SAMPLE * L + j]
+        if k < n_samples and k * dt_sample <= t_new:
+            t = W[W_START * L + j]
+            q_old = W[(W_START + 1) * L + j]
+            h = W[W_H * L + j]
+            dop853.hermite_coefficients(q_old, W[(W_START + 2) * L + j],
+                                        W[(W_START + 3) * L + j], q_new, v_new, fv_new, h, Qc)
+            tj.take_samples(acc, series[point[j]], t, t_new, h, q_old, Qc, dt_sample)
 
 
 # The ordinary steps' base-excitation metric and statistics, each compiled for its own kind
@@ -641,7 +657,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
         _keep_record_start(W, n_run, base)
         n_flagged, n_extrema, n_near = _finish(W, settings, n_samples, n_run, pi, eighth,
                                                parametric, base)
-        _ordinary_acceleration(W, settings, n_run, n_near, base)
+        _ordinary_acceleration(W, settings, n_run, n_near, series, point, Qc, base)
         if n_flagged == 0:
             continue
         if n_extrema > 0 and eighth is None:

@@ -864,10 +864,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base,
                         eighth)
             have_qc = True
-        while k < n_samples and k * dt_sample <= t_new:
-            series[k] = dense_value(q_old, h, Qc[0], (k * dt_sample - t) / h)
-            k += 1
-        acc[SAMPLE] = k
+        take_samples(acc, series, t, t_new, h, q_old, Qc, dt_sample)
 
     acc[T] = t_new
     acc[Q] = q_new
@@ -875,6 +872,19 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     last = fsal_row(K)
     acc[FQ] = K[last, 0]
     acc[FV] = K[last, 1]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def take_samples(acc, series, t, t_new, h, q_old, Qc, dt_sample):
+    """The time series' samples k dt_sample (s) that fall in the accepted step (t, t_new] of
+    size h (s) from q_old (m), on its dense output Qc (`interpolant`), into series[k] (m), the
+    next sample's index into acc[SAMPLE]."""
+    k = int(acc[SAMPLE])
+    n_samples = series.shape[0]
+    while k < n_samples and k * dt_sample <= t_new:
+        series[k] = dense_value(q_old, h, Qc[0], (k * dt_sample - t) / h)
+        k += 1
+    acc[SAMPLE] = k
 
 
 def _quintic_basis() -> np.ndarray:
