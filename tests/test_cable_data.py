@@ -199,6 +199,27 @@ def test_an_rms_level_on_a_sine_level_key_is_one_line_asking_for_the_peak(dotted
     assert "unknown unit" not in message
 
 
+@pytest.mark.parametrize("dotted, text, expected", [
+    ("base.asd_g2", "0.16 grms^2/Hz", 0.16), ("base.asd_g2", "0.16 grms2/Hz", 0.16),
+    ("base.asd_g2", "0.16 g_rms^2/Hz", 0.16), ("base.asd_g2", "0.04 GRMS2 Hz-1", 0.04),
+    ("base.asd", "0.16 Grms^2/Hz", 0.16 * G0 ** 2),
+    ("base.asd", "0.16 grms**2/Hz", 0.16 * G0 ** 2)])
+def test_grms_squared_per_hertz_on_a_spectral_density_is_g_squared_per_hertz(
+        dotted, text, expected):
+    """An ASD written "0.16 grms^2/Hz" (as engineers write it beside g^2/Hz, the same density)
+    was "unknown unit 'grms'"; it reads as g^2/Hz (by hand, 9.80665 m/s^2 per g)."""
+    key = schema.BY_DOTTED[dotted]
+    assert to_si(f"scene key '{dotted}'", key, text) == pytest.approx(expected, rel=1e-14)
+
+
+def test_grms_squared_per_hertz_through_a_scene_file():
+    text = ('[cable]\nlength = 0.15\nlinear_mass = 0.176\nbending_rigidity = 0.1\n'
+            'axial_rigidity = 1.65e6\n[base]\n'
+            'asd_g2 = [[20.0, "0.026 grms^2/Hz"], [2000.0, "0.026 grms2/Hz"]]\n'
+            'duration = 2.0\n')
+    assert load(text).get("base.asd_g2") == ((20.0, 0.026), (2000.0, 0.026))
+
+
 @pytest.mark.parametrize("dotted, text, named", [
     ("cable.linear_mass", "0.5 g0", "'g0'"), ("load.amplitude", "2 gn", "'gn'"),
     ("base.frequency", "500 mG", "'mG'")])

@@ -20,8 +20,10 @@ the keys in g: base.acceleration_g, base.levels_g) and an acceleration spectral 
 standard gravity (schema.STANDARD_GRAVITY, 9.80665 m/s^2), so "0.5 g" is half of it there, as
 are "g0", "gn", "g_0" and "g_n"; "mG" is a thousandth of it ("500 mG" is 0.5 g). There "mg", a
 milligram, is refused with a line suggesting mG, and an RMS level ("14.1 grms") on a sine's
-level key with a line saying that the key takes the peak. Everywhere else g is the gram
-("33.3 g/m"), and a G, mG, g0 or gn is refused with a line saying where it means gravity.
+level key with a line saying that the key takes the peak. On a spectral density "grms^2/Hz"
+("grms2/Hz", "g_rms^2/Hz", "Grms^2/Hz") is g^2/Hz: engineers write both for the same density.
+Everywhere else g is the gram ("33.3 g/m"), and a G, mG, g0 or gn is refused with a line
+saying where it means gravity.
 A reciprocal unit may be written with its 1: "20 1/s" is "20 /s".
 """
 
@@ -45,6 +47,9 @@ _GRAVITY_NAMES = re.compile(r"(?<![A-Za-z_])(?:g_?n(?![A-Za-z_])|g_?0(?![A-Za-z_
 _MILLI_G = re.compile(r"(?<![A-Za-z_])mG(?![A-Za-z_0-9])")      # a thousandth of gravity
 _MILLIGRAM = re.compile(r"(?<![A-Za-z_])mg(?![A-Za-z_0-9])")    # "500 mg": a mass
 _RMS = re.compile(r"(?<![A-Za-z])(?:[gG]_?)?(?:rms|RMS)(?![A-Za-z])")  # "14.1 grms", "1 g rms"
+_G_RMS = re.compile(r"(?<![A-Za-z_])([gG])_?(?:rms|RMS)(?![A-Za-z_])")   # grms, g_rms, Grms, GRMS
+SPECTRUM_UNITS = ("m2 s-4 Hz-1", schema.G2_UNITS)
+"""Schema units of an acceleration spectral density (base.asd, base.asd_g2)."""
 LEVEL_UNITS = ("m s-2", schema.G_UNITS)
 """Schema units of a sine's level keys (a peak acceleration)."""
 GRAVITY_WORDS = "'g', 'G', 'g0' or 'gn' is standard gravity and 'mG' a thousandth of it"
@@ -91,6 +96,8 @@ def accepted(key: schema.Key) -> str:
         return ""
     quantity = _QUANTITIES.get(key.units, key.units)
     gravity = f" ({GRAVITY_WORDS})" if key.units in ACCELERATION_UNITS else ""
+    if key.units in SPECTRUM_UNITS:
+        gravity = f" ({GRAVITY_WORDS}; 'grms^2/Hz' is g^2/Hz)"
     shown = {schema.G_UNITS: "g", schema.G2_UNITS: "g^2/Hz"}.get(key.units, key.units)
     return (f"a number in {shown}, or a string with "
             f"any {quantity} unit, e.g. {_EXAMPLES.get(key.units, key.units)}{gravity}")
@@ -206,6 +213,8 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
               "acceleration, in g or m/s^2", "give the peak, e.g. '0.5 g' or '4.9 m/s^2' (a "
               "sine's peak is sqrt(2) x its RMS); a random environment's grms comes from its "
               "spectrum, base.asd_g2 in g^2/Hz")
+    if key.units in SPECTRUM_UNITS:      # "0.16 grms^2/Hz" is the same density as g^2/Hz
+        parsed_text = _G_RMS.sub(r"\1", parsed_text)
     if acceleration:
         parsed_text = _MILLI_G.sub("milligravity", _LONE_G.sub("g_0", parsed_text))
     if key.units == "min-1":             # a sweep rate in octaves per minute: "2 oct/min"
@@ -253,7 +262,7 @@ def _milligram(where: str, key: schema.Key, text: str) -> None:
         value = to_si(where, key, fixed)
     except SceneError:
         return
-    power = 2 if key.units in ("m2 s-4 Hz-1", schema.G2_UNITS) else 1
+    power = 2 if key.units in SPECTRUM_UNITS else 1
     in_g = value if key.units in (schema.G_UNITS, schema.G2_UNITS) else (
         value / schema.STANDARD_GRAVITY ** power)
     unit = "g^2/Hz" if power == 2 else "g"
