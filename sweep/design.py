@@ -57,7 +57,7 @@ NaN (or empty, for a string axis) where every value's longest grid length passes
 `direction` already counts at its worst at each length, so --over direction leaves max_span
 as it is and adds `binding_direction`, the direction whose own span is the shorter. length
 and realisation cannot be given (the axis the span is found along; a random result's
-criteria are statistics over its realisations already).
+criteria are statistics over its realisations already), nor an axis twice (one line naming it).
 
 `refine_span` (`sweep design --refine [--tolerance M]`) goes beyond the grid: for each
 bracketed span it bisects on length with one-length engine runs of the result's stored scene,
@@ -637,9 +637,10 @@ BINDING = "binding_"
 
 def over_axes(over: str | Sequence[str] | None, axes: Sequence[str],
               which: str = "the result") -> tuple[str, ...]:
-    """The axes `over` names (one name or a sequence; each once, in the order given), each
-    one of `axes` (a result's swept axes, direction included) other than OVER_REFUSED; a
-    one-line UserError, saying which axes may be given, otherwise. () for none."""
+    """The axes `over` names (one name or a sequence, in the order given), each one of `axes`
+    (a result's swept axes, direction included) other than OVER_REFUSED, and each once; a
+    one-line UserError, saying which axes may be given or naming the repeated one, otherwise.
+    () for none."""
     if over is None:
         return ()
     names = (over,) if isinstance(over, str) else over
@@ -654,7 +655,13 @@ def over_axes(over: str | Sequence[str] | None, axes: Sequence[str],
             raise UserError(f"design: --over {name}: {OVER_REFUSED[name]} ({can})")
         if name not in choices:
             raise UserError(f"design: --over {name}: not an axis of {which} ({can})")
-    return tuple(dict.fromkeys(names))
+    once = tuple(dict.fromkeys(names))
+    for name in once:
+        if names.count(name) > 1:
+            raise UserError(f"design: --over {' '.join(names)}: names the axis '{name}' "
+                            f"{names.count(name)} times (name each axis once: --over "
+                            f"{' '.join(once)})")
+    return once
 
 
 def _first_shortest(spans: np.ndarray) -> np.ndarray:

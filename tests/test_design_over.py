@@ -209,6 +209,33 @@ def test_an_axis_over_cannot_take_is_one_line_naming_those_it_can(over, fragment
         assert "--over takes direction, base_frequency_ratio, damping_ratio" in message
 
 
+@pytest.mark.parametrize("over", [("damping_ratio", "damping_ratio"),
+                                  ["direction", "base_frequency_ratio", "direction"]])
+def test_an_axis_named_twice_is_one_line_naming_it(over):
+    """`over` naming an axis twice was quietly taken once; one line names the repeated axis
+    and asks for each once."""
+    with pytest.raises(sweep.UserError) as info:
+        max_span(stepped(), max_amplitude=2e-3, over=over)
+    message = str(info.value)
+    repeated = over[0]
+    assert "\n" not in message and f"names the axis '{repeated}' 2 times" in message, message
+    assert "name each axis once" in message, message
+
+
+def test_cli_design_over_an_axis_twice_is_one_line_exit_2(tmp_path, capsys):
+    from sweep.version import package_version
+    path = tmp_path / "stepped.nc"
+    stepped().assign_attrs(cable_sweep_version=package_version()).to_netcdf(path)
+    code = main(["design", str(path), "--max-amplitude", "2e-3",
+                 "--over", "base_frequency_ratio", "base_frequency_ratio"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert "'base_frequency_ratio' 2 times" in err and "name each axis once" in err, err
+    assert "--over base_frequency_ratio)" in err, err
+    assert main(["design", str(path), "--max-amplitude", "2e-3",
+                 "--over", "base_frequency_ratio"]) == 0
+
+
 def test_realisation_is_refused_its_criteria_are_over_it_already():
     from test_design_random import synthetic
     with pytest.raises(sweep.UserError, match="statistics over its realisations") as info:
