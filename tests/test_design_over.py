@@ -74,6 +74,37 @@ def test_over_the_mass_is_the_heaviest_cables_closed_form_span():
     assert "binding_bending_rigidity" in table(both) and "0.08" in table(both)
 
 
+def test_the_design_bar_gives_each_binding_value_with_its_units():
+    """The bar of a span over every axis says where it binds: each value was written bare
+    ("at linear_mass 0.08"); now in its axis's units as every other label (a level in g, a
+    dB level in dB, a pure number bare). Read from the figure's text (Agg)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from test_design_random import synthetic
+
+    from sweep import schema
+    from sweep.plot import plot_design
+
+    def note(design: xr.Dataset) -> str:
+        return plot_design(design).axes[0].texts[0].get_text()
+
+    pinned_both = max_span(pinned([0.05, 0.08, 0.03], [0.2, 0.31515]), min_frequency=F_MIN,
+                           over=["bending_rigidity", "linear_mass"])
+    text = note(pinned_both)
+    assert "at linear_mass 0.08 kg/m" in text and "at bending_rigidity 0.2 N m^2" in text, text
+    level = stepped().rename(damping_ratio="base_acceleration_g")
+    level["base_acceleration_g"].attrs.update(units=schema.G_UNITS, long_name="level")
+    text = note(max_span(level, max_amplitude=2e-3,
+                         over=["base_acceleration_g", "direction", "base_frequency_ratio"]))
+    assert "at base_acceleration_g 0.02 g" in text and "at direction up" in text, text
+    assert "at base_frequency_ratio 1\n" in text + "\n", text          # f / f1: no unit
+    random = synthetic(scales=(-3.0, 0.0))          # a real result's level: units 1, "in dB"
+    random["base_asd_scale"].attrs = {"units": "1",
+                                      "long_name": schema.BY_AXIS["base_asd_scale"].long_name}
+    text = note(max_span(random, max_rms=0.002, over="base_asd_scale"))
+    assert "at base_asd_scale 0 dB" in text, text
+
+
 def test_no_span_at_one_value_is_no_span_over_the_axis():
     """A cable so heavy that the shortest grid length already fails has no span (NaN): over
     its axis the NaN binds, named with its criterion and the first such value, however long

@@ -38,6 +38,22 @@ def _scale(spans: np.ndarray) -> tuple[float, str]:
     return (1e3, "mm") if finite.size == 0 or np.nanmax(np.abs(finite)) < 1.0 else (1.0, "m")
 
 
+def _binding_text(da: xr.DataArray) -> str:
+    """A binding_<axis> value of a result with no axis left, with its units as the figures
+    show them (a displacement in mm, a level in g, a dB level in dB; none for a pure number):
+    "0.08 kg/m", "-3 dB", "up"; '' where none binds (NaN, empty)."""
+    at = da.values[()]
+    if not isinstance(at, (float, np.number)):
+        return "" if str(at) in ("", "nan") else str(at)
+    if not np.isfinite(at):
+        return ""
+    factor, units = _unit(da)
+    if units == "1" and " in dB" in str(da.attrs.get("comment", "")):   # quotes the axis's
+        units = "dB"                                                     # long_name
+    text = f"{float(at) * factor:g}"
+    return f"{text} {units}" if units and units != "1" else text
+
+
 def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Figure:
     """max_span (mm below 1 m, else m) of a design result: over one axis a line with markers
     coloured by `limited_by` and a legend naming the criteria; over none a single bar with the
@@ -65,9 +81,8 @@ def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Fig
         note = (f"{v * factor:.4g} {units}\nlimited by {b}" if np.isfinite(v)
                 else f"none: the shortest length\nfails {b}")
         for name in [n for n in ds.data_vars if str(n).startswith("binding_")]:
-            at = ds[name].values[()]         # 'sweep design --over': where the span binds
-            shown = f"{at:g}" if isinstance(at, (float, np.number)) else str(at)
-            if shown not in ("", "nan"):
+            shown = _binding_text(ds[name])  # 'sweep design --over': where the span binds
+            if shown:
                 note += f"\nat {str(name).removeprefix('binding_')} {shown}"
         ax.annotate(note, (0, height), xytext=(0, 4), textcoords="offset points",
                     ha="center", va="bottom")
