@@ -587,7 +587,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     specialisation, compiled without the others' code. `base` likewise: None, or True when
     settings[BASE] is 1 (oscillator's base-excitation switch), or the records of a random base
     acceleration (kernels.excitation's record kind: each lane reads its row's record in its
-    stage chain, and every accepted step goes to record_step for the record's statistics);
+    stage chain; its ordinary steps' statistics are `_record_statistics`', the rest
+    record_step's);
     `steady` True when settings[STOP_STEADY] is 1 (the early stop, trajectory.record_step).
 
     halt (1,): once another thread sets halt[0] != 0 (an interrupt), the call returns after
