@@ -154,12 +154,14 @@ def test_derivative_record_is_the_analytic_derivative():
         np.testing.assert_allclose(fd, dx, atol=1e-6 * np.abs(dx).max())
 
 
-def test_records_follow_the_documented_draws():
+@pytest.mark.parametrize("threads", [1, 2, 5])
+def test_records_follow_the_documented_draws(threads):
     """Another engineer may rebuild a record from the contract: a_k, b_k = sqrt(W df) x
-    rng.standard_normal((2, N//2 + 1)), x(t) = sum a_k cos(2 pi f_k t) + b_k sin(2 pi f_k t)."""
+    rng.standard_normal((2, N//2 + 1)), x(t) = sum a_k cos(2 pi f_k t) + b_k sin(2 pi f_k t);
+    made on one thread or several (more threads than records included), the same records."""
     f, W = rnd.spectrum([[100, 0.1], [300, 0.3], [400, 0.05]])
     seed, fs = 21, 1500.0
-    rec = rnd.synthesise(f, W, 0.2, fs, 3, seed)
+    rec = rnd.synthesise(f, W, 0.2, fs, 3, seed, threads=threads)
     n = rec.samples
     assert n == 300
     df = fs / n
@@ -183,7 +185,9 @@ def test_records_are_deterministic_and_realisations_are_stable(gevs):
     b = rnd.synthesise(f, W, 0.1, 20000.0, 3, 42)
     c = rnd.synthesise(f, W, 0.1, 20000.0, 5, 42)
     d = rnd.synthesise(f, W, 0.1, 20000.0, 3, 43)
+    e = rnd.synthesise(f, W, 0.1, 20000.0, 3, 42, threads=2)
     assert np.array_equal(a.values, b.values)
+    assert np.array_equal(a.values, e.values)                 # the same bits on 2 threads
     assert np.array_equal(a.values, c.values[:3])
     assert not np.any(a.values[:, 0] == d.values[:, 0])
     assert not np.allclose(a.values[0], a.values[1])          # realisations differ

@@ -92,13 +92,14 @@ class RandomInputs:
                    clearance=tuple(float(u) for u in values.get("outputs.clearance") or ()),
                    ramp=random_scene.ramp_time(values))
 
-    def records(self) -> np.ndarray:
+    def records(self, threads: int = 1) -> np.ndarray:
         """The records the kernels take as their `base` switch: (R, 2, N) samples of a_b at
-        0 dB and their derivatives (sweep/models/random.py)."""
+        0 dB and their derivatives (sweep/models/random.py), made on `threads` threads (the
+        same bits on any number)."""
         from .random import synthesise
         f, w = self.spectrum
         return synthesise(f, w, self.duration, self.sample_rate, self.realisations,
-                          self.seed).values
+                          self.seed, threads).values
 
 
 def set_settings(settings: np.ndarray, random: RandomInputs, coeffs: dict[str, Any],

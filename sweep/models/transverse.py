@@ -492,7 +492,8 @@ def _run_time_domain(inputs: Inputs, coeffs: dict[str, Any],
     if inputs.random is not None:          # its statistics window, levels and records
         random_outputs.set_settings(settings, inputs.random, coeffs, inputs.params,
                                     settings[tk.TOL])
-        records = inputs.random.records()
+        from ..threads import thread_count
+        records = inputs.random.records(thread_count(options.threads))
     system = _system(inputs, settings, records)
     reduction = None
     if inputs.random is not None and "outputs.response_asd" in inputs.wanted:
