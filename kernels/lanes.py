@@ -56,7 +56,7 @@ from . import trajectory as tj
 from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, MAX_FACTOR,
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
-from .layout import RTOL, SAMPLE_DT, TOL, WANT_SETTLING
+from .layout import LEVEL_0, N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
@@ -89,7 +89,9 @@ W_AB = W_QN + 7                   # base excitation a_b(t + h) at the attempt's 
 W_K8 = W_QN + 8                   # DOP853's stage s = 1..11, component c: W_K8 + 2 (s - 1) + c
 W_START = W_K8 + 2 * (dop853.N_STAGES - 1)   # a record's attempt starts at (t s, q m, q' m/s,
                                              # q'' m/s^2) in rows W_START + 0..3 (`_keep_start`)
-W_ROWS = W_START + 4
+W_A_MID = W_START + 4   # a record's a_b at an ordinary step's middle (m/s^2; `_record_reads`)
+W_A_OLD = W_START + 5   # q'' + a_b at its start where no step-end sample holds it (m/s^2)
+W_ROWS = W_START + 6
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -410,44 +412,116 @@ def _keep_start(W, n_run, base):
         W[(W_START + 3) * L + j] = W[tj.FV * L + j]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _record_statistics(W, settings, n_run, n_near, series, point, Qc, base):
-    """A record's ordinary accepted steps (`_finish` moved them to their ends; the others go to
-    trajectory.record_step): what record_step adds for a record's step with no extremum or
-    tail start inside it, the absolute acceleration's step-end samples
-    (trajectory.observe_acceleration, with the attempt's own a_b at its end, W_AB), the
-    record's statistics over the step (trajectory.record_statistics: the quintic Hermite's
-    squares, Simpson's rule on the absolute acceleration, the crossings), on the lane's
-    accumulator W[j::LANES], and with DOP853 the time series' samples in the step (for the
-    spectra) on the quintic Hermite, as record_step takes them (trajectory.take_samples into
-    series[point[j]]; Qc: scratch). Not a vector loop (the record is read at the step's
-    middle), but cheaper than the scalar path's copies and calls (benchmarks/RESULTS.md)."""
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline="always")
+def _ordinary(W, j):
+    """Whether lane j's attempt was accepted as an ordinary step (`_finish` moved it)."""
     L = LANES
-    dt_sample = settings[SAMPLE_DT]
-    n_samples = series.shape[1]
+    return (W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0) & (W[W_FLAG * L + j] == ORDINARY)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_reads(W, n_run, base):
+    """The record's values a record's ordinary steps in the statistics window need (a scalar
+    loop: each lane reads its own record): a_b at the step's middle into W_A_MID, and q'' + a_b
+    at its start into W_A_OLD where the step-end samples will not hold it
+    (trajectory.record_statistics' a_old: the step before was not sampled). Before
+    `_record_sums`, which takes the step-end samples."""
+    L = LANES
     for j in range(n_run):
-        done = ((W[W_H * L + j] > 0.0) & (W[W_ERR * L + j] < 1.0)
-                & (W[W_FLAG * L + j] == ORDINARY))
-        if not done:
+        t = W[W_START * L + j]
+        if not (_ordinary(W, j) and t >= W[tj.T_TAIL * L + j]):
             continue
-        acc = W[j::L]
+        o = W_P * L + j
+        h = W[tj.T * L + j] - t
+        W[W_A_MID * L + j] = base_acceleration(t + 0.5 * h, W, o, L, None, base)
+        consecutive = W[tj.ACC_STEP * L + j] == W[tj.STEPS * L + j] - 1.0
+        if not consecutive or math.isnan(W[(tj.ACC_SAMPLES + tj.S_A) * L + j]):
+            W[W_A_OLD * L + j] = (W[(W_START + 3) * L + j]
+                                  + base_acceleration(t, W, o, L, None, base))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_sums(W, settings, n_run):
+    """trajectory.observe_acceleration and trajectory.record_statistics for every lane whose
+    step is ordinary, with straight-line selects so that LLVM vectorises the loop across the
+    lanes (the record's reads are `_record_reads`'): the absolute acceleration's step-end
+    samples (with the attempt's own a_b at its end, W_AB), the window's start and end, the
+    quintic Hermite's squares, Simpson's rule on the absolute acceleration and the crossings of
+    zero and of settings' levels. The same operations in the same order as
+    record_statistics, without fused multiply-adds: the same bits."""
+    L = LANES
+    for j in range(n_run):
+        take = _ordinary(W, j)
         t_new = W[tj.T * L + j]
         q_new = W[tj.Q * L + j]
         v_new = W[tj.V * L + j]
         fv_new = W[tj.FV * L + j]
-        tj.observe_acceleration(acc, 0, 1, t_new, q_new, v_new, fv_new,
-                                fv_new + W[W_AB * L + j], W[tj.T_TAIL * L + j], True)
-        tj.record_statistics(settings, acc, W, W_P * L + j, L, W[W_START * L + j], t_new,
-                             W[(W_START + 1) * L + j], W[(W_START + 2) * L + j],
-                             W[(W_START + 3) * L + j], q_new, v_new, fv_new, False, 0.0, base)
+        tj.observe_acceleration(W, j, L, t_new, q_new, v_new, fv_new,
+                                fv_new + W[W_AB * L + j], W[tj.T_TAIL * L + j], take)
+        t = W[W_START * L + j]
+        q_old = W[(W_START + 1) * L + j]
+        v_old = W[(W_START + 2) * L + j]
+        fv_old = W[(W_START + 3) * L + j]
+        window = take & (t >= W[tj.T_TAIL * L + j])
+        opened = W[tj.IN_WINDOW * L + j]
+        W[tj.W_START * L + j] = t if window & (opened == 0.0) else W[tj.W_START * L + j]
+        W[tj.IN_WINDOW * L + j] = 1.0 if window else opened
+        W[tj.W_END * L + j] = t_new if window else W[tj.W_END * L + j]
+        h = t_new - t
+        square, slope, curve = tj.quintic_squares(h, q_old, v_old, fv_old, q_new, v_new,
+                                                  fv_new)
+        a_new = W[(tj.ACC_SAMPLES + tj.S_A) * L + j]
+        a_old = W[(tj.ACC_SAMPLES + tj.SAMPLE_SIZE + tj.S_A) * L + j]
+        a_old = W[W_A_OLD * L + j] if a_old != a_old else a_old
+        a_mid = (tj.quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+                 + W[W_A_MID * L + j])
+        area = h / 6.0 * (a_old * a_old + 4.0 * a_mid * a_mid + a_new * a_new)
+        W[tj.SUM_Q2 * L + j] += square if window else 0.0
+        W[tj.SUM_V2 * L + j] += slope if window else 0.0
+        W[tj.SUM_F2 * L + j] += curve if window else 0.0
+        W[tj.SUM_A2 * L + j] += area if window else 0.0
+        W[tj.UP_ZERO * L + j] += 1.0 if window & (q_old < 0.0) & (0.0 <= q_new) else 0.0
+    for k in range(int(settings[N_LEVELS])):
+        u = settings[LEVEL_0 + k]
+        for j in range(n_run):
+            window = _ordinary(W, j) & (W[W_START * L + j] >= W[tj.T_TAIL * L + j])
+            a = W[(W_START + 1) * L + j]
+            b = W[tj.Q * L + j]
+            up = ((a < u) & (u <= b)) | ((a > -u) & (-u >= b))
+            W[(tj.UP_LEVEL + k) * L + j] += 1.0 if window & up else 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_samples(W, settings, n_run, series, point, Qc):
+    """With DOP853, the time series' samples (for the spectra) inside a record's ordinary
+    steps, on the quintic Hermite through both ends, as record_step takes them
+    (trajectory.take_samples into series[point[j]]; Qc: scratch)."""
+    L = LANES
+    dt_sample = settings[SAMPLE_DT]
+    n_samples = series.shape[1]
+    for j in range(n_run):
         k = W[tj.SAMPLE * L + j]
-        if k < n_samples and k * dt_sample <= t_new:
-            t = W[W_START * L + j]
-            q_old = W[(W_START + 1) * L + j]
-            h = W[W_H * L + j]
-            dop853.hermite_coefficients(q_old, W[(W_START + 2) * L + j],
-                                        W[(W_START + 3) * L + j], q_new, v_new, fv_new, h, Qc)
-            tj.take_samples(acc, series[point[j]], t, t_new, h, q_old, Qc, dt_sample)
+        t_new = W[tj.T * L + j]
+        if not (_ordinary(W, j) and k < n_samples and k * dt_sample <= t_new):
+            continue
+        t = W[W_START * L + j]
+        q_old = W[(W_START + 1) * L + j]
+        h = W[W_H * L + j]
+        dop853.hermite_coefficients(q_old, W[(W_START + 2) * L + j], W[(W_START + 3) * L + j],
+                                    W[tj.Q * L + j], W[tj.V * L + j], W[tj.FV * L + j], h, Qc)
+        tj.take_samples(W[j::L], series[point[j]], t, t_new, h, q_old, Qc, dt_sample)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _record_statistics(W, settings, n_run, n_near, series, point, Qc, base):
+    """A record's ordinary accepted steps (`_finish` moved them to their ends; the others go to
+    trajectory.record_step): what record_step adds for a record's step with no extremum or
+    tail start inside it, the record's reads (`_record_reads`), the step-end samples and
+    statistics (`_record_sums`, a vector loop) and the spectra's samples (`_record_samples`)."""
+    _record_reads(W, n_run, base)
+    _record_sums(W, settings, n_run)
+    if series.shape[1] > 0:
+        _record_samples(W, settings, n_run, series, point, Qc)
 
 
 # The ordinary steps' base-excitation metric and statistics, each compiled for its own kind

@@ -320,7 +320,7 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
             r1 += w * y_new[n + c]
             a0 += w * f[n + c]
             a1 += w * f_new[n + c]
-        square, slope, curve = tj._quintic_squares(h, c0, r0, a0, c1, r1, a1)
+        square, slope, curve = tj.quintic_squares(h, c0, r0, a0, c1, r1, a1)
         modal[slot + 3 * k] += square
         modal[slot + 3 * k + 1] += slope
         modal[slot + 3 * k + 2] += curve

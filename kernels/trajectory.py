@@ -933,8 +933,8 @@ def _quintic_midpoint_row() -> tuple[float, ...]:
 _MID = _quintic_midpoint_row()
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def _quintic_midpoint_curvature(h, q0, v0, a0, q1, v1, a1):
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def quintic_midpoint_curvature(h, q0, v0, a0, q1, v1, a1):
     """q'' (m/s^2) at the middle of a step of h (s) on the quintic Hermite through q, q' = v
     and q'' = a at both ends (`_MID`)."""
     return (_MID[0] * q0 + _MID[1] * h * v0 + _MID[2] * h * h * a0 + _MID[3] * q1
@@ -944,7 +944,7 @@ def _quintic_midpoint_curvature(h, q0, v0, a0, q1, v1, a1):
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _form(M, c0, c1, c2, c3, c4, c5):
     """c^T M c for the 6 x 6 matrix M, written out: a loop over a tuple's items indexes it at
-    run time, which Numba compiles to a slow switch (277 ns for `_quintic_squares` against 28
+    run time, which Numba compiles to a slow switch (277 ns for `quintic_squares` against 28
     written out, benchmarks/RESULTS.md)."""
     return (c0 * (M[0, 0] * c0 + M[0, 1] * c1 + M[0, 2] * c2 + M[0, 3] * c3 + M[0, 4] * c4
                   + M[0, 5] * c5)
@@ -960,8 +960,8 @@ def _form(M, c0, c1, c2, c3, c4, c5):
                     + M[5, 5] * c5))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def _quintic_squares(h, q0, v0, a0, q1, v1, a1):
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def quintic_squares(h, q0, v0, a0, q1, v1, a1):
     """The integrals over a step of length h (s) of q^2, q'^2 and q''^2 on the quintic
     Hermite through q, q' = v and q'' = a at both ends: (h c^T M c, c^T D c / h,
     c^T E c / h^3), c = (q0, h v0, h^2 a0, q1, h v1, h^2 a1), M, D, E `_quintic_gram`'s."""
@@ -1001,7 +1001,7 @@ def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_
     if math.isnan(a_old):
         a_old = fv_old + base_acceleration(t, p, o, s, None, base)
     h = t_new - t
-    a_mid = (_quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+    a_mid = (quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
              + base_acceleration(t + 0.5 * h, p, o, s, None, base))
     observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
                    a_old, a_mid, a_new, has_ext, qe)
@@ -1020,7 +1020,7 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
     deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
     m/s^2, at both ends and a_mid at the middle; qe its extremum inside the step where has_ext),
     once the step starts at or after the tail window's start: the integrals of q^2, q'^2 and
-    q''^2 on the quintic Hermite through q, q', q'' at both ends (`_quintic_squares`) and of
+    q''^2 on the quintic Hermite through q, q', q'' at both ends (`quintic_squares`) and of
     (q'' + a_b)^2 by Simpson's rule (SCALAR_SLOTS; the trapezoidal rule on the ends read a
     reviewer's clamped span's RMS 0.24-0.29 % high where the steps are long), and the
     crossings of zero and of settings' levels on the step's monotone pieces, q_old to qe to
@@ -1032,7 +1032,7 @@ def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, 
         acc[W_START] = t
     h = t_new - t
     acc[W_END] = t_new
-    square, slope, curve = _quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+    square, slope, curve = quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
     acc[SUM_Q2] += square
     acc[SUM_V2] += slope
     acc[SUM_F2] += curve

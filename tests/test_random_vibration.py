@@ -546,7 +546,7 @@ def test_a_steps_absolute_acceleration_is_integrated_by_simpson_on_its_quintic()
     v = lambda t: w * math.cos(w * t)                      # noqa: E731
     f = lambda t: -w * w * math.sin(w * t)                 # noqa: E731
     a = lambda t: f(t) + math.cos(3.0 * t)                 # noqa: E731
-    mid = tj._quintic_midpoint_curvature(h, q(t0), v(t0), f(t0), q(t1), v(t1), f(t1))
+    mid = tj.quintic_midpoint_curvature(h, q(t0), v(t0), f(t0), q(t1), v(t1), f(t1))
     assert mid == pytest.approx(f(t0 + h / 2), rel=2e-3)
     settings = np.zeros(tk.N_SETTINGS)
     acc = np.zeros(tj.SCALAR_SLOTS)
