@@ -56,7 +56,7 @@ from . import trajectory as tj
 from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, MAX_FACTOR,
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
-from .layout import LEVEL_0, N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
+from .layout import N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
 from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
@@ -442,13 +442,13 @@ def _record_reads(W, n_run, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_sums(W, settings, n_run):
-    """trajectory.observe_acceleration and trajectory.record_statistics for every lane whose
-    step is ordinary, with straight-line selects so that LLVM vectorises the loop across the
-    lanes (the record's reads are `_record_reads`'): the absolute acceleration's step-end
-    samples (with the attempt's own a_b at its end, W_AB), the window's start and end, the
-    quintic Hermite's squares, Simpson's rule on the absolute acceleration and the crossings of
-    zero and of settings' levels. The same operations in the same order as
-    record_statistics, without fused multiply-adds: the same bits."""
+    """For every lane whose step is ordinary, the Observer's step-end samples of the absolute
+    acceleration (trajectory.observe_acceleration, with the attempt's own a_b at its end,
+    W_AB) and the record's statistics (trajectory.observe_random: the window, the quintic
+    Hermite's squares, Simpson's rule, the zero crossings; observe_level_crossings in a loop of
+    its own), in loops across the lanes that LLVM vectorises (both observers are straight-line
+    selects; the record's reads are `_record_reads`'), with trajectory.record_statistics'
+    inputs and without fused multiply-adds: the scalar path's bits."""
     L = LANES
     for j in range(n_run):
         take = _ordinary(W, j)
@@ -462,33 +462,19 @@ def _record_sums(W, settings, n_run):
         q_old = W[(W_START + 1) * L + j]
         v_old = W[(W_START + 2) * L + j]
         fv_old = W[(W_START + 3) * L + j]
-        window = take & (t >= W[tj.T_TAIL * L + j])
-        opened = W[tj.IN_WINDOW * L + j]
-        W[tj.W_START * L + j] = t if window & (opened == 0.0) else W[tj.W_START * L + j]
-        W[tj.IN_WINDOW * L + j] = 1.0 if window else opened
-        W[tj.W_END * L + j] = t_new if window else W[tj.W_END * L + j]
         h = t_new - t
-        square, slope, curve = tj.quintic_squares(h, q_old, v_old, fv_old, q_new, v_new,
-                                                  fv_new)
         a_new = W[(tj.ACC_SAMPLES + tj.S_A) * L + j]
         a_old = W[(tj.ACC_SAMPLES + tj.SAMPLE_SIZE + tj.S_A) * L + j]
         a_old = W[W_A_OLD * L + j] if a_old != a_old else a_old
         a_mid = (tj.quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
                  + W[W_A_MID * L + j])
-        area = h / 6.0 * (a_old * a_old + 4.0 * a_mid * a_mid + a_new * a_new)
-        W[tj.SUM_Q2 * L + j] += square if window else 0.0
-        W[tj.SUM_V2 * L + j] += slope if window else 0.0
-        W[tj.SUM_F2 * L + j] += curve if window else 0.0
-        W[tj.SUM_A2 * L + j] += area if window else 0.0
-        W[tj.UP_ZERO * L + j] += 1.0 if window & (q_old < 0.0) & (0.0 <= q_new) else 0.0
+        tj.observe_random(W, j, L, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
+                          a_old, a_mid, a_new, False, 0.0, take)
     for k in range(int(settings[N_LEVELS])):
-        u = settings[LEVEL_0 + k]
         for j in range(n_run):
             window = _ordinary(W, j) & (W[W_START * L + j] >= W[tj.T_TAIL * L + j])
-            a = W[(W_START + 1) * L + j]
-            b = W[tj.Q * L + j]
-            up = ((a < u) & (u <= b)) | ((a > -u) & (-u >= b))
-            W[(tj.UP_LEVEL + k) * L + j] += 1.0 if window & up else 0.0
+            tj.observe_level_crossings(settings, W, j, L, k, W[(W_START + 1) * L + j], 0.0,
+                                       W[tj.Q * L + j], False, window)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -974,26 +974,28 @@ def quintic_squares(h, q0, v0, a0, q1, v1, a1):
             _form(_CURVE_GRAM, q0, c1, c2, q1, c4, c5) / (h * h * h))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def _count_crossings(settings, acc, a, b):
-    """Crossings on a monotone piece of q from a to b (m): of zero upwards, and of each of
-    settings' levels u by |q| upwards (q up through u, or down through -u)."""
-    if a < 0.0 <= b:
-        acc[UP_ZERO] += 1.0
-    for k in range(int(settings[N_LEVELS])):
-        u = settings[LEVEL_0 + k]
-        if (a < u <= b) or (a > -u >= b):
-            acc[UP_LEVEL + k] += 1.0
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _up_zero(a, b):
+    """1.0 where a monotone piece of q from a to b (m) crosses zero upwards, else 0.0."""
+    return 1.0 if (a < 0.0) & (0.0 <= b) else 0.0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _up_level(a, b, u):
+    """1.0 where a monotone piece of q from a to b (m) takes |q| up through the level u (m):
+    q up through u, or down through -u; else 0.0."""
+    return 1.0 if ((a < u) & (u <= b)) | ((a > -u) & (-u >= b)) else 0.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
-                            v_new, fv_new, has_ext, qe, base):
-    """`observe_random` for a record's accepted step [t, t_new] (s) (record_step's, and the
-    one-mode lanes' ordinary steps', kernels.lanes), with the absolute acceleration at both
-    ends (the newest sample's at t_new, the step before's end at t, evaluated here where there
-    is none) and at its middle (q'' on the quintic Hermite, plus a_b there). Call it after
-    `observe_acceleration` has taken the step's end as its newest sample."""
+                      v_new, fv_new, has_ext, qe, base):
+    """`observe_random` and `observe_level_crossings` for record_step's accepted step
+    [t, t_new] (s) of a record, with the absolute acceleration at both ends (the newest
+    sample's at t_new, the step before's end at t, evaluated here where there is none) and at
+    its middle (q'' on the quintic Hermite, plus a_b there). Call it after
+    `observe_acceleration` has taken the step's end as its newest sample. (The one-mode lanes
+    call the two observers in their own vector loops: kernels.lanes `_record_sums`.)"""
     if t < acc[T_TAIL]:
         return
     a_new = acc[ACC_SAMPLES + S_A]
@@ -1003,8 +1005,10 @@ def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_
     h = t_new - t
     a_mid = (quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
              + base_acceleration(t + 0.5 * h, p, o, s, None, base))
-    observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
-                   a_old, a_mid, a_new, has_ext, qe)
+    window = observe_random(acc, 0, 1, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
+                            a_old, a_mid, a_new, has_ext, qe, True)
+    for k in range(int(settings[N_LEVELS])):
+        observe_level_crossings(settings, acc, 0, 1, k, q_old, qe, q_new, has_ext, window)
 
 
 # record_step's kind-specific parts, each compiled only for its own kind (excitation.by_kind):
@@ -1013,35 +1017,46 @@ _refine_sine_peak = ex.by_kind(refine_acceleration_peak, None)
 _observe_record_step = ex.by_kind(None, record_statistics)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def observe_random(settings, acc, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
-                   a_old, a_mid, a_new, has_ext, qe):
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def observe_random(acc, a, sa, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new, a_old,
+                   a_mid, a_new, has_ext, qe, take):
     """The record kind's statistics of the accepted step [t, t_new] (s) of the watched
     deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
     m/s^2, at both ends and a_mid at the middle; qe its extremum inside the step where has_ext),
-    once the step starts at or after the tail window's start: the integrals of q^2, q'^2 and
-    q''^2 on the quintic Hermite through q, q', q'' at both ends (`quintic_squares`) and of
-    (q'' + a_b)^2 by Simpson's rule (SCALAR_SLOTS; the trapezoidal rule on the ends read a
-    reviewer's clamped span's RMS 0.24-0.29 % high where the steps are long), and the
-    crossings of zero and of settings' levels on the step's monotone pieces, q_old to qe to
-    q_new (a level grazed inside a step counts)."""
-    if t < acc[T_TAIL]:
-        return
-    if acc[IN_WINDOW] == 0.0:
-        acc[IN_WINDOW] = 1.0
-        acc[W_START] = t
+    accumulator at acc[a + slot * sa] as `observe_step_end`'s, where `take` and the step
+    starts at or after the tail window's start (returned: whether it did): the window's start
+    and end, the integrals of q^2, q'^2 and q''^2 on the quintic Hermite through q, q', q'' at
+    both ends (`quintic_squares`) and of (q'' + a_b)^2 by Simpson's rule (SCALAR_SLOTS; the
+    trapezoidal rule on the ends read a reviewer's clamped span's RMS 0.24-0.29 % high where
+    the steps are long), and the up-crossings of zero on the step's monotone pieces, q_old to
+    qe to q_new (the levels': `observe_level_crossings`). Straight-line selects, so that the
+    lanes' loop vectorises; adding 0.0 where not taken leaves a sum's bits as they were."""
+    window = take & (t >= acc[a + T_TAIL * sa])
+    opened = acc[a + IN_WINDOW * sa]
+    acc[a + W_START * sa] = t if window & (opened == 0.0) else acc[a + W_START * sa]
+    acc[a + IN_WINDOW * sa] = 1.0 if window else opened
+    acc[a + W_END * sa] = t_new if window else acc[a + W_END * sa]
     h = t_new - t
-    acc[W_END] = t_new
     square, slope, curve = quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
-    acc[SUM_Q2] += square
-    acc[SUM_V2] += slope
-    acc[SUM_F2] += curve
-    acc[SUM_A2] += h / 6.0 * (a_old * a_old + 4.0 * a_mid * a_mid + a_new * a_new)
-    if has_ext:
-        _count_crossings(settings, acc, q_old, qe)
-        _count_crossings(settings, acc, qe, q_new)
-    else:
-        _count_crossings(settings, acc, q_old, q_new)
+    area = h / 6.0 * (a_old * a_old + 4.0 * a_mid * a_mid + a_new * a_new)
+    acc[a + SUM_Q2 * sa] += square if window else 0.0
+    acc[a + SUM_V2 * sa] += slope if window else 0.0
+    acc[a + SUM_F2 * sa] += curve if window else 0.0
+    acc[a + SUM_A2 * sa] += area if window else 0.0
+    up = (_up_zero(q_old, qe) + _up_zero(qe, q_new)) if has_ext else _up_zero(q_old, q_new)
+    acc[a + UP_ZERO * sa] += up if window else 0.0
+    return window
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def observe_level_crossings(settings, acc, a, sa, k, q_old, qe, q_new, has_ext, window):
+    """Level k's up-crossings of |q| through settings[LEVEL_0 + k] (m) on the step's monotone
+    pieces, q_old to qe (its extremum, where has_ext) to q_new (m), into acc[a + (UP_LEVEL +
+    k) * sa], where `window` (`observe_random`'s; a level grazed inside a step counts)."""
+    u = settings[LEVEL_0 + k]
+    up = (_up_level(q_old, qe, u) + _up_level(qe, q_new, u)) if has_ext else _up_level(
+        q_old, q_new, u)
+    acc[a + (UP_LEVEL + k) * sa] += up if window else 0.0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

@@ -548,12 +548,11 @@ def test_a_steps_absolute_acceleration_is_integrated_by_simpson_on_its_quintic()
     a = lambda t: f(t) + math.cos(3.0 * t)                 # noqa: E731
     mid = tj.quintic_midpoint_curvature(h, q(t0), v(t0), f(t0), q(t1), v(t1), f(t1))
     assert mid == pytest.approx(f(t0 + h / 2), rel=2e-3)
-    settings = np.zeros(tk.N_SETTINGS)
     acc = np.zeros(tj.SCALAR_SLOTS)
     acc[tj.T_TAIL] = 0.0
     a_mid = mid + math.cos(3.0 * (t0 + h / 2))
-    tj.observe_random(settings, acc, t0, t1, q(t0), v(t0), f(t0), q(t1), v(t1), f(t1),
-                      a(t0), a_mid, a(t1), False, 0.0)
+    assert tj.observe_random(acc, 0, 1, t0, t1, q(t0), v(t0), f(t0), q(t1), v(t1), f(t1),
+                             a(t0), a_mid, a(t1), False, 0.0, True)
     exact = quad(lambda t: a(t) ** 2, t0, t1, epsabs=0.0, epsrel=1e-12)[0]
     trapezoid = 0.5 * h * (a(t0) ** 2 + a(t1) ** 2)
     assert acc[tj.SUM_A2] == pytest.approx(exact, rel=2e-3)
