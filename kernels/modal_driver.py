@@ -389,6 +389,29 @@ def _span_bound(y, h, QA, n_modes, shapes):
     return bound
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def illinois_next(lo, hi, g_lo, g_hi, bisect):
+    """The next point at which the Illinois method evaluates a rate g that falls through zero
+    in [lo, hi] (g_lo >= 0 > g_hi, ends already weighted by `illinois_keep`): the regula
+    falsi's root of the chord, or the middle where `bisect` (the bracket failed to halve), where
+    the chord is flat or where its root is not inside."""
+    if bisect or not g_lo > g_hi:
+        return 0.5 * (lo + hi)
+    x = lo + (hi - lo) * g_lo / (g_lo - g_hi)
+    return x if lo < x < hi else 0.5 * (lo + hi)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def illinois_keep(lo, hi, g_lo, g_hi, kept, x, g):
+    """The Illinois method's bracket (lo, hi, g_lo, g_hi, kept) after the rate g at x: x
+    replaces the end whose rate has g's side (g > 0: lo), and the other end's rate is halved
+    where that end was kept the step before too (kept: the end kept last, -1 lo, +1 hi, 0
+    none), so the chord does not stall on one side."""
+    if g > 0.0:
+        return x, hi, g, g_hi * 0.5 if kept == 1 else g_hi, 1
+    return lo, x, g_lo * 0.5 if kept == -1 else g_lo, g, -1
+
+
 SPAN_SAMPLES = 4
 """Intervals of an accepted step at whose ends `observe_span` takes the span's maximum: a
 crest in time of the largest deflection shows as its rate turning from rising to falling
@@ -518,26 +541,12 @@ def _span_crest(y, h, QA, n, qx, basis, lo, hi, g_lo, g_hi, x_lo, x_hi):
     width = hi - lo
     bisect = False
     for _ in range(SPAN_ITERATIONS):
-        if bisect or not g_lo > g_hi:
-            s = 0.5 * (lo + hi)
-        else:
-            s = lo + (hi - lo) * g_lo / (g_lo - g_hi)
-            if not (lo < s < hi):
-                s = 0.5 * (lo + hi)
+        s = illinois_next(lo, hi, g_lo, g_hi, bisect)
         value, place, g = _span_sample(y, h, QA, s, n, qx, basis)
         if value > top:
             top = value
             where = place
-        if g > 0.0:
-            lo, g_lo = s, g
-            if kept == 1:
-                g_hi *= 0.5
-            kept = 1
-        else:
-            hi, g_hi = s, g
-            if kept == -1:
-                g_lo *= 0.5
-            kept = -1
+        lo, hi, g_lo, g_hi, kept = illinois_keep(lo, hi, g_lo, g_hi, kept, s, g)
         if hi - lo <= SPAN_WIDTH or g == 0.0:
             break
         bisect = hi - lo > 0.5 * width
@@ -838,26 +847,12 @@ def _load_peak(t, y, h, QA, n, basis, modal, qv, m, p1, base, k, g_lo, g_hi, x_t
     bisect = False
     peak = 0.0
     for _ in range(ROOT_ITERATIONS):
-        if bisect or not g_lo > g_hi:
-            x = 0.5 * (lo + hi)
-        else:
-            x = lo + (hi - lo) * g_lo / (g_lo - g_hi)
-            if not (lo < x < hi):
-                x = 0.5 * (lo + hi)
+        x = illinois_next(lo, hi, g_lo, g_hi, bisect)
         _loads_at(t, y, h, QA, x, n, basis, modal, qv, m, p1, base)
         if x >= x_tail:
             peak = max(peak, abs(m[2 * k]))
         g = _load_rises(m, k)
-        if g > 0.0:
-            lo, g_lo = x, g
-            if kept == 1:
-                g_hi *= 0.5
-            kept = 1
-        else:
-            hi, g_hi = x, g
-            if kept == -1:
-                g_lo *= 0.5
-            kept = -1
+        lo, hi, g_lo, g_hi, kept = illinois_keep(lo, hi, g_lo, g_hi, kept, x, g)
         if hi - lo <= ROOT_WIDTH or g == 0.0:
             break
         bisect = hi - lo > 0.5 * width
