@@ -38,9 +38,11 @@ A random base acceleration (kernels.excitation's record kind: `base` is the reco
 too, on stage chains of its own (`_chain5_r`, `_chain8_r`: each lane reads its row's record
 through a call, so that loop is not vectorised, but the chain is still written out from the
 tableau). A record's accepted step with anything to locate inside it (an extremum of q, the
-tail's start, a sample) goes to record_step as above; its ordinary steps get the record's
-statistics (trajectory.record_statistics, the scalar driver's arithmetic) in
-`_record_statistics`, on the lane's own accumulator, without the scalar path's copies.
+tail's start, a divergence) goes to record_step as above; its ordinary steps get the
+record's statistics in `_record_statistics`, on the lane's own accumulator: the record's
+reads in a scalar loop, then the observers record_step calls (trajectory.observe_acceleration,
+observe_random, observe_level_crossings: straight-line selects) in vector loops, and the
+spectra's samples (trajectory.take_samples), so the same bits as the scalar path.
 """
 
 import math
