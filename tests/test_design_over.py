@@ -105,6 +105,40 @@ def test_the_design_bar_gives_each_binding_value_with_its_units():
     assert "at base_asd_scale 0 dB" in text, text
 
 
+def test_the_design_line_writes_where_each_span_binds_with_units():
+    """Over one axis left the chart coloured each point by its criterion but drew no binding
+    value; now each point is labelled with the --over values it binds at, in their units,
+    and the legend names the axes. The values are the hand-computed ones of
+    test_over_frequency_and_direction_is_the_resonant_steps_span (1.1 down at 5 % damping,
+    1 up at 2 %) and the heaviest cable of the closed form (0.08 kg/m). Read from the
+    figure's text (Agg)."""
+    import matplotlib
+    matplotlib.use("Agg")
+
+    from sweep.plot import plot_design
+
+    def labels(design: xr.Dataset) -> tuple[dict[float, str], str]:
+        ax = plot_design(design).axes[0]
+        legend = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert any("max_amplitude" in t or "min_frequency" in t for t in legend), legend
+        return ({round(float(t.xy[0]), 9): t.get_text() for t in ax.texts},
+                "\n".join(legend))
+
+    texts, legend = labels(max_span(stepped(), max_amplitude=2e-3,
+                                    over=("base_frequency_ratio", "direction")))
+    assert texts == {0.05: "1.1\ndown", 0.02: "1\nup"}, texts
+    assert "base_frequency_ratio / direction it binds at" in legend, legend
+    texts, legend = labels(max_span(pinned([0.05, 0.08, 0.03], [0.2, 0.31515]),
+                                    min_frequency=F_MIN, over="linear_mass"))
+    assert texts == {0.2: "0.08 kg/m", 0.31515: "0.08 kg/m"}, texts
+    assert "linear_mass it binds at" in legend, legend
+    # over more than a dozen points a value is written where it changes: here once
+    texts, legend = labels(max_span(pinned([0.05, 0.08], list(np.linspace(0.2, 0.32, 13))),
+                                    min_frequency=F_MIN, over="linear_mass"))
+    assert texts == {0.2: "0.08 kg/m"}, texts
+    assert "where they change" in legend, legend
+
+
 def test_no_span_at_one_value_is_no_span_over_the_axis():
     """A cable so heavy that the shortest grid length already fails has no span (NaN): over
     its axis the NaN binds, named with its criterion and the first such value, however long

@@ -1,6 +1,7 @@
 """The design chart of a 'sweep design' result (sweep/design.py): max_span against the one
-axis the result has left, each point coloured by the criterion that binds it; a result with
-no axis left gets a single bar with its value written on it."""
+axis the result has left, each point coloured by the criterion that binds it and labelled
+with the values of the --over axes it binds at; a result with no axis left gets a single bar
+with its value, criterion and binding values written on it."""
 
 from __future__ import annotations
 
@@ -54,9 +55,38 @@ def _binding_text(da: xr.DataArray) -> str:
     return f"{text} {units}" if units and units != "1" else text
 
 
+MAX_POINT_LABELS = 12
+"""Over more points than this the line chart writes a point's binding values only where they
+change from the point before (a run of equal values labelled at its first point)."""
+
+
+def _label_bindings(ax: Axes, ds: xr.Dataset, x: np.ndarray, y: np.ndarray,
+                    floor: float) -> str:
+    """Write above each point of the line chart the values its span binds at ('sweep design
+    --over': the binding_<axis> variables, one a line, in their units as `_binding_text`
+    gives them; a NaN span's at the marker on the floor). Returns the legend line naming the
+    axes in the order the labels list them ('' where the result has none)."""
+    names = [str(n) for n in ds.data_vars if str(n).startswith("binding_")]
+    if not names:
+        return ""
+    texts = ["\n".join(_binding_text(ds[n][i]) or "-" for n in names) for i in range(len(x))]
+    changes_only = len(x) > MAX_POINT_LABELS
+    for i, text in enumerate(texts):
+        if set(text.split("\n")) == {"-"} or (changes_only and i and text == texts[i - 1]):
+            continue                                     # none binds (grid), or a repeat
+        ax.annotate(text, (x[i], y[i] if np.isfinite(y[i]) else floor), xytext=(0, 7),
+                    textcoords="offset points", ha="center", va="bottom", fontsize="small",
+                    linespacing=1.0, zorder=3)
+    ax.margins(x=0.1, y=0.08 + 0.06 * len(names))      # room for the top and end labels
+    axes = " / ".join(n.removeprefix("binding_") for n in names)
+    where = " where they change" if changes_only else ""
+    return f"above each point{where}: the {axes} it binds at"
+
+
 def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Figure:
     """max_span (mm below 1 m, else m) of a design result: over one axis a line with markers
-    coloured by `limited_by` and a legend naming the criteria; over none a single bar with the
+    coloured by `limited_by`, a legend naming the criteria and, for a span over other axes
+    ('sweep design --over'), the values it binds at written above each point; over none a single bar with the
     value annotated. A NaN span (the shortest grid length fails) is marked at the bottom of
     the axes. Extra keyword arguments go to `Axes.plot` (or `Axes.bar`). Returns the Figure.
     Raises UserError (one line) for a result over more than one axis (select one value of the
@@ -112,6 +142,9 @@ def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Fig
                            color=colour, marker="v", s=40, zorder=2)
                 text += "; v: shortest length fails"
             handles.append(Line2D([], [], color=colour, marker=marker, ls="", label=text))
+        key = _label_bindings(ax, ds, x, values * factor, floor)
+        if key:
+            handles.append(Line2D([], [], ls="", label=key))
         ax.set_xlabel(label(ds[dim], units=_unit(ds[dim])[1]))
         if dim == POINT_DIM:
             point_ticks(ax, ds, "x")
