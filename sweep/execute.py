@@ -904,10 +904,14 @@ def _connect(scheduler: str | None, workers: int) -> tuple[Any, Any]:
     import dask
     cluster = None
     try:
+        # No dashboard; the scheduler's HTTP server (health and metrics routes, which it
+        # always starts) on a free loopback port: on its default, 8787, it warns "Port 8787 is
+        # already in use" to the user whenever another cluster or process holds that port.
         with dask.config.set({"distributed.worker.preload": ["sweep.dask_worker"]}):
             cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
                                    threads_per_worker=1,
                                    processes=True, dashboard_address=None, host="127.0.0.1",
+                                   scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                    silence_logs=logging.CRITICAL + 1)
         return Client(cluster, timeout=CONNECT_SECONDS), cluster
     except (Exception, asyncio.CancelledError) as exc:

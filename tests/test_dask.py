@@ -264,6 +264,32 @@ def test_a_listener_that_never_answers_is_one_line_not_a_hang(tmp_path, capsys, 
         listener.close()
 
 
+def test_a_dask_run_says_nothing_of_a_busy_dashboard_port(tmp_path):
+    """The LocalCluster's scheduler always starts an HTTP server; on its default port, 8787,
+    it warned the user "Port 8787 is already in use ... Hosting the HTTP server on port N
+    instead" whenever another cluster held it. With 8787 held here (or by someone else: then
+    busy all the same), a quiet dask run of a tiny scene writes nothing to stderr."""
+    pytest.importorskip("dask.distributed")
+    holder = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen(1)
+    except OSError:
+        pass                                          # in use already: as busy as we need
+    scene = tmp_path / "s.toml"
+    scene.write_text(TINY)
+    try:
+        proc = subprocess.run([sys.executable, "-m", "sweep", "run", str(scene), "-q",
+                               "-o", str(tmp_path / "out.nc"), "--backend", "dask",
+                               "--workers", "1"], capture_output=True, text=True,
+                              env=_env(), cwd=tmp_path, timeout=240)
+    finally:
+        holder.close()
+    assert proc.returncode == 0, proc.stderr
+    assert stderr_lines(proc.stderr) == [], proc.stderr
+    assert (tmp_path / "out.nc").exists()
+
+
 def _stderr_target() -> str:
     return os.readlink("/proc/self/fd/2")
 
