@@ -350,3 +350,60 @@ def test_a_quiet_run_without_an_output_is_refused_before_any_work(capsys):
     assert main(["run", "paper-fig5", "-q"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--quiet without -o" in err[0]
+
+
+SINE_BESIDE = """
+name = "sine-beside-gevs"
+[model]
+kind = "transverse"
+coefficients = "consistent"
+modes = 1
+[base]
+acceleration_g = 1.0
+sweep = { start = 20.0, stop = 40.0, rate = 8.0, direction = "both" }
+[initial]
+displacement = 0.0
+velocity = 0.0
+"""
+
+
+def test_the_readme_merge_of_a_sine_and_a_random_result_keeps_both(random_file, tmp_path,
+                                                                     monkeypatch):
+    """A sine sweep and a random result of the same cable and spans name their run outputs
+    alike over other dimensions: a plain xr.merge stops on one of them. The README's lines (run
+    as printed, on qual.nc and gevs.nc) give one Dataset with the span's natural_frequency
+    once and each run's state and peak_amplitude as that run wrote them."""
+    import re
+    from pathlib import Path
+
+    gevs, gevs_path = random_file
+    cable = sweep.load_scene_text(gevs.attrs["scene"])
+    keys = ("linear_mass", "bending_rigidity", "axial_rigidity", "damping_ratio")
+    scene = sweep.load_scene_text(SINE_BESIDE, overrides={
+        **{f"cable.{k}": cable.get(f"cable.{k}") for k in keys},
+        "axes.length": [float(v) for v in gevs["length"].values]})
+    monkeypatch.chdir(tmp_path)
+    sine = sweep.run(scene, output="qual.nc", progress=False)
+    Path("gevs.nc").symlink_to(gevs_path)
+    with xr.open_dataset("qual.nc") as a, xr.open_dataset("gevs.nc") as b:
+        with pytest.raises(xr.MergeError, match="conflicting values for variable"):
+            xr.merge([a, b], compat="no_conflicts", join="outer")
+    readme = (Path(sweep.__file__).resolve().parents[1] / "README.md").read_text()
+    start = readme.index("**A sine and a random result in one Dataset.**")
+    block = re.search(r"```python\n(.*?)```", readme[start:], re.S).group(1)
+    names: dict = {}
+    exec(block, names)
+    both = names["both"]
+    assert "random_natural_frequency" not in both
+    np.testing.assert_array_equal(both["natural_frequency"], sine["natural_frequency"])
+    np.testing.assert_array_equal(both["natural_frequency"], gevs["natural_frequency"])
+    for name in ("state", "peak_amplitude"):
+        assert both[name].dims == sine[name].dims == ("direction", "length")
+        np.testing.assert_array_equal(both[name], sine[name])
+        assert both[f"random_{name}"].dims == gevs[name].dims
+        np.testing.assert_array_equal(both[f"random_{name}"], gevs[name])
+        assert both[f"random_{name}"].attrs["long_name"] == gevs[name].attrs["long_name"]
+    assert both["rms_deflection_mean"].attrs["units"] == "m"
+    assert "scene" not in both.attrs and both.attrs["Conventions"] == sine.attrs["Conventions"]
+    for ds in (names["sine"], names["gevs"]):
+        ds.close()
