@@ -183,7 +183,7 @@ def _hermite(y0, d0, y1, d1, u, dt):
             + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_acceleration(t, p, o, s, records):
     """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
     at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
@@ -194,7 +194,7 @@ def record_acceleration(t, p, o, s, records):
     return scale * _hermite(y0, d0, y1, d1, u, dt) * _rise(t, p[o + RAMP * s])
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_and_rate(t, p, o, s, records):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the record kind: `record_acceleration` and the
     time derivative of its cubic Hermite interpolant (and of the ramp's rise)."""
@@ -205,7 +205,7 @@ def record_and_rate(t, p, o, s, records):
     return _ramped(t, p[o + RAMP * s], scale * _hermite(y0, d0, y1, d1, u, dt), scale * slope)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def level_bound(t0, t1, p, o, s, base):
     """An upper bound (m/s^2) of |a_b(t)| over [t0, t1] (s) for the sine kinds: the constant
     level |ACCEL|, or the level table's largest A over the stretch of ln w that [t0, t1]
@@ -232,7 +232,7 @@ def level_bound(t0, t1, p, o, s, base):
     return top
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_bound(t0, t1, p, o, s, records):
     """An upper bound (m/s^2) of |a_b(t)| over [t0, t1] (s) for the record kind: on each
     sample interval the span touches, the cubic Hermite through (y0, d0) and (y1, d1) is at

@@ -255,7 +255,7 @@ def place_slot(n_modes):
     return 3 * n_modes + 20
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def inertia_at(factor, t, p1, base):
     """(inertia, its rate) (m, m/s) for kernels.modes.span_loads at t (s): `factor` (the
     accumulator's, kernels.modes.inertia_factor, s^2) times a_b(t) and a_b'(t) of the
@@ -276,7 +276,7 @@ def end_load_at(modal, n_modes, t):
     return md.end_load(modal[s], modal[s + 1], modal[s + 2], modal[s + 3], t)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def state_loads(rows, coupling, q, v, n_modes, modal, t, p1, base, out):
     """kernels.modes.span_loads of the modes' state (q, v) at t (s), its shear factor, end load
     and base inertia read from the modes' accumulator `modal` (`modal_size`; a lane's column
@@ -295,7 +295,7 @@ def square_slot(n_modes):
     return 3 * n_modes + 9
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
     """The accepted step's integrals of c^2, c'^2 and c''^2 for the clamp's curvature at
     s = 0 and midspan's (kernels.modes BEND_0, BEND_MID; c = sum phi_n''(s) q_n, times l^2:
@@ -326,7 +326,7 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
         modal[slot + 3 * k + 2] += curve
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _observe_record_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
     """The record kind's modal statistics of the accepted step [t, t + h] (K: its stages, the
     last f(t + h, y_new)), as trajectory.observe_random's for the midspan: the curvature

@@ -39,9 +39,11 @@ trajectory ends is classified as modal_driver.solve_point does and takes the nex
 block. Set-up (f(0), SciPy's initial step) is the scalar driver's arithmetic.
 
 A random base acceleration (the record kind, kernels.excitation) runs here too: the right-hand
-side reads each lane's record, and every accepted step goes to the scalar path, whose
+side reads each lane's record; a step with an event goes to the scalar path as above, whose
 `record_step` and `modal_driver.observe_random_modes` accumulate the statistics (the lanes'
-accumulator then has the record's slots, trajectory.SCALAR_SLOTS).
+accumulator then has the record's slots, trajectory.SCALAR_SLOTS), and an ordinary step gets
+the same two from `_record_steps`, lane by lane (the midspan's statistics,
+trajectory.record_statistics, and the curvature squares).
 
 Not bit for bit the scalar driver's (fast_cos, fast_sin, inv_fifth_root to an ulp or two; the
 loops fuse multiply-adds), so results equal its results to what a trajectory makes of
@@ -75,7 +77,7 @@ LANES = 32      # trajectories per lock-step group: the lane loops' trip count; 
 SIMD = 4        # the vector loops cover the active lanes rounded up to this
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
     """OUT[c, l] = Y[c, l] + (K[0, c, l] w[0] + ... + K[s - 1, c, l] w[s - 1]) H[l] (SciPy's
     stage sums, in order; with skip_zeros the zero weights are left out)."""
@@ -100,7 +102,7 @@ def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
                 OUT[c, l] = Y[c, l] + OUT[c, l] * H[l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
              base, CP):
     """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
@@ -169,7 +171,7 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
             ERR[l] = math.sqrt(ST[0, l] / dim)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _control(W, H, ERR, SC, settings, n_run):
     """trajectory.control across the lanes with an attempt (H > 0): the counts, the step-size
     update (SciPy's controller for the method, or the PI controller) and accept/reject. SC[0]:
@@ -204,7 +206,7 @@ def _control(W, H, ERR, SC, settings, n_run):
         W[tj.STEPS * L + l] += 1.0 if active & accepted else 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
     """KM[s, 0, l], KM[s, 1, l]: the stages of lane l projected on the midspan deflection and
     its rate (modal_driver._project's sums, in order), for the stages record_step reads: all
@@ -231,7 +233,7 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
                         QV[part, l] += w * YN[part * n + i, l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base):
     """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
     the tail window and modal_driver._span_bound over the step (on each mode's interpolant:
@@ -240,8 +242,7 @@ def _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES
     deflection so far (MOD's slot 2N), else 0: the step may hold a larger one, which
     `_span_lane` searches for (a step on the scalar path searches in
     modal_driver._observe_modes). K: the stages; eighth: the method switch; SHAPES: the basis'
-    mode shapes; base: the excitation switch (excitation.by_kind, `_sine_span_events`: a
-    record's steps are all the scalar path's)."""
+    mode shapes; base: the excitation switch."""
     L = LANES
     last = K.shape[0] - 1                   # f(t + h, y_new)
     for l in range(n_run):
@@ -294,7 +295,7 @@ def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basi
     MOD[place, j] = ml[place]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, an extremum of q_n in a mode not negligible
@@ -304,8 +305,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
     shear (kernels.modes.span_loads, CP: the basis' coupling;
     MOD's shear factor; LD (2, 6): scratch; P1L: the lanes' Observer rows, for the base
     inertia's part of the shear, modal_driver.inertia_at), where the scene observes the loads
-    (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch
-    (excitation.by_kind, `_sine_mode_events`: a record's steps never call this)."""
+    (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
@@ -355,13 +355,12 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     output: no extremum of the midspan deflection or of any mode (EV), no divergence, not the
     tail's start, no time-series sample, no threshold crossing) gets the Observer's step-end
     metrics (trajectory.observe_step_end, as in record_step) and moves to its end (MOVE 1);
-    any other is left to the scalar path (FLAG 2), and so is every step of a random record
-    (its statistics are record_step's). Returns how many lanes it flagged."""
+    any other is left to the scalar path (FLAG 2). A random record's ordinary steps get their
+    statistics from `_record_steps`. Returns how many lanes it flagged."""
     L = LANES
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
     dt_sample = settings[SAMPLE_DT]
-    record = ex.is_record(base)     # a random record's statistics: every step's (record_step)
     n_flagged = 0
     for l in range(n_run):
         t_tail = W[tj.T_TAIL * L + l]          # the lane's own tail window start
@@ -383,7 +382,7 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
         event = active & accepted & ((EV[l] != 0.0) | extremum | (not bounded) | straddles
-                                     | due | crosses | record)
+                                     | due | crosses)
         done = active & accepted & (not event)
         FLAG[l] = 2.0 if event else 0.0
         MOVE[l] = 1.0 if done else 0.0
@@ -398,7 +397,7 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     return n_flagged
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
@@ -406,8 +405,7 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
     same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
     their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
     theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
-    the Observer rows, modal_driver.inertia_at's). base: the excitation switch
-    (excitation.by_kind, `_sine_tail_modes`)."""
+    the Observer rows, modal_driver.inertia_at's). base: the excitation switch."""
     L = LANES
     for i in range(n):
         for l in range(n_run):
@@ -440,7 +438,7 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
     """The lanes with MOVE[l] != 0 (an accepted step that goes on) move to the step's end:
     Y = y_new and K[0] = f(t + h, y_new)."""
@@ -600,12 +598,63 @@ def _refine_marked(W, P1L, n_run, base):
             tj.refine_acceleration_peak(W[j::LANES], 0, 1, P1L[j], 0, 1, base)
 
 
-# The ordinary steps' work, which a random record's steps never do (each goes to the scalar
-# path): compiled for the sine kinds or none only (excitation.by_kind)
-_sine_mode_events = ex.by_kind(_mode_events, None)
-_sine_tail_modes = ex.by_kind(_tail_modes, None)
-_sine_span_events = ex.by_kind(_span_events, None)
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _keep_start(W, START, n_run, base):
+    """Each lane's midspan state at its attempt's start (t, q, q', q'': rows 0-3 of START),
+    before `_finish` moves an ordinary step to its end: a record's statistics need both ends
+    (`_record_steps`). base: the excitation switch (excitation.by_kind)."""
+    L = LANES
+    for j in range(n_run):
+        START[0, j] = W[tj.T * L + j]
+        START[1, j] = W[tj.Q * L + j]
+        START[2, j] = W[tj.V * L + j]
+        START[3, j] = W[tj.FV * L + j]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, basis,
+                  yl, ynl, Kl, ml, base):
+    """A random record's ordinary accepted steps (MOVE 1, FLAG 0: `_finish` moved them to
+    their ends, with the step-end sample of the absolute acceleration; the others are the
+    scalar path's, `_flagged_lane`): what the scalar path adds for such a step, on the
+    scalar path's types, lane by lane: the midspan's statistics over the step
+    (trajectory.record_statistics, as record_step calls it; START: the step's start,
+    `_keep_start`) and, where the scene observes the loads, the curvature squares
+    (modal_driver.observe_random_modes on copies of the lane's columns; yl, ynl, Kl, ml:
+    scratch). Before `_advance` (Y is the steps' start)."""
+    L = LANES
+    last = K.shape[0] - 1                      # f(t + h, y_new)
+    bends = MOD[drv.factor_slot(n) + 1, 0] != 0.0      # settings[LOADS]
+    for j in range(n_run):
+        if not ((MOVE[j] != 0.0) & (FLAG[j] == 0.0)):
+            continue
+        acc = W[j::L]
+        t = START[0, j]
+        t_tail = acc[tj.T_TAIL]
+        if t < t_tail:
+            continue                           # the statistics start in the window
+        tj.record_statistics(settings, acc, P1L[j], 0, 1, t, acc[tj.T], START[1, j],
+                             START[2, j], START[3, j], acc[tj.Q], acc[tj.V], acc[tj.FV],
+                             False, 0.0, base)
+        if not bends:
+            continue
+        for c in range(2 * n):
+            yl[c] = Y[c, j]
+            ynl[c] = YN[c, j]
+            Kl[0, c] = K[0, c, j]
+            Kl[last, c] = K[last, c, j]
+        for c in range(MOD.shape[0]):
+            ml[c] = MOD[c, j]
+        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, basis, ml, base)
+        for c in range(MOD.shape[0]):
+            MOD[c, j] = ml[c]
+
+
+# A sine's acceleration peaks refined (ordinary steps'), a record's statistics (its ordinary
+# steps'): each compiled for its own kind only (excitation.by_kind)
 _sine_refine_marked = ex.by_kind(_refine_marked, None)
+_keep_record_start = ex.by_kind(None, _keep_start)
+_record_statistics = ex.by_kind(None, _record_steps)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -634,8 +683,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     T = basis[md.TABLES]
     nodes = T.shape[2]
     weights = basis[md.MIDSPAN]
-    record = ex.is_record(base)      # a random record: every accepted step is the scalar
-    slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # path's, with its statistics' slots
+    record = ex.is_record(base)      # a random record: the accumulator has its
+    slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
     W = np.zeros(slots * L)
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
@@ -645,6 +694,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     K = np.zeros((n_stages + 1, dim, L))
     KM = np.zeros((n_stages + 1, 2, L))
     QV = np.zeros((2, L))
+    START = np.zeros((4, L))
     MOD = np.zeros((drv.modal_size(n), L))
     for l in range(L):
         MOD[drv.factor_slot(n) + 1, l] = settings[LOADS]     # as modal_driver.start sets it
@@ -730,17 +780,19 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, basis[md.COUPLING])
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        # (a record's steps: no events to find, no ordinary step: the _sine_ functions)
-        _sine_mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
-                          basis[md.COUPLING], LD, P1L, base)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
+                     basis[md.COUPLING], LD, P1L, base)
+        _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
-        _sine_tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS],
-                         basis[md.COUPLING], LD, P1L, base)
-        _sine_span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth,
-                          basis[md.SHAPES], base)
+        _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
+                           basis, yl, ynl, Kl, ml, base)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING],
+                    LD, P1L, base)
+        _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth,
+                     basis[md.SHAPES], base)
         for j in range(n_run):
-            if SPAN[j] != 0.0:          # (a record's: never; its steps are the scalar path's)
+            if SPAN[j] != 0.0:
                 _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis)
         if base is not None:
             _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema

@@ -114,7 +114,7 @@ N_BENDS = 3         # rows 0..2: the curvatures, linear in q, watched alike
 N_OBSERVED = 10
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, inertia_rate,
                out):
     """The stretching and the clamps' shear as the load observers watch them, for the modes'
@@ -470,7 +470,7 @@ def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
             FLD[2, j, l] = g2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _lanes_signal(tt, PP, sc, SC, n_run, base):
     """SC[2, l] = a_b(tt[l]) (m/s^2) of each lane's excitation block (rows sc + S_EXCITATION..
     of PP), any kind (kernels.excitation: libm's sine, or a record read lane by lane)."""

@@ -987,7 +987,7 @@ def _up_level(a, b, u):
     return 1.0 if ((a < u) & (u <= b)) | ((a > -u) & (-u >= b)) else 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_new,
                       v_new, fv_new, has_ext, qe, base):
     """`observe_random` and `observe_level_crossings` for record_step's accepted step

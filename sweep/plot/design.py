@@ -86,8 +86,8 @@ def _label_bindings(ax: Axes, ds: xr.Dataset, x: np.ndarray, y: np.ndarray,
 def plot_design(ds: xr.Dataset, *, ax: Axes | None = None, **kwargs: Any) -> Figure:
     """max_span (mm below 1 m, else m) of a design result: over one axis a line with markers
     coloured by `limited_by`, a legend naming the criteria and, for a span over other axes
-    ('sweep design --over'), the values it binds at written above each point; over none a single bar with the
-    value annotated. A NaN span (the shortest grid length fails) is marked at the bottom of
+    ('sweep design --over'), the values it binds at written above each point; over none a
+    single bar with the value annotated. A NaN span (the shortest grid length fails) is marked at the bottom of
     the axes. Extra keyword arguments go to `Axes.plot` (or `Axes.bar`). Returns the Figure.
     Raises UserError (one line) for a result over more than one axis (select one value of the
     others first) or one the chart cannot show (`check_design_result`)."""
