@@ -205,7 +205,7 @@ DENSE_TERMS = 7     # columns of an interpolant's coefficient array: up to degre
 QUARTIC_TERMS = 4   # columns of RK45's own: its quartic (its drivers allocate no more)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def dense_coefficients(K, Q):
     """Q[:, :4] = K^T P: the quartic interpolant of the last step. Q has shape (2,
     QUARTIC_TERMS), or (2, DENSE_TERMS), the layout of DOP853's seventh-order interpolant
@@ -231,7 +231,7 @@ def dense_value(y_old_i, h, c, x):
         c[4] + x * (c[5] + x * c[6])))))))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def dense_root(y_old_i, h, c, target, xa, xb):
     """x in [xa, xb] where one component of the interpolant (row c = Q[i] of
     dense_coefficients) equals `target`.
@@ -275,7 +275,7 @@ EXTREMUM_NEWTON_STEPS = 4     # Newton steps `dense_extremum` takes before it fa
 EXTREMUM_RESIDUAL = 1e-14     # dense_root; |q'(x)| / (|q'_old| + |q'_new|) that ends them
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def dense_extremum(v_old, v_new, h, c):
     """x in [0, 1] where the interpolated q' (row c = Q[1] of an interpolant; v_old, v_new: q'
     at the step's ends, of opposite signs or v_new = 0) vanishes: Newton's method from the

@@ -69,7 +69,7 @@ def valid(row, n_modes):
     return row[md.W1_SQ] > 0.0 and row[md.BOUND] > 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _project(v, weights, offset, n):
     """sum_i weights[i] v[offset + i]."""
     s = 0.0
@@ -166,7 +166,7 @@ def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, S, n_modes,
     return min(100.0 * h0, h1, t_end, max_step)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _mode_interpolant(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
     """Qm (2, 5): mode i's dense output over the accepted step (RK45's quartic from the stages,
     DOP853's quintic Hermite), in dopri5.dense_coefficients' layout; Km (n_stages + 1, 2) is
@@ -352,7 +352,7 @@ def curvature_moments(modal, n, acc, reals):
         reals[CURVATURE_M0 + k] = modal[square_slot(n) + k] / span
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _turns(r0, r1):
     """Whether a rate going from r0 to r1 over a step changes sign (an extremum)."""
     return (r0 > 0.0 and r1 <= 0.0) or (r0 < 0.0 and r1 >= 0.0)
@@ -376,7 +376,7 @@ def mode_reach(y, h, QA, c):
     return abs(y[c]) + abs(h) * reach
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _span_bound(y, h, QA, n_modes, shapes):
     """An upper bound (m) of |w(x, t)| over the span and over the accepted step (every mode's
     interpolant in QA, q_c = y_c + h sum_k QA[c, 0, k] x^(k+1), x in [0, 1]):
@@ -423,7 +423,7 @@ SPAN_WIDTH = 2.0 ** -30
 then exact to about (1e-9)^2 of the step's curvature in time, far below round-off."""
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _span_sample(y, h, QA, s, n, qx, basis):
     """(max over the span of |w| (m), its place x* / l, the rate of |w(x*)| (m per unit s))
     at the fraction s of the accepted step, on every mode's interpolant (QA): the maximum by
@@ -463,7 +463,7 @@ CREST_NEWTON = 12
 """Most Newton iterations of `_crest_newton`."""
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _crest_newton(y, h, QA, n, qx, basis, lo, hi, s, x):
     """(max |w| (m), its place x* / l, whether found) at the crest of the span's maximum in
     (time, place) between the fractions lo and hi of the step, by Newton's method on
@@ -514,7 +514,7 @@ def _crest_newton(y, h, QA, n, qx, basis, lo, hi, s, x):
     return abs(w), x, True
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _span_crest(y, h, QA, n, qx, basis, lo, hi, g_lo, g_hi, x_lo, x_hi):
     """(the largest span maximum found (m), its place x* / l) at the crest in time of the
     span's maximum between the fractions lo < hi of the step, where its rate
@@ -554,7 +554,7 @@ def _span_crest(y, h, QA, n, qx, basis, lo, hi, g_lo, g_hi, x_lo, x_hi):
     return top, where
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _span_spread(h, QA, n, shapes, s_m, r, a):
     """An upper bound (m) of |w(x, s) - w(x, s_m)| over the span and |s - s_m| <= r (fractions
     of the step): sum_c max |phi_c| sum_k |a_k| r^k, a_k the Taylor coefficients at s_m of
@@ -578,7 +578,7 @@ def _span_spread(h, QA, n, shapes, s_m, r, a):
     return total
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def observe_span(y, h, QA, s_lo, n_modes, qx, modal, basis):
     """The largest deflection over the span and over the fractions s_lo..1 of the accepted
     step (every mode's interpolant in QA) into modal[2N] (m) and its place x* / l into
@@ -638,7 +638,7 @@ def negligible(peak, largest):
     return not (peak > HIDDEN_FLOOR * largest)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
                    basis, Qp, p1, base):
     """The modes' accumulator `modal` (`modal_size`) over the accepted step [t, t_new]: each mode's
@@ -697,7 +697,7 @@ WHOLE_RUN = 2.0
 """settings[LOADS]: over the whole run (a sine sweep's peak over the sweep)."""
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _observe_bends(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis, Qp,
                    located):
     """The curvature at each clamp and at midspan, c_e(t) = sum phi_n''(s_e) q_n(t) (s_e = 0,
@@ -748,7 +748,7 @@ ROOT_WIDTH = 2.0 ** -48
 """The bracket (a fraction of the step) at which `_load_peak` stops."""
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _loads_at(t, y, h, QA, x, n, basis, modal, qv, out, p1, base):
     """kernels.modes.span_loads at the fraction x of the step from t (s), on every mode's
     interpolant (QA); qv (2N): scratch for q and its rate there; p1, base: `inertia_at`'s."""
@@ -766,7 +766,7 @@ def _load_rises(out, k):
     return out[1] if k == 0 else out[2 * k] * out[2 * k + 1]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, basis,
                    located, qx, p1, base):
     """The largest stretch E and clamp shears |F_0|, |F_1| (kernels.modes.span_loads) over
@@ -811,7 +811,7 @@ def _observe_loads(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, b
     return located
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
     """An upper bound of |L_k| (kernels.modes.span_loads' load k) over the accepted step
     [t, t_new] (s), on every mode's interpolant (QA, `mode_reach`), the end load's largest
@@ -832,7 +832,7 @@ def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
                               inertia, k)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _load_peak(t, y, h, QA, n, basis, modal, qv, m, p1, base, k, g_lo, g_hi, x_tail):
     """The largest |L_k| (kernels.modes.span_loads' load k) found while locating its maximum
     inside the step, where its rise g = `_load_rises` is g_lo > 0 at the step's start and
@@ -860,7 +860,7 @@ def _load_peak(t, y, h, QA, n, basis, modal, qv, m, p1, base, k, g_lo, g_hi, x_t
     return peak
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _combined(weights, y, h, QA, x, n):
     """sum weights[c] q_c at the fraction x of the step, on every mode's interpolant."""
     v = 0.0
@@ -869,7 +869,7 @@ def _combined(weights, y, h, QA, x, n):
     return v
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal, Km, QA, qx,
                   basis, Qp, p1, base):
     """After trajectory.record_step on the step [t, t_new]: where the early stop

@@ -683,6 +683,9 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     T = basis[md.TABLES]
     nodes = T.shape[2]
     weights = basis[md.MIDSPAN]
+    CV = basis[md.CLAMPS]            # (the basis' arrays taken once: a tuple's item taken in
+    CP = basis[md.COUPLING]          # the loop costs a reference count update a call)
+    SHAPES = basis[md.SHAPES]
     record = ex.is_record(base)      # a random record: the accumulator has its
     slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
     W = np.zeros(slots * L)
@@ -777,20 +780,17 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                 tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
-                 n_run, base, basis[md.COUPLING])
+                 n_run, base, CP)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, basis[md.CLAMPS],
-                     basis[md.COUPLING], LD, P1L, base)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base)
         _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
                            basis, yl, ynl, Kl, ml, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, basis[md.CLAMPS], basis[md.COUPLING],
-                    LD, P1L, base)
-        _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth,
-                     basis[md.SHAPES], base)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base)
+        _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base)
         for j in range(n_run):
             if SPAN[j] != 0.0:
                 _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis)

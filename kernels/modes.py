@@ -162,7 +162,7 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, i
         out[3 + 2 * end] = d3 - (axial_rate * s1 + axial * d1) + sign * inertia_rate
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def span_load_bound(rows, coupling, q_max, n_modes, kappa, load_max, inertia_max, k):
     """An upper bound of |L_k| (`span_loads`' load k: 0 the stretch E, 1 and 2 the shears F_0
     and F_1, m^2 and m) over states whose modes are within |q_n| <= q_max[n] (m), with the end
@@ -271,7 +271,7 @@ def prepared_size(n_modes):
     return 3 * n_modes + N_SCALARS
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def shape_at(shapes, i, x):
     """Mode i's shape and its first two derivatives in s = x / l at s = x, (phi, phi', phi''),
     from its beam-function row shapes[i] = (beta, A, B, C, D) (module docstring); the
@@ -301,7 +301,7 @@ def shape_at(shapes, i, x):
     return v, beta * d1, beta * beta * d2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def span_argmax(q, n_modes, basis):
     """(max over the span of |w(x)| (m), its x / l) for the modal coefficients q[0..N-1]
     (m), w = sum_n q_n phi_n(x / l): the values at the basis' stations (8 per half-wave of

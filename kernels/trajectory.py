@@ -423,7 +423,7 @@ def fsal_row(K):
     return dop853.N_STAGES if K.shape[0] == dop853.N_STAGES_EXTENDED else K.shape[0] - 1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base, eighth):
     """Qc (2, QUARTIC_TERMS) for RK45, (2, DENSE_TERMS) for DOP853: the dense output of the
     accepted step from acc's state to (q_new, v_new), K its stage derivatives. `eighth`, the
@@ -444,7 +444,7 @@ def interpolant(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base
                                     K[fsal_row(K), 1], h, Qc)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _seventh_order_sine(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
     """DOP853's own seventh-order interpolant into Qc where `interpolant` takes it (the
     extended K, rtol below dop853.SEVENTH_ORDER_BELOW_RTOL), its three extra right-hand sides
@@ -460,7 +460,7 @@ def _seventh_order_sine(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametr
     return True
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _hermite_only(p, o, s, settings, acc, K, q_new, v_new, h, Qc, parametric, base):
     """A random record's interpolant is always the quintic Hermite (`interpolant`)."""
     return False
