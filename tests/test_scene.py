@@ -1045,6 +1045,8 @@ def test_harness_clamps_runs_on_the_scalar_driver():
     ({"model.modes": 3, "base.realisations": 4}, "lanes"),                          # 9 x 2 x 4
     ({"model.modes": 3, "base.realisations": 1, "clamps.rotation": "elastic",
       "clamps.rotational_stiffness": 1.0, "cable.diameter": "3 mm"}, "scalar"),     # 2 a basis
+    ({"model.modes": 3, "base.realisations": 2, "clamps.rotation": "elastic",
+      "clamps.rotational_stiffness": 1.0, "cable.diameter": "3 mm"}, "lanes"),      # 4 a basis
     ({"model.modes": 3, "clamps.rotation": "elastic", "clamps.rotational_stiffness": 1.0,
       "cable.diameter": "3 mm"}, "lanes"),                                          # 16 a basis
     ({"model.modes": 3, "base.realisations": 1, "solver.driver": "lanes"}, "lanes"),

@@ -156,11 +156,13 @@ lanes packed): the lanes took 3.4x the scalar driver's time with 1 point a basis
 0.70x with 8, 0.52x with 16 (their vector loops and per-step bookkeeping cost nearly as much
 for one running lane as for sixteen); harness-stepped-sine's 3 lines a direction, one thread:
 5.0 s on the lanes, 4.1 s on the scalar driver."""
-RANDOM_LANES_LEAST_POINTS = 8
-"""The same for a random scene, counting each record (base.realisations) as a point: every
-accepted step of a record goes to the lanes' scalar path, so they need more company. Measured
-(elastic clamps, 3 modes, one basis a span, 2 s GEVS records, one thread): the lanes took 2.79x
-the scalar driver's time with 1 record a basis, 1.23x with 4, 0.77x with 8."""
+RANDOM_LANES_LEAST_POINTS = 4
+"""The same for a random scene, counting each record (base.realisations) as a point. Measured
+(3 modes, one 100 mm span at -10 dB, 2 s GEVS records, one thread, 2026-12-06, once a record's
+ordinary steps stayed in the lanes; benchmarks/random_lanes.py --occupancy for pinned ends):
+the lanes took 1.7-2.2x the scalar driver's time with 2 records a basis, 0.81x (pinned), 0.87x
+(clamped) and 0.88x (elastic, K = 1) with 4, 0.55-0.73x with 8. (8 until then, when every
+step of a record went to the lanes' scalar path: 1.23x with 4, 0.77x with 8.)"""
 RANDOM_ONE_MODE_LANES_LEAST_POINTS = 2
 """The same for a random scene of one mode (no basis: one kernel call takes every point),
 counting each record as a point. Measured (benchmarks/random_lanes.py --one-mode, GEVS at
