@@ -327,7 +327,7 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def observe_record_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
+def _observe_record_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
     """The record kind's modal statistics of the accepted step [t, t + h] (K: its stages, the
     last f(t + h, y_new)), as trajectory.observe_random's for the midspan: the curvature
     squares at the clamp and midspan (`_observe_bend_squares`) once the step starts in the
@@ -336,8 +336,8 @@ def observe_record_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
         _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, basis, modal)
 
 
-# `observe_record_modes` for a random record, nothing for the sine kinds (not compiled there)
-observe_random_modes = ex.by_kind(None, observe_record_modes)
+# `_observe_record_modes` for a random record, nothing for the sine kinds (not compiled there)
+observe_random_modes = ex.by_kind(None, _observe_record_modes)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

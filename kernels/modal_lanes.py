@@ -620,9 +620,8 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
     scalar path's types, lane by lane: the midspan's statistics over the step
     (trajectory.record_statistics, as record_step calls it; START: the step's start,
     `_keep_start`) and, where the scene observes the loads, the curvature squares
-    (modal_driver.observe_record_modes, what observe_random_modes calls for a record, on
-    copies of the lane's columns; yl, ynl, Kl, ml: scratch). Before `_advance` (Y is the
-    steps' start). Compiled for records only (`_record_statistics`)."""
+    (modal_driver.observe_random_modes on copies of the lane's columns; yl, ynl, Kl, ml:
+    scratch). Before `_advance` (Y is the steps' start)."""
     L = LANES
     last = K.shape[0] - 1                      # f(t + h, y_new)
     bends = MOD[drv.factor_slot(n) + 1, 0] != 0.0      # settings[LOADS]
@@ -646,17 +645,9 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
             Kl[last, c] = K[last, c, j]
         for c in range(MOD.shape[0]):
             ml[c] = MOD[c, j]
-        drv.observe_record_modes(t, t_tail, yl, ynl, Kl, H[j], n, basis, ml, base)
+        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, basis, ml, base)
         for c in range(MOD.shape[0]):
             MOD[c, j] = ml[c]
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _next_attempt(settings, W, j):
-    """trajectory.next_attempt of lane j (its accumulator W[j::LANES]): the step (s) to try
-    next, or 0 where the trajectory ends. A function of its own without reference counting:
-    the view taken in solve_block's loop cost two atomic updates a lane and attempt."""
-    return tj.next_attempt(settings, W[j::LANES])
 
 
 # A sine's acceleration peaks refined (ordinary steps'), a record's statistics (its ordinary
@@ -755,10 +746,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
             if j >= n_run and point[j] < 0 and next_point >= hi:
                 H[j] = 0.0
                 continue
+            acc = W[j::L]
             step = 0.0
             while True:
                 if point[j] >= 0:
-                    step = _next_attempt(settings, W, j)
+                    step = tj.next_attempt(settings, acc)
                     if step > 0.0:
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
