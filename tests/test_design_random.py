@@ -388,7 +388,7 @@ def test_the_readme_merge_of_a_sine_and_a_random_result_keeps_both(random_file, 
     with xr.open_dataset("qual.nc") as a, xr.open_dataset("gevs.nc") as b:
         with pytest.raises(xr.MergeError, match="conflicting values for variable"):
             xr.merge([a, b], compat="no_conflicts", join="outer")
-    readme = (Path(sweep.__file__).resolve().parents[1] / "README.md").read_text()
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
     start = readme.index("**A sine and a random result in one Dataset.**")
     block = re.search(r"```python\n(.*?)```", readme[start:], re.S).group(1)
     names: dict = {}
