@@ -350,13 +350,15 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_run, base):
+def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_run,
+            sampled_here, base):
     """For every lane's accepted attempt: an ordinary step (nothing to locate on the dense
     output: no extremum of the midspan deflection or of any mode (EV), no divergence, not the
     tail's start, no time-series sample, no threshold crossing) gets the Observer's step-end
     metrics (trajectory.observe_step_end, as in record_step) and moves to its end (MOVE 1);
     any other is left to the scalar path (FLAG 2). A random record's ordinary steps get their
-    statistics from `_record_steps`. Returns how many lanes it flagged."""
+    statistics from `_record_steps`, and with DOP853 (sampled_here) their time-series samples
+    too. Returns how many lanes it flagged."""
     L = LANES
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
@@ -382,7 +384,7 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
         due = (sample < n_samples) & (sample * dt_sample <= t_new)
         crosses = track & (abs(qn) <= thr) & (thr < abs(q_old))
         event = active & accepted & ((EV[l] != 0.0) | extremum | (not bounded) | straddles
-                                     | due | crosses)
+                                     | (due & (not sampled_here)) | crosses)
         done = active & accepted & (not event)
         FLAG[l] = 2.0 if event else 0.0
         MOVE[l] = 1.0 if done else 0.0
@@ -613,7 +615,7 @@ def _keep_start(W, START, n_run, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, basis,
-                  yl, ynl, Kl, ml, base):
+                  yl, ynl, Kl, ml, series, point, Qc, base):
     """A random record's ordinary accepted steps (MOVE 1, FLAG 0: `_finish` moved them to
     their ends, with the step-end sample of the absolute acceleration; the others are the
     scalar path's, `_flagged_lane`): what the scalar path adds for such a step, on the
@@ -621,15 +623,27 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
     (trajectory.record_statistics, as record_step calls it; START: the step's start,
     `_keep_start`) and, where the scene observes the loads, the curvature squares
     (modal_driver.observe_random_modes on copies of the lane's columns; yl, ynl, Kl, ml:
-    scratch). Before `_advance` (Y is the steps' start)."""
+    scratch); with DOP853, the time series' samples in the step (for the spectra) on the
+    midspan's quintic Hermite through both ends, as record_step takes them
+    (trajectory.take_samples into series[point[j]]; Qc: scratch; RK45's samples are its
+    quartic's, from the stages: `_finish` leaves those steps to the scalar path). Before
+    `_advance` (Y is the steps' start)."""
     L = LANES
     last = K.shape[0] - 1                      # f(t + h, y_new)
     bends = MOD[drv.factor_slot(n) + 1, 0] != 0.0      # settings[LOADS]
+    dt_sample = settings[SAMPLE_DT]
+    n_samples = series.shape[1]
     for j in range(n_run):
         if not ((MOVE[j] != 0.0) & (FLAG[j] == 0.0)):
             continue
         acc = W[j::L]
         t = START[0, j]
+        k = acc[tj.SAMPLE]
+        if k < n_samples and k * dt_sample <= acc[tj.T]:      # (DOP853's: see `_finish`)
+            dop853.hermite_coefficients(START[1, j], START[2, j], START[3, j], acc[tj.Q],
+                                        acc[tj.V], acc[tj.FV], H[j], Qc)
+            tj.take_samples(acc, series[point[j]], t, acc[tj.T], H[j], START[1, j], Qc,
+                            dt_sample)
         t_tail = acc[tj.T_TAIL]
         if t < t_tail:
             continue                           # the statistics start in the window
@@ -688,6 +702,9 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     SHAPES = basis[md.SHAPES]
     record = ex.is_record(base)      # a random record: the accumulator has its
     slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
+    # a record's samples (the spectra's) on DOP853's quintic Hermite: `_record_steps`' in an
+    # ordinary step (RK45's are its quartic from the stages: the scalar path's)
+    sampled_here = record and eighth is not None
     W = np.zeros(slots * L)
     for j in range(L):
         W[tj.STATUS * L + j] = mt.DIVERGED         # idle until loaded
@@ -786,9 +803,9 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base)
         _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
-                            n_run, base)
+                            n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
-                           basis, yl, ynl, Kl, ml, base)
+                           basis, yl, ynl, Kl, ml, series, point, Qc, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base)
         _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base)
         for j in range(n_run):
