@@ -615,7 +615,7 @@ def _keep_start(W, START, n_run, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, basis,
-                  yl, ynl, Kl, ml, series, point, Qc, base):
+                  yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
     """A random record's ordinary accepted steps (MOVE 1, FLAG 0: `_finish` moved them to
     their ends, with the step-end sample of the absolute acceleration; the others are the
     scalar path's, `_flagged_lane`): what the scalar path adds for such a step, on the
@@ -626,7 +626,8 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
     scratch); with DOP853, the time series' samples in the step (for the spectra) on the
     midspan's quintic Hermite through both ends, as record_step takes them
     (trajectory.take_samples into series[point[j]]; Qc: scratch; RK45's samples are its
-    quartic's, from the stages: `_finish` leaves those steps to the scalar path). Before
+    quartic's, from the stages: `_finish` leaves those steps to the scalar path, and
+    sampled_here is False). Before
     `_advance` (Y is the steps' start)."""
     L = LANES
     last = K.shape[0] - 1                      # f(t + h, y_new)
@@ -639,7 +640,7 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
         acc = W[j::L]
         t = START[0, j]
         k = acc[tj.SAMPLE]
-        if k < n_samples and k * dt_sample <= acc[tj.T]:      # (DOP853's: see `_finish`)
+        if sampled_here and k < n_samples and k * dt_sample <= acc[tj.T]:
             dop853.hermite_coefficients(START[1, j], START[2, j], START[3, j], acc[tj.Q],
                                         acc[tj.V], acc[tj.FV], H[j], Qc)
             tj.take_samples(acc, series[point[j]], t, acc[tj.T], H[j], START[1, j], Qc,
@@ -805,7 +806,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
-                           basis, yl, ynl, Kl, ml, series, point, Qc, base)
+                           basis, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base)
         _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base)
         for j in range(n_run):
