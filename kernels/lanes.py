@@ -483,21 +483,16 @@ def _record_sums(W, settings, n_run):
 def _record_samples(W, settings, n_run, series, point, Qc):
     """With DOP853, the time series' samples (for the spectra) inside a record's ordinary
     steps, on the quintic Hermite through both ends, as record_step takes them
-    (trajectory.take_samples into series[point[j]]; Qc: scratch)."""
+    (trajectory.take_hermite_samples into series[point[j]]; Qc: scratch)."""
     L = LANES
     dt_sample = settings[SAMPLE_DT]
-    n_samples = series.shape[1]
     for j in range(n_run):
-        k = W[tj.SAMPLE * L + j]
-        t_new = W[tj.T * L + j]
-        if not (_ordinary(W, j) and k < n_samples and k * dt_sample <= t_new):
-            continue
-        t = W[W_START * L + j]
-        q_old = W[(W_START + 1) * L + j]
-        h = W[W_H * L + j]
-        dop853.hermite_coefficients(q_old, W[(W_START + 2) * L + j], W[(W_START + 3) * L + j],
-                                    W[tj.Q * L + j], W[tj.V * L + j], W[tj.FV * L + j], h, Qc)
-        tj.take_samples(W[j::L], series[point[j]], t, t_new, h, q_old, Qc, dt_sample)
+        if _ordinary(W, j):
+            tj.take_hermite_samples(W[j::L], series[point[j]], W[W_START * L + j],
+                                    W[tj.T * L + j], W[W_H * L + j], W[(W_START + 1) * L + j],
+                                    W[(W_START + 2) * L + j], W[(W_START + 3) * L + j],
+                                    W[tj.Q * L + j], W[tj.V * L + j], W[tj.FV * L + j], Qc,
+                                    dt_sample)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")

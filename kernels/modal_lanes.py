@@ -625,7 +625,7 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
     (modal_driver.observe_random_modes on copies of the lane's columns; yl, ynl, Kl, ml:
     scratch); with DOP853, the time series' samples in the step (for the spectra) on the
     midspan's quintic Hermite through both ends, as record_step takes them
-    (trajectory.take_samples into series[point[j]]; Qc: scratch; RK45's samples are its
+    (trajectory.take_hermite_samples into series[point[j]]; Qc: scratch; RK45's samples are its
     quartic's, from the stages: `_finish` leaves those steps to the scalar path, and
     sampled_here is False). Before
     `_advance` (Y is the steps' start)."""
@@ -633,18 +633,15 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
     last = K.shape[0] - 1                      # f(t + h, y_new)
     bends = MOD[drv.factor_slot(n) + 1, 0] != 0.0      # settings[LOADS]
     dt_sample = settings[SAMPLE_DT]
-    n_samples = series.shape[1]
     for j in range(n_run):
         if not ((MOVE[j] != 0.0) & (FLAG[j] == 0.0)):
             continue
         acc = W[j::L]
         t = START[0, j]
-        k = acc[tj.SAMPLE]
-        if sampled_here and k < n_samples and k * dt_sample <= acc[tj.T]:
-            dop853.hermite_coefficients(START[1, j], START[2, j], START[3, j], acc[tj.Q],
-                                        acc[tj.V], acc[tj.FV], H[j], Qc)
-            tj.take_samples(acc, series[point[j]], t, acc[tj.T], H[j], START[1, j], Qc,
-                            dt_sample)
+        if sampled_here:
+            tj.take_hermite_samples(acc, series[point[j]], t, acc[tj.T], H[j], START[1, j],
+                                    START[2, j], START[3, j], acc[tj.Q], acc[tj.V],
+                                    acc[tj.FV], Qc, dt_sample)
         t_tail = acc[tj.T_TAIL]
         if t < t_tail:
             continue                           # the statistics start in the window

@@ -887,6 +887,21 @@ def take_samples(acc, series, t, t_new, h, q_old, Qc, dt_sample):
     acc[SAMPLE] = k
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def take_hermite_samples(acc, series, t, t_new, h, q_old, v_old, a_old, q_new, v_new, a_new,
+                         Qc, dt_sample):
+    """The time series' samples (for the spectra) in an accepted step (t, t_new] of size h
+    (s) that the lanes drivers keep off the scalar path, on DOP853's quintic Hermite through
+    both ends' deflection (m), velocity (m/s) and acceleration (m/s^2), as record_step takes
+    them through `interpolant` (take_samples into series, acc[SAMPLE] advanced; Qc: scratch).
+    Does nothing when no sample is due in the step."""
+    k = acc[SAMPLE]
+    if not (k < series.shape[0] and k * dt_sample <= t_new):
+        return
+    dop853.hermite_coefficients(q_old, v_old, a_old, q_new, v_new, a_new, h, Qc)
+    take_samples(acc, series, t, t_new, h, q_old, Qc, dt_sample)
+
+
 def _quintic_basis() -> np.ndarray:
     """The quintic Hermite basis H_i (the polynomials of degree 5 with H_i's value, slope and
     second derivative at 0 and 1 the unit vector e_i, in the order value, slope, second
