@@ -35,9 +35,10 @@ for bit: to what a trajectory makes of round-off, which on strongly nonlinear po
 driver).
 
 A random base acceleration (kernels.excitation's record kind: `base` is the records) runs here
-too, on stage chains of its own (`_chain5_r`, `_chain8_r`: each lane reads its row's record
-through a call, so that loop is not vectorised, but the chain is still written out from the
-tableau). A record's accepted step with anything to locate inside it (an extremum of q, the
+too, on stage chains of its own (`_chain5_r`, `_chain8_r`, written out from the tableau as
+the others): each lane's record is read at the attempt's stage times before the attempt, in a
+scalar loop (`_stage_reads`), and the chain's right-hand side (`_accel_read`) reads those
+values from W, so the chain's loop across the lanes vectorises as the sine kinds' does. A record's accepted step with anything to locate inside it (an extremum of q, the
 tail's start, a divergence) goes to record_step as above; its ordinary steps get the
 record's statistics in `_record_statistics`, on the lane's own accumulator: the record's
 reads in a scalar loop, then the observers record_step calls (trajectory.observe_acceleration,
@@ -59,7 +60,8 @@ from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, 
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
 from .layout import N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
-from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare
+from .oscillator import (BOUND, EXCITATION, N_PARAMS, PARTICIPATION, acceleration, base_acceleration,
+                         prepare)
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
 
@@ -93,7 +95,10 @@ W_START = W_K8 + 2 * (dop853.N_STAGES - 1)   # a record's attempt starts at (t s
                                              # q'' m/s^2) in rows W_START + 0..3 (`_keep_start`)
 W_A_MID = W_START + 4   # a record's a_b at an ordinary step's middle (m/s^2; `_record_reads`)
 W_A_OLD = W_START + 5   # q'' + a_b at its start where no step-end sample holds it (m/s^2)
-W_ROWS = W_START + 6
+W_AB_STAGES = W_START + 6   # a record's a_b (m/s^2) at the attempt's stage s = 1 .. n (the
+                            # last at t + h) in row W_AB_STAGES + s - 1, read before the
+                            # attempt (`_stage_reads`)
+W_ROWS = W_AB_STAGES + dop853.N_STAGES
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -133,12 +138,46 @@ def _accel(W, j, t, q, v, parametric, base):
     return acceleration(t, q, v, W, W_P * LANES + j, LANES, True, parametric, base)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _accel_read(W, j, t, q, v, parametric, base, stage):
+    """q'' (m/s^2) of lane j at (t, q, v) under a random record, its a_b at the attempt's
+    stage `stage` read from row W_AB_STAGES + stage - 1 (`_stage_reads`): the System's
+    right-hand side without the base term, then that term, in `acceleration`'s own order, so
+    the chain's loop across the lanes has no record read in it and vectorises."""
+    L = LANES
+    a = acceleration(t, q, v, W, W_P * L + j, L, True, parametric, None)
+    return a - W[(W_P + PARTICIPATION) * L + j] * W[(W_AB_STAGES + stage - 1) * L + j]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _stage_reads(W, n_run, eighth, base):
+    """Each lane's a_b (m/s^2) at its attempt's stage times t + C[s] h, s = 1 .. n - 1, and at
+    t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads, before the attempt,
+    so that its chain's loop has none (and vectorises: 6-10 % of a one-mode random run,
+    benchmarks/RESULTS.md). The reads themselves stay a scalar loop: LLVM will not vectorise
+    a gather from the records beside a store into W, which it cannot prove apart."""
+    L = LANES
+    nodes = dop853.C if eighth is not None else C
+    n = len(nodes)
+    for s in range(1, n + 1):
+        if s == n and nodes[n - 1] == 1.0:   # both methods' last stage is at t + h already
+            for j in range(n_run):
+                W[(W_AB_STAGES + n - 1) * L + j] = W[(W_AB_STAGES + n - 2) * L + j]
+            break
+        for j in range(n_run):
+            t = W[tj.T * L + j]
+            h = W[W_H * L + j]
+            at = t + nodes[s] * h if s < n else t + h
+            W[(W_AB_STAGES + s - 1) * L + j] = base_acceleration(at, W, W_P * L + j, L, True,
+                                                                 base)
+
+
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in
 # the tableau's order, so the loops across the lanes stay vectorised. RK45 sums every entry
 # of its tableau; DOP853 leaves out the zeros of its sparse one. One chain per combination of
 # the System's optional terms (suffix p: parametric, b: a sine base excitation, r: a random
-# record, the base switch then left an argument: the records), its right-hand side written
-# out for those terms alone: `_attempt` picks one by its switches, in branches on its own
+# record: the right-hand side `_accel_read`, which takes the stage's number and reads the
+# stage's a_b from W), its right-hand side written out for those terms alone: `_attempt` picks one by its switches, in branches on its own
 # arguments, which Numba prunes before it inlines, so it copies only the chain it uses, and
 # only the code of those terms (each copy costs compile time).
 _KINDS = (({"parametric": None, "base": None}, ""), ({"parametric": True, "base": None}, "_p"),
@@ -147,8 +186,10 @@ _KINDS = (({"parametric": None, "base": None}, ""), ({"parametric": True, "base"
 
 
 def _chains(A, B, C, sums, skip_zeros, name):
-    return tuple(stages.make_chain(A, B, C, _accel, sums, skip_zeros, f"{name}{suffix}",
-                                   switches) for switches, suffix in _KINDS)
+    return tuple(stages.make_chain(A, B, C, _accel_read if "base" not in switches else _accel,
+                                   sums, skip_zeros, f"{name}{suffix}", switches,
+                                   stage_argument="base" not in switches)
+                 for switches, suffix in _KINDS)
 
 
 _chain5, _chain5_p, _chain5_b, _chain5_pb, _chain5_r, _chain5_pr = _chains(
@@ -207,7 +248,9 @@ def _attempt(W, rtol, n_run, parametric, base, record):
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
-        if base is not None:      # the last stage's own a_b (the same arithmetic)
+        if record is not None:    # the last stage's own a_b
+            W[W_AB * L + j] = W[(W_AB_STAGES + N_STAGES - 1) * L + j]
+        elif base is not None:    # (the same arithmetic)
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
@@ -271,7 +314,9 @@ def _attempt8(W, rtol, n_run, parametric, base, record):
         W[W_QN * L + j] = qn
         W[W_VN * L + j] = vn
         W[W_ERR * L + j] = dop853.combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv)
-        if base is not None:
+        if record is not None:
+            W[W_AB * L + j] = W[(W_AB_STAGES + dop853.N_STAGES - 1) * L + j]
+        elif base is not None:
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
@@ -706,6 +751,8 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
         if top == 0:
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
+        if record is not None:
+            _stage_reads(W, n_run, eighth, base)
         if eighth is None:
             _attempt(W, rtol, n_run, parametric, base, record)
         else:

@@ -71,11 +71,14 @@ def _weighted(names: Sequence[str], values: Sequence[float], skip_zeros: bool) -
 
 def chain_source(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[float],
                  sums: Sequence[Sequence[float]] = (), skip_zeros: bool = False,
-                 name: str = "chain") -> str:
+                 name: str = "chain", stage_argument: bool = False) -> str:
     """Python source of the stage chain of the explicit tableau (A, B, C) (module docstring):
     a function `name`(CHAIN_ARGS) that calls `rhs`, with the tableau's entries written in as
     float literals (each reads back as the same double) and the weighted sums of `sums` (weight
-    vectors of length len(B) + 1)."""
+    vectors of length len(B) + 1). With `stage_argument`, each call of rhs gets the stage's
+    number (1 .. len(B), the last f(t + h, y_new)) as an eighth argument, an int literal: a
+    right-hand side that reads what was computed for that stage before the chain (the lanes'
+    record reads, lanes._accel_read)."""
     n = len(B)
     if len(A) != n or len(C) != n or any(len(w) != n + 1 for w in sums):
         raise ValueError("tableau sizes disagree: A and C need len(B) rows, sums len(B) + 1")
@@ -89,14 +92,15 @@ def chain_source(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[f
         lines.append(f"    q{s} = q + ({dq}) * h" if dq else f"    q{s} = q")
         lines.append(f"    {kq[s]} = v + ({dv}) * h" if dv else f"    {kq[s]} = v")
         lines.append(f"    {kv[s]} = rhs(W, j, t + {_literal(C[s])} * h, q{s}, {kq[s]}, "
-                     "parametric, base)")
+                     f"parametric, base{f', {s}' if stage_argument else ''})")
     weights = [float(x) for x in B]
     sq = _weighted(kq[:n], weights, skip_zeros)
     sv = _weighted(kv[:n], weights, skip_zeros)
     lines.append(f"    qn = q + h * ({sq})" if sq else "    qn = q")
     lines.append(f"    vn = v + h * ({sv})" if sv else "    vn = v")
     lines.append(f"    {kq[n]} = vn")
-    lines.append(f"    {kv[n]} = rhs(W, j, t + h, qn, vn, parametric, base)")
+    lines.append(f"    {kv[n]} = rhs(W, j, t + h, qn, vn, parametric, "
+                 f"base{f', {n}' if stage_argument else ''})")
     results = [f"({', '.join(kq)})", f"({', '.join(kv)})", "qn", "vn"]
     for i, w in enumerate(sums):
         values = [float(x) for x in w]
@@ -399,14 +403,15 @@ def _written_rhs(rhs: Callable, switches: tuple) -> Callable:
 
 def make_chain(A: Sequence[Sequence[float]], B: Sequence[float], C: Sequence[float],
                rhs: Callable, sums: Sequence[Sequence[float]] = (), skip_zeros: bool = False,
-               name: str = "chain", switches: dict | None = None) -> Callable:
+               name: str = "chain", switches: dict | None = None,
+               stage_argument: bool = False) -> Callable:
     """The stage chain of (A, B, C) (`chain_source`) as an inline-always Numba function that
-    calls `rhs` (a Numba function rhs(W, j, t, q, v, parametric, base) -> q'' in m/s^2),
-    itself written out with its callees (`written_out`, specialised to `switches`: e.g.
-    {"parametric": None, "base": True}; the chain's own parametric and base are then unread)
-    and inlined into the chain's caller."""
+    calls `rhs` (a Numba function rhs(W, j, t, q, v, parametric, base) -> q'' in m/s^2, with
+    `stage_argument` rhs(W, j, t, q, v, parametric, base, stage)), itself written out with its
+    callees (`written_out`, specialised to `switches`: e.g. {"parametric": None, "base": True};
+    the chain's own parametric and base are then unread) and inlined into the chain's caller."""
     namespace = {"rhs": _written_rhs(rhs, tuple(sorted((switches or {}).items())))}
-    source = chain_source(A, B, C, sums, skip_zeros, name)
+    source = chain_source(A, B, C, sums, skip_zeros, name, stage_argument)
     exec(compile(source, f"<stage chain {name}>", "exec"), namespace)
     function = namespace[name]
     function.__doc__ = source
