@@ -821,6 +821,13 @@ def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
     that search took two thirds of a three-mode run). q_max (N): scratch."""
     for c in range(n):
         q_max[c] = mode_reach(y, h, QA, c)
+    return load_bound_within(t, t_new, q_max, n, basis, modal, p1, base, k)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def load_bound_within(t, t_new, q_max, n, basis, modal, p1, base, k):
+    """`_load_bound` over the step [t, t_new] (s) from bounds q_max (N, m) of each mode's
+    |q_n| over it (the multi-mode lanes' own, modal_lanes._mode_events)."""
     s = end_load_slot(n)
     inertia = 0.0
     if base is not None and k > 0:

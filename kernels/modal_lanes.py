@@ -234,21 +234,17 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base):
-    """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
-    the tail window and modal_driver._span_bound over the step (on each mode's interpolant:
-    DOP853's quintic Hermite through the state and its rates at both ends, RK45's quartic from
-    the stages, as modal_driver._mode_interpolant builds them) exceeds the span's largest
-    deflection so far (MOD's slot 2N), else 0: the step may hold a larger one, which
-    `_span_lane` searches for (a step on the scalar path searches in
-    modal_driver._observe_modes). K: the stages; eighth: the method switch; SHAPES: the basis'
-    mode shapes; base: the excitation switch."""
-    L = LANES
+def _reaches(Y, YN, K, H, REACH, n, n_run, eighth):
+    """REACH[c, l]: an upper bound (m) of |q_c(t) - q_c(t_0)| over lane l's attempt, on mode
+    c's interpolant as the scalar path builds it (modal_driver._mode_interpolant: DOP853's
+    quintic Hermite through the state and its rates at both ends, RK45's quartic from the
+    stages): the sum of its coefficients' sizes, as modal_driver.mode_reach (a value located
+    inside the step on the scalar path can never exceed |q_c(t_0)| + REACH[c, l]). K: the
+    stages; eighth: the method switch. The one rule behind the lanes' tests of whether a
+    step could hold a new largest deflection, mode amplitude, curvature or load
+    (`_mode_events`, `_span_events`)."""
     last = K.shape[0] - 1                   # f(t + h, y_new)
-    for l in range(n_run):
-        SPAN[l] = 0.0                       # the bound, until the test below
     for c in range(n):
-        size = drv.shape_size(SHAPES, c)
         for l in range(n_run):
             h = H[l]
             if eighth:
@@ -264,7 +260,28 @@ def _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES
                         term += K[j, c, l] * dopri5.P[j, k]
                     reach += abs(term)
                 reach *= abs(h)
-            SPAN[l] += (abs(Y[c, l]) + reach) * size
+            REACH[c, l] = reach * BOUND_MARGIN
+
+
+BOUND_MARGIN = 1.0 + 1e-12
+"""REACH's margin over the coefficients' sum: the lanes' arithmetic (fused multiply-adds)
+may round the sum an ulp or two below the scalar path's."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+def _span_events(W, Y, REACH, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES):
+    """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
+    the tail window and modal_driver._span_bound over the step (from REACH, `_reaches`)
+    exceeds the span's largest deflection so far (MOD's slot 2N), else 0: the step may hold
+    a larger one, which `_span_lane` searches for (a step on the scalar path searches in
+    modal_driver._observe_modes). SHAPES: the basis' mode shapes."""
+    L = LANES
+    for l in range(n_run):
+        SPAN[l] = 0.0                       # the bound, until the test below
+    for c in range(n):
+        size = drv.shape_size(SHAPES, c)
+        for l in range(n_run):
+            SPAN[l] += (abs(Y[c, l]) + REACH[c, l]) * size
     for l in range(n_run):
         ordinary = (MOVE[l] != 0.0) & (FLAG[l] == 0.0)
         tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
@@ -296,16 +313,24 @@ def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basi
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, REACH,
+                 QMAX, basis, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
-    q_n' not finite), or, ending in the tail window, an extremum of q_n in a mode not negligible
-    beside the largest (modal_driver.negligible; BIG: scratch, the largest mode's peak) or a
-    crest of the curvature at a clamp or at midspan (CV: the basis' kernels.modes.CLAMPS rows;
-    a pinned clamp's are all 0: never a crest), or a maximum of the stretch or of a clamp's
-    shear (kernels.modes.span_loads, CP: the basis' coupling;
-    MOD's shear factor; LD (2, 6): scratch; P1L: the lanes' Observer rows, for the base
-    inertia's part of the shear, modal_driver.inertia_at), where the scene observes the loads
-    (settings[LOADS], in MOD): the scalar path's turn; else 0. base: the excitation switch."""
+    q_n' not finite), or, ending in the tail window, something the scalar path would locate
+    inside it that could beat its largest so far (REACH, `_reaches`: each mode's bound over
+    the step): an extremum of q_n in a mode not negligible beside the largest
+    (modal_driver.negligible; BIG: scratch, the largest mode's peak) whose bound exceeds the
+    mode's tail amplitude, a crest of the curvature at a clamp or at midspan (CV: the basis'
+    kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest) whose bound exceeds
+    its largest so far, or a maximum of the stretch or of a clamp's shear
+    (kernels.modes.span_loads, CP: the basis' coupling; MOD's shear factor; LD (2, 6):
+    scratch; P1L: the lanes' Observer rows, for the base inertia's part of the shear,
+    modal_driver.inertia_at) whose bound (modal_driver.load_bound_within; QMAX (N): scratch)
+    exceeds its largest so far, where the scene observes the loads (settings[LOADS], in
+    MOD): the scalar path's turn; else 0. A step whose events could not beat the largest
+    values so far changes none of them on the scalar path (on a random record most of them:
+    the extrema of the modes, curvatures and shears come at nearly every step). base: the
+    excitation switch."""
     L = LANES
     for l in range(n_run):
         EV[l] = 0.0
@@ -319,24 +344,32 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
             v0 = Y[n + i, l]
             v1 = YN[n + i, l]
             turns = ((((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0)))
-                     & (not drv.negligible(max(MOD[n + i, l], abs(YN[i, l])), BIG[l])))
+                     & (not drv.negligible(max(MOD[n + i, l], abs(YN[i, l])), BIG[l]))
+                     & (abs(Y[i, l]) + REACH[i, l] > MOD[i, l]))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
             EV[l] = 1.0 if (turns & tail) | bad else EV[l]
     if not observe:
         return
+    slot = drv.clamp_slot(n)
     for e in range(md.N_BENDS):
         for l in range(n_run):
             r0 = 0.0
             r1 = 0.0
+            c0 = 0.0
+            reach = 0.0
             for i in range(n):
                 r0 += CV[e, i] * Y[n + i, l]
                 r1 += CV[e, i] * YN[n + i, l]
+                c0 += CV[e, i] * Y[i, l]
+                reach += abs(CV[e, i]) * REACH[i, l]
             crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
-            EV[l] = 1.0 if crest & tail else EV[l]
+            beats = abs(c0) + reach > MOD[slot + e, l]
+            EV[l] = 1.0 if crest & tail & beats else EV[l]
     a = LD[0]
     b = LD[1]
+    loads = drv.load_slot(n)
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
@@ -345,8 +378,14 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
         drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
                         P1L[l], base, b)
         for k in range(3):
-            if drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0:
+            if not (drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0):
+                continue
+            for c in range(n):
+                QMAX[c] = abs(Y[c, l]) + REACH[c, l]
+            if drv.load_bound_within(W[tj.T * L + l], W[tj.T_NEW * L + l], QMAX, n, basis,
+                                     MOD[:, l], P1L[l], base, k) > MOD[loads + k, l]:
                 EV[l] = 1.0
+                break
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -730,6 +769,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     MOVE = np.zeros(L)
     BOUNDS = np.zeros(L)
     BIG = np.zeros(L)
+    REACH = np.zeros((n, L))
+    QMAX = np.empty(n)
     pp = np.empty(md.prepared_size(n))
     yl = np.empty(dim)
     ynl = np.empty(dim)
@@ -798,14 +839,16 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, CP)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, base)
+        _reaches(Y, YN, K, H, REACH, n, n_run, eighth)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, REACH,
+                     QMAX, basis, base)
         _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
                            basis, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base)
-        _span_events(W, Y, YN, K, H, MOD, SPAN, MOVE, FLAG, n, n_run, eighth, SHAPES, base)
+        _span_events(W, Y, REACH, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES)
         for j in range(n_run):
             if SPAN[j] != 0.0:
                 _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis)
