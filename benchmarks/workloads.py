@@ -8,8 +8,9 @@ a few points that keep the scene's regimes, below, at and above resonance; `--se
 overrides):
 
 - the reference: the sample with solver.method = "dop853", rtol 1e-12 and the scalar driver,
-  which is SciPy's DOP853 step for step (tests/test_modal_driver.py, test_transverse.py check
-  the equality), so an independent SciPy solution at rtol 1e-12;
+  which is SciPy's DOP853 step for step (tests/test_kernel_vs_scipy.py checks it for one
+  mode, tests/test_mode_convergence.py the modal driver's steps against it at N = 1), so an
+  independent SciPy solution at rtol 1e-12;
 - the scene as shipped and each of the engine's settings (method rk45 / dop853 x rtol 1e-6 ..
   1e-10, the shipped driver): its time per point (best of --repeats after a compile run, one
   thread: run.threads = 1) and its error: max |x - x_ref| / max |x_ref| of the scene's

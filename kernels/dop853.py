@@ -17,8 +17,9 @@ step's middle), and since DOP853's steps shrink only as rtol^(1/8), it outgrows 
 integration's own error as rtol tightens: on the work-precision points it adds 3 % to the
 amplitude error at rtol 1e-5, doubles it at 1e-6 and makes it 23x at 1e-8. So the one-mode
 drivers take the seventh-order interpolant where rtol < SEVENTH_ORDER_BELOW_RTOL and the
-Hermite one above; the modal drivers, whose midspan deflection is a projection of N modes,
-always the Hermite one. The state is y = (q, q') in (m, m/s).
+Hermite one above (and always for a random record: trajectory.interpolant); the modal
+drivers, whose midspan deflection is a projection of N modes, always the Hermite one.
+The state is y = (q, q') in (m, m/s).
 
 Coefficients: SciPy's `dop853_coefficients` (BSD-3-Clause), from Hairer's DOP853 Fortran code.
 """

@@ -17,7 +17,7 @@ These loops run across the lanes with straight-line arithmetic, so LLVM vectoris
   output (safeguarded Newton), run only when some lane has one. A DOP853 step that holds one is
   located by trajectory.record_step on DOP853's dense output (trajectory.interpolant: its own
   seventh-order interpolant below rtol 3e-6, whose three extra right-hand sides it computes for
-  that lane alone; the quintic Hermite one above).
+  that lane alone; the quintic Hermite one above, and for a random record).
 
 Whatever else is not ordinary (a lane's first or last step, a step near SciPy's minimum, the
 extremum's bookkeeping, the tail's start, a time-series sample, a threshold crossing, a
@@ -42,8 +42,9 @@ values from W, so the chain's loop across the lanes vectorises as the sine kinds
 tail's start, a divergence) goes to record_step as above; its ordinary steps get the
 record's statistics in `_record_statistics`, on the lane's own accumulator: the record's
 reads in a scalar loop, then the observers record_step calls (trajectory.observe_acceleration,
-observe_random, observe_level_crossings: straight-line selects) in vector loops, and the
-spectra's samples (trajectory.take_samples), so the same bits as the scalar path.
+observe_random, observe_level_crossings: straight-line selects) in vector loops, and, with
+DOP853, the spectra's samples (`_record_samples`: trajectory.take_hermite_samples, as
+record_step takes them), so the same bits as the scalar path.
 """
 
 import math

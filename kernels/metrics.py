@@ -2,7 +2,8 @@
 
 While it integrates, the driver records every extremum of q (located on the dense output), the
 running peak |q|, the tail window's max |q| and range, and the last time |q - centre| exceeded
-a threshold. `classify` turns those into a state, a settling time and a response period.
+a threshold. `classify` (kernels/transverse.py) turns those, with this module's reductions,
+into a state, a settling time and a response period.
 
 States (integer flags, stored with CF flag_values / flag_meanings):
     INVALID_INPUT      the point's coefficients are not finite or its mass is not positive
@@ -18,7 +19,8 @@ States (integer flags, stored with CF flag_values / flag_meanings):
     DIVERGED           non-finite state or |q| beyond the divergence bound
     STEP_TOO_SMALL     the step size fell below SciPy's minimum (10 ulps of t)
     MAX_STEPS          the bound on accepted steps was reached
-    COMPLETED          (longitudinal only) the span reached t_end
+    COMPLETED          the run reached t_end with no settling to judge (a longitudinal span;
+                       a transverse span under a sine sweep)
 """
 
 import math

@@ -43,7 +43,8 @@ side reads each lane's record; a step with an event goes to the scalar path as a
 `record_step` and `modal_driver.observe_random_modes` accumulate the statistics (the lanes'
 accumulator then has the record's slots, trajectory.SCALAR_SLOTS), and an ordinary step gets
 the same two from `_record_steps`, lane by lane (the midspan's statistics,
-trajectory.record_statistics, and the curvature squares).
+trajectory.record_statistics, and the curvature squares), and with DOP853 its time-series
+samples too (trajectory.take_hermite_samples).
 
 Not bit for bit the scalar driver's (fast_cos, fast_sin, inv_fifth_root to an ulp or two; the
 loops fuse multiply-adds), so results equal its results to what a trajectory makes of

@@ -47,7 +47,9 @@ terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as b
 `basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives: (T, the
 shapes' derivatives at the nodes and the projection weights; stations, the shapes at stations
 along the span; midspan, phi_n(1/2); ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes,
-(N, 5): each mode's beam-function form, for `shape_at`). Nothing here knows the shapes' kind.
+(N, 5): each mode's beam-function form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
+uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below).
+Nothing here knows the shapes' kind.
 
 A point's raw row (columns below) holds the span's linear coefficients (w_p, its damping), the
 load, the membrane and the base excitation, then the initial state of every mode; `prepare`

@@ -3,6 +3,9 @@
     m q'' + c q' + (k0 + k1 cos(W t + phi_W)) q + (g0 + g1 cos(W t + phi_W)) q^3 + h q^5
         = -m G a_b(t),    a_b(t) = A sin(w_b t + phi_b)
 
+(a_b(t) as written for a fixed sine; a swept sine, a level table or a random record in
+general: kernels.excitation)
+
 q is the midspan deflection relative to the clamps (m), t the time (s), a_b the transverse
 acceleration of both clamps (base excitation, m/s^2) and G its participation factor (4/pi for
 the first mode). A point's coefficients live in one row of a float64 parameter array; the
@@ -13,8 +16,9 @@ Every driver reads a row through the same accessor, p[o + column * s]: a row of 
 lane's first parameter slot, s the number of lanes). Before integrating, `prepare` writes the
 row in the form `acceleration` reads: the force coefficients divided by -m, so the right-hand
 side is a sum of products with no division. Both drivers, the initial step, the metrics
-(`kernels.observer`) and the at-rest test call `acceleration`; the SciPy references of the
-benchmarks call its pure-Python form (`acceleration.py_func`). There is no other copy.
+(the Observer, `kernels.trajectory`) and the at-rest test call `acceleration`; the SciPy
+references of the benchmarks call its pure-Python form (`acceleration.py_func`). There is no
+other copy.
 
 Compile-time switches (None or True: Numba compiles one specialisation per choice, and the
 branches not taken are not in it):

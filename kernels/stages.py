@@ -21,7 +21,8 @@ and kv are the tuples (k0 .. kn) of both components (m/s and m/s^2); s_iq, s_iv 
 k0 w_i[0] + ... + kn w_i[n] of each weight vector w_i of `sums` (an error estimator's E, not
 yet times h). Every sum runs over the stages in order, left to right; with skip_zeros the
 terms whose tableau entry is exactly 0 are left out (a sparse tableau: DOP853's). `rhs` is the
-driver's right-hand side (for the lanes, lanes._accel: lane j of the working memory W).
+driver's right-hand side (for the lanes, lanes._accel: lane j of the working memory W; with
+`stage_argument`, a random record's lanes._accel_read, which also takes the stage's number).
 
 The source is generated and exec'd once per process, at import (milliseconds; print it with
 `chain_source`). A chain is never compiled on its own: Numba inlines it into its caller's IR

@@ -1,7 +1,7 @@
 """The state table: the integer flag of every grid point's outcome, one table for every model
 kind (an integer never means two things). Plain constants, no Numba: the sweep layer reads
 them (dataset flags, scene rules) without compiling or importing a kernel. Their meanings are
-in kernels/metrics.py's docstring and docs/architecture.md.
+in kernels/metrics.py's docstring and docs/model.md sec. 3.
 """
 
 INVALID_INPUT = 0

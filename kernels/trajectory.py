@@ -9,7 +9,7 @@ buffer, so a driver can advance many of them side by side:
     ... the driver computes one attempt of size h (RK45 or DOP853) and its error norm ...
     buf = finish_attempt(...)          SciPy's accept/reject and step-size update (`control`);
                                        on acceptance the in-kernel metrics (`record_step`)
-    classify(...)                      state, amplitude, settling time, period, counts
+    transverse.classify(...)           state, amplitude, settling time, period, counts
 
 Each point's attempts are SciPy's RK45's or DOP853's (settings[METHOD]), in SciPy's order,
 whatever the driver.

@@ -1,9 +1,10 @@
 """Batched transverse drivers: adaptive RK45 (or DOP853) trajectories over the rows of a
 parameter table.
 
-`solve_block(params, settings, lo, hi, states, reals, counts, series)` is the interface the
-sweep layer uses: rows lo..hi-1 of `params` (columns in `oscillator`) in, per-point metrics
-out. Two drivers have it, with the same results to round-off:
+`solve_block(params, settings, lo, hi, states, reals, counts, series, ...)` (then the
+compile-time switches and the `halt` flag) is the interface the sweep layer uses: rows
+lo..hi-1 of `params` (columns in `oscillator`) in, per-point metrics out. Two drivers have
+it, with the same results to round-off:
 
 - `solve_block` here: one trajectory after another (the reference);
 - `kernels.lanes.solve_block`: LANES trajectories advanced in lock-step in SIMD lanes, each

@@ -169,7 +169,7 @@ def _integrals(b, nodes=400):
 
 
 def test_the_clamped_basis_is_the_textbook_clamped_span():
-    """basis.clamped against MODEL's reference values (docs/model.md sec. 10: Thomson App. D,
+    """basis.clamped against the reference values of docs/model.md sec. 10 (Thomson App. D,
     Rao Table 8.1): the eigenvalues b_n l of cos(b l) cosh(b l) = 1, mode 1 scaled to max
     |phi| = 1 (its integrals, participation, curvature at the clamp and at midspan), the
     non-diagonal axial-load matrix A_ij of the unit-normalised modes 1-3 (the coupling of modes
@@ -212,7 +212,7 @@ def test_the_clamped_basis_is_the_textbook_clamped_span():
     (10.0, 4.1557, 14.98, 13.58, 10.458), (30.0, 4.4714, 21.82, 15.38, 11.223),
     (100.0, 4.6413, 25.93, 16.50, 11.875)])
 def test_elastic_ends_are_the_rotational_spring_table(stiffness, beta, end, mid, ratio):
-    """basis.elastic_ends against MODEL's table (docs/model.md sec. 10.3, rotational springs
+    """basis.elastic_ends against the rotational-spring table (docs/model.md sec. 10, springs
     K = k_t l / EI at both ends): mode 1's b_1 l, f1 / f1 pinned = (b_1 l / pi)^2, the
     curvatures at the end and at midspan per unit midspan amplitude, int phi'^2 / int phi^2;
     and the end conditions phi = 0, phi'' = K phi' (s = 0), phi'' = -K phi' (s = 1)."""

@@ -6,7 +6,8 @@ same engine, against references written here from the textbook, not from sweep.m
    textbook cosh/cos form), below, at and above resonance, one mode and three;
 2. the nonlinear clamped span (stretching and curvature terms of Eq.17) against SciPy's DOP853
    on Galerkin equations projected on the textbook shapes (tests/galerkin.py);
-3. elastic ends: f1 and the linear response from MODEL's rotational-spring eigenvalues;
+3. elastic ends: f1 and the linear response from the rotational-spring eigenvalues
+   (docs/model.md sec. 10);
 4. bad [clamps] input, one line each.
 """
 
@@ -193,7 +194,7 @@ def _symmetric_modes(stiffness: float, count: int) -> list[tuple[float, Callable
 
 @pytest.mark.parametrize("stiffness, table", [(1.0, 1.170), (10.0, 1.750), (100.0, 2.183)])
 def test_elastic_ends_give_the_spring_table_frequency(stiffness, table):
-    """f1 over the pinned span's f1 (MODEL's rotational-spring table, 3 digits) equals
+    """f1 over the pinned span's f1 (docs/model.md sec. 10's spring table, 3 digits) equals
     (b_1 l / pi)^2 of the symmetric formulation written here, to 1e-9."""
     ds = sweep.run(scene("elastic", t_end=0.2,
                          extra=f"rotational_stiffness = {stiffness * EI / LENGTH!r}"),

@@ -289,7 +289,7 @@ def test_elastic_ends_against_scipy():
     near the combination W = w1 + w3."""
     stiffness = 10.0
     shapes, bl = elastic_shapes(stiffness)
-    assert bl[0] == pytest.approx(4.1557, abs=1e-4)                # MODEL's table
+    assert bl[0] == pytest.approx(4.1557, abs=1e-4)                # docs/model.md sec. 10
     M, B, A = matrices(shapes, stiffness)
     assert np.allclose(np.linalg.solve(M, B) * LENGTH ** 4, np.diag(bl ** 4), rtol=1e-9,
                        atol=1e-9 * bl[-1] ** 4)            # the shapes are the span's modes

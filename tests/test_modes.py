@@ -465,7 +465,7 @@ rtol = {rtol!r}
 def test_a_sine_sweeps_largest_deflection_over_the_span():
     """A log sweep of three modes through mode 3's resonance (9 f1 = 137 Hz, the clamps at
     2 g): max_deflection over the whole sweep and its place against tests/galerkin.py's
-    equations under the same swept base (MODEL.md sec. 6: f_s 2^(r t / 60), the level's
+    equations under the same swept base (docs/model.md sec. 6: f_s 2^(r t / 60), the level's
     (1 - cos)/2 rise over ramp_cycles / f_s) integrated by SciPy DOP853 and searched by brute
     force over the sweep and the span: within 1e-6 relative, and well above the midspan's
     peak_amplitude (8.6 % above it: mode 3 moves the crest off midspan)."""

@@ -156,8 +156,9 @@ def test_derivative_record_is_the_analytic_derivative():
 
 @pytest.mark.parametrize("threads", [1, 2, 5])
 def test_records_follow_the_documented_draws(threads):
-    """Another engineer may rebuild a record from the contract: a_k, b_k = sqrt(W df) x
-    rng.standard_normal((2, N//2 + 1)), x(t) = sum a_k cos(2 pi f_k t) + b_k sin(2 pi f_k t);
+    """Another engineer may rebuild a record from docs/model.md sec. 11:
+    a_k, b_k = sqrt(W df) x rng.standard_normal((2, N//2 + 1)),
+    x(t) = sum a_k cos(2 pi f_k t) + b_k sin(2 pi f_k t);
     made on one thread or several (more threads than records included), the same records."""
     f, W = rnd.spectrum([[100, 0.1], [300, 0.3], [400, 0.05]])
     seed, fs = 21, 1500.0

@@ -66,10 +66,10 @@ def test_paper_fig5_amplitudes():
 
 
 def test_an_undamped_span_has_no_settling_time():
-    """MODEL: never a settling time for an undamped response. paper-fig5 (Eq.32, undamped) is
-    steady from t = 0, which the envelope test reads as 0 s: NaN instead; with damping the
-    same span decays to its static state and has one (the last time |q| > tol * peak, found
-    by the kernels: positive and before t_end)."""
+    """docs/model.md sec. 3: never a settling time for an undamped response. paper-fig5
+    (Eq.32, undamped) is steady from t = 0, which the envelope test reads as 0 s: NaN instead;
+    with damping the same span decays to its static state and has one (the last time
+    |q| > tol * peak, found by the kernels: positive and before t_end)."""
     scene = sweep.load_scene("paper-fig5", overrides={"axes.length": [0.5],
                                                       "axes.damping_ratio": [0.0, 0.3]})
     ds = sweep.run(scene, progress=False).squeeze()

@@ -2,7 +2,7 @@
 
 A model is a module with:
     KIND      its model.kind
-    run(scene, *, threads, progress, output, resume, overwrite, scheduler) -> xarray.Dataset
+    run(scene, options) -> xarray.Dataset   (options: sweep.runner.RunOptions)
               every grid point of the scene solved (through sweep/runner.py) and assembled
 and beside it whatever its physics needs: coefficients from cable data, the kernel settings,
 the output variables with units and long names. Today's models:

@@ -177,8 +177,8 @@ MULTI_MODE_METHOD = "dop853"
 built-in scenes' samples (benchmarks/workloads.py, benchmarks/RESULTS.md): at the default rtol
 1e-8 DOP853 runs harness-base-sine 1.75x, harness-clamps 2.0x and harness-stepped-sine 2.4x
 faster than RK45, its headline output within 2e-9 of the rtol 1e-12 reference on each (RK45:
-within 9e-9). A one-mode scene keeps RK45 (the contract's default; DOP853 gains 1.1-1.4x there,
-`solver.method = "dop853"`)."""
+within 9e-9). A one-mode scene keeps RK45 (solver.method's default; DOP853 gains 1.1-1.4x
+there, `solver.method = "dop853"`)."""
 
 SWEEP_MAX_STEPS = 20_000_000
 """solver.max_steps of a swept scene that gives none: a 130 s sweep to 100 Hz takes up to ~1e6

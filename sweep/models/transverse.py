@@ -889,7 +889,7 @@ def _undamped_unsettled(settling: xr.DataArray, inputs: Inputs) -> xr.DataArray:
 
 def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
              elapsed: float, records: np.ndarray | None = None) -> xr.Dataset:
-    """Build the result Dataset of the contract from the flat kernel result: the variables the
+    """Build the result Dataset from the flat kernel result: the variables the
     scene asked for (inputs.wanted), with units and long names; the derived closed forms
     (`coeffs`, sweep/models/modal.py) on their own axes; elapsed: the solve's wall time (s).
     A random scene: its records (for the input's realised grms)."""
