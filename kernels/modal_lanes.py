@@ -27,7 +27,8 @@ compile to packed AVX-512 FMAs on zmm registers):
   deflection so far, and the move to the step's end.
 
 An accepted step with anything to locate on a dense output (an extremum of the midspan
-deflection or of any mode, the tail's start, a time-series sample, a threshold crossing) or a
+deflection; an extremum of a mode, a crest of a curvature or a clamp load where its bound over
+the step (`_reaches`) could beat the largest so far; the tail's start, a time-series sample, a threshold crossing) or a
 divergence goes to the scalar path for that lane alone (`_flagged_lane`): the scalar driver's
 own functions on copies of the lane's columns (the divergence test on every mode,
 modal_driver._observe_modes, trajectory.record_step on the lane's accumulator W[j::LANES]
