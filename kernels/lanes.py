@@ -38,7 +38,8 @@ A random base acceleration (kernels.excitation's record kind: `base` is the reco
 too, on stage chains of its own (`_chain5_r`, `_chain8_r`, written out from the tableau as
 the others): each lane's record is read at the attempt's stage times before the attempt, in a
 scalar loop (`_stage_reads`), and the chain's right-hand side (`_accel_read`) reads those
-values from W, so the chain's loop across the lanes vectorises as the sine kinds' does. A record's accepted step with anything to locate inside it (an extremum of q, the
+values from W, so the chain's loop across the lanes vectorises as the sine kinds' does. A
+record's accepted step with anything to locate inside it (an extremum of q, the
 tail's start, a divergence) goes to record_step as above; its ordinary steps get the
 record's statistics in `_record_statistics`, on the lane's own accumulator: the record's
 reads in a scalar loop, then the observers record_step calls (trajectory.observe_acceleration,
@@ -61,7 +62,7 @@ from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, 
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
 from .layout import N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
-from .oscillator import (BOUND, EXCITATION, N_PARAMS, PARTICIPATION, acceleration, base_acceleration,
+from .oscillator import (BOUND, N_PARAMS, PARTICIPATION, acceleration, base_acceleration,
                          prepare)
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
@@ -154,23 +155,21 @@ def _accel_read(W, j, t, q, v, parametric, base, stage):
 def _stage_reads(W, n_run, eighth, base):
     """Each lane's a_b (m/s^2) at its attempt's stage times t + C[s] h, s = 1 .. n - 1, and at
     t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads, before the attempt,
-    so that its chain's loop has none (and vectorises: 6-10 % of a one-mode random run,
+    so that its chain's loop has none and vectorises (5-8 % of a one-mode random run,
     benchmarks/RESULTS.md). The reads themselves stay a scalar loop: LLVM will not vectorise
     a gather from the records beside a store into W, which it cannot prove apart."""
     L = LANES
     nodes = dop853.C if eighth is not None else C
     n = len(nodes)
-    for s in range(1, n + 1):
-        if s == n and nodes[n - 1] == 1.0:   # both methods' last stage is at t + h already
-            for j in range(n_run):
-                W[(W_AB_STAGES + n - 1) * L + j] = W[(W_AB_STAGES + n - 2) * L + j]
-            break
+    for s in range(1, n):
         for j in range(n_run):
-            t = W[tj.T * L + j]
-            h = W[W_H * L + j]
-            at = t + nodes[s] * h if s < n else t + h
+            at = W[tj.T * L + j] + nodes[s] * W[W_H * L + j]
             W[(W_AB_STAGES + s - 1) * L + j] = base_acceleration(at, W, W_P * L + j, L, True,
                                                                  base)
+    for j in range(n_run):               # f(t + h, y_new): both methods' last stage is there
+        W[(W_AB_STAGES + n - 1) * L + j] = (
+            W[(W_AB_STAGES + n - 2) * L + j] if nodes[n - 1] == 1.0 else base_acceleration(
+                W[tj.T * L + j] + W[W_H * L + j], W, W_P * L + j, L, True, base))
 
 
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in
@@ -178,7 +177,8 @@ def _stage_reads(W, n_run, eighth, base):
 # of its tableau; DOP853 leaves out the zeros of its sparse one. One chain per combination of
 # the System's optional terms (suffix p: parametric, b: a sine base excitation, r: a random
 # record: the right-hand side `_accel_read`, which takes the stage's number and reads the
-# stage's a_b from W), its right-hand side written out for those terms alone: `_attempt` picks one by its switches, in branches on its own
+# stage's a_b from W), its right-hand side written out for those terms alone: `_attempt`
+# picks one by its switches, in branches on its own
 # arguments, which Numba prunes before it inlines, so it copies only the chain it uses, and
 # only the code of those terms (each copy costs compile time).
 _KINDS = (({"parametric": None, "base": None}, ""), ({"parametric": True, "base": None}, "_p"),
