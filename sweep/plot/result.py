@@ -463,6 +463,11 @@ def _parse_scene(text: str) -> dict[str, Any]:
     return tomllib.loads(text)
 
 
+# Why a sweep's `direction` is never selected (--select and select=).
+_DIRECTION_NOTE = ("a sweep's up and down directions: the figures draw both, up solid and down "
+                   "dashed, or one figure each")
+
+
 def parse_select(items: Iterable[str]) -> dict[str, float]:
     """`["length=0.5", "frequency_ratio=2"]` -> {"length": 0.5, "frequency_ratio": 2.0}."""
     out: dict[str, float] = {}
@@ -471,6 +476,9 @@ def parse_select(items: Iterable[str]) -> dict[str, float]:
         dim, value = dim.strip(), value.strip()
         if not sep or not dim or not value:
             raise UserError(f"--select '{item}': expected DIM=VALUE, e.g. --select length=0.5")
+        if dim == DIRECTION_DIM:
+            raise UserError(f"--select '{item}': '{dim}' is not a swept axis to select "
+                            f"({_DIRECTION_NOTE}); select a swept axis, e.g. --select length=0.5")
         try:
             out[dim] = float(value)
         except ValueError:
@@ -539,7 +547,9 @@ def select_points(ds: xr.Dataset, select: Mapping[str, Any] | None = None) -> xr
         shown = f"{value:g}" if isinstance(value, (int, float, np.number)) else str(value)
         if dim not in axes:
             records = (" (the random records: the figures show statistics over them)"
-                       if dim == REALISATION_DIM and dim in ds[name].dims else "")
+                       if dim == REALISATION_DIM and dim in ds[name].dims else
+                       f" ({_DIRECTION_NOTE})" if dim == DIRECTION_DIM and dim in ds[name].dims
+                       else "")
             raise UserError(f"select {dim}={shown}: '{dim}' is not a swept axis of this result"
                             f"{records} (its axes: {', '.join(axes) or 'none'})")
         coord = np.asarray(ds[dim].values, dtype=float)
