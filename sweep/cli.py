@@ -279,6 +279,11 @@ def _check_dask_flags(args: argparse.Namespace, backend: str) -> None:
         raise UserError(f"--workers {args.workers}: sizes the dask backend's LocalCluster, and "
                         "this run uses in-process threads (add --backend dask, or use --threads "
                         "N for threads)")
+    cores = os.cpu_count() or 1          # the scene's own check (run.workers) says the same
+    if args.workers is not None and args.workers > cores:
+        raise UserError(f"--workers {args.workers}: {args.workers} worker processes on a machine "
+                        f"of {cores} core{'s' if cores != 1 else ''}: more would only compete for "
+                        f"them (give --workers {cores} or fewer, or 0 for one per core)")
 
 
 def _plot(args: argparse.Namespace) -> int:
