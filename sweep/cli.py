@@ -512,7 +512,12 @@ def _interrupted(exc: KeyboardInterrupt, args: argparse.Namespace,
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `sweep` console script."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra and args.command == "design" and not any(word.startswith("-") for word in extra):
+        args.result = [*args.result, *extra]   # result files after an option, in any order
+    elif extra:
+        parser.parse_args(argv)                # argparse's own one-line usage error, exit 2
     _one_line_warnings()
     try:
         if args.command == "run":

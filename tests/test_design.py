@@ -301,6 +301,22 @@ def test_cli_design_writes_a_cf_clean_file(results, tmp_path, capsys):
     back.close()
 
 
+def test_cli_design_takes_result_files_after_its_options(results, capsys):
+    """`sweep design A.nc --min-frequency 100 B.nc` as `sweep design A.nc B.nc --min-frequency
+    100` (a user's natural order once a file is added; argparse alone refused it with its
+    top-level usage); an unknown option is still argparse's one-line error."""
+    _, first = results["coarse"]
+    _, second = results["linear"]
+    assert main(["design", str(first), str(second), "--min-frequency", "100"]) == 0
+    expected = capsys.readouterr().out
+    assert main(["design", str(first), "--min-frequency", "100", str(second)]) == 0
+    assert capsys.readouterr().out == expected
+    with pytest.raises(SystemExit) as info:
+        main(["design", str(first), "--min-frequency", "100", "--no-such-option"])
+    assert info.value.code == 2
+    assert "unrecognized arguments: --no-such-option" in capsys.readouterr().err
+
+
 def test_cli_design_says_when_its_span_is_interpolated(results, capsys):
     """A response criterion's span is interpolated between grid lengths (a resonance between
     them can make it unsafe): the command says so and points at --refine; a frequency
