@@ -279,6 +279,9 @@ def _check_dask_flags(args: argparse.Namespace, backend: str) -> None:
         raise UserError(f"--workers {args.workers}: sizes the dask backend's LocalCluster, and "
                         "this run uses in-process threads (add --backend dask, or use --threads "
                         "N for threads)")
+    if args.workers is not None and args.workers < 0:
+        raise UserError(f"--workers {args.workers}: a number of worker processes cannot be "
+                        "negative (give 0 for one per core, or a positive count)")
     cores = os.cpu_count() or 1          # the scene's own check (run.workers) says the same
     if args.workers is not None and args.workers > cores:
         raise UserError(f"--workers {args.workers}: {args.workers} worker processes on a machine "

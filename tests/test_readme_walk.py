@@ -71,3 +71,16 @@ def test_workers_beyond_the_cores_names_the_flag(tmp_path, capsys):
     assert lines[0].startswith(f"sweep: error: --workers {workers}: {workers} worker processes")
     assert f"give --workers {os.cpu_count() or 1} or fewer" in lines[0]
     assert not out.exists()
+
+
+def test_negative_workers_names_the_flag(tmp_path, capsys):
+    """--workers -1 is refused naming the flag the user typed, not the scene key run.workers."""
+    scene = tmp_path / "s.toml"
+    scene.write_text(TINY)
+    out = tmp_path / "out.nc"
+    assert sweep_main(["run", str(scene), "-q", "-o", str(out), "--backend", "dask",
+                       "--workers", "-1"]) == 2
+    lines = stderr_lines(capsys.readouterr().err)
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("sweep: error: --workers -1: ") and "run.workers" not in lines[0]
+    assert not out.exists()
