@@ -62,8 +62,7 @@ from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, 
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
 from .layout import N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
-from .oscillator import (BOUND, N_PARAMS, PARTICIPATION, acceleration, base_acceleration,
-                         prepare)
+from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare, shaken
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
 
@@ -144,11 +143,12 @@ def _accel(W, j, t, q, v, parametric, base):
 def _accel_read(W, j, t, q, v, parametric, base, stage):
     """q'' (m/s^2) of lane j at (t, q, v) under a random record, its a_b at the attempt's
     stage `stage` read from row W_AB_STAGES + stage - 1 (`_stage_reads`): the System's
-    right-hand side without the base term, then that term, in `acceleration`'s own order, so
-    the chain's loop across the lanes has no record read in it and vectorises."""
+    right-hand side without the base term, then that term (oscillator.shaken, as
+    `acceleration` adds it), so the chain's loop across the lanes has no record read in it
+    and vectorises."""
     L = LANES
-    a = acceleration(t, q, v, W, W_P * L + j, L, True, parametric, None)
-    return a - W[(W_P + PARTICIPATION) * L + j] * W[(W_AB_STAGES + stage - 1) * L + j]
+    return shaken(acceleration(t, q, v, W, W_P * L + j, L, True, parametric, None), W,
+                  W_P * L + j, L, W[(W_AB_STAGES + stage - 1) * L + j])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

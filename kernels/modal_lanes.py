@@ -28,8 +28,8 @@ compile to packed AVX-512 FMAs on zmm registers):
 
 An accepted step with anything to locate on a dense output (an extremum of the midspan
 deflection; an extremum of a mode, a crest of a curvature or a clamp load where its bound over
-the step (`_reaches`) could beat the largest so far; the tail's start, a time-series sample, a threshold crossing) or a
-divergence goes to the scalar path for that lane alone (`_flagged_lane`): the scalar driver's
+the step (`_reaches`) could beat the largest so far; the tail's start, a time-series sample,
+a threshold crossing) or a divergence goes to the scalar path for that lane alone (`_flagged_lane`): the scalar driver's
 own functions on copies of the lane's columns (the divergence test on every mode,
 modal_driver._observe_modes, trajectory.record_step on the lane's accumulator W[j::LANES]
 and its Observer row, with the scalar driver's types, so that they compile once for both).
@@ -379,11 +379,11 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
                         P1L[l], base, a)
         drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
                         P1L[l], base, b)
+        for c in range(n):
+            QMAX[c] = abs(Y[c, l]) + REACH[c, l]
         for k in range(3):
             if not (drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0):
                 continue
-            for c in range(n):
-                QMAX[c] = abs(Y[c, l]) + REACH[c, l]
             if drv.load_bound_within(W[tj.T * L + l], W[tj.T_NEW * L + l], QMAX, n, basis,
                                      MOD[:, l], P1L[l], base, k) > MOD[loads + k, l]:
                 EV[l] = 1.0

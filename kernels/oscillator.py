@@ -147,8 +147,17 @@ def acceleration(t, q, v, p, o, s, fast, parametric, base):
         a = p[o + K0 * s] * q + p[o + G0 * s] * q * q2 + p[o + H * s] * q * q2 * q2
     a = a + p[o + DAMPING * s] * v
     if base is not None:
-        a = a - p[o + PARTICIPATION * s] * base_acceleration(t, p, o, s, fast, base)
+        a = shaken(a, p, o, s, base_acceleration(t, p, o, s, fast, base))
     return a
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def shaken(a, p, o, s, a_b):
+    """q'' (m/s^2) of the span with no base excitation, a (m/s^2), with the clamps'
+    acceleration a_b (m/s^2) added as the right-hand side's -G a_b (G: the mode's
+    participation factor): `acceleration`'s base term, and the lanes' where a_b was read
+    before the stages (kernels.lanes._accel_read)."""
+    return a - p[o + PARTICIPATION * s] * a_b
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
