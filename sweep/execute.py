@@ -131,11 +131,13 @@ def reduced_chunk(params: np.ndarray, inner: Callable[..., dict], inner_args: tu
     outputs. A long series not kept lives only for the call. on_block and stop as
     `transverse_chunk`'s."""
     reduced: dict[str, np.ndarray] = {}
+    making = threading.Lock()           # blocks are reported from several threads at once
 
     def outputs_of(solved: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        if not reduced:
-            reduced.update(solved)
-            reduced.update(reduction.empty(params.shape[0]))
+        with making:
+            if not reduced:
+                reduced.update(solved)
+                reduced.update(reduction.empty(params.shape[0]))
         return reduced
 
     def report(lo: int, hi: int, solved: dict[str, np.ndarray]) -> None:

@@ -170,8 +170,11 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
-    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.ticker(), lanes=driver == "lanes")
+    try:
+        run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+                   tick=watch.ticker(), lanes=driver == "lanes")
+    finally:
+        watch.drain()                    # rows whose report a solving thread left to others
 
 
 def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.ndarray,
@@ -232,8 +235,11 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
-    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.ticker(), lanes=driver == "lanes")
+    try:
+        run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+                   tick=watch.ticker(), lanes=driver == "lanes")
+    finally:
+        watch.drain()                    # rows whose report a solving thread left to others
 
 
 def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
@@ -334,13 +340,25 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
             raise
 
 
+class _Block:
+    """A block in progress, for `Watch`: its rows' end, how far they are reported, and the
+    lock that keeps its reports in order."""
+
+    def __init__(self, hi: int, lo: int) -> None:
+        self.hi, self.reported = hi, lo
+        self.reporting = threading.Lock()
+
+
 class Watch:
     """The rows of the blocks in progress, for a watcher thread: which are final (their state
     written, >= 0: the kernels write a row's state after every other output of it, and rows
     still NOT_SOLVED, SECOND_PASS, OFF_MIDSPAN or HIDDEN_MODE are not), reported to
-    on_block(lo, hi) in
-    order, each row once, whichever thread gets there first; and an interrupt (`stop`) passed
-    to the kernels through `halt`."""
+    on_block(lo, hi) in order within a block, each row once, whichever thread gets there
+    first; and an interrupt (`stop`) passed to the kernels through `halt`.
+
+    on_block runs outside the lock that guards the table of blocks: a caller's on_block may
+    take long (a random scene's spectra are computed there, about 40 % of its work), and
+    under that lock it kept the other threads from starting their next block."""
 
     def __init__(self, states: np.ndarray, on_block: Callable[[int, int], None] | None,
                  stop: threading.Event | None) -> None:
@@ -351,21 +369,30 @@ class Watch:
         self.halt = np.zeros(1, np.int8)     # read by the lanes drivers every attempt, the
                                              # scalar ones between rows
         self.lock = threading.Lock()
-        self.blocks: dict[int, list[int]] = {}   # a block's first row -> [its end, reported to]
+        self.blocks: dict[int, _Block] = {}   # a block's first row -> the block
         self.not_solved = st.NOT_SOLVED
 
     def begin(self, lo: int, hi: int) -> None:
         """Rows lo..hi-1 start (from the solving thread)."""
         self.states[lo:hi] = self.not_solved
         with self.lock:
-            self.blocks[lo] = [hi, lo]
+            self.blocks[lo] = _Block(hi, lo)
 
     def end(self, lo: int) -> None:
         """The block that starts at `lo` is done (its follow-up passes too): its final rows are
-        reported, and it is forgotten (from the solving thread)."""
+        reported (from the solving thread), unless another thread is reporting the block's
+        rows: then the solving thread goes on to its next block, and that thread's next
+        report, the next tick or `drain` reports the rest."""
+        self._report(lo, wait=False)
+
+    def drain(self) -> None:
+        """Report every final row not yet reported (once the blocks have stopped running)."""
         with self.lock:
+            firsts = list(self.blocks)
+        for lo in firsts:
             self._report(lo)
-            del self.blocks[lo]
+        with self.lock:
+            self.blocks.clear()
 
     def ticker(self) -> Callable[[], None] | None:
         """`tick`, for run_blocks, where there is anyone to tell or anything to stop (a caller's
@@ -381,14 +408,29 @@ class Watch:
         if self.stop.is_set():
             self.halt[0] = 1
         with self.lock:
-            for lo in list(self.blocks):
-                self._report(lo)
+            firsts = list(self.blocks)
+        for lo in firsts:
+            self._report(lo)
 
-    def _report(self, lo: int) -> None:
-        hi, reported = self.blocks[lo]
-        pending = np.flatnonzero(self.states[reported:hi] < 0)
-        final = reported + int(pending[0] if pending.size else hi - reported)
-        if final > reported:
-            self.blocks[lo][1] = final
-            if self.on_block is not None:
-                self.on_block(reported, final)
+    def _report(self, lo: int, wait: bool = True) -> None:
+        """Report the block's rows that have turned final; a block reported to its end is
+        forgotten. wait False: return at once where another thread is reporting it."""
+        with self.lock:
+            block = self.blocks.get(lo)
+        if block is None or not block.reporting.acquire(blocking=wait):
+            return                       # reported to its end, or being reported
+        try:
+            while True:                  # rows that turned final during a report, too
+                reported = block.reported
+                pending = np.flatnonzero(self.states[reported:block.hi] < 0)
+                final = reported + int(pending[0] if pending.size else block.hi - reported)
+                if final == reported:
+                    break
+                block.reported = final
+                if self.on_block is not None:
+                    self.on_block(reported, final)
+            if block.reported == block.hi:
+                with self.lock:
+                    self.blocks.pop(lo, None)
+        finally:
+            block.reporting.release()

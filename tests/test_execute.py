@@ -323,6 +323,52 @@ def test_blocks_are_reported_once_each_and_stop_ends_the_solve(threads):
     assert np.all(np.isin(part["states"][~solved], (-1, NOT_SOLVED)))
 
 
+def test_a_long_report_holds_up_neither_other_blocks_nor_its_own_solver():
+    """threads.Watch calls on_block outside the lock on its table of blocks: while one thread
+    reports rows of a block (a random scene's spectra are computed there), a solving thread
+    ends that block without waiting and begins and ends another; the reporter reports the
+    rows that turned final meanwhile; every row is reported once, in order within its block."""
+    import threading
+
+    from sweep.threads import Watch
+    states = np.full(20, NOT_SOLVED, np.int8)
+    inside, release, solver_done = threading.Event(), threading.Event(), threading.Event()
+    seen = []
+
+    def on_block(lo, hi):
+        seen.append((lo, hi))
+        if lo == 0:
+            inside.set()
+            release.wait(10)
+
+    watch = Watch(states, on_block, None)
+    watch.begin(0, 10)
+    states[:4] = 0                             # rows 0..3 final
+    reporter = threading.Thread(target=watch.tick)
+
+    def solve():
+        states[4:10] = 0
+        watch.end(0)                           # being reported: returns at once
+        watch.begin(10, 20)
+        states[10:20] = 0
+        watch.end(10)
+        solver_done.set()
+
+    solver = threading.Thread(target=solve)
+    try:
+        reporter.start()
+        assert inside.wait(10)                 # the reporter is inside on_block(0, 4)
+        solver.start()
+        assert solver_done.wait(5), "the solving thread waited for another thread's report"
+    finally:
+        release.set()
+        reporter.join(10)
+        solver.join(10)
+    watch.drain()
+    assert sorted(seen) == [(0, 4), (4, 10), (10, 20)]
+    assert seen.index((0, 4)) < seen.index((4, 10))
+
+
 SLOW_MODES = """
 name = "slow-blocks"
 [model]

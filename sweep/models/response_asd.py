@@ -115,7 +115,7 @@ def welch(x: np.ndarray, fs: float, nperseg: int) -> tuple[np.ndarray, np.ndarra
     window = _hann(nperseg)
     spectra = _transforms(np.asarray(x, float), window, nperseg // 2 + 1)
     return (np.fft.rfftfreq(nperseg, 1.0 / fs),
-            _density(np.abs(spectra) ** 2, window, fs).mean(axis=-2))
+            _density(_power(spectra), window, fs).mean(axis=-2))
 
 
 def _hann(n: int) -> np.ndarray:
@@ -136,7 +136,14 @@ def _transforms(x: np.ndarray, window: np.ndarray, n_freq: int) -> np.ndarray:
     axis; `_segments`, window.size samples), its mean removed and `window` applied."""
     segments = _segments(x, window.size)
     centred = segments - segments.mean(axis=-1, keepdims=True)
-    return np.fft.rfft(centred * window, axis=-1)[..., :n_freq]
+    centred *= window                  # in place: one large temporary fewer
+    return np.fft.rfft(centred, axis=-1)[..., :n_freq]
+
+
+def _power(spectra: np.ndarray) -> np.ndarray:
+    """|X|^2 of complex transforms, as re^2 + im^2 (abs() ** 2 takes a square root to square
+    it again)."""
+    return spectra.real * spectra.real + spectra.imag * spectra.imag
 
 
 def _density(power: np.ndarray, window: np.ndarray, fs: float) -> np.ndarray:
@@ -201,17 +208,20 @@ class Reduction:
             q = series[i, first:]
             if not (q.size >= self.nperseg + 2 and np.all(np.isfinite(q))):
                 continue                                   # escaped, or too short: NaN
-            k = np.arange(first + 1, first + q.size - 1)
             a_rel = (q[2:] - 2.0 * q[1:-1] + q[:-2]) * (self.rate * self.rate)
-            a_base = (params[i, self.scale_column]
-                      * records[int(params[i, self.record_column]), 0,
-                                (k * self.decimation) % n_rec])
+            m = self.decimation                # a_b at the samples k = first + 1 .. q's last - 1
+            start, last = (first + 1) * m, (first + q.size - 2) * m
+            record = records[int(params[i, self.record_column]), 0]
+            base = (record[start:last + 1:m] if last < n_rec      # a view: no gather
+                    else record[np.arange(start, last + 1, m) % n_rec])
+            a_base = params[i, self.scale_column] * base
             fq = _transforms(q[1:-1], window, self.n_freq)
             fr = _transforms(a_rel, window, self.n_freq)
             fb = _transforms(a_base, window, self.n_freq)
-            out["deflection_asd"][i] = _density(np.abs(fq) ** 2, window, self.rate).mean(-2)
-            out["acceleration_asd"][i] = _density(np.abs(fr * gain + fb) ** 2, window,
-                                                  self.rate).mean(-2)
+            fr *= gain
+            fr += fb
+            out["deflection_asd"][i] = _density(_power(fq), window, self.rate).mean(-2)
+            out["acceleration_asd"][i] = _density(_power(fr), window, self.rate).mean(-2)
 
 
 def reduction(random: Any, shortest: float, resolution: float | None, t_end: float,
