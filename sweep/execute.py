@@ -147,8 +147,16 @@ def reduced_chunk(params: np.ndarray, inner: Callable[..., dict], inner_args: tu
 
     solved = inner(params, *inner_args, threads=threads,
                    on_block=None if on_block is None else report, stop=stop)
-    if on_block is None:
-        reduction.fill(params, records, solved, outputs_of(solved), 0, params.shape[0])
+    if on_block is None:                 # (a dask worker's chunk) every row at once, in parts
+        out = outputs_of(solved)         # on the chunk's threads
+        from concurrent.futures import ThreadPoolExecutor
+
+        from .threads import thread_count
+        n = params.shape[0]
+        edges = np.linspace(0, n, min(thread_count(threads), max(n, 1)) + 1).astype(int)
+        with ThreadPoolExecutor(len(edges) - 1) as pool:
+            list(pool.map(lambda lo, hi: reduction.fill(params, records, solved, out, lo, hi),
+                          edges[:-1], edges[1:]))
     return outputs_of(solved)
 
 

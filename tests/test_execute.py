@@ -75,6 +75,21 @@ def test_longitudinal_on_dask_equals_threads():
     assert_same_result(dask, threads, ignore={"scene"})
 
 
+@pytest.mark.slow
+def test_random_spectra_on_dask_equal_threads():
+    """A dask worker's chunk computes the response's spectra after its solve (in parts on the
+    chunk's threads), the threads backend block by block as the rows turn final: the same
+    values either way."""
+    pytest.importorskip("dask.distributed")
+    small = {"axes.length": [0.1, 0.15], "axes.base_asd_scale": [0.0], "base.realisations": 3,
+             "base.duration": 1.0, "outputs.response_asd": True, "run.threads": 2}
+    threads = sweep.run(sweep.load_scene("launch-random-gevs", small), progress=False)
+    dask = sweep.run(sweep.load_scene("launch-random-gevs", {
+        **small, "run.backend": "dask", "run.workers": 2, "run.chunk_size": 4}), progress=False)
+    assert np.isfinite(threads["deflection_asd"].values).all()
+    assert_same_result(dask, threads, ignore={"scene"})
+
+
 def _cli(args, cwd, **kwargs):
     env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
     return subprocess.Popen([sys.executable, "-m", "sweep.cli", *args], cwd=cwd, env=env,
