@@ -8,11 +8,13 @@ reference sweep (benchmarks/reference_sweep.py's scene, `sweep.run.solve_points`
 
     python benchmarks/before_after.py BEFORE_ROOT AFTER_ROOT [--method rk45|dop853]
         [--driver lanes|scalar] [--repeats 40] [--pairs 2]
-        [--scene NAME --set KEY=VALUE ...]
+        [--scene NAME --set KEY=VALUE ... [--threads N]]
 
 With --scene, each run is instead `sweep.run` of that built-in scene (its own method and
 driver unless --set says otherwise) on one thread, with the --set overrides (TOML values, as
-`sweep run --set`), after one warm-up run: the whole run as a user makes it.
+`sweep run --set`), after one warm-up run: the whole run as a user makes it. With --threads N
+(N > 1, --scene only) the scene runs on N threads, so the two checkouts cannot share the
+machine: each pair runs them one after the other, unpinned, in alternating order.
 
 BEFORE_ROOT and AFTER_ROOT are repository checkouts (e.g. `git clone . /tmp/before && git -C
 /tmp/before checkout REV`); each is imported from its own directory. Needs 2 cores and taskset.
@@ -52,7 +54,8 @@ root, name, repeats = sys.argv[1], sys.argv[2], int(sys.argv[3])
 sys.path[:0] = [root]
 import sweep
 from sweep.scene.overrides import parse_override
-overrides = {"run.threads": 1, **dict(parse_override(item) for item in sys.argv[4:])}
+overrides = {"run.threads": int(sys.argv[4]),
+             **dict(parse_override(item) for item in sys.argv[5:])}
 scene = sweep.load_scene(name, overrides=overrides)
 sweep.run(scene)
 best = float("inf")
@@ -67,14 +70,27 @@ print(best)
 def pair(roots: tuple[str, str], cores: tuple[int, int], args: argparse.Namespace) -> list[float]:
     """Best times (s) of both roots, run at once on the given cores."""
     if args.scene:
-        command = ["-c", SCENE_RUN, "ROOT", args.scene, str(args.repeats), *args.set]
+        command = ["-c", SCENE_RUN, "ROOT", args.scene, str(args.repeats), str(args.threads),
+                   *args.set]
     else:
         command = ["-c", ONE_RUN, "ROOT", args.method, args.driver, str(args.repeats)]
-    procs = [subprocess.Popen(["taskset", "-c", str(core), sys.executable,
-                               *[root if c == "ROOT" else c for c in command]],
-                              cwd=root, stdout=subprocess.PIPE, text=True)
-             for root, core in zip(roots, cores)]
-    return [float(p.communicate()[0].split()[-1]) for p in procs]
+
+    def start(root: str, core: int) -> subprocess.Popen:
+        pin = ["taskset", "-c", str(core)] if args.threads == 1 else []
+        return subprocess.Popen([*pin, sys.executable,
+                                 *[root if c == "ROOT" else c for c in command]],
+                                cwd=root, stdout=subprocess.PIPE, text=True)
+
+    def best(proc: subprocess.Popen) -> float:
+        return float(proc.communicate()[0].split()[-1])
+
+    if args.threads == 1:
+        procs = [start(root, core) for root, core in zip(roots, cores)]
+        return [best(proc) for proc in procs]
+    first = 0 if cores == (0, 1) else 1     # several threads: one at a time, alternating
+    times = {first: best(start(roots[first], 0))}
+    times[1 - first] = best(start(roots[1 - first], 0))
+    return [times[0], times[1]]
 
 
 def main() -> None:
@@ -88,7 +104,11 @@ def main() -> None:
     p.add_argument("--scene", help="time `sweep.run` of this built-in scene instead")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a scene override (with --scene), as `sweep run --set`")
+    p.add_argument("--threads", type=int, default=1,
+                   help="run.threads of each --scene run (> 1: the checkouts one at a time)")
     args = p.parse_args()
+    if args.threads != 1 and not args.scene:
+        p.error("--threads: with --scene only")
     roots = (str(Path(args.before).resolve()), str(Path(args.after).resolve()))
     before, after = [], []
     for _ in range(args.pairs):
@@ -99,7 +119,8 @@ def main() -> None:
     ratios = ", ".join(f"{a / b:.3f}" for a, b in zip(after, before))
     what = (f"{args.scene} {' '.join(args.set)}" if args.scene
             else f"{args.driver} {args.method}")
-    print(f"{what}, 1 thread, best of {args.repeats} each run")
+    threads = "1 thread" if args.threads == 1 else f"{args.threads} threads, one at a time"
+    print(f"{what}, {threads}, best of {args.repeats} each run")
     print(f"before: best {min(before):.4f} s  runs {', '.join(f'{b:.4f}' for b in before)}")
     print(f"after:  best {min(after):.4f} s  runs {', '.join(f'{a:.4f}' for a in after)}")
     print(f"after / before: best {min(after) / min(before):.3f}; per pair {ratios}")
