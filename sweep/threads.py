@@ -8,7 +8,8 @@ spans better than a static schedule. There is no Numba parallel region to compil
 took ~3 s on a cold cache), and a point's result never depends on the blocks or the number of
 threads.
 
-Blocks are also sized by time: once a thread has timed a block, its next one takes about
+Blocks are also sized by time: once a thread has timed a block (a grid of at most two
+MIN_TIMED_BLOCK blocks a thread is split into equal shares instead), its next one takes about
 BLOCK_SECONDS (never fewer than MIN_TIMED_BLOCK points on the lanes, whose lanes drain at a
 block's end; SCALAR_BLOCK on a scalar driver, which has none). A block of slow points
 (several modes: 64 of them took 17 s) is not waited for: a watcher thread looks every
@@ -170,11 +171,8 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
-    try:
-        run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-                   tick=watch.ticker(), lanes=driver == "lanes")
-    finally:
-        watch.drain()                    # rows whose report a solving thread left to others
+    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+               tick=watch.ticker(), lanes=driver == "lanes")
 
 
 def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.ndarray,
@@ -235,11 +233,8 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
-    try:
-        run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-                   tick=watch.ticker(), lanes=driver == "lanes")
-    finally:
-        watch.drain()                    # rows whose report a solving thread left to others
+    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+               tick=watch.ticker(), lanes=driver == "lanes")
 
 
 def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
@@ -311,12 +306,17 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
     n_threads = max(1, min(thread_count(threads), -(-n // per_thread)))
     stop = stop or threading.Event()     # set on an interrupt: no new blocks are started
     most = SOLO_BLOCK if n_threads == 1 else MAX_BLOCK
+    share = -(-n // n_threads)
+    # The first block is short: it times the points, which sizes the next ones. A grid of at
+    # most two such blocks a thread has no next ones to size: each thread takes an equal share
+    # (144 random points on 2 threads were blocks of 64, 64 and 16, the last on one thread).
+    first = share if 1 < n_threads and share <= 2 * least_timed else least_timed
     start = 0
     lock = threading.Lock()
 
     def work() -> None:
         nonlocal start
-        cap = least_timed                # the first block is short: it times the points
+        cap = first
         while not stop.is_set():
             with lock:
                 lo = start
@@ -340,25 +340,18 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
             raise
 
 
-class _Block:
-    """A block in progress, for `Watch`: its rows' end, how far they are reported, and the
-    lock that keeps its reports in order."""
-
-    def __init__(self, hi: int, lo: int) -> None:
-        self.hi, self.reported = hi, lo
-        self.reporting = threading.Lock()
-
-
 class Watch:
     """The rows of the blocks in progress, for a watcher thread: which are final (their state
     written, >= 0: the kernels write a row's state after every other output of it, and rows
     still NOT_SOLVED, SECOND_PASS, OFF_MIDSPAN or HIDDEN_MODE are not), reported to
-    on_block(lo, hi) in order within a block, each row once, whichever thread gets there
-    first; and an interrupt (`stop`) passed to the kernels through `halt`.
+    on_block(lo, hi) each row once, whichever thread gets there first; and an interrupt
+    (`stop`) passed to the kernels through `halt`.
 
-    on_block runs outside the lock that guards the table of blocks: a caller's on_block may
-    take long (a random scene's spectra are computed there, about 40 % of its work), and
-    under that lock it kept the other threads from starting their next block."""
+    A thread claims the rows it reports under the lock that guards the table of blocks and
+    calls on_block outside it: a caller's on_block may take long (a random scene's spectra are
+    computed there, about 40 % of its work), and under that lock it kept the other threads
+    from ending or beginning blocks. Two threads may so report disjoint rows of one block at
+    the same time, in either order."""
 
     def __init__(self, states: np.ndarray, on_block: Callable[[int, int], None] | None,
                  stop: threading.Event | None) -> None:
@@ -369,30 +362,21 @@ class Watch:
         self.halt = np.zeros(1, np.int8)     # read by the lanes drivers every attempt, the
                                              # scalar ones between rows
         self.lock = threading.Lock()
-        self.blocks: dict[int, _Block] = {}   # a block's first row -> the block
+        self.blocks: dict[int, list[int]] = {}   # a block's first row -> [its end, claimed to]
         self.not_solved = st.NOT_SOLVED
 
     def begin(self, lo: int, hi: int) -> None:
         """Rows lo..hi-1 start (from the solving thread)."""
         self.states[lo:hi] = self.not_solved
         with self.lock:
-            self.blocks[lo] = _Block(hi, lo)
+            self.blocks[lo] = [hi, lo]
 
     def end(self, lo: int) -> None:
-        """The block that starts at `lo` is done (its follow-up passes too): its final rows are
-        reported (from the solving thread), unless another thread is reporting the block's
-        rows: then the solving thread goes on to its next block, and that thread's next
-        report, the next tick or `drain` reports the rest."""
-        self._report(lo, wait=False)
-
-    def drain(self) -> None:
-        """Report every final row not yet reported (once the blocks have stopped running)."""
+        """The block that starts at `lo` is done (its follow-up passes too): its final rows not
+        yet claimed are reported, and it is forgotten (from the solving thread)."""
+        self._report(lo)
         with self.lock:
-            firsts = list(self.blocks)
-        for lo in firsts:
-            self._report(lo)
-        with self.lock:
-            self.blocks.clear()
+            self.blocks.pop(lo, None)
 
     def ticker(self) -> Callable[[], None] | None:
         """`tick`, for run_blocks, where there is anyone to tell or anything to stop (a caller's
@@ -412,25 +396,16 @@ class Watch:
         for lo in firsts:
             self._report(lo)
 
-    def _report(self, lo: int, wait: bool = True) -> None:
-        """Report the block's rows that have turned final; a block reported to its end is
-        forgotten. wait False: return at once where another thread is reporting it."""
+    def _report(self, lo: int) -> None:
+        """Claim the block's rows that have turned final since its last claim, and report
+        them."""
         with self.lock:
             block = self.blocks.get(lo)
-        if block is None or not block.reporting.acquire(blocking=wait):
-            return                       # reported to its end, or being reported
-        try:
-            while True:                  # rows that turned final during a report, too
-                reported = block.reported
-                pending = np.flatnonzero(self.states[reported:block.hi] < 0)
-                final = reported + int(pending[0] if pending.size else block.hi - reported)
-                if final == reported:
-                    break
-                block.reported = final
-                if self.on_block is not None:
-                    self.on_block(reported, final)
-            if block.reported == block.hi:
-                with self.lock:
-                    self.blocks.pop(lo, None)
-        finally:
-            block.reporting.release()
+            if block is None:
+                return                   # ended since the caller looked
+            hi, reported = block
+            pending = np.flatnonzero(self.states[reported:hi] < 0)
+            final = reported + int(pending[0] if pending.size else hi - reported)
+            block[1] = final
+        if final > reported and self.on_block is not None:
+            self.on_block(reported, final)

@@ -340,9 +340,9 @@ def test_blocks_are_reported_once_each_and_stop_ends_the_solve(threads):
 
 def test_a_long_report_holds_up_neither_other_blocks_nor_its_own_solver():
     """threads.Watch calls on_block outside the lock on its table of blocks: while one thread
-    reports rows of a block (a random scene's spectra are computed there), a solving thread
-    ends that block without waiting and begins and ends another; the reporter reports the
-    rows that turned final meanwhile; every row is reported once, in order within its block."""
+    reports rows of a block (a random scene's spectra are computed there), the block's solving
+    thread reports the rows that turned final since, ends the block, and begins and ends
+    another; every row is reported once."""
     import threading
 
     from sweep.threads import Watch
@@ -363,7 +363,7 @@ def test_a_long_report_holds_up_neither_other_blocks_nor_its_own_solver():
 
     def solve():
         states[4:10] = 0
-        watch.end(0)                           # being reported: returns at once
+        watch.end(0)
         watch.begin(10, 20)
         states[10:20] = 0
         watch.end(10)
@@ -375,13 +375,12 @@ def test_a_long_report_holds_up_neither_other_blocks_nor_its_own_solver():
         assert inside.wait(10)                 # the reporter is inside on_block(0, 4)
         solver.start()
         assert solver_done.wait(5), "the solving thread waited for another thread's report"
+        assert seen == [(0, 4), (4, 10), (10, 20)]
     finally:
         release.set()
         reporter.join(10)
         solver.join(10)
-    watch.drain()
-    assert sorted(seen) == [(0, 4), (4, 10), (10, 20)]
-    assert seen.index((0, 4)) < seen.index((4, 10))
+    assert not watch.blocks
 
 
 SLOW_MODES = """

@@ -256,6 +256,31 @@ def test_guided_blocks_cover_every_row_once(least):
             assert seen[-1][1] - seen[-1][0] <= 2 * SCALAR_BLOCK, seen[-3:]
 
 
+def test_a_small_grid_is_split_evenly_between_the_threads():
+    """A grid of at most two timed blocks a thread (MIN_TIMED_BLOCK) runs as one equal share a
+    thread (there is no later block for the timing to size); a larger one starts with timed
+    blocks."""
+    import threading
+
+    from sweep.threads import MIN_TIMED_BLOCK, run_blocks, thread_count
+    if thread_count(2) < 2:
+        pytest.skip("needs 2 threads")
+    seen, lock = [], threading.Lock()
+
+    def solve(lo, hi):
+        with lock:
+            seen.append((lo, hi))
+
+    for n in (144, 4 * MIN_TIMED_BLOCK - 1, 4 * MIN_TIMED_BLOCK):
+        seen.clear()
+        run_blocks(solve, n, 2, None)
+        half = -(-n // 2)
+        assert sorted(seen) == [(0, half), (half, n)], n
+    seen.clear()
+    run_blocks(solve, 4 * MIN_TIMED_BLOCK + 2, 2, None)
+    assert sorted(seen)[0] == (0, MIN_TIMED_BLOCK)
+
+
 def test_sweep_run_refuses_a_negative_thread_count():
     import sweep
     scene = sweep.load_scene("paper-fig5")
