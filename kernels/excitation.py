@@ -183,15 +183,22 @@ def _hermite(y0, d0, y1, d1, u, dt):
             + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def record_acceleration(t, p, o, s, records):
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def record_value(t, p, o, s, records):
     """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
     at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
     fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
     p[o + RECORD_SCALE * s], and over the first RAMP seconds (base.ramp; 0: none) by the
-    ramp's (1 - cos(pi t / RAMP)) / 2, as a shaker brings its level up."""
+    ramp's (1 - cos(pi t / RAMP)) / 2, as a shaker brings its level up. Inlined where it is
+    called (`inlined_signal`); `record_acceleration` is the same as a call."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
     return scale * _hermite(y0, d0, y1, d1, u, dt) * _rise(t, p[o + RAMP * s])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def record_acceleration(t, p, o, s, records):
+    """`record_value` as a call of its own (`signal`: the several-mode System's reads)."""
+    return record_value(t, p, o, s, records)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -282,6 +289,22 @@ def signal(t, p, o, s, base):
 def _signal(t, p, o, s, base):
     if isinstance(base, types.Array):
         return lambda t, p, o, s, base: record_acceleration(t, p, o, s, base)
+    return lambda t, p, o, s, base: acceleration(t, p, o, s)
+
+
+def inlined_signal(t, p, o, s, base):
+    """`signal` with the record kind's read inlined into the caller (`record_value`): the
+    one-mode System's reads (kernels.oscillator). Shared as a call with the several-mode
+    System, whose process could compile it first (or another process, into the Numba cache),
+    it made the one-mode results depend on which scenes had been compiled before
+    (tests/test_jitcache.py)."""
+    return signal(t, p, o, s, base)
+
+
+@overload(inlined_signal, inline="always")
+def _inlined_signal(t, p, o, s, base):
+    if isinstance(base, types.Array):
+        return lambda t, p, o, s, base: record_value(t, p, o, s, base)
     return lambda t, p, o, s, base: acceleration(t, p, o, s)
 
 

@@ -109,8 +109,9 @@ def prepare(row, p, o, s):
 def _excitation_signal(t, p, o, s, base):
     """kernels.excitation's a_b(t) of the row's block (a sine kind, fixed or swept, or, where
     `base` is an array of records, the record kind: `excitation.signal`): a call of its own, so
-    that inlining `base_acceleration` into a vector loop copies no more than its sine."""
-    return ex.signal(t, p, o + EXCITATION * s, s, base)
+    that inlining `base_acceleration` into a vector loop copies no more than its sine; a
+    record's read inlined into it (`excitation.inlined_signal`)."""
+    return ex.inlined_signal(t, p, o + EXCITATION * s, s, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4))

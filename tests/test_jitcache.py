@@ -48,3 +48,44 @@ def test_a_cache_elsewhere_is_left_alone(package, monkeypatch):
 
 def test_a_missing_package_is_not_an_error():
     assert not drop_stale_cache("no_such_package_for_jitcache.kernels")
+
+
+_RECORD_RUNS = """
+import sys, sweep
+def rms(overrides):
+    overrides = {"run.threads": 1, "axes.length": [0.1], "base.realisations": 2,
+                 "base.duration": 1.0, "outputs.response_asd": False,
+                 "axes.base_asd_scale": [0.0], **overrides}
+    ds = sweep.run(sweep.load_scene("launch-random-gevs", overrides), progress=False)
+    return repr(float(ds.rms_deflection.values.ravel()[0]))
+print(" ".join(rms(eval(overrides)) for overrides in sys.argv[1:]))
+"""
+
+
+@pytest.mark.slow
+def test_a_record_s_result_does_not_depend_on_what_was_compiled_before(tmp_path):
+    """A one-mode and a 3-mode record scene, each compiled alone on an empty Numba cache, and
+    each compiled after the other (the one-mode scene in a process of its own on the cache the
+    3-mode one filled; the 3-mode one in the process that compiled the one-mode one): the same
+    bits. Before, the one-mode scene's read of its record (excitation.record_acceleration, a
+    call shared with the several-mode System) was compiled by whichever came first, and the
+    one-mode rms_deflection came out 3.78e-4 instead of 4.45e-4, the 3-mode one 1.1909800e-4
+    instead of 1.1909872e-4."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = str(Path(__file__).resolve().parents[1])
+
+    def rms(cache, *overrides):
+        env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": root}
+        done = subprocess.run([sys.executable, "-c", _RECORD_RUNS, *overrides], env=env,
+                              cwd=tmp_path, capture_output=True, text=True, timeout=900)
+        assert done.returncode == 0, done.stderr[-2000:]
+        return [float(x) for x in done.stdout.split()]
+
+    one, three = '{"base.ramp": 0.2}', '{"model.modes": 3}'
+    one_alone, three_alone = rms(tmp_path / "a", one)[0], rms(tmp_path / "b", three)[0]
+    assert rms(tmp_path / "b", one) == [one_alone]           # on the cache 3 modes filled
+    assert rms(tmp_path / "c", one, three) == [one_alone, three_alone]   # in one process
