@@ -153,10 +153,10 @@ def reduced_chunk(params: np.ndarray, inner: Callable[..., dict], inner_args: tu
 
         from .threads import thread_count
         n = params.shape[0]
-        edges = np.linspace(0, n, min(thread_count(threads), max(n, 1)) + 1).astype(int)
-        with ThreadPoolExecutor(len(edges) - 1) as pool:
-            list(pool.map(lambda lo, hi: reduction.fill(params, records, solved, out, lo, hi),
-                          edges[:-1], edges[1:]))
+        parts = chunk_ranges(n, max(1, -(-n // thread_count(threads))))
+        with ThreadPoolExecutor(max(1, len(parts))) as pool:
+            list(pool.map(lambda part: reduction.fill(params, records, solved, out, *part),
+                          parts))
     return outputs_of(solved)
 
 
