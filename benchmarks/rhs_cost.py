@@ -44,7 +44,7 @@ from clamps_cost import SCENE  # noqa: E402
 import sweep  # noqa: E402
 from sweep.kernels import modes as md  # noqa: E402
 from sweep.models.basis import (CLAMPED, _eigenvalues, _normalised, from_shapes,  # noqa: E402
-                                quadrature_nodes)
+                                quadrature_nodes, with_force_form)
 from sweep.models.transverse import modal_rows, resolve  # noqa: E402
 
 LANES = 32
@@ -63,7 +63,7 @@ def lanes_loop(row, basis, calls, lanes):
     X = np.empty((2 * n, lanes))
     K = np.empty((1, 2 * n, lanes))
     tt = np.zeros(lanes)
-    FLD = np.empty((4, T.shape[2], lanes))
+    FLD = np.empty((4, md.field_rows(basis), lanes))
     SC = np.empty((4, lanes))
     total = 0.0
     for k in range(calls):
@@ -72,7 +72,7 @@ def lanes_loop(row, basis, calls, lanes):
                 X[c, l] = 1e-3 + k * 1e-12 + l * 1e-9
                 tt[l] = k * 1e-5
         md.lanes_derivative(tt, X, K, 0, PP, n, T, FLD, SC, lanes, True, True,
-                            basis[md.COUPLING])
+                            basis[md.COUPLING], basis[md.POLYNOMIAL])
         total += K[0, n, 0]
     return total
 
@@ -134,7 +134,7 @@ def quadrature_error(n: int, nodes: int, states: list[np.ndarray]) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--modes", type=int, nargs="+", default=[3, 5])
+    parser.add_argument("--modes", type=int, nargs="+", default=[2, 3, 4, 5, 6])
     parser.add_argument("--calls", type=int, default=20000)
     args = parser.parse_args()
     rows = []
@@ -143,17 +143,25 @@ def main() -> None:
                 ("pinned", False, "energy, uniform tension"),
                 ("pinned", True, "Eq.17, local membrane"),
                 ("clamped", False, "energy, uniform tension")):
-            row, basis = span(n, rotation, membrane)
-            lanes_loop(row, basis, 10, LANES)
-            one_state_loop(row, basis, 10)
-            lane = best_ns(lambda: lanes_loop(row, basis, args.calls, LANES),
-                           args.calls * LANES)
-            one = best_ns(lambda: one_state_loop(row, basis, 10 * args.calls),
-                          10 * args.calls)
-            rows.append([f"{n}", rotation, physics, f"{basis[md.TABLES].shape[2]}",
-                         f"{lane:.1f}", f"{one:.0f}"])
+            row, arrays = span(n, rotation, membrane)
+            cells = []
+            for polynomial in (False, True):
+                basis = with_force_form(arrays, polynomial)
+                lanes_loop(row, basis, 10, LANES)
+                one_state_loop(row, basis, 10)
+                cells.append((best_ns(lambda: lanes_loop(row, basis, args.calls, LANES),
+                                      args.calls * LANES),
+                              best_ns(lambda: one_state_loop(row, basis, 10 * args.calls),
+                                      10 * args.calls)))
+            (lane_q, one_q), (lane_p, one_p) = cells
+            chosen = "polynomial" if md.uses_polynomial(arrays) else "quadrature"
+            rows.append([f"{n}", rotation, physics, f"{arrays[md.TABLES].shape[2]}",
+                         f"{lane_q:.1f}", f"{lane_p:.1f}", f"{one_q:.0f}", f"{one_p:.0f}",
+                         chosen])
     print(markdown_table(["modes", "ends", "terms", "quadrature nodes",
-                          f"ns a lane ({LANES} lanes)", "ns one state"], rows))
+                          f"quadrature, ns a lane ({LANES} lanes)", "polynomial, ns a lane",
+                          "quadrature, ns one state", "polynomial, ns one state", "chosen"],
+                         rows))
     rng = np.random.default_rng(1)
     table = []
     for n in args.modes:

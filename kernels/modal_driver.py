@@ -1059,7 +1059,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
     T = basis[md.TABLES]
     pp = np.empty(md.prepared_size(n))
     md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, basis[md.COUPLING])
+    S = md.scratch(pp, n, basis)
     p1 = observer_row(row, n, pp)
     K = np.empty((n_stages + 1, dim))
     K_mid = np.empty((n_stages + 1, 2))

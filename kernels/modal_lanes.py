@@ -106,13 +106,13 @@ def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
-             base, CP):
+             base, CP, PY):
     """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
     rk_step: K[1..n_stages] and YN = y_new, K[n_stages] = f(t + h, y_new); K[0] = f(t, y)
     given) and SciPy's error norm over the 2N components (ERR): RK45's RMS, or DOP853's
     combination of its fifth- and third-order estimates (`eighth`). The absolute tolerances are
-    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP: the basis' coupling
-    (kernels.modes.lanes_derivative)."""
+    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY: the basis' coupling
+    and polynomial (kernels.modes.lanes_derivative)."""
     L = LANES
     dim = 2 * n
     n_stages = B.shape[0]
@@ -121,11 +121,11 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
         c = C[s]
         for l in range(n_run):
             TT[l] = W[tj.T * L + l] + c * H[l]
-        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP)
+        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY)
     _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
     for l in range(n_run):
         TT[l] = W[tj.T * L + l] + H[l]
-    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP)
+    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP, PY)
     # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
     for l in range(n_run):
         ST[0, l] = 0.0
@@ -516,7 +516,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states,
         states[point] = mt.INVALID_INPUT
         return False
     md.prepare(row, n, pp, basis[md.RATIOS])
-    S = md.scratch(pp, n, basis[md.COUPLING])
+    S = md.scratch(pp, n, basis)
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
     p1 = drv.observer_row(row, n, pp)
@@ -734,10 +734,11 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     B = dop853.B if eighth else dopri5.B
     C = dop853.C if eighth else dopri5.C
     T = basis[md.TABLES]
-    nodes = T.shape[2]
+    rows = md.field_rows(basis)
     weights = basis[md.MIDSPAN]
     CV = basis[md.CLAMPS]            # (the basis' arrays taken once: a tuple's item taken in
     CP = basis[md.COUPLING]          # the loop costs a reference count update a call)
+    PY = basis[md.POLYNOMIAL]
     SHAPES = basis[md.SHAPES]
     record = ex.is_record(base)      # a random record: the accumulator has its
     slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
@@ -760,7 +761,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     PP = np.zeros((md.prepared_size(n), L))
     P1 = np.zeros(N_PARAMS * L)
     P1L = np.zeros((L, N_PARAMS))       # the same rows, a lane's contiguous (the scalar path)
-    FLD = np.zeros((4, nodes, L))
+    FLD = np.zeros((4, rows, L))
     SC = np.zeros((4, L))
     TT = np.zeros(L)
     H = np.zeros(L)
@@ -838,7 +839,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                 tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
-                 n_run, base, CP)
+                 n_run, base, CP, PY)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
         _reaches(Y, YN, K, H, REACH, n, n_run, eighth)

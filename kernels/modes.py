@@ -27,9 +27,13 @@ summed with its weights. For pinned sines the integrand is a trigonometric polyn
 at most 6N and the trapezoidal rule on M = 3N + 1 equal intervals of [0, pi] is exact for it;
 the axial load's term gives the diagonal n^2 P k^2 / rho A there, and couples the modes through
 A_ij = int phi_i' phi_j' for other shapes with no code of its own. The cost grows as N^2
-(fields and projection), where precomputed coupling tensors would grow as N^6 (the quintic's).
-With N = 1 it reproduces the one-mode coefficients K3 and K5 of docs/model.md sec. 2
-(tests/test_modes.py).
+(fields and projection). The same force is also each mode's polynomial in q, of degree 5:
+where the basis' Gauss-Legendre rule needs many nodes (clamped and elastic ends need 6 N + 12
+to reach round-off, pinned sines 3 N) and the modes are few, evaluating that polynomial costs
+less (a basis' POLYNOMIAL item, built from FORCE_TERMS by sweep.models.basis.force_polynomial:
+the same terms, expanded once per basis; its monomials grow as N^5, so it is not built above
+a few modes). With N = 1 it reproduces the one-mode coefficients K3 and K5 of docs/model.md
+sec. 2 (tests/test_modes.py).
 
 Eq.17's bending terms are not the gradient of an energy with several modes (their Jacobian
 is not symmetric: an undamped span's energy wanders). The span's bending energy (EI / 2) int
@@ -48,7 +52,8 @@ terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as b
 shapes' derivatives at the nodes and the projection weights; stations, the shapes at stations
 along the span; midspan, phi_n(1/2); ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes,
 (N, 5): each mode's beam-function form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
-uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below).
+uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
+polynomial: the force's polynomial, or empty arrays where the quadrature is used).
 Nothing here knows the shapes' kind.
 
 A point's raw row (columns below) holds the span's linear coefficients (w_p, its damping), the
@@ -99,6 +104,7 @@ RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
 SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
 CLAMPS = 6          # (10, N): what the load observers watch per mode (rows below; s = x / l)
+POLYNOMIAL = 7      # the same force as a polynomial in q, or empty (FORCE_TERMS, below)
 
 # Rows of basis[CLAMPS]: what the load observers of the modal drivers read (per unit q_n).
 BEND_0 = 0          # phi_n''(0): the curvature at the clamp x = 0 (times 1 / l^2)
@@ -432,6 +438,142 @@ def _axial(a, b, linear, membrane):
     return (linear - membrane * (a * a)) * b
 
 
+# The nonlinear and axial-load force as data, term by term: (group, projection row of the
+# tables, coefficient, fields), the fields 0..3 = a, b, c, d; the force on mode m is the sum of
+# group scale x coefficient x int (product of the fields) x (the projection row's shape), the
+# same terms the node functions above evaluate (tests/test_modes.py checks the two against each
+# other). sweep.models.basis expands them into each mode's polynomial in q (`POLYNOMIAL`), which
+# the right-hand side evaluates instead of the quadrature where that costs less.
+G_LINEAR = 0        # P(t) k^2 / rho A less the uniform tension's N k^2 / rho A: SC[0]
+G_MEMBRANE = 1      # beta_m(t), the paper's local membrane term: SC[1]
+G_ENERGY_CUBIC = 2  # beta_b, lanes whose bending terms come from the span's energy
+G_ENERGY_QUINTIC = 3    # beta_q, the same lanes
+G_EQ17_CUBIC = 4    # beta_b, lanes with Eq.17's bending terms
+G_EQ17_QUINTIC = 5  # beta_q, the same lanes
+N_GROUPS = 6
+FORCE_TERMS = (
+    (G_LINEAR, 4, 1.0, (1,)),                      # _axial: linear b, on phi_m
+    (G_MEMBRANE, 4, -1.0, (0, 0, 1)),              # - membrane a^2 b, on phi_m
+    (G_ENERGY_CUBIC, 5, -3.0, (0, 1, 1)),          # _energy_bending: -3 beta_b a b^2, on phi_m'
+    (G_ENERGY_CUBIC, 6, -3.0, (0, 0, 1)),          # -3 beta_b a^2 b, on phi_m''
+    (G_ENERGY_QUINTIC, 5, 12.0, (0, 0, 0, 1, 1)),  # 12 beta_q a^3 b^2, on phi_m'
+    (G_ENERGY_QUINTIC, 6, 6.0, (0, 0, 0, 0, 1)),   # 6 beta_q a^4 b, on phi_m''
+    (G_EQ17_CUBIC, 4, -3.0, (1, 1, 1)),            # _eq17_bending: beta_b (-3 b^3
+    (G_EQ17_CUBIC, 4, -11.0, (0, 1, 2)),           # - 11 a b c
+    (G_EQ17_CUBIC, 4, -3.0, (0, 0, 3)),            # - 3 a^2 d)
+    (G_EQ17_QUINTIC, 4, 10.5, (0, 0, 1, 1, 1)),    # + 10.5 beta_q a^2 b^3, on phi_m
+)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def uses_polynomial(basis):
+    """Whether the right-hand side evaluates the basis' force as its polynomial (POLYNOMIAL)
+    rather than by quadrature (callable from Python and from the kernels)."""
+    return basis[POLYNOMIAL][0].shape[0] > 0
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def field_rows(basis):
+    """The middle axis of the lanes' scratch FLD (4, rows, lanes) for `basis`: its quadrature
+    nodes, or room for the polynomial's monomials and group scales (`_polynomial_lanes`)."""
+    need = basis[POLYNOMIAL][0].shape[0] + N_GROUPS + 1
+    return max(basis[TABLES].shape[2], (need + 3) // 4)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _group_scale(g, linear, membrane, beta_b, beta_q, energy):
+    """Group g's scale (FORCE_TERMS) for one state: energy 1 where the bending terms come
+    from the span's energy, 0 where from Eq.17."""
+    if g == G_LINEAR:
+        return linear
+    if g == G_MEMBRANE:
+        return membrane
+    if g == G_ENERGY_CUBIC:
+        return energy * beta_b
+    if g == G_ENERGY_QUINTIC:
+        return energy * beta_q
+    if g == G_EQ17_CUBIC:
+        return (1.0 - energy) * beta_b
+    return (1.0 - energy) * beta_q
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run):
+    """The polynomial form of the force (POLYNOMIAL: program (K, 2), starts (N, N_GROUPS + 1),
+    monomials (T,), coefficients (T,)) for every lane: R[0..K-1] the monomials (R[k] =
+    R[program[k, 0]] R[program[k, 1]] for k >= N, the q_n below), R[K + g] group g's scale;
+    returns the bit mask of the groups some lane has a non-zero scale in. Each mode's sum is
+    `_polynomial_mode`'s."""
+    program = PY[0]
+    n_mono = program.shape[0]
+    for k in range(n):
+        for l in range(n_run):
+            R[k, l] = X[k, l]
+    for k in range(n, n_mono):
+        i = program[k, 0]
+        j = program[k, 1]
+        for l in range(n_run):
+            R[k, l] = R[i, l] * R[j, l]
+    for l in range(n_run):
+        R[n_mono + G_LINEAR, l] = SC[0, l]
+        R[n_mono + G_MEMBRANE, l] = SC[1, l]
+        e = PP[sc + S_ENERGY, l]
+        R[n_mono + G_ENERGY_CUBIC, l] = e * PP[sc + S_BETA_B, l]
+        R[n_mono + G_ENERGY_QUINTIC, l] = e * PP[sc + S_BETA_Q, l]
+        R[n_mono + G_EQ17_CUBIC, l] = (1.0 - e) * PP[sc + S_BETA_B, l]
+        R[n_mono + G_EQ17_QUINTIC, l] = (1.0 - e) * PP[sc + S_BETA_Q, l]
+    active = 0
+    for g in range(N_GROUPS):
+        for l in range(n_run):
+            if R[n_mono + g, l] != 0.0:
+                active |= 1 << g
+                break
+    return active
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _polynomial_mode(i, PY, R, active, out, n_run):
+    """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
+    the sum over the groups in `active` of the group's scale R[K + g] times its terms'
+    coefficients x monomials (`_polynomial_lanes` filled R)."""
+    starts = PY[1]
+    mono = PY[2]
+    coef = PY[3]
+    n_mono = PY[0].shape[0]
+    for l in range(n_run):
+        out[l] = 0.0
+    for g in range(N_GROUPS):
+        lo = starts[i, g]
+        hi = starts[i, g + 1]
+        if lo == hi or not (active >> g) & 1:
+            continue
+        c = coef[lo]
+        k = mono[lo]
+        for l in range(n_run):
+            R[n_mono + N_GROUPS, l] = c * R[k, l]
+        t = lo + 1
+        while t + 4 <= hi:              # four terms a pass over the lanes
+            c0 = coef[t]
+            c1 = coef[t + 1]
+            c2 = coef[t + 2]
+            c3 = coef[t + 3]
+            k0 = mono[t]
+            k1 = mono[t + 1]
+            k2 = mono[t + 2]
+            k3 = mono[t + 3]
+            for l in range(n_run):
+                R[n_mono + N_GROUPS, l] += ((c0 * R[k0, l] + c1 * R[k1, l])
+                                            + (c2 * R[k2, l] + c3 * R[k3, l]))
+            t += 4
+        for u in range(t, hi):
+            c = coef[u]
+            k = mono[u]
+            for l in range(n_run):
+                R[n_mono + N_GROUPS, l] += c * R[k, l]
+        for l in range(n_run):
+            out[l] += R[n_mono + g, l] * R[n_mono + N_GROUPS, l]
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
     """The nonlinear forces at the nodes (per unit rho A, in the fields' units) of lanes
@@ -496,7 +638,7 @@ _lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP):
+def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
     (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis' tables
@@ -509,7 +651,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     N = k_s e, e = (k^2 l / 2) sum CP_ij q_i q_j, which adds -N k^2 b / rho A to F (a lane whose
     TENSION is 0 has none; when no lane has one it is not computed). A lane whose S_ENERGY is
     1 takes its bending terms from the span's energy (module docstring), projected on the
-    shapes' slopes and curvatures too (`_energy_forces`).
+    shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL; where it
+    is not empty, the same force is evaluated as each mode's polynomial in q
+    (`_polynomial_lanes`, FLD its scratch: `field_rows`) instead of at the nodes.
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode
     there: the nonlinear terms and the axial load's linear term P(t) w_xx (for pinned sines a
@@ -547,12 +691,17 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             _lanes_signal(tt, PP, sc, SC, n_run, base)
         else:
             _lanes_fast_signal(tt, PP, sc, SC, n_run, base)
+    polynomial = PY[0].shape[0] > 0
+    R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))
+    active = 0
+    if polynomial:
+        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run)
     energy = False                      # some lane's bending terms from the span's energy
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
     for l in range(n_run):
         energy = energy or PP[sc + S_ENERGY, l] != 0.0
         eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-    for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
+    for f in range(0, 0 if polynomial else (4 if eq17 else 2), 2):   # (a, b), then (c, d)
         for j in range(nodes):
             t0 = T[f, 0, j]
             t1 = T[f + 1, 0, j]
@@ -568,7 +717,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                     q = X[i, l]
                     FLD[f, j, l] += t0 * q
                     FLD[f + 1, j, l] += t1 * q
-    if energy and not eq17:
+    if polynomial:
+        pass
+    elif energy and not eq17:
         _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
     elif energy:
         _energy_forces(PP, sc, FLD, SC, nodes, n_run)
@@ -583,19 +734,22 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                                               PP[sc + S_BETA_Q, l])
                                 + _axial(a, b, SC[0, l], SC[1, l]))
     for i in range(n):
-        w = T[4, i, 0]
-        for l in range(n_run):
-            SC[3, l] = w * FLD[0, 0, l]
-        for j in range(1, nodes):
-            w = T[4, i, j]
+        if polynomial:
+            _polynomial_mode(i, PY, R, active, SC[3], n_run)
+        else:
+            w = T[4, i, 0]
             for l in range(n_run):
-                SC[3, l] += w * FLD[0, j, l]
-        if energy:                      # the weak form's parts, on phi_m' and phi_m''
-            for j in range(nodes):
-                w1 = T[5, i, j]
-                w2 = T[6, i, j]
+                SC[3, l] = w * FLD[0, 0, l]
+            for j in range(1, nodes):
+                w = T[4, i, j]
                 for l in range(n_run):
-                    SC[3, l] += w1 * FLD[1, j, l] + w2 * FLD[2, j, l]
+                    SC[3, l] += w * FLD[0, j, l]
+            if energy:                  # the weak form's parts, on phi_m' and phi_m''
+                for j in range(nodes):
+                    w1 = T[5, i, j]
+                    w2 = T[6, i, j]
+                    for l in range(n_run):
+                        SC[3, l] += w1 * FLD[1, j, l] + w2 * FLD[2, j, l]
         for l in range(n_run):
             acc = (PP[P_STIFF * n + i, l] * X[i, l] + PP[P_DAMPING * n + i, l] * X[n + i, l]
                    - SC[3, l])
@@ -606,11 +760,13 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def scratch(pp, n_modes, CP):
+def scratch(pp, n_modes, basis):
     """What the one-state right-hand side (`derivative`) reads and writes besides its state:
-    a copy of the prepared row pp, its projections' accumulator (N) and the basis' coupling
-    CP (basis[COUPLING])."""
-    return pp.copy(), np.empty(n_modes), CP
+    a copy of the prepared row pp, its projections' accumulator (N), the basis' coupling
+    (basis[COUPLING]) and polynomial (basis[POLYNOMIAL]), and the polynomial's monomials'
+    scratch."""
+    PY = basis[POLYNOMIAL]
+    return pp.copy(), np.empty(n_modes), basis[COUPLING], PY, np.empty(PY[0].shape[0])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -621,7 +777,42 @@ def row_scratch(row, basis):
     n = basis_modes(basis)
     pp = np.empty(prepared_size(n))
     prepare(row, n, pp, basis[RATIOS])
-    return scratch(pp, n, basis[COUPLING])
+    return scratch(pp, n, basis)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
+    """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
+    (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
+    monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's)."""
+    program = PY[0]
+    starts = PY[1]
+    mono = PY[2]
+    coef = PY[3]
+    for k in range(n):
+        MB[k] = y[k]
+    for k in range(n, program.shape[0]):
+        MB[k] = MB[program[k, 0]] * MB[program[k, 1]]
+    for i in range(n):
+        f = 0.0
+        for g in range(N_GROUPS):
+            lo = starts[i, g]
+            hi = starts[i, g + 1]
+            if lo == hi:
+                continue
+            scale = _group_scale(g, linear, membrane, beta_b, beta_q, energy)
+            if scale == 0.0:
+                continue
+            acc = coef[lo] * MB[mono[lo]]
+            t = lo + 1
+            while t + 4 <= hi:          # as `_polynomial_mode`: four terms at a time
+                acc += ((coef[t] * MB[mono[t]] + coef[t + 1] * MB[mono[t + 1]])
+                        + (coef[t + 2] * MB[mono[t + 2]] + coef[t + 3] * MB[mono[t + 3]]))
+                t += 4
+            for u in range(t, hi):
+                acc += coef[u] * MB[mono[u]]
+            f += scale * acc
+        F[i] = f
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -631,10 +822,10 @@ def derivative(t, y, dy, S, n_modes, T, base):
     from the same node-level pieces (`_axial`, `_energy_bending`, `_eq17_bending`) in one
     state's loop order: each node's fields summed over the modes in registers and its forces
     projected on every mode at once (with one lane, the lanes' loops cost more in overhead
-    than in arithmetic: 2-3x this). It agrees with `lanes_derivative` to round-off. S:
-    `scratch`(prepared row, N, the basis' coupling) or `row_scratch`; T: the basis' tables;
-    y and dy distinct."""
-    pp, F, CP = S                       # F: the projections, mode by mode
+    than in arithmetic: 2-3x this), or, where the basis has one, its polynomial
+    (`_polynomial_state`). It agrees with `lanes_derivative` to round-off. S: `scratch`
+    (prepared row, N, the basis) or `row_scratch`; T: the basis' tables; y and dy distinct."""
+    pp, F, CP, PY, MB = S               # F: the projections, mode by mode
     n = n_modes
     sc = 3 * n
     x = pp[sc + S_OMEGA] * t + pp[sc + S_LOAD_PHASE]
@@ -653,9 +844,14 @@ def derivative(t, y, dy, S, n_modes, T, base):
     beta_b = pp[sc + S_BETA_B]
     beta_q = pp[sc + S_BETA_Q]
     energy = pp[sc + S_ENERGY] != 0.0
-    for i in range(n):
-        F[i] = 0.0
-    for j in range(T.shape[2]):
+    if PY[0].shape[0] > 0:
+        _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, pp[sc + S_ENERGY], F)
+        nodes = 0
+    else:
+        nodes = T.shape[2]
+        for i in range(n):
+            F[i] = 0.0
+    for j in range(nodes):
         a = 0.0
         b = 0.0
         for i in range(n):

@@ -22,7 +22,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
 from sweep.models import transverse as tm
-from sweep.models.basis import pinned_sines
+from sweep.models.basis import clamped, pinned_sines
 from sweep.specialise import call
 from sweep.threads import early_stop, method_switch
 
@@ -220,26 +220,30 @@ def test_packed_lanes_give_each_point_its_own_results(name):
 @pytest.mark.skipif(__import__("platform").machine().lower() not in ("x86_64", "amd64"),
                     reason="reads x86 assembly")
 @pytest.mark.parametrize("base", [None, True])
-def test_the_lanes_right_hand_side_is_vectorised(base):
+@pytest.mark.parametrize("ends", ["pinned", "clamped"])
+def test_the_lanes_right_hand_side_is_vectorised(base, ends):
     """The multi-mode lanes are fast only while LLVM vectorises the right-hand side across
     the lanes (kernels.modes.lanes_derivative: 19-72 ns a lane for 2-5 modes, against 150-400
     ns for one state): compiled afresh as the lanes call it (fast True; no base term, or the
     sine's), it must run largely on packed-double instructions, as tests/test_lanes.py asks of
     the one-mode lanes' loops (left scalar, a loop has ~0.15 packed per scalar one). Its many
     short loops each keep a scalar remainder: measured 243 packed to 611 scalar (0.40) without
-    the base term, so the bar is 0.25 here."""
+    the base term, so the bar is 0.25 here. Both forms of the force: the quadrature (pinned
+    sines) and the polynomial (3 clamped modes, sweep.models.basis.polynomial_pays)."""
     import re
 
     import numba
     kernel = md.lanes_derivative
     options = {k: v for k, v in kernel.targetoptions.items() if k not in ("cache", "nopython")}
     fresh = numba.njit(**options)(kernel.py_func)
-    arrays = pinned_sines(3).kernel_arrays()
+    arrays = (pinned_sines(3) if ends == "pinned" else clamped(3)).kernel_arrays()
+    assert md.uses_polynomial(arrays) == (ends == "clamped")
     n, lanes = 3, modal_lanes.LANES
     T, CP = arrays[md.TABLES], arrays[md.COUPLING]
     fresh(np.zeros(lanes), np.zeros((2 * n, lanes)), np.zeros((2, 2 * n, lanes)), 1,
-          np.zeros((md.prepared_size(n), lanes)), n, T, np.zeros((4, T.shape[2], lanes)),
-          np.zeros((4, lanes)), lanes, True, base, CP)
+          np.zeros((md.prepared_size(n), lanes)), n, T,
+          np.zeros((4, md.field_rows(arrays), lanes)), np.zeros((4, lanes)), lanes, True, base,
+          CP, arrays[md.POLYNOMIAL])
     mnemonics = [line.split()[0] for text in fresh.inspect_asm().values()
                  for line in text.splitlines() if line.startswith("\t") and line.split()]
     packed = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+pd", m))

@@ -525,53 +525,116 @@ def test_bad_modes_input_is_refused_with_one_line(values, key):
     assert "\n" not in message and key in message
 
 
+def _both_right_hand_sides(row, basis, y, t, base):
+    """(derivative's dy, lanes_derivative's with one lane) of a raw row on kernel arrays
+    `basis` at state y, time t (compiled on first use)."""
+    import numba as nb
+    from sweep.kernels import modes as md
+
+    global _BOTH
+    if _BOTH is None:
+        @nb.njit
+        def both(row, basis, y, t, base):
+            n = md.basis_modes(basis)
+            T = basis[md.TABLES]
+            S = md.row_scratch(row, basis)
+            dy = np.empty(2 * n)
+            md.derivative(t, y, dy, S, n, T, base)
+            pp = S[0]
+            PP = np.empty((pp.shape[0], 1))         # one lane of the lanes driver's arrays
+            PP[:, 0] = pp
+            X = np.empty((2 * n, 1))
+            X[:, 0] = y
+            K = np.empty((1, 2 * n, 1))
+            tt = np.full(1, t)
+            md.lanes_derivative(tt, X, K, 0, PP, n, T,
+                                np.empty((4, md.field_rows(basis), 1)), np.empty((4, 1)), 1,
+                                None, base, basis[md.COUPLING], basis[md.POLYNOMIAL])
+            return dy, K[0, :, 0].copy()
+        _BOTH = both
+    return _BOTH(row, basis, y, t, base)
+
+
+_BOTH = None
+
+
+def _force_scene(n_modes, rotation, membrane):
+    """(raw row, kernel arrays) of a 0.4 m span of n_modes modes with an end load and base
+    excitation; rotation: clamps.rotation ("elastic": 20 N m/rad); membrane: model.membrane
+    (None: the uniform tension and the energy's bending terms)."""
+    from sweep.models.transverse import modal_rows, resolve
+    text = (f'[model]\nmodes = {n_modes}\ncoefficients = "consistent"\n'
+            + (f"membrane = {membrane}\n" if membrane is not None else "")
+            + f'[clamps]\nrotation = "{rotation}"\n'
+            + ('rotational_stiffness = "20 N m"\n' if rotation == "elastic" else "")
+            + '[cable]\nlinear_mass = "53.4 g/m"\nbending_rigidity = "0.31515 N m^2"\n'
+            'axial_rigidity = "660 kN"\ndiameter = "2.76 mm"\ndamping_ratio = 0.02\n'
+            'length = 0.4\n[load]\namplitude = 3.0\nfrequency_ratio = 1.3\n'
+            '[base]\nacceleration_g = 2.0\nfrequency = 40.0\n')
+    inputs = resolve(sweep.load_scene_text(text))
+    return modal_rows(inputs, np.arange(1))[0].copy(), inputs.basis.kernel_arrays()
+
+
+@pytest.mark.parametrize("polynomial", [False, True])
 @pytest.mark.parametrize("rotation, membrane", [("pinned", 0.375), ("pinned", None),
                                                 ("clamped", None)])
-def test_the_one_state_right_hand_side_is_the_lanes_one(rotation, membrane):
+def test_the_one_state_right_hand_side_is_the_lanes_one(rotation, membrane, polynomial):
     """kernels.modes.derivative (the scalar driver's loop order) against lanes_derivative with
     one lane (the lanes driver's, libm's cos): the same physics to round-off (1e-14 of the
     largest component) at random states and times, with the base excitation and without, for
     Eq.17's terms with the local membrane and the energy's with the uniform tension (clamped
-    modes too); both drivers are checked against independent references elsewhere."""
-    import numba as nb
-    from sweep.kernels import modes as md
-    from sweep.models.transverse import modal_rows, resolve
-
-    @nb.njit
-    def both(row, basis, y, t, base):
-        n = md.basis_modes(basis)
-        T = basis[md.TABLES]
-        S = md.row_scratch(row, basis)
-        dy = np.empty(2 * n)
-        md.derivative(t, y, dy, S, n, T, base)
-        pp, _, CP = S
-        PP = np.empty((pp.shape[0], 1))         # one lane of the lanes driver's arrays
-        PP[:, 0] = pp
-        X = np.empty((2 * n, 1))
-        X[:, 0] = y
-        K = np.empty((1, 2 * n, 1))
-        tt = np.full(1, t)
-        md.lanes_derivative(tt, X, K, 0, PP, n, T, np.empty((4, T.shape[2], 1)),
-                            np.empty((4, 1)), 1, None, base, CP)
-        return dy, K[0, :, 0].copy()
-
-    text = (f'[model]\nmodes = 4\ncoefficients = "consistent"\n'
-            + (f"membrane = {membrane}\n" if membrane is not None else "")
-            + f'[clamps]\nrotation = "{rotation}"\n'
-            '[cable]\nlinear_mass = "53.4 g/m"\nbending_rigidity = "0.31515 N m^2"\n'
-            'axial_rigidity = "660 kN"\ndiameter = "2.76 mm"\ndamping_ratio = 0.02\nlength = 0.4\n'
-            '[load]\namplitude = 3.0\nfrequency_ratio = 1.3\n'
-            '[base]\nacceleration_g = 2.0\nfrequency = 40.0\n')
-    text_scene = sweep.load_scene_text(text)
-    inputs = resolve(text_scene)
-    row = modal_rows(inputs, np.arange(1))[0].copy()
-    basis = inputs.basis.kernel_arrays()
+    modes too), the force by quadrature and as its polynomial; both drivers are checked against
+    independent references elsewhere."""
+    from sweep.models.basis import with_force_form
+    row, arrays = _force_scene(4, rotation, membrane)
+    basis = with_force_form(arrays, polynomial)
     rng = np.random.default_rng(5)
     for base in (True, None):
         for _ in range(10):
             y = rng.normal(size=8) * np.r_[np.full(4, 5e-3), np.full(4, 2.0)]
-            got, want = both(row, basis, y, rng.uniform(0.0, 2.0), base)
+            got, want = _both_right_hand_sides(row, basis, y, rng.uniform(0.0, 2.0), base)
             np.testing.assert_allclose(got, want, rtol=0, atol=1e-14 * np.abs(want).max())
+
+
+@pytest.mark.parametrize("n_modes", [1, 2, 3, 5])
+@pytest.mark.parametrize("rotation, membrane", [("pinned", 0.375), ("pinned", None),
+                                                ("clamped", None), ("elastic", None)])
+def test_the_force_s_polynomial_is_its_quadrature(rotation, membrane, n_modes):
+    """The force expanded into each mode's polynomial in q (sweep.models.basis.force_polynomial,
+    from kernels.modes.FORCE_TERMS: the terms as data) against the same force summed at the
+    quadrature nodes by the node functions the right-hand side has always used (_axial,
+    _energy_bending, _eq17_bending): equal to round-off (1e-14 of the largest component) at
+    random states of every size up to the buckled span's, with and without base excitation,
+    through both the one-state and the lanes' right-hand side, for Eq.17's terms, the energy's,
+    and clamped and elastic ends (their non-diagonal coupling)."""
+    from sweep.models.basis import with_force_form
+    row, arrays = _force_scene(n_modes, rotation, membrane)
+    by_nodes = with_force_form(arrays, False)
+    expanded = with_force_form(arrays, True)
+    rng = np.random.default_rng(11)
+    n = n_modes
+    for base in (True, None):
+        for size in (1e-4, 5e-3, 2e-2):
+            y = rng.normal(size=2 * n) * np.r_[np.full(n, size), np.full(n, 2.0)]
+            t = rng.uniform(0.0, 2.0)
+            want, _ = _both_right_hand_sides(row, by_nodes, y, t, base)
+            for got in _both_right_hand_sides(row, expanded, y, t, base):
+                np.testing.assert_allclose(got, want, rtol=0,
+                                           atol=1e-14 * np.abs(want).max())
+
+
+def test_the_polynomial_is_chosen_where_it_costs_less():
+    """sweep.models.basis.polynomial_pays (the rule measured by benchmarks/rhs_cost.py): the
+    polynomial for clamped and elastic ends of up to 4 modes, whose Gauss-Legendre rule needs
+    6 N + 12 nodes; never for pinned sines, whose 3 N + 1 cost as little (their results keep
+    their bits); never above POLYNOMIAL_MAX_MODES."""
+    from sweep.kernels import modes as md
+    from sweep.models.basis import POLYNOMIAL_MAX_MODES, clamped, elastic_ends, pinned_sines
+    for n in range(1, 8):
+        assert not md.uses_polynomial(pinned_sines(n).kernel_arrays())
+        assert md.uses_polynomial(clamped(n).kernel_arrays()) == (n <= 4)
+        assert md.uses_polynomial(elastic_ends(n, 3.0).kernel_arrays()) == (n <= 4)
+    assert POLYNOMIAL_MAX_MODES < 8
 
 
 def test_one_modes_modal_lists_are_its_initial_state():

@@ -79,8 +79,10 @@ class Basis:
         return int(self.shapes.shape[0])
 
     def kernel_arrays(self) -> tuple[np.ndarray, ...]:
-        """(T, stations, midspan, ratios, shapes, coupling, clamps): the basis as
-        kernels/modes.py reads it; ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi)."""
+        """(T, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the basis as
+        kernels/modes.py reads it; ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi);
+        polynomial: the force as each mode's polynomial in q where that costs the right-hand
+        side less than the quadrature (`force_polynomial`), else empty."""
         if not self._arrays:
             ratios = np.ascontiguousarray(np.stack([self.frequency_ratio,
                                                     self.participation_ratio]), np.float64)
@@ -88,9 +90,132 @@ class Basis:
                 self.tables, self.stations, self.midspan)) + (
                 ratios, np.ascontiguousarray(self.shapes, np.float64),
                 np.ascontiguousarray(self.coupling, np.float64),
-                np.ascontiguousarray(self.clamps, np.float64))
+                np.ascontiguousarray(self.clamps, np.float64),
+                force_polynomial(self.tables) if polynomial_pays(self.tables)
+                else no_polynomial(self.n_modes))
             object.__setattr__(self, "_arrays", arrays)
         return self._arrays
+
+
+POLYNOMIAL_MAX_MODES = 6
+"""Above this many modes the force's polynomial has more terms than the quadrature has
+multiply-adds (its quintic part grows as N^6, the quadrature as N^2), and is not built."""
+
+
+def _term_tensor(tables: np.ndarray, row: int, fields: tuple[int, ...]) -> np.ndarray:
+    """D[m, i_1..i_d] = sum_j tables[row, m, j] prod_k tables[fields[k], i_k, j]: the
+    quadrature of one FORCE_TERM's product of fields, projected on mode m, per unit
+    q_i1 .. q_id (kernels/modes.py)."""
+    letters = "abcdefgh"[:len(fields)]
+    spec = ",".join(["mz"] + [f"{c}z" for c in letters]) + "->m" + letters
+    return np.einsum(spec, tables[row], *(tables[f] for f in fields), optimize=True)
+
+
+def _symmetrised(tensor: np.ndarray) -> np.ndarray:
+    """The sum of `tensor` over every order of its axes after the first."""
+    import itertools
+    d = tensor.ndim - 1
+    total = np.zeros_like(tensor)
+    for order in itertools.permutations(range(1, d + 1)):
+        total += tensor.transpose((0,) + order)
+    return total
+
+
+POLYNOMIAL_ZERO = 1e-12
+"""A polynomial coefficient whose size is below this fraction of the sum of its quadrature's
+terms' sizes is a cancellation to round-off (a coefficient the shapes' symmetry or
+orthogonality makes 0) and is dropped."""
+
+
+def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The right-hand side's nonlinear and axial-load force (kernels/modes.py FORCE_TERMS, the
+    quadrature on `tables`) expanded into each mode's polynomial in q: (program (K, 2),
+    starts (N, N_GROUPS + 1), monomials (T,), coefficients (T,)). Monomial k >= N is the product
+    of monomials program[k] (k < N: q_k); mode m's terms of group g are
+    starts[m, g]..starts[m, g + 1] - 1, each a monomial's index and its coefficient (the
+    quadrature's, summed over the monomial's orderings; those that cancel to round-off,
+    POLYNOMIAL_ZERO, dropped). The kernel multiplies each group's sum by its scale (beta_b,
+    beta_q, the axial load, the membrane term) lane by lane."""
+    import itertools
+    from math import factorial
+
+    from ..kernels.modes import FORCE_TERMS, N_GROUPS
+    n = tables.shape[1]
+    terms: list[dict[tuple[int, ...], list[float]]] = [{} for _ in range(N_GROUPS)]
+    for group, row, c, fields in FORCE_TERMS:
+        d = len(fields)
+        value = _symmetrised(_term_tensor(tables, row, fields)) * c
+        size = _symmetrised(_term_tensor(np.abs(tables), row, fields)) * abs(c)
+        for mono in itertools.combinations_with_replacement(range(n), d):
+            ways = math.prod(factorial(mono.count(i)) for i in set(mono))
+            at = (slice(None),) + mono
+            sums = terms[group].setdefault(mono, [np.zeros(n), np.zeros(n)])
+            sums[0] += value[at] / ways
+            sums[1] += size[at] / ways
+    index = {(i,): i for i in range(n)}
+    program = [(0, 0)] * n
+
+    def monomial(mono: tuple[int, ...]) -> int:
+        if mono not in index:
+            split = {2: 1, 3: 2, 4: 2, 5: 3}[len(mono)]
+            left, right = monomial(mono[:split]), monomial(mono[split:])
+            index[mono] = len(program)
+            program.append((left, right))
+        return index[mono]
+
+    starts = np.zeros((n, N_GROUPS + 1), np.int64)
+    monos: list[int] = []
+    coefs: list[float] = []
+    for m in range(n):
+        for g in range(N_GROUPS):
+            starts[m, g] = len(monos)
+            for mono, (value, size) in terms[g].items():
+                if abs(value[m]) > POLYNOMIAL_ZERO * size[m]:
+                    monos.append(monomial(mono))
+                    coefs.append(float(value[m]))
+        starts[m, N_GROUPS] = len(monos)
+    return (np.array(program, np.int64).reshape(-1, 2), starts,
+            np.array(monos, np.int64), np.array(coefs, np.float64))
+
+
+def no_polynomial(n_modes: int) -> tuple[np.ndarray, ...]:
+    """The empty polynomial: the right-hand side evaluates the force by quadrature."""
+    from ..kernels.modes import N_GROUPS
+    return (np.zeros((0, 2), np.int64), np.zeros((n_modes, N_GROUPS + 1), np.int64),
+            np.zeros(0, np.int64), np.zeros(0))
+
+
+def with_force_form(arrays: tuple[np.ndarray, ...], polynomial: bool) -> tuple[np.ndarray, ...]:
+    """A basis' kernel arrays with its force evaluated as the polynomial (True) or by
+    quadrature (False), whichever the basis would choose: for comparing the two."""
+    tables = arrays[0]
+    return arrays[:7] + (force_polynomial(tables) if polynomial
+                         else no_polynomial(tables.shape[1]),)
+
+
+POLYNOMIAL_ADVANTAGE = 2.5
+"""The polynomial is used where its monomials and the terms of either form of its bending
+terms (the span's energy's or Eq.17's, each with the axial ones) number at most this many
+times the quadrature's nodes x modes. Measured (benchmarks/rhs_cost.py, lanes and one
+state): pinned sines, whose trapezoidal rule needs few nodes, cost the same either way at 2.6
+and 3.8 times (2 and 3 modes), more as the polynomial at 5.4 and up; clamped ends cost 0.5 of
+the quadrature at 0.65 and 1.2 times (2 and 3 modes), 0.6-0.9 at 2.0 (4 modes), and at 3.3
+(5 modes) 0.85 on the lanes but 1.2 in one state."""
+
+
+def polynomial_pays(tables: np.ndarray) -> bool:
+    """Whether the force's polynomial costs the right-hand side less than the quadrature on
+    `tables` (7, N, nodes): POLYNOMIAL_ADVANTAGE."""
+    from ..kernels.modes import (G_ENERGY_CUBIC, G_ENERGY_QUINTIC, G_EQ17_CUBIC,
+                                 G_EQ17_QUINTIC)
+    n, nodes = tables.shape[1], tables.shape[2]
+    if n > POLYNOMIAL_MAX_MODES:
+        return False
+    program, starts, _, _ = force_polynomial(tables)
+    counts = np.diff(starts, axis=1).sum(axis=0)
+    energy = counts.sum() - counts[G_EQ17_CUBIC] - counts[G_EQ17_QUINTIC]
+    eq17 = counts.sum() - counts[G_ENERGY_CUBIC] - counts[G_ENERGY_QUINTIC]
+    return program.shape[0] + max(energy, eq17) <= POLYNOMIAL_ADVANTAGE * nodes * n
 
 
 def pinned_sines(n_modes: int) -> Basis:
