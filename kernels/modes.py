@@ -53,7 +53,7 @@ shapes' derivatives at the nodes and the projection weights; stations, the shape
 along the span; midspan, phi_n(1/2); ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes,
 (N, 5): each mode's beam-function form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
 uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
-polynomial: the force's polynomial, or empty arrays where the quadrature is used).
+polynomial: the force's polynomial, or None where the quadrature is used).
 Nothing here knows the shapes' kind.
 
 A point's raw row (columns below) holds the span's linear coefficients (w_p, its damping), the
@@ -465,19 +465,26 @@ FORCE_TERMS = (
 )
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def uses_polynomial(basis):
     """Whether the right-hand side evaluates the basis' force as its polynomial (POLYNOMIAL)
-    rather than by quadrature (callable from Python and from the kernels)."""
-    return basis[POLYNOMIAL][0].shape[0] > 0
+    rather than by quadrature (POLYNOMIAL None: a switch, so that each compiles only its own)."""
+    return basis[POLYNOMIAL] is not None
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _field_rows(T, PY):
+    """`field_rows` of tables T and polynomial PY."""
+    if PY is None:
+        return T.shape[2]
+    return max(T.shape[2], (PY[0].shape[0] + N_GROUPS + 1 + 3) // 4)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def field_rows(basis):
     """The middle axis of the lanes' scratch FLD (4, rows, lanes) for `basis`: its quadrature
-    nodes, or room for the polynomial's monomials and group scales (`_polynomial_lanes`)."""
-    need = basis[POLYNOMIAL][0].shape[0] + N_GROUPS + 1
-    return max(basis[TABLES].shape[2], (need + 3) // 4)
+    nodes, or room for the polynomial's monomials and group scales (`_polynomial_lanes`)
+    (callable from Python and from the kernels)."""
+    return _field_rows(basis[TABLES], basis[POLYNOMIAL])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -691,17 +698,17 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             _lanes_signal(tt, PP, sc, SC, n_run, base)
         else:
             _lanes_fast_signal(tt, PP, sc, SC, n_run, base)
-    polynomial = PY[0].shape[0] > 0
     R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))
     active = 0
-    if polynomial:
+    if PY is not None:                  # (a switch: None where the basis has no polynomial)
         active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run)
+        nodes = 0
     energy = False                      # some lane's bending terms from the span's energy
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
     for l in range(n_run):
         energy = energy or PP[sc + S_ENERGY, l] != 0.0
         eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-    for f in range(0, 0 if polynomial else (4 if eq17 else 2), 2):   # (a, b), then (c, d)
+    for f in range(0, 4 if eq17 and PY is None else 2, 2):   # (a, b), then (c, d)
         for j in range(nodes):
             t0 = T[f, 0, j]
             t1 = T[f + 1, 0, j]
@@ -717,7 +724,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                     q = X[i, l]
                     FLD[f, j, l] += t0 * q
                     FLD[f + 1, j, l] += t1 * q
-    if polynomial:
+    if PY is not None:
         pass
     elif energy and not eq17:
         _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
@@ -734,7 +741,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                                               PP[sc + S_BETA_Q, l])
                                 + _axial(a, b, SC[0, l], SC[1, l]))
     for i in range(n):
-        if polynomial:
+        if PY is not None:
             _polynomial_mode(i, PY, R, active, SC[3], n_run)
         else:
             w = T[4, i, 0]
@@ -765,8 +772,16 @@ def scratch(pp, n_modes, basis):
     a copy of the prepared row pp, its projections' accumulator (N), the basis' coupling
     (basis[COUPLING]) and polynomial (basis[POLYNOMIAL]), and the polynomial's monomials'
     scratch."""
-    PY = basis[POLYNOMIAL]
-    return pp.copy(), np.empty(n_modes), basis[COUPLING], PY, np.empty(PY[0].shape[0])
+    return (pp.copy(), np.empty(n_modes), basis[COUPLING], basis[POLYNOMIAL],
+            _monomials_scratch(basis[POLYNOMIAL]))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _monomials_scratch(PY):
+    """Room for polynomial PY's monomials (none for None)."""
+    if PY is None:
+        return np.empty(0)
+    return np.empty(PY[0].shape[0])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -781,10 +796,16 @@ def row_scratch(row, basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
+def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
-    monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's)."""
+    monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's). Returns
+    the quadrature nodes still to sum: none; or, PY None (no polynomial: a switch, so that the
+    polynomial's code is not compiled), F zeroed and every node of the tables T."""
+    if PY is None:
+        for i in range(n):
+            F[i] = 0.0
+        return T.shape[2]
     program = PY[0]
     starts = PY[1]
     mono = PY[2]
@@ -813,6 +834,7 @@ def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F)
                 acc += coef[u] * MB[mono[u]]
             f += scale * acc
         F[i] = f
+    return 0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
@@ -844,13 +866,9 @@ def derivative(t, y, dy, S, n_modes, T, base):
     beta_b = pp[sc + S_BETA_B]
     beta_q = pp[sc + S_BETA_Q]
     energy = pp[sc + S_ENERGY] != 0.0
-    if PY[0].shape[0] > 0:
-        _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, pp[sc + S_ENERGY], F)
-        nodes = 0
-    else:
-        nodes = T.shape[2]
-        for i in range(n):
-            F[i] = 0.0
+    # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
+    nodes = _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q,
+                              pp[sc + S_ENERGY], F)
     for j in range(nodes):
         a = 0.0
         b = 0.0

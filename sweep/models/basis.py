@@ -78,11 +78,12 @@ class Basis:
     def n_modes(self) -> int:
         return int(self.shapes.shape[0])
 
-    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
+    def kernel_arrays(self) -> tuple[Any, ...]:
         """(T, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the basis as
         kernels/modes.py reads it; ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi);
         polynomial: the force as each mode's polynomial in q where that costs the right-hand
-        side less than the quadrature (`force_polynomial`), else empty."""
+        side less than the quadrature (`force_polynomial`), else None (a switch: the kernels
+        compile only the form a basis uses)."""
         if not self._arrays:
             ratios = np.ascontiguousarray(np.stack([self.frequency_ratio,
                                                     self.participation_ratio]), np.float64)
@@ -91,8 +92,7 @@ class Basis:
                 ratios, np.ascontiguousarray(self.shapes, np.float64),
                 np.ascontiguousarray(self.coupling, np.float64),
                 np.ascontiguousarray(self.clamps, np.float64),
-                force_polynomial(self.tables) if polynomial_pays(self.tables)
-                else no_polynomial(self.n_modes))
+                force_polynomial(self.tables) if polynomial_pays(self.tables) else None)
             object.__setattr__(self, "_arrays", arrays)
         return self._arrays
 
@@ -178,19 +178,10 @@ def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
             np.array(monos, np.int64), np.array(coefs, np.float64))
 
 
-def no_polynomial(n_modes: int) -> tuple[np.ndarray, ...]:
-    """The empty polynomial: the right-hand side evaluates the force by quadrature."""
-    from ..kernels.modes import N_GROUPS
-    return (np.zeros((0, 2), np.int64), np.zeros((n_modes, N_GROUPS + 1), np.int64),
-            np.zeros(0, np.int64), np.zeros(0))
-
-
-def with_force_form(arrays: tuple[np.ndarray, ...], polynomial: bool) -> tuple[np.ndarray, ...]:
+def with_force_form(arrays: tuple[Any, ...], polynomial: bool) -> tuple[Any, ...]:
     """A basis' kernel arrays with its force evaluated as the polynomial (True) or by
     quadrature (False), whichever the basis would choose: for comparing the two."""
-    tables = arrays[0]
-    return arrays[:7] + (force_polynomial(tables) if polynomial
-                         else no_polynomial(tables.shape[1]),)
+    return arrays[:7] + (force_polynomial(arrays[0]) if polynomial else None,)
 
 
 POLYNOMIAL_ADVANTAGE = 2.5
@@ -637,7 +628,7 @@ class BasisFamily:
             raise ValueError("a span's rotational stiffness K is not one of the family's")
         return at
 
-    def kernel_arrays(self) -> list[tuple[np.ndarray, ...]]:
+    def kernel_arrays(self) -> list[tuple[Any, ...]]:
         """One Basis.kernel_arrays() per K, in `bases` order (sweep.execute.modes_chunk)."""
         return [b.kernel_arrays() for b in self.bases]
 
