@@ -558,23 +558,9 @@ def _polynomial_mode(i, PY, R, active, out, n_run):
         k = mono[lo]
         for l in range(n_run):
             R[n_mono + N_GROUPS, l] = c * R[k, l]
-        t = lo + 1
-        while t + 4 <= hi:              # four terms a pass over the lanes
-            c0 = coef[t]
-            c1 = coef[t + 1]
-            c2 = coef[t + 2]
-            c3 = coef[t + 3]
-            k0 = mono[t]
-            k1 = mono[t + 1]
-            k2 = mono[t + 2]
-            k3 = mono[t + 3]
-            for l in range(n_run):
-                R[n_mono + N_GROUPS, l] += ((c0 * R[k0, l] + c1 * R[k1, l])
-                                            + (c2 * R[k2, l] + c3 * R[k3, l]))
-            t += 4
-        for u in range(t, hi):
-            c = coef[u]
-            k = mono[u]
+        for t in range(lo + 1, hi):
+            c = coef[t]
+            k = mono[t]
             for l in range(n_run):
                 R[n_mono + N_GROUPS, l] += c * R[k, l]
         for l in range(n_run):
@@ -698,48 +684,46 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             _lanes_signal(tt, PP, sc, SC, n_run, base)
         else:
             _lanes_fast_signal(tt, PP, sc, SC, n_run, base)
-    R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))
     active = 0
-    if PY is not None:                  # (a switch: None where the basis has no polynomial)
-        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run)
-        nodes = 0
     energy = False                      # some lane's bending terms from the span's energy
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
-    for l in range(n_run):
-        energy = energy or PP[sc + S_ENERGY, l] != 0.0
-        eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-    for f in range(0, 4 if eq17 and PY is None else 2, 2):   # (a, b), then (c, d)
-        for j in range(nodes):
-            t0 = T[f, 0, j]
-            t1 = T[f + 1, 0, j]
-            for l in range(n_run):
-                q = X[0, l]
-                FLD[f, j, l] = t0 * q
-                FLD[f + 1, j, l] = t1 * q
-        for i in range(1, n):
-            for j in range(nodes):
-                t0 = T[f, i, j]
-                t1 = T[f + 1, i, j]
-                for l in range(n_run):
-                    q = X[i, l]
-                    FLD[f, j, l] += t0 * q
-                    FLD[f + 1, j, l] += t1 * q
-    if PY is not None:
-        pass
-    elif energy and not eq17:
-        _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
-    elif energy:
-        _energy_forces(PP, sc, FLD, SC, nodes, n_run)
+    if PY is not None:                  # (a switch: None where the basis has no polynomial,
+        R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))   # each compiles its own)
+        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run)
     else:
-        for j in range(nodes):
-            for l in range(n_run):
-                a = FLD[0, j, l]
-                b = FLD[1, j, l]
-                c = FLD[2, j, l]
-                d = FLD[3, j, l]
-                FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
-                                              PP[sc + S_BETA_Q, l])
-                                + _axial(a, b, SC[0, l], SC[1, l]))
+        for l in range(n_run):
+            energy = energy or PP[sc + S_ENERGY, l] != 0.0
+            eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
+        for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
+            for j in range(nodes):
+                t0 = T[f, 0, j]
+                t1 = T[f + 1, 0, j]
+                for l in range(n_run):
+                    q = X[0, l]
+                    FLD[f, j, l] = t0 * q
+                    FLD[f + 1, j, l] = t1 * q
+            for i in range(1, n):
+                for j in range(nodes):
+                    t0 = T[f, i, j]
+                    t1 = T[f + 1, i, j]
+                    for l in range(n_run):
+                        q = X[i, l]
+                        FLD[f, j, l] += t0 * q
+                        FLD[f + 1, j, l] += t1 * q
+        if energy and not eq17:
+            _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
+        elif energy:
+            _energy_forces(PP, sc, FLD, SC, nodes, n_run)
+        else:
+            for j in range(nodes):
+                for l in range(n_run):
+                    a = FLD[0, j, l]
+                    b = FLD[1, j, l]
+                    c = FLD[2, j, l]
+                    d = FLD[3, j, l]
+                    FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
+                                                  PP[sc + S_BETA_Q, l])
+                                    + _axial(a, b, SC[0, l], SC[1, l]))
     for i in range(n):
         if PY is not None:
             _polynomial_mode(i, PY, R, active, SC[3], n_run)
@@ -825,13 +809,8 @@ def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy,
             if scale == 0.0:
                 continue
             acc = coef[lo] * MB[mono[lo]]
-            t = lo + 1
-            while t + 4 <= hi:          # as `_polynomial_mode`: four terms at a time
-                acc += ((coef[t] * MB[mono[t]] + coef[t + 1] * MB[mono[t + 1]])
-                        + (coef[t + 2] * MB[mono[t + 2]] + coef[t + 3] * MB[mono[t + 3]]))
-                t += 4
-            for u in range(t, hi):
-                acc += coef[u] * MB[mono[u]]
+            for t in range(lo + 1, hi):
+                acc += coef[t] * MB[mono[t]]
             f += scale * acc
         F[i] = f
     return 0

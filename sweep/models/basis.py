@@ -92,7 +92,7 @@ class Basis:
                 ratios, np.ascontiguousarray(self.shapes, np.float64),
                 np.ascontiguousarray(self.coupling, np.float64),
                 np.ascontiguousarray(self.clamps, np.float64),
-                force_polynomial(self.tables) if polynomial_pays(self.tables) else None)
+                cheaper_polynomial(self.tables))
             object.__setattr__(self, "_arrays", arrays)
         return self._arrays
 
@@ -194,15 +194,22 @@ the quadrature at 0.65 and 1.2 times (2 and 3 modes), 0.6-0.9 at 2.0 (4 modes), 
 (5 modes) 0.85 on the lanes but 1.2 in one state."""
 
 
-def polynomial_pays(tables: np.ndarray) -> bool:
-    """Whether the force's polynomial costs the right-hand side less than the quadrature on
-    `tables` (7, N, nodes): POLYNOMIAL_ADVANTAGE."""
+def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
+    """The force's polynomial (`force_polynomial`) where it costs the right-hand side less
+    than the quadrature on `tables` (7, N, nodes), else None (`polynomial_pays`)."""
+    if tables.shape[1] > POLYNOMIAL_MAX_MODES:
+        return None
+    polynomial = force_polynomial(tables)
+    return polynomial if polynomial_pays(tables, polynomial) else None
+
+
+def polynomial_pays(tables: np.ndarray, polynomial: tuple[np.ndarray, ...]) -> bool:
+    """Whether `polynomial` (`force_polynomial(tables)`) costs the right-hand side less than
+    the quadrature on `tables` (7, N, nodes): POLYNOMIAL_ADVANTAGE."""
     from ..kernels.modes import (G_ENERGY_CUBIC, G_ENERGY_QUINTIC, G_EQ17_CUBIC,
                                  G_EQ17_QUINTIC)
     n, nodes = tables.shape[1], tables.shape[2]
-    if n > POLYNOMIAL_MAX_MODES:
-        return False
-    program, starts, _, _ = force_polynomial(tables)
+    program, starts, _, _ = polynomial
     counts = np.diff(starts, axis=1).sum(axis=0)
     energy = counts.sum() - counts[G_EQ17_CUBIC] - counts[G_EQ17_QUINTIC]
     eq17 = counts.sum() - counts[G_ENERGY_CUBIC] - counts[G_ENERGY_QUINTIC]
