@@ -104,7 +104,7 @@ RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
 SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
 CLAMPS = 6          # (10, N): what the load observers watch per mode (rows below; s = x / l)
-POLYNOMIAL = 7      # the same force as a polynomial in q, or empty (FORCE_TERMS, below)
+POLYNOMIAL = 7      # the same force as a polynomial in q, or None (FORCE_TERMS, below)
 
 # Rows of basis[CLAMPS]: what the load observers of the modal drivers read (per unit q_n).
 BEND_0 = 0          # phi_n''(0): the curvature at the clamp x = 0 (times 1 / l^2)
@@ -521,16 +521,11 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run):
         j = program[k, 1]
         for l in range(n_run):
             R[k, l] = R[i, l] * R[j, l]
-    for l in range(n_run):
-        R[n_mono + G_LINEAR, l] = SC[0, l]
-        R[n_mono + G_MEMBRANE, l] = SC[1, l]
-        e = PP[sc + S_ENERGY, l]
-        R[n_mono + G_ENERGY_CUBIC, l] = e * PP[sc + S_BETA_B, l]
-        R[n_mono + G_ENERGY_QUINTIC, l] = e * PP[sc + S_BETA_Q, l]
-        R[n_mono + G_EQ17_CUBIC, l] = (1.0 - e) * PP[sc + S_BETA_B, l]
-        R[n_mono + G_EQ17_QUINTIC, l] = (1.0 - e) * PP[sc + S_BETA_Q, l]
     active = 0
     for g in range(N_GROUPS):
+        for l in range(n_run):
+            R[n_mono + g, l] = _group_scale(g, SC[0, l], SC[1, l], PP[sc + S_BETA_B, l],
+                                            PP[sc + S_BETA_Q, l], PP[sc + S_ENERGY, l])
         for l in range(n_run):
             if R[n_mono + g, l] != 0.0:
                 active |= 1 << g
@@ -645,7 +640,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     TENSION is 0 has none; when no lane has one it is not computed). A lane whose S_ENERGY is
     1 takes its bending terms from the span's energy (module docstring), projected on the
     shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL; where it
-    is not empty, the same force is evaluated as each mode's polynomial in q
+    is not None, the same force is evaluated as each mode's polynomial in q
     (`_polynomial_lanes`, FLD its scratch: `field_rows`) instead of at the nodes.
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode

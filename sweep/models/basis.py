@@ -180,7 +180,7 @@ def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def with_force_form(arrays: tuple[Any, ...], polynomial: bool) -> tuple[Any, ...]:
     """A basis' kernel arrays with its force evaluated as the polynomial (True) or by
-    quadrature (False), whichever the basis would choose: for comparing the two."""
+    quadrature (False), whatever the basis would choose: for comparing the two."""
     return arrays[:7] + (force_polynomial(arrays[0]) if polynomial else None,)
 
 
@@ -188,10 +188,10 @@ POLYNOMIAL_ADVANTAGE = 2.5
 """The polynomial is used where its monomials and the terms of either form of its bending
 terms (the span's energy's or Eq.17's, each with the axial ones) number at most this many
 times the quadrature's nodes x modes. Measured (benchmarks/rhs_cost.py, lanes and one
-state): pinned sines, whose trapezoidal rule needs few nodes, cost the same either way at 2.6
-and 3.8 times (2 and 3 modes), more as the polynomial at 5.4 and up; clamped ends cost 0.5 of
-the quadrature at 0.65 and 1.2 times (2 and 3 modes), 0.6-0.9 at 2.0 (4 modes), and at 3.3
-(5 modes) 0.85 on the lanes but 1.2 in one state."""
+state): for pinned sines, whose trapezoidal rule needs few nodes, the polynomial costs 1.2-1.4
+times the quadrature at 2.6 and 3.8 times (2 and 3 modes), more at 5.4 and up; for clamped
+ends 0.5-0.7 at 0.65 and 1.2 times (2 and 3 modes), 0.65 on the lanes and 1.0 in one state at
+2.0 (4 modes), and 1.0 on the lanes but 1.45 in one state at 3.3 (5 modes)."""
 
 
 def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
