@@ -12,7 +12,9 @@ excitation, sweep.models.transverse.modal_rows), for N in --modes:
   local membrane term (Eq.17's bending terms: harness-base-sine's physics), and clamped ends
   (energy, uniform tension: harness-clamps' physics);
 - per lane with 32 lanes side by side (the lanes driver) and with 1 (`derivative`, the scalar
-  driver's one state), ns per evaluation, best of 5 loops of --calls calls;
+  driver's one state), ns per evaluation, best of 5 loops of --calls calls, with the force
+  summed at the quadrature's nodes and as its polynomial (sweep.models.basis.force_polynomial),
+  and which of the two the basis chooses (`polynomial_pays`);
 - the quadrature: the clamped basis' nonlinear force (the energy's cubic and quintic parts
   and the axial load's linear one, each projected on every mode) at 20 random modal states,
   with J Gauss-Legendre nodes against 300, largest error over the largest value; the rule in
@@ -20,7 +22,7 @@ excitation, sweep.models.transverse.modal_rows), for N in --modes:
 
 Command
 -------
-    PYTHONPATH=. python benchmarks/rhs_cost.py [--modes 3 5] [--calls 20000]
+    PYTHONPATH=. python benchmarks/rhs_cost.py [--modes 2 3 4 5 6] [--calls 20000]
 
 Prints two Markdown tables and the command line.
 """
