@@ -106,9 +106,12 @@ def _term_tensor(tables: np.ndarray, row: int, fields: tuple[int, ...]) -> np.nd
     """D[m, i_1..i_d] = sum_j tables[row, m, j] prod_k tables[fields[k], i_k, j]: the
     quadrature of one FORCE_TERM's product of fields, projected on mode m, per unit
     q_i1 .. q_id (kernels/modes.py)."""
-    letters = "abcdefgh"[:len(fields)]
-    spec = ",".join(["mz"] + [f"{c}z" for c in letters]) + "->m" + letters
-    return np.einsum(spec, tables[row], *(tables[f] for f in fields), optimize=True)
+    n, nodes = tables.shape[1], tables.shape[2]
+    product = tables[row]                               # (N, nodes), then one axis a field
+    for f in fields:
+        product = product[..., None, :] * tables[f].reshape((1,) * (product.ndim - 1)
+                                                            + (n, nodes))
+    return product.sum(axis=-1)
 
 
 def _symmetrised(tensor: np.ndarray) -> np.ndarray:
