@@ -527,35 +527,35 @@ def test_bad_modes_input_is_refused_with_one_line(values, key):
 
 def _both_right_hand_sides(row, basis, y, t, base):
     """(derivative's dy, lanes_derivative's with one lane) of a raw row on kernel arrays
-    `basis` at state y, time t (compiled on first use)."""
+    `basis` at state y, time t."""
+    return _both_kernel()(row, basis, y, t, base)
+
+
+@functools.cache
+def _both_kernel():
+    """The compiled pair of right-hand sides `_both_right_hand_sides` calls (compiled once)."""
     import numba as nb
     from sweep.kernels import modes as md
 
-    global _BOTH
-    if _BOTH is None:
-        @nb.njit
-        def both(row, basis, y, t, base):
-            n = md.basis_modes(basis)
-            T = basis[md.TABLES]
-            S = md.row_scratch(row, basis)
-            dy = np.empty(2 * n)
-            md.derivative(t, y, dy, S, n, T, base)
-            pp = S[0]
-            PP = np.empty((pp.shape[0], 1))         # one lane of the lanes driver's arrays
-            PP[:, 0] = pp
-            X = np.empty((2 * n, 1))
-            X[:, 0] = y
-            K = np.empty((1, 2 * n, 1))
-            tt = np.full(1, t)
-            md.lanes_derivative(tt, X, K, 0, PP, n, T,
-                                np.empty((4, md.field_rows(basis), 1)), np.empty((4, 1)), 1,
-                                None, base, basis[md.COUPLING], basis[md.POLYNOMIAL])
-            return dy, K[0, :, 0].copy()
-        _BOTH = both
-    return _BOTH(row, basis, y, t, base)
-
-
-_BOTH = None
+    @nb.njit
+    def both(row, basis, y, t, base):
+        n = md.basis_modes(basis)
+        T = basis[md.TABLES]
+        S = md.row_scratch(row, basis)
+        dy = np.empty(2 * n)
+        md.derivative(t, y, dy, S, n, T, base)
+        pp = S[0]
+        PP = np.empty((pp.shape[0], 1))         # one lane of the lanes driver's arrays
+        PP[:, 0] = pp
+        X = np.empty((2 * n, 1))
+        X[:, 0] = y
+        K = np.empty((1, 2 * n, 1))
+        tt = np.full(1, t)
+        md.lanes_derivative(tt, X, K, 0, PP, n, T,
+                            np.empty((4, md.field_rows(basis), 1)), np.empty((4, 1)), 1,
+                            None, base, basis[md.COUPLING], basis[md.POLYNOMIAL])
+        return dy, K[0, :, 0].copy()
+    return both
 
 
 def _force_scene(n_modes, rotation, membrane):

@@ -28,6 +28,7 @@ ratios, shapes, coupling, clamps). The kernels know nothing of sines: a new end 
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -116,7 +117,6 @@ def _term_tensor(tables: np.ndarray, row: int, fields: tuple[int, ...]) -> np.nd
 
 def _symmetrised(tensor: np.ndarray) -> np.ndarray:
     """The sum of `tensor` over every order of its axes after the first."""
-    import itertools
     d = tensor.ndim - 1
     total = np.zeros_like(tensor)
     for order in itertools.permutations(range(1, d + 1)):
@@ -139,18 +139,16 @@ def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
     quadrature's, summed over the monomial's orderings; those that cancel to round-off,
     POLYNOMIAL_ZERO, dropped). The kernel multiplies each group's sum by its scale (beta_b,
     beta_q, the axial load, the membrane term) lane by lane."""
-    import itertools
-    from math import factorial
-
     from ..kernels.modes import FORCE_TERMS, N_GROUPS
     n = tables.shape[1]
-    terms: list[dict[tuple[int, ...], list[float]]] = [{} for _ in range(N_GROUPS)]
+    # each group's monomials: (coefficient, size of its quadrature's terms) for every mode
+    terms: list[dict[tuple[int, ...], list[np.ndarray]]] = [{} for _ in range(N_GROUPS)]
     for group, row, c, fields in FORCE_TERMS:
         d = len(fields)
         value = _symmetrised(_term_tensor(tables, row, fields)) * c
         size = _symmetrised(_term_tensor(np.abs(tables), row, fields)) * abs(c)
         for mono in itertools.combinations_with_replacement(range(n), d):
-            ways = math.prod(factorial(mono.count(i)) for i in set(mono))
+            ways = math.prod(math.factorial(mono.count(i)) for i in set(mono))
             at = (slice(None),) + mono
             sums = terms[group].setdefault(mono, [np.zeros(n), np.zeros(n)])
             sums[0] += value[at] / ways
