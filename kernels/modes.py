@@ -23,8 +23,12 @@ b = -sum n^2 q_n sin(n xi), ...), Eq.17's force per unit rho A is
 
 (w_p^2 = (EI / rho A) k^4, the pinned span's first frequency squared) and N_m = int F phi_m /
 int phi_m^2, evaluated by the basis' quadrature: the fields at its nodes (its tables), F there,
-summed with its weights. For pinned sines the integrand is a trigonometric polynomial of degree
-at most 6N and the trapezoidal rule on M = 3N + 1 equal intervals of [0, pi] is exact for it;
+summed with its weights. The nodes and the modes are symmetric about midspan (equal clamps),
+so the tables are folded there (sweep.models.basis.mirrored_quadrature): a node's fields and its
+mirror node's come from one sum over the modes, the symmetric and antisymmetric ones apart,
+and each mode projects the pair's forces at once, about half the work of a plain node loop.
+For pinned sines the integrand is a trigonometric polynomial of degree at most 6N and the
+trapezoidal rule on M = 3N + 1 equal intervals of [0, pi] is exact for it;
 the axial load's term gives the diagonal n^2 P k^2 / rho A there, and couples the modes through
 A_ij = int phi_i' phi_j' for other shapes with no code of its own. The cost grows as N^2
 (fields and projection). The same force is also each mode's polynomial in q, of degree 5:
@@ -48,8 +52,9 @@ per unit rho A, in the fields above,
 (T rows 5 and 6); the stretching and the axial load stay as above, without Eq.17's bending
 terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as before.
 
-`basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives: (T, the
-shapes' derivatives at the nodes and the projection weights; stations, the shapes at stations
+`basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives:
+(quadrature, (T, parity, paired): the shapes' derivatives at the nodes and the projection
+weights, folded about midspan (above); stations, the shapes at stations
 along the span; midspan, phi_n(1/2); ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes,
 (N, 5): each mode's beam-function form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
 uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
@@ -97,7 +102,7 @@ FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", 
 
 
 # The items of the `basis` tuple every modal kernel takes (module docstring).
-TABLES = 0          # (7, N, nodes): the shapes' derivatives at the nodes, projection weights
+TABLES = 0          # (T (7, N, half), parity (N,), paired): the quadrature, folded at midspan
 STATIONS = 1        # (M + 1, N): the shapes at stations along the span
 MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
@@ -472,17 +477,18 @@ def uses_polynomial(basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _field_rows(T, PY):
-    """`field_rows` of tables T and polynomial PY."""
+def _field_rows(Q, PY):
+    """`field_rows` of quadrature Q and polynomial PY."""
+    nodes = Q[0].shape[2] + Q[2]
     if PY is None:
-        return T.shape[2]
-    return max(T.shape[2], (PY[0].shape[0] + N_GROUPS + 1 + 3) // 4)
+        return nodes
+    return max(nodes, (PY[0].shape[0] + N_GROUPS + 1 + 3) // 4)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def field_rows(basis):
     """The middle axis of the lanes' scratch FLD (4, rows, lanes) for `basis`: its quadrature
-    nodes, or room for the polynomial's monomials and group scales (`_polynomial_lanes`)
+    nodes (each pair's two: `_lanes_fields`), or room for the polynomial's monomials and group scales (`_polynomial_lanes`)
     (callable from Python and from the kernels)."""
     return _field_rows(basis[TABLES], basis[POLYNOMIAL])
 
@@ -626,12 +632,101 @@ _lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY):
+def _lanes_fields(Q, f, X, FLD, n, n_run, symmetric):
+    """Fields f and f + 1 (0: a and b, 2: c and d) of every lane at every node of the basis'
+    quadrature Q = (T, parity, paired) (sweep.models.basis.mirrored_quadrature): FLD[f, j]
+    and FLD[f + 1, j] at the nodes of T's columns j < half, and at the mirror of each paired
+    node j < paired in row half + j. A paired node's symmetric modes (parity +1) and its
+    antisymmetric ones are summed apart, e and o, over half the nodes; at the mirror node the
+    field is (-1)^order (e - o), order 1 for a and 3 for c, 2 for b and 4 for d. symmetric
+    (`_symmetric_lanes`): the antisymmetric modes are at rest, o = 0, and the mirror rows are
+    not written (the forces there are the nodes' own, mirrored)."""
+    T, parity, paired = Q
+    half = T.shape[2]
+    mirrors = 0 if symmetric else paired
+    odd0 = parity[0] < 0.0
+    for j in range(mirrors):            # the rows mode 0 does not write
+        r = j if odd0 else half + j
+        for l in range(n_run):
+            FLD[f, r, l] = 0.0
+            FLD[f + 1, r, l] = 0.0
+    for i in range(n):
+        odd = parity[i] < 0.0
+        if symmetric and odd:
+            continue
+        for j in range(half):
+            r = half + j if odd and j < mirrors else j
+            t0 = T[f, i, j]
+            t1 = T[f + 1, i, j]
+            if i == 0:
+                for l in range(n_run):
+                    q = X[0, l]
+                    FLD[f, r, l] = t0 * q
+                    FLD[f + 1, r, l] = t1 * q
+            else:
+                for l in range(n_run):
+                    q = X[i, l]
+                    FLD[f, r, l] += t0 * q
+                    FLD[f + 1, r, l] += t1 * q
+    for j in range(mirrors):
+        for l in range(n_run):
+            e = FLD[f, j, l]
+            o = FLD[f, half + j, l]
+            FLD[f, j, l] = e + o
+            FLD[f, half + j, l] = o - e
+            e = FLD[f + 1, j, l]
+            o = FLD[f + 1, half + j, l]
+            FLD[f + 1, j, l] = e + o
+            FLD[f + 1, half + j, l] = e - o
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def _pair_forces(FLD, half, paired, parts, n_run, symmetric):
+    """The forces FLD[0..parts-1] at each paired node j (row j) and its mirror (row half + j)
+    replaced by their sum (row j) and difference (row half + j): what a mode of either parity
+    projects there (`lanes_derivative`). symmetric: the mirror's forces are the node's own
+    mirrored (an even function of the antisymmetric fields on phi_m and phi_m'', odd on
+    phi_m'), so what a symmetric mode projects is twice the node's own, in row j, the same
+    bits as the sum or difference."""
+    for c in range(parts):
+        for j in range(paired):
+            if symmetric:
+                for l in range(n_run):
+                    FLD[c, j, l] = 2.0 * FLD[c, j, l]
+                continue
+            for l in range(n_run):
+                g = FLD[c, j, l]
+                h = FLD[c, half + j, l]
+                FLD[c, j, l] = g + h
+                FLD[c, half + j, l] = g - h
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _symmetric_lanes(Q, X, n, n_run):
+    """Whether every lane's antisymmetric modes (parity -1 in the folded quadrature Q) are
+    exactly at rest, q = 0, with a symmetric first mode: then the span's shape is symmetric
+    about midspan, the forces on the antisymmetric modes are exactly 0 and the mirror nodes'
+    exactly the nodes' own, so the right-hand side skips them (a symmetric span under a
+    symmetric load from rest stays so: the base excitation's usual case)."""
+    parity = Q[1]
+    if Q[2] == 0 or parity[0] < 0.0:
+        return False
+    for i in range(n):
+        if parity[i] < 0.0:
+            for l in range(n_run):
+                if X[i, l] != 0.0:
+                    return False
+    return True
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+def lanes_derivative(tt, X, K, s, PP, n_modes, Q, FLD, SC, n_run, fast, base, CP, PY):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
-    (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis' tables
-    (sweep.models.basis: the shapes' derivatives at the quadrature nodes and the projection
-    weights); FLD (4, nodes, lanes) and SC (4, lanes): scratch. fast: None (libm's cos and
+    (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); Q: the basis'
+    quadrature (basis[TABLES]: the shapes' derivatives at the quadrature nodes and the
+    projection weights, folded about midspan: `_lanes_fields`); FLD (4, `field_rows`, lanes)
+    and SC (4, lanes): scratch. fast: None (libm's cos and
     sin) or True (vecmath's vectorisable ones); base: None (no base excitation term), True
     (a sine kind) or the records of a random base acceleration (kernels.excitation: read lane
     by lane, fast or not);
@@ -653,7 +748,12 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     vectorises it. The one-state `derivative` is this with one lane."""
     n = n_modes
     sc = 3 * n
-    nodes = T.shape[2]
+    T = Q[0]
+    half = T.shape[2]
+    paired = Q[2]
+    nodes = half + paired
+    symmetric = False                   # (the quadrature's: `_symmetric_lanes`)
+    mirrors = paired
     for l in range(n_run):
         x = PP[sc + S_OMEGA, l] * tt[l] + PP[sc + S_LOAD_PHASE, l]
         cw = math.cos(x) if fast is None else fast_cos(x)
@@ -689,22 +789,11 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         for l in range(n_run):
             energy = energy or PP[sc + S_ENERGY, l] != 0.0
             eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
+        symmetric = _symmetric_lanes(Q, X, n, n_run)
+        mirrors = 0 if symmetric else paired
+        nodes = half + mirrors
         for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
-            for j in range(nodes):
-                t0 = T[f, 0, j]
-                t1 = T[f + 1, 0, j]
-                for l in range(n_run):
-                    q = X[0, l]
-                    FLD[f, j, l] = t0 * q
-                    FLD[f + 1, j, l] = t1 * q
-            for i in range(1, n):
-                for j in range(nodes):
-                    t0 = T[f, i, j]
-                    t1 = T[f + 1, i, j]
-                    for l in range(n_run):
-                        q = X[i, l]
-                        FLD[f, j, l] += t0 * q
-                        FLD[f + 1, j, l] += t1 * q
+            _lanes_fields(Q, f, X, FLD, n, n_run, symmetric)
         if energy and not eq17:
             _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
         elif energy:
@@ -719,23 +808,37 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                     FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
                                                   PP[sc + S_BETA_Q, l])
                                     + _axial(a, b, SC[0, l], SC[1, l]))
+    if PY is None:
+        _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
         if PY is not None:
             _polynomial_mode(i, PY, R, active, SC[3], n_run)
-        else:
-            w = T[4, i, 0]
+        elif symmetric and Q[1][i] < 0.0:
             for l in range(n_run):
-                SC[3, l] = w * FLD[0, 0, l]
-            for j in range(1, nodes):
+                SC[3, l] = 0.0
+        else:
+            # a paired node's row j holds the pair's sum, row half + j its difference: a
+            # symmetric mode takes the sum on phi_m and phi_m'' and the difference on phi_m'
+            even = Q[1][i] > 0.0
+            r0 = 0 if even else half
+            r1 = half if even else 0
+            w = T[4, i, 0]
+            j0 = r0 if mirrors > 0 else 0
+            for l in range(n_run):
+                SC[3, l] = w * FLD[0, j0, l]
+            for j in range(1, half):
                 w = T[4, i, j]
+                r = r0 + j if j < mirrors else j
                 for l in range(n_run):
-                    SC[3, l] += w * FLD[0, j, l]
+                    SC[3, l] += w * FLD[0, r, l]
             if energy:                  # the weak form's parts, on phi_m' and phi_m''
-                for j in range(nodes):
+                for j in range(half):
                     w1 = T[5, i, j]
                     w2 = T[6, i, j]
+                    p1 = r1 + j if j < mirrors else j
+                    p2 = r0 + j if j < mirrors else j
                     for l in range(n_run):
-                        SC[3, l] += w1 * FLD[1, j, l] + w2 * FLD[2, j, l]
+                        SC[3, l] += w1 * FLD[1, p1, l] + w2 * FLD[2, p2, l]
         for l in range(n_run):
             acc = (PP[P_STIFF * n + i, l] * X[i, l] + PP[P_DAMPING * n + i, l] * X[n + i, l]
                    - SC[3, l])
@@ -775,16 +878,17 @@ def row_scratch(row, basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
+def _polynomial_state(y, Q, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
     monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's). Returns
     the quadrature nodes still to sum: none; or, PY None (no polynomial: a switch, so that the
-    polynomial's code is not compiled), F zeroed and every node of the tables T."""
+    polynomial's code is not compiled), F zeroed and every column of the quadrature Q's
+    tables."""
     if PY is None:
         for i in range(n):
             F[i] = 0.0
-        return T.shape[2]
+        return Q[0].shape[2]
     program = PY[0]
     starts = PY[1]
     mono = PY[2]
@@ -811,8 +915,19 @@ def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy,
     return 0
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+def _node_forces(a, b, c, d, linear, membrane, beta_b, beta_q, energy):
+    """One node's forces from its fields (a, b, c, d): (on phi_m, on phi_m', on phi_m''), the
+    bending terms from the span's energy (energy True: c and d unread) or Eq.17's."""
+    g0 = _axial(a, b, linear, membrane)
+    if energy:
+        g1, g2 = _energy_bending(a, b, beta_b, beta_q)
+        return g0, g1, g2
+    return g0 + _eq17_bending(a, b, c, d, beta_b, beta_q), 0.0, 0.0
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def derivative(t, y, dy, S, n_modes, T, base):
+def derivative(t, y, dy, S, n_modes, Q, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s), dy = (q', q'') (m/s,
     m/s^2): `lanes_derivative`'s right-hand side for the scalar driver, libm's cos and sin,
     from the same node-level pieces (`_axial`, `_energy_bending`, `_eq17_bending`) in one
@@ -820,7 +935,9 @@ def derivative(t, y, dy, S, n_modes, T, base):
     projected on every mode at once (with one lane, the lanes' loops cost more in overhead
     than in arithmetic: 2-3x this), or, where the basis has one, its polynomial
     (`_polynomial_state`). It agrees with `lanes_derivative` to round-off. S: `scratch`
-    (prepared row, N, the basis) or `row_scratch`; T: the basis' tables; y and dy distinct."""
+    (prepared row, N, the basis) or `row_scratch`; Q: the basis' quadrature (basis[TABLES],
+    folded about midspan: the fields of a paired node and its mirror from one pass over the
+    modes, each mode projecting both nodes' forces at once); y and dy distinct."""
     pp, F, CP, PY, MB = S               # F: the projections, mode by mode
     n = n_modes
     sc = 3 * n
@@ -841,28 +958,73 @@ def derivative(t, y, dy, S, n_modes, T, base):
     beta_q = pp[sc + S_BETA_Q]
     energy = pp[sc + S_ENERGY] != 0.0
     # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
-    nodes = _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q,
+    nodes = _polynomial_state(y, Q, PY, MB, n, linear, membrane, beta_b, beta_q,
                               pp[sc + S_ENERGY], F)
+    T, parity, paired = Q
+    # every antisymmetric mode at rest: the mirror nodes' forces are the nodes' own, mirrored,
+    # and the antisymmetric modes' are 0 (`_symmetric_lanes`; the same bits, skipped)
+    symmetric = nodes > 0 and paired > 0 and parity[0] > 0.0
+    for i in range(n):
+        symmetric = symmetric and (parity[i] > 0.0 or y[i] == 0.0)
     for j in range(nodes):
-        a = 0.0
-        b = 0.0
+        # a node's fields, its modes of parity +1 (e) and -1 (o) apart where it is paired
+        # (sweep.models.basis.mirrored_quadrature): there the mirror node's are (-1)^order
+        # (e - o), and each mode projects both nodes' forces at once, their sum or difference
+        pair = j < paired
+        ae = 0.0
+        be = 0.0
+        ao = 0.0
+        bo = 0.0
         for i in range(n):
-            a += T[0, i, j] * y[i]
-            b += T[1, i, j] * y[i]
-        g0 = _axial(a, b, linear, membrane)
-        if energy:
-            g1, g2 = _energy_bending(a, b, beta_b, beta_q)
+            if symmetric and parity[i] < 0.0:
+                continue
+            if pair and parity[i] < 0.0:
+                ao += T[0, i, j] * y[i]
+                bo += T[1, i, j] * y[i]
+            else:
+                ae += T[0, i, j] * y[i]
+                be += T[1, i, j] * y[i]
+        ce = 0.0
+        de = 0.0
+        co = 0.0
+        do = 0.0
+        if not energy:
+            for i in range(n):
+                if symmetric and parity[i] < 0.0:
+                    continue
+                if pair and parity[i] < 0.0:
+                    co += T[2, i, j] * y[i]
+                    do += T[3, i, j] * y[i]
+                else:
+                    ce += T[2, i, j] * y[i]
+                    de += T[3, i, j] * y[i]
+        g0, g1, g2 = _node_forces(ae + ao, be + bo, ce + co, de + do, linear, membrane,
+                                  beta_b, beta_q, energy)
+        if not pair:
             for i in range(n):
                 F[i] += T[4, i, j] * g0 + T[5, i, j] * g1 + T[6, i, j] * g2
-        else:
-            c = 0.0
-            d = 0.0
+            continue
+        if symmetric:
+            s0 = g0 + g0
+            d1 = g1 + g1
+            s2 = g2 + g2
             for i in range(n):
-                c += T[2, i, j] * y[i]
-                d += T[3, i, j] * y[i]
-            g0 += _eq17_bending(a, b, c, d, beta_b, beta_q)
-            for i in range(n):
-                F[i] += T[4, i, j] * g0
+                if parity[i] > 0.0:
+                    F[i] += T[4, i, j] * s0 + T[5, i, j] * d1 + T[6, i, j] * s2
+            continue
+        h0, h1, h2 = _node_forces(ao - ae, be - bo, co - ce, de - do, linear, membrane,
+                                  beta_b, beta_q, energy)
+        s0 = g0 + h0
+        d0 = g0 - h0
+        s1 = g1 + h1
+        d1 = g1 - h1
+        s2 = g2 + h2
+        d2 = g2 - h2
+        for i in range(n):
+            if parity[i] > 0.0:
+                F[i] += T[4, i, j] * s0 + T[5, i, j] * d1 + T[6, i, j] * s2
+            else:
+                F[i] += T[4, i, j] * d0 + T[5, i, j] * s1 + T[6, i, j] * d2
     ab = base_acceleration(t, pp, n, base) if base is not None else 0.0
     for i in range(n):
         acc = pp[P_STIFF * n + i] * y[i] + pp[P_DAMPING * n + i] * y[n + i] - F[i]

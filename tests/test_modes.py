@@ -32,6 +32,7 @@ from scipy.integrate import quad
 
 import sweep
 from sweep.errors import UserError
+from sweep.models.basis import full_tables
 
 from conftest import fast_first
 from galerkin import (Cable, Projection, absolute_tail_maximum, galerkin_rhs, integrate,
@@ -366,6 +367,26 @@ def test_mode_2_grows_in_its_principal_parametric_tongue_only(driver):
     np.testing.assert_allclose(ds["max_deflection"].values, modal[:, 1], rtol=1e-12)
 
 
+@pytest.mark.parametrize("rotation, n_modes", [("pinned", 4), ("clamped", 4), ("clamped", 5)])
+def test_a_symmetric_span_shaken_by_its_clamps_stays_exactly_symmetric(rotation, n_modes):
+    """Base excitation from rest, below, at and above the first resonance (0.6, 1.0, 1.5 f1,
+    3 g): the symmetric modes move and the antisymmetric ones stay exactly 0 (the folded
+    quadrature and the bases' exact zeros, docs/model.md sec. 7); seeded with 1e-9 m, mode
+    2 moves (so exact symmetry is not an output that cannot change). Pinned sines and clamped
+    ends, by quadrature (clamped 4 and 5 modes: their folded Gauss-Legendre rule)."""
+    values = {"model.modes": n_modes, "clamps.rotation": rotation, "base.acceleration_g": 3.0,
+              "load.amplitude": 0.0, "solver.t_end": 0.3, "metrics.tail": 0.5}
+    ds = sweep.run(scene(values, {"base_frequency_ratio": [0.6, 1.0, 1.5]}), progress=False)
+    modal = ds["modal_amplitude"].transpose("base_frequency_ratio", "mode").values
+    assert np.all(modal[:, 0] > 1e-5)
+    assert np.all(modal[:, 1::2] == 0.0), modal
+    seed = [0.0] * n_modes
+    seed[1] = 1e-9
+    ds = sweep.run(scene({**values, "initial.modal_displacement": seed},
+                         {"base_frequency_ratio": [1.0]}), progress=False)
+    assert float(ds["modal_amplitude"].sel(mode=2).max()) > 1e-10
+
+
 # ------------------------------------------------------- 6. the largest deflection over the span
 
 @pytest.mark.parametrize("n_modes", [1, 2, 3, 6])
@@ -623,17 +644,65 @@ def test_the_force_s_polynomial_is_its_quadrature(rotation, membrane, n_modes):
                                            atol=1e-14 * np.abs(want).max())
 
 
+@pytest.mark.parametrize("n_modes", [1, 2, 3, 4, 5])
+@pytest.mark.parametrize("rotation, membrane", [("pinned", 0.375), ("pinned", None),
+                                                ("clamped", None), ("elastic", None)])
+def test_the_folded_quadrature_is_the_node_by_node_one(rotation, membrane, n_modes):
+    """The quadrature folded about midspan (sweep.models.basis.mirrored_quadrature: half the
+    nodes, each standing for its mirror node too; the forces projected a pair at a time)
+    against the same tables read node by node: equal to round-off (1e-14 of the largest
+    component) at random states, symmetric modes and antisymmetric ones together, through both
+    right-hand sides, for odd and even node counts (pinned sines: 3N; clamped and elastic:
+    6N + 12). The node-by-node sum is checked against independent references elsewhere."""
+    from sweep.models.basis import with_force_form
+    row, arrays = _force_scene(n_modes, rotation, membrane)
+    folded = with_force_form(arrays, False)
+    by_nodes = with_force_form(arrays, False, mirrored=False)
+    assert folded[0][2] == full_tables(folded[0]).shape[2] // 2 > 0 and by_nodes[0][2] == 0
+    rng = np.random.default_rng(13)
+    n = n_modes
+    for base in (True, None):
+        for size in (1e-4, 5e-3, 2e-2):
+            y = rng.normal(size=2 * n) * np.r_[np.full(n, size), np.full(n, 2.0)]
+            t = rng.uniform(0.0, 2.0)
+            want, _ = _both_right_hand_sides(row, by_nodes, y, t, base)
+            for got in _both_right_hand_sides(row, folded, y, t, base):
+                np.testing.assert_allclose(got, want, rtol=0,
+                                           atol=1e-14 * np.abs(want).max())
+
+
+def test_tables_fold_only_where_they_mirror():
+    """mirrored_quadrature unfolds back to the tables it folded (every built-in end
+    condition, odd and even node counts), finds the modes' parities (+1, -1, +1, ...), and
+    leaves whole, paired = 0, tables that do not mirror about midspan: one mode's shape
+    perturbed on one side by 1e-9, or nodes placed off symmetry."""
+    from sweep.models.basis import (clamped, elastic_ends, from_shapes, mirrored_quadrature,
+                                    pinned_sines)
+    for basis in (pinned_sines(3), pinned_sines(4), clamped(3), elastic_ends(4, 5.0)):
+        half, parity, paired = mirrored_quadrature(basis.tables)
+        assert paired == basis.tables.shape[2] // 2
+        assert list(parity) == [1.0 if i % 2 == 0 else -1.0 for i in range(basis.n_modes)]
+        np.testing.assert_allclose(full_tables((half, parity, paired)), basis.tables,
+                                   rtol=0, atol=1e-14 * np.abs(basis.tables).max())
+    tables = clamped(3).tables.copy()
+    tables[1, 2, 0] *= 1.0 + 1e-9
+    assert mirrored_quadrature(tables)[2] == 0
+    shifted = from_shapes("shifted", clamped(2).shapes, 20).tables[:, :, 1:]   # 19 of 20 nodes
+    assert mirrored_quadrature(shifted)[2] == 0
+    np.testing.assert_array_equal(full_tables(mirrored_quadrature(shifted)), shifted)
+
+
 def test_the_polynomial_is_chosen_where_it_costs_less():
     """sweep.models.basis.polynomial_pays (the rule measured by benchmarks/rhs_cost.py): the
-    polynomial for clamped and elastic ends of up to 4 modes, whose Gauss-Legendre rule needs
-    6 N + 12 nodes; never for pinned sines, whose 3 N + 1 cost as little (their results keep
-    their bits); never above POLYNOMIAL_MAX_MODES."""
+    polynomial for clamped and elastic ends of up to 3 modes, whose Gauss-Legendre rule needs
+    6 N + 12 nodes (3 N + 6 folded); never for pinned sines, whose 3 N (folded: half) cost as
+    little; never above POLYNOMIAL_MAX_MODES."""
     from sweep.kernels import modes as md
     from sweep.models.basis import POLYNOMIAL_MAX_MODES, clamped, elastic_ends, pinned_sines
     for n in range(1, 8):
         assert not md.uses_polynomial(pinned_sines(n).kernel_arrays())
-        assert md.uses_polynomial(clamped(n).kernel_arrays()) == (n <= 4)
-        assert md.uses_polynomial(elastic_ends(n, 3.0).kernel_arrays()) == (n <= 4)
+        assert md.uses_polynomial(clamped(n).kernel_arrays()) == (n <= 3)
+        assert md.uses_polynomial(elastic_ends(n, 3.0).kernel_arrays()) == (n <= 3)
     assert POLYNOMIAL_MAX_MODES < 8
 
 

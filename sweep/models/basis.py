@@ -80,16 +80,17 @@ class Basis:
         return int(self.shapes.shape[0])
 
     def kernel_arrays(self) -> tuple[Any, ...]:
-        """(T, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the basis as
-        kernels/modes.py reads it; ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi);
+        """(quadrature, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the
+        basis as kernels/modes.py reads it; quadrature: the tables folded about midspan
+        (`mirrored_quadrature`); ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi);
         polynomial: the force as each mode's polynomial in q where that costs the right-hand
         side less than the quadrature (`force_polynomial`), else None (a switch: the kernels
         compile only the form a basis uses)."""
         if not self._arrays:
             ratios = np.ascontiguousarray(np.stack([self.frequency_ratio,
                                                     self.participation_ratio]), np.float64)
-            arrays = tuple(np.ascontiguousarray(a, np.float64) for a in (
-                self.tables, self.stations, self.midspan)) + (
+            arrays = (mirrored_quadrature(self.tables),) + tuple(
+                np.ascontiguousarray(a, np.float64) for a in (self.stations, self.midspan)) + (
                 ratios, np.ascontiguousarray(self.shapes, np.float64),
                 np.ascontiguousarray(self.coupling, np.float64),
                 np.ascontiguousarray(self.clamps, np.float64),
@@ -179,20 +180,79 @@ def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
             np.array(monos, np.int64), np.array(coefs, np.float64))
 
 
-def with_force_form(arrays: tuple[Any, ...], polynomial: bool) -> tuple[Any, ...]:
+def with_force_form(arrays: tuple[Any, ...], polynomial: bool,
+                    mirrored: bool = True) -> tuple[Any, ...]:
     """A basis' kernel arrays with its force evaluated as the polynomial (True) or by
-    quadrature (False), whatever the basis would choose: for comparing the two."""
-    return arrays[:7] + (force_polynomial(arrays[0]) if polynomial else None,)
+    quadrature (False), whatever the basis would choose, and its quadrature folded about
+    midspan (`mirrored_quadrature`) or not: for comparing the forms."""
+    tables = full_tables(arrays[0])
+    quadrature = mirrored_quadrature(tables) if mirrored else _unfolded(tables)
+    return ((quadrature,) + arrays[1:7]
+            + (force_polynomial(tables) if polynomial else None,))
+
+
+TABLE_ORDERS = (1, 2, 3, 4, 0, 1, 2)
+"""The derivative order, in s, of the shapes in each row of a basis' tables (the fields a, b,
+c, d, then the projections on phi_n, phi_n' and phi_n''): under the mirror s -> 1 - s a mode of
+parity p (+1 symmetric about midspan, -1 antisymmetric) has row k's value times p (-1)^order."""
+
+MIRROR_TOLERANCE = 1e-12
+"""How closely (relative to each row's largest entry) a basis' tables must mirror about
+midspan for the kernels to read half of them (`mirrored_quadrature`); the built-in bases
+mirror to 4e-15."""
+
+
+def _unfolded(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """`mirrored_quadrature`'s form of tables read node by node: no node paired."""
+    return np.ascontiguousarray(tables, np.float64), np.ones(tables.shape[1]), 0
+
+
+def mirrored_quadrature(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """(half, parity, paired): the quadrature `tables` (7, N, J) as the kernels read it. Where
+    the nodes lie symmetrically about midspan and every mode is symmetric or antisymmetric
+    about it (parity +1 or -1: equal clamps at both ends), each of the first `paired` = J // 2
+    nodes stands for itself and its mirror node J - 1 - j, whose values are its own times
+    parity (-1)^order (`TABLE_ORDERS`); half = the first (J + 1) // 2 nodes' columns (the
+    middle node of an odd J last, its entries that vanish by symmetry set to 0). The kernels
+    then sum the fields over half the nodes and project the forces of each pair at once (their
+    sum or difference), about half the right-hand side's work (kernels/modes.py). Tables that
+    do not mirror (to MIRROR_TOLERANCE) come back whole, paired = 0, read node by node."""
+    tables = np.asarray(tables, np.float64)
+    n, nodes = tables.shape[1], tables.shape[2]
+    orders = np.array(TABLE_ORDERS)[:, None, None]
+    parity = np.empty(n)
+    for i in range(n):
+        j = int(np.argmax(np.abs(tables[4, i])))
+        parity[i] = 1.0 if tables[4, i, nodes - 1 - j] * tables[4, i, j] > 0.0 else -1.0
+    signs = parity[None, :, None] * (-1.0) ** orders              # (7, N, 1)
+    mirror = signs * tables[:, :, ::-1]
+    scale = np.abs(tables).max(axis=2, keepdims=True)
+    if nodes < 2 or np.any(np.abs(mirror - tables) > MIRROR_TOLERANCE * scale):
+        return _unfolded(tables)
+    half = tables[:, :, :(nodes + 1) // 2].copy()
+    if nodes % 2:
+        half[:, :, -1] = np.where(signs[:, :, 0] < 0.0, 0.0, half[:, :, -1])
+    return np.ascontiguousarray(half), parity, nodes // 2
+
+
+def full_tables(quadrature: tuple[np.ndarray, np.ndarray, int]) -> np.ndarray:
+    """The tables (7, N, J) that `mirrored_quadrature` folded, unfolded again."""
+    half, parity, paired = quadrature
+    if paired == 0:
+        return half
+    signs = parity[None, :, None] * (-1.0) ** np.array(TABLE_ORDERS)[:, None, None]
+    return np.concatenate([half, signs * half[:, :, :paired][:, :, ::-1]], axis=2)
 
 
 POLYNOMIAL_ADVANTAGE = 2.5
 """The polynomial is used where its monomials and the terms of either form of its bending
 terms (the span's energy's or Eq.17's, each with the axial ones) number at most this many
-times the quadrature's nodes x modes. Measured (benchmarks/rhs_cost.py, lanes and one
-state): for pinned sines, whose trapezoidal rule needs few nodes, the polynomial costs 1.2-1.4
-times the quadrature at 2.6 and 3.8 times (2 and 3 modes), more at 5.4 and up; for clamped
-ends 0.5-0.7 at 0.65 and 1.2 times (2 and 3 modes), 0.65 on the lanes and 1.0 in one state at
-2.0 (4 modes), and 1.0 on the lanes but 1.45 in one state at 3.3 (5 modes)."""
+times the folded quadrature's nodes (half the rule's, `mirrored_quadrature`) x modes.
+Measured (benchmarks/rhs_cost.py, lanes and one state, against the folded quadrature with the
+antisymmetric modes at rest, base excitation's usual case): for clamped ends the polynomial
+costs 0.80 and 1.0 times the quadrature at 1.3 times (2 modes), 0.83 and 1.07 at 2.4 (3 modes),
+1.24 and 1.40 at 4.0 (4 modes); for pinned sines, whose trapezoidal rule needs few nodes,
+1.4-3 times at 5 and more."""
 
 
 def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
@@ -206,10 +266,11 @@ def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
 
 def polynomial_pays(tables: np.ndarray, polynomial: tuple[np.ndarray, ...]) -> bool:
     """Whether `polynomial` (`force_polynomial(tables)`) costs the right-hand side less than
-    the quadrature on `tables` (7, N, nodes): POLYNOMIAL_ADVANTAGE."""
+    the quadrature on `tables` (7, N, nodes), folded: POLYNOMIAL_ADVANTAGE."""
     from ..kernels.modes import (G_ENERGY_CUBIC, G_ENERGY_QUINTIC, G_EQ17_CUBIC,
                                  G_EQ17_QUINTIC)
-    n, nodes = tables.shape[1], tables.shape[2]
+    n = tables.shape[1]
+    nodes = mirrored_quadrature(tables)[0].shape[2]
     program, starts, _, _ = polynomial
     counts = np.diff(starts, axis=1).sum(axis=0)
     energy = counts.sum() - counts[G_EQ17_CUBIC] - counts[G_EQ17_QUINTIC]
@@ -341,7 +402,12 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     general case, for shapes whose integrals the kernel has no closed form of (clamped and
     elastic ends). The nodes must make the projections exact to round-off for the shapes and
     number of modes in use (products of six shapes): the caller checks that, e.g. by doubling
-    them."""
+    them. Where the shapes are symmetric and antisymmetric about midspan (alike ends:
+    `mirrored_quadrature` finds the parities), what vanishes by symmetry is set to 0 rather
+    than left at round-off: an antisymmetric mode's participation, midspan value, curvature
+    at midspan and share of the inertia's reaction, and the coupling of modes of unlike
+    parity; so a symmetric motion under base excitation stays exactly symmetric, as it does
+    on pinned sines (their closed forms)."""
     shapes = np.asarray(shapes, float)
     n = shapes.shape[0]
     x, w = np.polynomial.legendre.leggauss(nodes)
@@ -359,9 +425,17 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     midspan = shape_values(shapes, np.array([0.5]))[:, 0]
     slope = shape_values(shapes, s, 1)
     coupling = (slope * w) @ slope.T / math.pi ** 2
+    clamps = np.vstack([observed_rows(shapes), reaction_rows(shapes, nodes)])
+    _, parity, paired = mirrored_quadrature(tables)
+    if paired:          # symmetric ends: what vanishes by symmetry is 0, not round-off, so
+        odd = parity < 0.0      # that a symmetric motion stays exactly symmetric
+        gamma[odd] = 0.0
+        midspan[odd] = 0.0
+        clamps[OBSERVED.index((2, 0.5)), odd] = 0.0         # phi_n''(1/2)
+        clamps[len(OBSERVED), odd] = 0.0                    # the inertia's share (Gamma_n = 0)
+        coupling[parity[:, None] != parity[None, :]] = 0.0
     return Basis(name=name, shapes=shapes, frequency_ratio=(shapes[:, 0] / math.pi) ** 2,
-                 coupling=coupling,
-                 clamps=np.vstack([observed_rows(shapes), reaction_rows(shapes, nodes)]),
+                 coupling=coupling, clamps=clamps,
                  participation_ratio=gamma / (4.0 / math.pi),
                  tables=tables, midspan=midspan, stations=np.ascontiguousarray(stations),
                  mode_text=mode_text, frequency_text=frequency_text)
