@@ -46,7 +46,7 @@ from clamps_cost import SCENE  # noqa: E402
 import sweep  # noqa: E402
 from sweep.kernels import modes as md  # noqa: E402
 from sweep.models.basis import (CLAMPED, _eigenvalues, _normalised, from_shapes,  # noqa: E402
-                                full_tables, quadrature_nodes, with_force_form)
+                                quadrature_nodes, unfolded_tables, with_force_form)
 from sweep.models.transverse import modal_rows, resolve  # noqa: E402
 
 LANES = 32
@@ -163,7 +163,7 @@ def main() -> None:
                               best_ns(lambda: one_state_loop(row, basis, 10 * args.calls,
                                                              symmetric), 10 * args.calls)))
             chosen = "polynomial" if md.uses_polynomial(arrays) else "quadrature"
-            rows.append([f"{n}", rotation, physics, f"{full_tables(arrays[md.TABLES]).shape[2]}"]
+            rows.append([f"{n}", rotation, physics, f"{unfolded_tables(arrays[md.TABLES]).shape[2]}"]
                         + [f"{lane:.1f}" for lane, _ in cells] + [f"{one:.0f}" for _, one in cells]
                         + [chosen])
     forms = ["node by node", "folded", "folded, symmetric", "polynomial"]

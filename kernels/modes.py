@@ -53,8 +53,8 @@ per unit rho A, in the fields above,
 terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as before.
 
 `basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives:
-(quadrature, (T, parity, paired): the shapes' derivatives at the nodes and the projection
-weights, folded about midspan (above); stations, the shapes at stations
+(T, the shapes' derivatives at the nodes and the projection weights, folded about midspan
+(above; PARITY); stations, the shapes at stations
 along the span; midspan, phi_n(1/2); ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes,
 (N, 5): each mode's beam-function form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
 uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
@@ -102,7 +102,7 @@ FIXED_NAMES = ("w1_sq", "damping", "load_mean", "load_cos", "membrane", "k_sq", 
 
 
 # The items of the `basis` tuple every modal kernel takes (module docstring).
-TABLES = 0          # (T (7, N, half), parity (N,), paired): the quadrature, folded at midspan
+TABLES = 0          # (8, N, columns): the quadrature's tables, folded about midspan (PARITY)
 STATIONS = 1        # (M + 1, N): the shapes at stations along the span
 MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
@@ -125,6 +125,20 @@ AXIAL_0 = 8         # the axial load's reaction at x = 0 per unit q_n and (N - P
 AXIAL_1 = 9         # the modes leave out carried statically (phi_n'(e) for pinned sines)
 N_BENDS = 3         # rows 0..2: the curvatures, linear in q, watched alike
 N_OBSERVED = 10
+
+# Rows of basis[TABLES] (sweep.models.basis): 0..3 the fields' shapes (a, b, c, d per unit
+# q_n), 4..6 the projection weights on phi_m, phi_m' and phi_m'', then
+PARITY = 7          # each mode's parity about midspan along every column where the tables are
+                    # folded (every column a node and its mirror): +1, -1, +1, ... (mode n is
+                    # symmetric for odd n, antisymmetric for even n); 0 where not folded
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def folded_pairs(T):
+    """How many columns of tables T stand for a node and its mirror: all where they are
+    folded about midspan (T[PARITY] not 0), none where they are read node by node. Where they
+    are, the modes of even index i (n = i + 1 odd) are the symmetric ones."""
+    return T.shape[2] if T[PARITY, 0, 0] != 0.0 else 0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -477,9 +491,9 @@ def uses_polynomial(basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _field_rows(Q, PY):
-    """`field_rows` of quadrature Q and polynomial PY."""
-    nodes = Q[0].shape[2] + Q[2]
+def _field_rows(T, PY):
+    """`field_rows` of tables T and polynomial PY."""
+    nodes = T.shape[2] + folded_pairs(T)
     if PY is None:
         return nodes
     return max(nodes, (PY[0].shape[0] + N_GROUPS + 1 + 3) // 4)
@@ -632,26 +646,23 @@ _lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _lanes_fields(Q, f, X, FLD, n, n_run, symmetric):
+def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
     """Fields f and f + 1 (0: a and b, 2: c and d) of every lane at every node of the basis'
-    quadrature Q = (T, parity, paired) (sweep.models.basis.mirrored_quadrature): FLD[f, j]
-    and FLD[f + 1, j] at the nodes of T's columns j < half, and at the mirror of each paired
-    node j < paired in row half + j. A paired node's symmetric modes (parity +1) and its
-    antisymmetric ones are summed apart, e and o, over half the nodes; at the mirror node the
-    field is (-1)^order (e - o), order 1 for a and 3 for c, 2 for b and 4 for d. symmetric
+    folded tables T (sweep.models.basis.mirrored_quadrature): FLD[f, j] and FLD[f + 1, j] at
+    the nodes of T's columns j < half, and at the mirror of each paired node j < paired
+    (`folded_pairs`: all or none) in row half + j. A paired node's symmetric modes (even i)
+    and its antisymmetric ones (odd i) are summed apart, e and o, over half the nodes; at the
+    mirror node the field is (-1)^order (e - o), order 1 for a and 3 for c, 2 for b and 4 for d. symmetric
     (`_symmetric_lanes`): the antisymmetric modes are at rest, o = 0, and the mirror rows are
     not written (the forces there are the nodes' own, mirrored)."""
-    T, parity, paired = Q
     half = T.shape[2]
-    mirrors = 0 if symmetric else paired
-    odd0 = parity[0] < 0.0
-    for j in range(mirrors):            # the rows mode 0 does not write
-        r = j if odd0 else half + j
+    mirrors = 0 if symmetric else folded_pairs(T)
+    for j in range(mirrors):            # the rows mode 1 (symmetric) does not write
         for l in range(n_run):
-            FLD[f, r, l] = 0.0
-            FLD[f + 1, r, l] = 0.0
+            FLD[f, half + j, l] = 0.0
+            FLD[f + 1, half + j, l] = 0.0
     for i in range(n):
-        odd = parity[i] < 0.0
+        odd = folded_pairs(T) > 0 and i % 2 == 1
         if symmetric and odd:
             continue
         for j in range(half):
@@ -702,29 +713,27 @@ def _pair_forces(FLD, half, paired, parts, n_run, symmetric):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _symmetric_lanes(Q, X, n, n_run):
-    """Whether every lane's antisymmetric modes (parity -1 in the folded quadrature Q) are
-    exactly at rest, q = 0, with a symmetric first mode: then the span's shape is symmetric
+def _symmetric_lanes(T, X, n, n_run):
+    """Whether every lane's antisymmetric modes (even n, in folded tables T) are exactly at
+    rest, q = 0: then the span's shape is symmetric
     about midspan, the forces on the antisymmetric modes are exactly 0 and the mirror nodes'
     exactly the nodes' own, so the right-hand side skips them (a symmetric span under a
     symmetric load from rest stays so: the base excitation's usual case)."""
-    parity = Q[1]
-    if Q[2] == 0 or parity[0] < 0.0:
+    if folded_pairs(T) == 0:
         return False
-    for i in range(n):
-        if parity[i] < 0.0:
-            for l in range(n_run):
-                if X[i, l] != 0.0:
-                    return False
+    for i in range(1, n, 2):
+        for l in range(n_run):
+            if X[i, l] != 0.0:
+                return False
     return True
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def lanes_derivative(tt, X, K, s, PP, n_modes, Q, FLD, SC, n_run, fast, base, CP, PY):
+def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
-    (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); Q: the basis'
-    quadrature (basis[TABLES]: the shapes' derivatives at the quadrature nodes and the
+    (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis'
+    tables (basis[TABLES]: the shapes' derivatives at the quadrature nodes and the
     projection weights, folded about midspan: `_lanes_fields`); FLD (4, `field_rows`, lanes)
     and SC (4, lanes): scratch. fast: None (libm's cos and
     sin) or True (vecmath's vectorisable ones); base: None (no base excitation term), True
@@ -748,9 +757,8 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, Q, FLD, SC, n_run, fast, base, CP
     vectorises it. The one-state `derivative` is this with one lane."""
     n = n_modes
     sc = 3 * n
-    T = Q[0]
     half = T.shape[2]
-    paired = Q[2]
+    paired = folded_pairs(T)
     nodes = half + paired
     symmetric = False                   # (the quadrature's: `_symmetric_lanes`)
     mirrors = paired
@@ -789,11 +797,11 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, Q, FLD, SC, n_run, fast, base, CP
         for l in range(n_run):
             energy = energy or PP[sc + S_ENERGY, l] != 0.0
             eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-        symmetric = _symmetric_lanes(Q, X, n, n_run)
+        symmetric = _symmetric_lanes(T, X, n, n_run)
         mirrors = 0 if symmetric else paired
         nodes = half + mirrors
         for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
-            _lanes_fields(Q, f, X, FLD, n, n_run, symmetric)
+            _lanes_fields(T, f, X, FLD, n, n_run, symmetric)
         if energy and not eq17:
             _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
         elif energy:
@@ -813,13 +821,13 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, Q, FLD, SC, n_run, fast, base, CP
     for i in range(n):
         if PY is not None:
             _polynomial_mode(i, PY, R, active, SC[3], n_run)
-        elif symmetric and Q[1][i] < 0.0:
+        elif symmetric and i % 2 == 1:
             for l in range(n_run):
                 SC[3, l] = 0.0
         else:
             # a paired node's row j holds the pair's sum, row half + j its difference: a
             # symmetric mode takes the sum on phi_m and phi_m'' and the difference on phi_m'
-            even = Q[1][i] > 0.0
+            even = i % 2 == 0
             r0 = 0 if even else half
             r1 = half if even else 0
             w = T[4, i, 0]
@@ -878,17 +886,16 @@ def row_scratch(row, basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_state(y, Q, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
+def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
     monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's). Returns
     the quadrature nodes still to sum: none; or, PY None (no polynomial: a switch, so that the
-    polynomial's code is not compiled), F zeroed and every column of the quadrature Q's
-    tables."""
+    polynomial's code is not compiled), F zeroed and every column of the tables T."""
     if PY is None:
         for i in range(n):
             F[i] = 0.0
-        return Q[0].shape[2]
+        return T.shape[2]
     program = PY[0]
     starts = PY[1]
     mono = PY[2]
@@ -926,8 +933,33 @@ def _node_forces(a, b, c, d, linear, membrane, beta_b, beta_q, energy):
     return g0 + _eq17_bending(a, b, c, d, beta_b, beta_q), 0.0, 0.0
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+def _state_fields(T, f, j, y, n, split, symmetric):
+    """Fields f and f + 1 (0: a and b, 2: c and d) of one state at column j of the folded
+    tables T, as (e_f, o_f, e_f+1, o_f+1): split (folded), the antisymmetric modes' share
+    (odd i, o) apart from the symmetric ones' (even i, e), else all in e; symmetric, the
+    antisymmetric modes skipped (at rest)."""
+    e0 = 0.0
+    o0 = 0.0
+    e1 = 0.0
+    o1 = 0.0
+    if not split:
+        for i in range(n):
+            e0 += T[f, i, j] * y[i]
+            e1 += T[f + 1, i, j] * y[i]
+        return e0, o0, e1, o1
+    for i in range(0, n, 2):
+        e0 += T[f, i, j] * y[i]
+        e1 += T[f + 1, i, j] * y[i]
+    if not symmetric:
+        for i in range(1, n, 2):
+            o0 += T[f, i, j] * y[i]
+            o1 += T[f + 1, i, j] * y[i]
+    return e0, o0, e1, o1
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def derivative(t, y, dy, S, n_modes, Q, base):
+def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s), dy = (q', q'') (m/s,
     m/s^2): `lanes_derivative`'s right-hand side for the scalar driver, libm's cos and sin,
     from the same node-level pieces (`_axial`, `_energy_bending`, `_eq17_bending`) in one
@@ -935,7 +967,7 @@ def derivative(t, y, dy, S, n_modes, Q, base):
     projected on every mode at once (with one lane, the lanes' loops cost more in overhead
     than in arithmetic: 2-3x this), or, where the basis has one, its polynomial
     (`_polynomial_state`). It agrees with `lanes_derivative` to round-off. S: `scratch`
-    (prepared row, N, the basis) or `row_scratch`; Q: the basis' quadrature (basis[TABLES],
+    (prepared row, N, the basis) or `row_scratch`; T: the basis' tables (basis[TABLES],
     folded about midspan: the fields of a paired node and its mirror from one pass over the
     modes, each mode projecting both nodes' forces at once); y and dy distinct."""
     pp, F, CP, PY, MB = S               # F: the projections, mode by mode
@@ -958,73 +990,51 @@ def derivative(t, y, dy, S, n_modes, Q, base):
     beta_q = pp[sc + S_BETA_Q]
     energy = pp[sc + S_ENERGY] != 0.0
     # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
-    nodes = _polynomial_state(y, Q, PY, MB, n, linear, membrane, beta_b, beta_q,
+    nodes = _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q,
                               pp[sc + S_ENERGY], F)
-    T, parity, paired = Q
-    # every antisymmetric mode at rest: the mirror nodes' forces are the nodes' own, mirrored,
-    # and the antisymmetric modes' are 0 (`_symmetric_lanes`; the same bits, skipped)
-    symmetric = nodes > 0 and paired > 0 and parity[0] > 0.0
-    for i in range(n):
-        symmetric = symmetric and (parity[i] > 0.0 or y[i] == 0.0)
+    # A paired node sums its symmetric modes (e) and antisymmetric ones (o) apart: the mirror
+    # node's fields are (-1)^order (e - o), and each mode projects both nodes' forces at once,
+    # their sum or difference. Where every antisymmetric mode is at rest the mirror nodes'
+    # forces are the nodes' own, mirrored, and the antisymmetric modes' are 0
+    # (`_symmetric_lanes`): skipped, the same bits.
+    paired = folded_pairs(T)
+    symmetric = paired > 0
+    for i in range(1, n, 2):
+        symmetric = symmetric and y[i] == 0.0
     for j in range(nodes):
-        # a node's fields, its modes of parity +1 (e) and -1 (o) apart where it is paired
-        # (sweep.models.basis.mirrored_quadrature): there the mirror node's are (-1)^order
-        # (e - o), and each mode projects both nodes' forces at once, their sum or difference
         pair = j < paired
-        ae = 0.0
-        be = 0.0
-        ao = 0.0
-        bo = 0.0
-        for i in range(n):
-            if symmetric and parity[i] < 0.0:
-                continue
-            if pair and parity[i] < 0.0:
-                ao += T[0, i, j] * y[i]
-                bo += T[1, i, j] * y[i]
-            else:
-                ae += T[0, i, j] * y[i]
-                be += T[1, i, j] * y[i]
+        ae, ao, be, bo = _state_fields(T, 0, j, y, n, pair, symmetric)
         ce = 0.0
-        de = 0.0
         co = 0.0
+        de = 0.0
         do = 0.0
         if not energy:
-            for i in range(n):
-                if symmetric and parity[i] < 0.0:
-                    continue
-                if pair and parity[i] < 0.0:
-                    co += T[2, i, j] * y[i]
-                    do += T[3, i, j] * y[i]
-                else:
-                    ce += T[2, i, j] * y[i]
-                    de += T[3, i, j] * y[i]
+            ce, co, de, do = _state_fields(T, 2, j, y, n, pair, symmetric)
         g0, g1, g2 = _node_forces(ae + ao, be + bo, ce + co, de + do, linear, membrane,
                                   beta_b, beta_q, energy)
-        if not pair:
-            for i in range(n):
+        h0 = h1 = h2 = 0.0              # an antisymmetric mode's share of a pair
+        if pair and symmetric:          # the mirror's forces: the node's own, mirrored
+            g0 += g0
+            g1 += g1
+            g2 += g2
+        elif pair:                      # the pair's sums and differences
+            h0, h1, h2 = _node_forces(ao - ae, be - bo, co - ce, de - do, linear, membrane,
+                                      beta_b, beta_q, energy)
+            g0, h0 = g0 + h0, g0 - h0
+            g1, h1 = g1 - h1, g1 + h1
+            g2, h2 = g2 + h2, g2 - h2
+        # the symmetric modes (every mode where the tables are not folded), then the others
+        for i in range(0, n, 2 if pair else 1):
+            if energy:
                 F[i] += T[4, i, j] * g0 + T[5, i, j] * g1 + T[6, i, j] * g2
-            continue
-        if symmetric:
-            s0 = g0 + g0
-            d1 = g1 + g1
-            s2 = g2 + g2
-            for i in range(n):
-                if parity[i] > 0.0:
-                    F[i] += T[4, i, j] * s0 + T[5, i, j] * d1 + T[6, i, j] * s2
-            continue
-        h0, h1, h2 = _node_forces(ao - ae, be - bo, co - ce, de - do, linear, membrane,
-                                  beta_b, beta_q, energy)
-        s0 = g0 + h0
-        d0 = g0 - h0
-        s1 = g1 + h1
-        d1 = g1 - h1
-        s2 = g2 + h2
-        d2 = g2 - h2
-        for i in range(n):
-            if parity[i] > 0.0:
-                F[i] += T[4, i, j] * s0 + T[5, i, j] * d1 + T[6, i, j] * s2
             else:
-                F[i] += T[4, i, j] * d0 + T[5, i, j] * s1 + T[6, i, j] * d2
+                F[i] += T[4, i, j] * g0
+        if pair and not symmetric:
+            for i in range(1, n, 2):
+                if energy:
+                    F[i] += T[4, i, j] * h0 + T[5, i, j] * h1 + T[6, i, j] * h2
+                else:
+                    F[i] += T[4, i, j] * h0
     ab = base_acceleration(t, pp, n, base) if base is not None else 0.0
     for i in range(n):
         acc = pp[P_STIFF * n + i] * y[i] + pp[P_DAMPING * n + i] * y[n + i] - F[i]

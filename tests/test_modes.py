@@ -32,7 +32,7 @@ from scipy.integrate import quad
 
 import sweep
 from sweep.errors import UserError
-from sweep.models.basis import full_tables
+from sweep.models.basis import unfolded_tables
 
 from conftest import fast_first
 from galerkin import (Cable, Projection, absolute_tail_maximum, galerkin_rhs, integrate,
@@ -630,18 +630,28 @@ def test_the_force_s_polynomial_is_its_quadrature(rotation, membrane, n_modes):
     and clamped and elastic ends (their non-diagonal coupling)."""
     from sweep.models.basis import with_force_form
     row, arrays = _force_scene(n_modes, rotation, membrane)
-    by_nodes = with_force_form(arrays, False)
-    expanded = with_force_form(arrays, True)
-    rng = np.random.default_rng(11)
-    n = n_modes
+    _assert_the_same_force(row, with_force_form(arrays, False), with_force_form(arrays, True),
+                           n_modes, seed=11)
+
+
+def _assert_the_same_force(row, reference, other, n, seed):
+    """Both right-hand sides on kernel arrays `other` against the one-state right-hand side on
+    `reference`, at random states of every size up to the buckled span's (and the same states
+    with their antisymmetric modes at rest), times and with and without base excitation: equal
+    to 1e-14 of the largest component."""
+    rng = np.random.default_rng(seed)
     for base in (True, None):
         for size in (1e-4, 5e-3, 2e-2):
             y = rng.normal(size=2 * n) * np.r_[np.full(n, size), np.full(n, 2.0)]
+            symmetric = y.copy()
+            symmetric[1:n:2] = 0.0
+            symmetric[n + 1::2] = 0.0
             t = rng.uniform(0.0, 2.0)
-            want, _ = _both_right_hand_sides(row, by_nodes, y, t, base)
-            for got in _both_right_hand_sides(row, expanded, y, t, base):
-                np.testing.assert_allclose(got, want, rtol=0,
-                                           atol=1e-14 * np.abs(want).max())
+            for state in (y, symmetric):
+                want, _ = _both_right_hand_sides(row, reference, state, t, base)
+                for got in _both_right_hand_sides(row, other, state, t, base):
+                    np.testing.assert_allclose(got, want, rtol=0,
+                                               atol=1e-14 * np.abs(want).max())
 
 
 @pytest.mark.parametrize("n_modes", [1, 2, 3, 4, 5])
@@ -651,45 +661,40 @@ def test_the_folded_quadrature_is_the_node_by_node_one(rotation, membrane, n_mod
     """The quadrature folded about midspan (sweep.models.basis.mirrored_quadrature: half the
     nodes, each standing for its mirror node too; the forces projected a pair at a time)
     against the same tables read node by node: equal to round-off (1e-14 of the largest
-    component) at random states, symmetric modes and antisymmetric ones together, through both
-    right-hand sides, for odd and even node counts (pinned sines: 3N; clamped and elastic:
+    component) at random states, symmetric modes and antisymmetric ones together and the
+    antisymmetric ones at rest (the skipped half), through both right-hand sides, for odd and
+    even node counts (pinned sines: 3N; clamped and elastic:
     6N + 12). The node-by-node sum is checked against independent references elsewhere."""
     from sweep.models.basis import with_force_form
     row, arrays = _force_scene(n_modes, rotation, membrane)
     folded = with_force_form(arrays, False)
     by_nodes = with_force_form(arrays, False, mirrored=False)
-    assert folded[0][2] == full_tables(folded[0]).shape[2] // 2 > 0 and by_nodes[0][2] == 0
-    rng = np.random.default_rng(13)
-    n = n_modes
-    for base in (True, None):
-        for size in (1e-4, 5e-3, 2e-2):
-            y = rng.normal(size=2 * n) * np.r_[np.full(n, size), np.full(n, 2.0)]
-            t = rng.uniform(0.0, 2.0)
-            want, _ = _both_right_hand_sides(row, by_nodes, y, t, base)
-            for got in _both_right_hand_sides(row, folded, y, t, base):
-                np.testing.assert_allclose(got, want, rtol=0,
-                                           atol=1e-14 * np.abs(want).max())
+    assert np.all(folded[0][7] != 0.0) and not np.any(by_nodes[0][7])
+    assert folded[0].shape[2] == (by_nodes[0].shape[2] + 1) // 2
+    _assert_the_same_force(row, by_nodes, folded, n_modes, seed=13)
 
 
 def test_tables_fold_only_where_they_mirror():
     """mirrored_quadrature unfolds back to the tables it folded (every built-in end
-    condition, odd and even node counts), finds the modes' parities (+1, -1, +1, ...), and
-    leaves whole, paired = 0, tables that do not mirror about midspan: one mode's shape
-    perturbed on one side by 1e-9, or nodes placed off symmetry."""
+    condition, odd and even node counts: pinned 3 and 4 modes have 9 and 12 nodes), finds the
+    modes' parities (+1, -1, +1, ...), and leaves whole, parity row 0, tables that do not
+    mirror about midspan: one mode's curvature perturbed at one node by 1e-9, or nodes placed
+    off symmetry."""
     from sweep.models.basis import (clamped, elastic_ends, from_shapes, mirrored_quadrature,
                                     pinned_sines)
     for basis in (pinned_sines(3), pinned_sines(4), clamped(3), elastic_ends(4, 5.0)):
-        half, parity, paired = mirrored_quadrature(basis.tables)
-        assert paired == basis.tables.shape[2] // 2
-        assert list(parity) == [1.0 if i % 2 == 0 else -1.0 for i in range(basis.n_modes)]
-        np.testing.assert_allclose(full_tables((half, parity, paired)), basis.tables,
+        folded = mirrored_quadrature(basis.tables)
+        assert folded.shape[2] == (basis.tables.shape[2] + 1) // 2
+        assert list(folded[7, :, 0]) == [1.0 if i % 2 == 0 else -1.0
+                                         for i in range(basis.n_modes)]
+        np.testing.assert_allclose(unfolded_tables(folded), basis.tables,
                                    rtol=0, atol=1e-14 * np.abs(basis.tables).max())
     tables = clamped(3).tables.copy()
     tables[1, 2, 0] *= 1.0 + 1e-9
-    assert mirrored_quadrature(tables)[2] == 0
+    assert not np.any(mirrored_quadrature(tables)[7])
     shifted = from_shapes("shifted", clamped(2).shapes, 20).tables[:, :, 1:]   # 19 of 20 nodes
-    assert mirrored_quadrature(shifted)[2] == 0
-    np.testing.assert_array_equal(full_tables(mirrored_quadrature(shifted)), shifted)
+    assert not np.any(mirrored_quadrature(shifted)[7])
+    np.testing.assert_array_equal(unfolded_tables(mirrored_quadrature(shifted)), shifted)
 
 
 def test_the_polynomial_is_chosen_where_it_costs_less():

@@ -80,8 +80,8 @@ class Basis:
         return int(self.shapes.shape[0])
 
     def kernel_arrays(self) -> tuple[Any, ...]:
-        """(quadrature, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the
-        basis as kernels/modes.py reads it; quadrature: the tables folded about midspan
+        """(tables, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the
+        basis as kernels/modes.py reads it; tables: folded about midspan
         (`mirrored_quadrature`); ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi);
         polynomial: the force as each mode's polynomial in q where that costs the right-hand
         side less than the quadrature (`force_polynomial`), else None (a switch: the kernels
@@ -184,8 +184,8 @@ def with_force_form(arrays: tuple[Any, ...], polynomial: bool,
                     mirrored: bool = True) -> tuple[Any, ...]:
     """A basis' kernel arrays with its force evaluated as the polynomial (True) or by
     quadrature (False), whatever the basis would choose, and its quadrature folded about
-    midspan (`mirrored_quadrature`) or not: for comparing the forms."""
-    tables = full_tables(arrays[0])
+    midspan (`mirrored_quadrature`) or read node by node: for comparing the forms."""
+    tables = unfolded_tables(arrays[0])
     quadrature = mirrored_quadrature(tables) if mirrored else _unfolded(tables)
     return ((quadrature,) + arrays[1:7]
             + (force_polynomial(tables) if polynomial else None,))
@@ -202,46 +202,81 @@ midspan for the kernels to read half of them (`mirrored_quadrature`); the built-
 mirror to 4e-15."""
 
 
-def _unfolded(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """`mirrored_quadrature`'s form of tables read node by node: no node paired."""
-    return np.ascontiguousarray(tables, np.float64), np.ones(tables.shape[1]), 0
+def _unfolded(tables: np.ndarray) -> np.ndarray:
+    """`mirrored_quadrature`'s form of tables read node by node: every node's column, and the
+    parity row 0."""
+    return np.ascontiguousarray(np.concatenate([tables, np.zeros((1,) + tables.shape[1:])]),
+                                np.float64)
 
 
-def mirrored_quadrature(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-    """(half, parity, paired): the quadrature `tables` (7, N, J) as the kernels read it. Where
-    the nodes lie symmetrically about midspan and every mode is symmetric or antisymmetric
-    about it (parity +1 or -1: equal clamps at both ends), each of the first `paired` = J // 2
-    nodes stands for itself and its mirror node J - 1 - j, whose values are its own times
-    parity (-1)^order (`TABLE_ORDERS`); half = the first (J + 1) // 2 nodes' columns (the
-    middle node of an odd J last, its entries that vanish by symmetry set to 0). The kernels
-    then sum the fields over half the nodes and project the forces of each pair at once (their
-    sum or difference), about half the right-hand side's work (kernels/modes.py). Tables that
-    do not mirror (to MIRROR_TOLERANCE) come back whole, paired = 0, read node by node."""
-    tables = np.asarray(tables, np.float64)
+def _parities(tables: np.ndarray) -> np.ndarray | None:
+    """Each mode's parity about midspan (+1 symmetric, -1 antisymmetric) where the tables
+    (7, N, J) mirror about it to MIRROR_TOLERANCE (`TABLE_ORDERS`) and the modes alternate
+    +1, -1, +1, ... (a symmetric span's modes in order of frequency: mode n has n - 1 nodes),
+    else None."""
     n, nodes = tables.shape[1], tables.shape[2]
-    orders = np.array(TABLE_ORDERS)[:, None, None]
+    if nodes < 2:
+        return None
     parity = np.empty(n)
     for i in range(n):
         j = int(np.argmax(np.abs(tables[4, i])))
         parity[i] = 1.0 if tables[4, i, nodes - 1 - j] * tables[4, i, j] > 0.0 else -1.0
-    signs = parity[None, :, None] * (-1.0) ** orders              # (7, N, 1)
-    mirror = signs * tables[:, :, ::-1]
-    scale = np.abs(tables).max(axis=2, keepdims=True)
-    if nodes < 2 or np.any(np.abs(mirror - tables) > MIRROR_TOLERANCE * scale):
-        return _unfolded(tables)
-    half = tables[:, :, :(nodes + 1) // 2].copy()
-    if nodes % 2:
-        half[:, :, -1] = np.where(signs[:, :, 0] < 0.0, 0.0, half[:, :, -1])
-    return np.ascontiguousarray(half), parity, nodes // 2
-
-
-def full_tables(quadrature: tuple[np.ndarray, np.ndarray, int]) -> np.ndarray:
-    """The tables (7, N, J) that `mirrored_quadrature` folded, unfolded again."""
-    half, parity, paired = quadrature
-    if paired == 0:
-        return half
     signs = parity[None, :, None] * (-1.0) ** np.array(TABLE_ORDERS)[:, None, None]
-    return np.concatenate([half, signs * half[:, :, :paired][:, :, ::-1]], axis=2)
+    scale = np.abs(tables).max(axis=2, keepdims=True)
+    if np.any(np.abs(signs * tables[:, :, ::-1] - tables) > MIRROR_TOLERANCE * scale):
+        return None
+    if np.any(parity != np.where(np.arange(n) % 2 == 0, 1.0, -1.0)):
+        return None             # the kernels take mode n's parity as (-1)^(n + 1)
+    return parity
+
+
+def mirrored_quadrature(tables: np.ndarray) -> np.ndarray:
+    """The quadrature `tables` (7, N, J) as the kernels read it, (8, N, columns): where the
+    nodes lie symmetrically about midspan and every mode is symmetric or antisymmetric about
+    it (parity +1 or -1: alike clamps at both ends), the first (J + 1) // 2 nodes' columns,
+    each standing for itself and its mirror node J - 1 - j, whose values are its own times
+    parity (-1)^order (`TABLE_ORDERS`); the middle node of an odd J is its own mirror, its
+    projection weights (rows 4-6) halved so that the pair counts it once, and its entries that
+    vanish by symmetry set to 0. Row 7 (kernels.modes.PARITY) is each mode's parity, along
+    every column. The kernels then sum the fields over half the nodes and project the forces
+    of each pair at once (kernels/modes.py). Tables that do not mirror come back whole, row 7
+    zero: read node by node."""
+    tables = np.asarray(tables, np.float64)
+    parity = _parities(tables)
+    if parity is None:
+        return _unfolded(tables)
+    n, nodes = tables.shape[1], tables.shape[2]
+    half = np.empty((8, n, (nodes + 1) // 2))
+    half[:7] = tables[:, :, :half.shape[2]]
+    half[7] = parity[:, None]
+    if nodes % 2:
+        signs = parity[None, :] * (-1.0) ** np.array(TABLE_ORDERS)[:, None]     # (7, N)
+        half[:7, :, -1] = np.where(signs < 0.0, 0.0, half[:7, :, -1])
+        half[4:7, :, -1] *= 0.5
+    return np.ascontiguousarray(half)
+
+
+def unfolded_tables(folded: np.ndarray) -> np.ndarray:
+    """The tables (7, N, J) that `mirrored_quadrature` folded, whole again (J even where no
+    column is its own mirror: the half weights of a middle node tell it)."""
+    if not np.any(folded[7]):
+        return folded[:7]
+    parity = folded[7, :, 0]
+    signs = parity[None, :, None] * (-1.0) ** np.array(TABLE_ORDERS)[:, None, None]
+    half = folded[:7]
+    middle = _has_middle_node(half, parity)
+    if middle:
+        whole = half.copy()
+        whole[4:7, :, -1] *= 2.0
+        return np.concatenate([whole, (signs * whole)[:, :, -2::-1]], axis=2)
+    return np.concatenate([half, (signs * half)[:, :, ::-1]], axis=2)
+
+
+def _has_middle_node(half: np.ndarray, parity: np.ndarray) -> bool:
+    """Whether the last column of folded tables is a middle node (its own mirror): there
+    every entry that vanishes by symmetry is exactly 0."""
+    signs = parity[None, :] * (-1.0) ** np.array(TABLE_ORDERS)[:, None]
+    return bool(np.all(half[:, :, -1][signs < 0.0] == 0.0))
 
 
 POLYNOMIAL_ADVANTAGE = 2.5
@@ -270,7 +305,7 @@ def polynomial_pays(tables: np.ndarray, polynomial: tuple[np.ndarray, ...]) -> b
     from ..kernels.modes import (G_ENERGY_CUBIC, G_ENERGY_QUINTIC, G_EQ17_CUBIC,
                                  G_EQ17_QUINTIC)
     n = tables.shape[1]
-    nodes = mirrored_quadrature(tables)[0].shape[2]
+    nodes = mirrored_quadrature(tables).shape[2]
     program, starts, _, _ = polynomial
     counts = np.diff(starts, axis=1).sum(axis=0)
     energy = counts.sum() - counts[G_EQ17_CUBIC] - counts[G_EQ17_QUINTIC]
@@ -426,9 +461,9 @@ def from_shapes(name: str, shapes: np.ndarray, nodes: int, mode_text: str = "mod
     slope = shape_values(shapes, s, 1)
     coupling = (slope * w) @ slope.T / math.pi ** 2
     clamps = np.vstack([observed_rows(shapes), reaction_rows(shapes, nodes)])
-    _, parity, paired = mirrored_quadrature(tables)
-    if paired:          # symmetric ends: what vanishes by symmetry is 0, not round-off, so
-        odd = parity < 0.0      # that a symmetric motion stays exactly symmetric
+    parity = _parities(tables)
+    if parity is not None:  # alike ends: what vanishes by symmetry is 0, not round-off, so
+        odd = parity < 0.0  # that a symmetric motion stays exactly symmetric
         gamma[odd] = 0.0
         midspan[odd] = 0.0
         clamps[OBSERVED.index((2, 0.5)), odd] = 0.0         # phi_n''(1/2)
