@@ -154,7 +154,8 @@ def main() -> None:
             row, arrays = span(n, rotation, membrane)
             cells = []
             for polynomial, mirrored, symmetric in ((False, False, False), (False, True, False),
-                                                    (False, True, True), (True, True, False)):
+                                                    (False, True, True), (True, True, False),
+                                                    (True, True, True)):
                 basis = with_force_form(arrays, polynomial, mirrored)
                 lanes_loop(row, basis, 10, LANES, symmetric)
                 one_state_loop(row, basis, 10, symmetric)
@@ -166,7 +167,8 @@ def main() -> None:
             rows.append([f"{n}", rotation, physics, f"{unfolded_tables(arrays[md.TABLES]).shape[2]}"]
                         + [f"{lane:.1f}" for lane, _ in cells] + [f"{one:.0f}" for _, one in cells]
                         + [chosen])
-    forms = ["node by node", "folded", "folded, symmetric", "polynomial"]
+    forms = ["node by node", "folded", "folded, symmetric", "polynomial",
+             "polynomial, symmetric"]
     print(markdown_table(["modes", "ends", "terms", "quadrature nodes"]
                          + [f"{form}, ns a lane" for form in forms]
                          + [f"{form}, ns one state" for form in forms] + ["chosen"], rows))

@@ -525,18 +525,19 @@ def _group_scale(g, linear, membrane, beta_b, beta_q, energy):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run):
+def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     """The polynomial form of the force (POLYNOMIAL: program (K, 2), starts (N, N_GROUPS + 1),
-    monomials (T,), coefficients (T,)) for every lane: R[0..K-1] the monomials (R[k] =
+    monomials (T,), coefficients (T,), symmetric (N, N_GROUPS)) for every lane: R[0..K-1] the monomials (R[k] =
     R[program[k, 0]] R[program[k, 1]] for k >= N, the q_n below), R[K + g] group g's scale;
     returns the bit mask of the groups some lane has a non-zero scale in. Each mode's sum is
-    `_polynomial_mode`'s."""
+    `_polynomial_mode`'s. symmetric (`_symmetric_lanes`): the monomials of the symmetric modes
+    alone, the first PY[5] (the others are 0 and unread)."""
     program = PY[0]
     n_mono = program.shape[0]
     for k in range(n):
         for l in range(n_run):
             R[k, l] = X[k, l]
-    for k in range(n, n_mono):
+    for k in range(n, PY[5] if symmetric else n_mono):
         i = program[k, 0]
         j = program[k, 1]
         for l in range(n_run):
@@ -554,10 +555,12 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_mode(i, PY, R, active, out, n_run):
+def _polynomial_mode(i, PY, R, active, out, n_run, symmetric):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
     the sum over the groups in `active` of the group's scale R[K + g] times its terms'
-    coefficients x monomials (`_polynomial_lanes` filled R)."""
+    coefficients x monomials (`_polynomial_lanes` filled R); symmetric (`_symmetric_lanes`):
+    the terms of symmetric modes alone, the others being 0 (sweep.models.basis.
+    force_polynomial), and none for an antisymmetric mode."""
     starts = PY[1]
     mono = PY[2]
     coef = PY[3]
@@ -566,7 +569,7 @@ def _polynomial_mode(i, PY, R, active, out, n_run):
         out[l] = 0.0
     for g in range(N_GROUPS):
         lo = starts[i, g]
-        hi = starts[i, g + 1]
+        hi = PY[4][i, g] if symmetric else starts[i, g + 1]
         if lo == hi or not (active >> g) & 1:
             continue
         c = coef[lo]
@@ -792,7 +795,8 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
     if PY is not None:                  # (a switch: None where the basis has no polynomial,
         R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))   # each compiles its own)
-        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run)
+        symmetric = _symmetric_lanes(T, X, n, n_run)
+        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric)
     else:
         for l in range(n_run):
             energy = energy or PP[sc + S_ENERGY, l] != 0.0
@@ -820,7 +824,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
         if PY is not None:
-            _polynomial_mode(i, PY, R, active, SC[3], n_run)
+            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric)
         elif symmetric and i % 2 == 1:
             for l in range(n_run):
                 SC[3, l] = 0.0
@@ -900,15 +904,22 @@ def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy,
     starts = PY[1]
     mono = PY[2]
     coef = PY[3]
+    # the antisymmetric modes at rest: their monomials are 0 and unread (`_polynomial_mode`)
+    symmetric = folded_pairs(T) > 0
+    for i in range(1, n, 2):
+        symmetric = symmetric and y[i] == 0.0
     for k in range(n):
         MB[k] = y[k]
-    for k in range(n, program.shape[0]):
+    for k in range(n, PY[5] if symmetric else program.shape[0]):
         MB[k] = MB[program[k, 0]] * MB[program[k, 1]]
     for i in range(n):
         f = 0.0
+        if symmetric and i % 2 == 1:
+            F[i] = f
+            continue
         for g in range(N_GROUPS):
             lo = starts[i, g]
-            hi = starts[i, g + 1]
+            hi = PY[4][i, g] if symmetric else starts[i, g + 1]
             if lo == hi:
                 continue
             scale = _group_scale(g, linear, membrane, beta_b, beta_q, energy)

@@ -699,15 +699,15 @@ def test_tables_fold_only_where_they_mirror():
 
 def test_the_polynomial_is_chosen_where_it_costs_less():
     """sweep.models.basis.polynomial_pays (the rule measured by benchmarks/rhs_cost.py): the
-    polynomial for clamped and elastic ends of up to 3 modes, whose Gauss-Legendre rule needs
+    polynomial for clamped and elastic ends of up to 4 modes, whose Gauss-Legendre rule needs
     6 N + 12 nodes (3 N + 6 folded); never for pinned sines, whose 3 N (folded: half) cost as
     little; never above POLYNOMIAL_MAX_MODES."""
     from sweep.kernels import modes as md
     from sweep.models.basis import POLYNOMIAL_MAX_MODES, clamped, elastic_ends, pinned_sines
     for n in range(1, 8):
         assert not md.uses_polynomial(pinned_sines(n).kernel_arrays())
-        assert md.uses_polynomial(clamped(n).kernel_arrays()) == (n <= 3)
-        assert md.uses_polynomial(elastic_ends(n, 3.0).kernel_arrays()) == (n <= 3)
+        assert md.uses_polynomial(clamped(n).kernel_arrays()) == (n <= 4)
+        assert md.uses_polynomial(elastic_ends(n, 3.0).kernel_arrays()) == (n <= 4)
     assert POLYNOMIAL_MAX_MODES < 8
 
 

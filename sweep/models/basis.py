@@ -134,12 +134,17 @@ orthogonality makes 0) and is dropped."""
 def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
     """The right-hand side's nonlinear and axial-load force (kernels/modes.py FORCE_TERMS, the
     quadrature on `tables`) expanded into each mode's polynomial in q: (program (K, 2),
-    starts (N, N_GROUPS + 1), monomials (T,), coefficients (T,)). Monomial k >= N is the product
-    of monomials program[k] (k < N: q_k); mode m's terms of group g are
-    starts[m, g]..starts[m, g + 1] - 1, each a monomial's index and its coefficient (the
-    quadrature's, summed over the monomial's orderings; those that cancel to round-off,
-    POLYNOMIAL_ZERO, dropped). The kernel multiplies each group's sum by its scale (beta_b,
-    beta_q, the axial load, the membrane term) lane by lane."""
+    starts (N, N_GROUPS + 1), monomials (T,), coefficients (T,), symmetric (N, N_GROUPS),
+    pure).
+    Monomial k >= N is the product of monomials program[k] (k < N: q_k); mode m's terms of
+    group g are starts[m, g]..starts[m, g + 1] - 1, each a monomial's index and its coefficient
+    (the quadrature's, summed over the monomial's orderings; those that cancel to round-off,
+    POLYNOMIAL_ZERO, dropped), those whose monomial holds symmetric modes alone first, up to
+    symmetric[m, g], and those monomials first in the program too, below `pure` (an int; where
+    the tables fold about midspan, `mirrored_quadrature`; else no term and every monomial):
+    with the antisymmetric modes at rest the others are 0, and the kernels stop there. The
+    kernel multiplies each group's sum by its scale (beta_b, beta_q, the axial load, the
+    membrane term) lane by lane."""
     from ..kernels.modes import FORCE_TERMS, N_GROUPS
     n = tables.shape[1]
     # each group's monomials: (coefficient, size of its quadrature's terms) for every mode
@@ -165,19 +170,38 @@ def force_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...]:
             program.append((left, right))
         return index[mono]
 
+    folded = _parities(tables) is not None
+
+    def mixed(mono: tuple[int, ...]) -> bool:
+        """Whether a monomial holds an antisymmetric mode (odd index, where the tables
+        fold: mode n is symmetric for odd n)."""
+        return folded and any(i % 2 for i in mono)
+
+    kept = [[sorted((mono for mono, (value, size) in terms[g].items()
+                     if abs(value[m]) > POLYNOMIAL_ZERO * size[m]), key=mixed)
+             for g in range(N_GROUPS)] for m in range(n)]
+    for pure in (True, False):          # the symmetric modes' own monomials first
+        for groups in kept:
+            for group in groups:
+                for mono in group:
+                    if mixed(mono) != pure:
+                        monomial(mono)
+        if pure:
+            pure_count = len(program)
     starts = np.zeros((n, N_GROUPS + 1), np.int64)
+    symmetric = np.zeros((n, N_GROUPS), np.int64)
     monos: list[int] = []
     coefs: list[float] = []
     for m in range(n):
         for g in range(N_GROUPS):
             starts[m, g] = len(monos)
-            for mono, (value, size) in terms[g].items():
-                if abs(value[m]) > POLYNOMIAL_ZERO * size[m]:
-                    monos.append(monomial(mono))
-                    coefs.append(float(value[m]))
+            symmetric[m, g] = starts[m, g] + sum(not mixed(mono) for mono in kept[m][g])
+            for mono in kept[m][g]:
+                monos.append(monomial(mono))
+                coefs.append(float(terms[g][mono][0][m]))
         starts[m, N_GROUPS] = len(monos)
     return (np.array(program, np.int64).reshape(-1, 2), starts,
-            np.array(monos, np.int64), np.array(coefs, np.float64))
+            np.array(monos, np.int64), np.array(coefs, np.float64), symmetric, pure_count)
 
 
 def with_force_form(arrays: tuple[Any, ...], polynomial: bool,
@@ -280,14 +304,23 @@ def _has_middle_node(half: np.ndarray, parity: np.ndarray) -> bool:
 
 
 POLYNOMIAL_ADVANTAGE = 2.5
-"""The polynomial is used where its monomials and the terms of either form of its bending
-terms (the span's energy's or Eq.17's, each with the axial ones) number at most this many
-times the folded quadrature's nodes (half the rule's, `mirrored_quadrature`) x modes.
-Measured (benchmarks/rhs_cost.py, lanes and one state, against the folded quadrature with the
-antisymmetric modes at rest, base excitation's usual case): for clamped ends the polynomial
-costs 0.80 and 1.0 times the quadrature at 1.3 times (2 modes), 0.83 and 1.07 at 2.4 (3 modes),
-1.24 and 1.40 at 4.0 (4 modes); for pinned sines, whose trapezoidal rule needs few nodes,
-1.4-3 times at 5 and more."""
+"""The polynomial is used where, with the antisymmetric modes at rest (base excitation's usual
+case), its symmetric modes' own monomials and terms (of either form of the bending terms, the
+span's energy's or Eq.17's, each with the axial ones) number at most this many times the
+folded quadrature's nodes (`mirrored_quadrature`) x symmetric modes, and (POLYNOMIAL_LIMIT)
+an asymmetric state does not cost it far more than the quadrature. Measured
+(benchmarks/rhs_cost.py, twenty-sixth session, lanes and one state, both forms with the
+antisymmetric modes at rest): for clamped ends the polynomial costs 0.75 and 0.95 times the
+quadrature at 0.75 (2 modes), 0.67 and 0.94 at 1.6 (3), 0.62 and 0.79 at 1.4 (4), 0.66 and
+0.92 at 2.8 (5), 0.66 and 0.85 at 2.4 (6); for pinned sines, whose trapezoidal rule needs few
+nodes, 1.4 and 1.35 at 3.0 (2 modes), 1.27 and 1.42 at 4.0 (3), 1.22 and 1.23 at 3.4 (4), 1.2
+and 1.4 at 5.3 (5)."""
+
+POLYNOMIAL_LIMIT = 4.5
+"""... and where all its monomials and terms number at most this many times the folded
+quadrature's nodes x modes: measured as above but for states with every mode moving, the
+polynomial costs 0.66 and 1.09 times the quadrature at 4.0 (clamped, 4 modes), 1.03 and 1.72
+at 6.6 (5), 1.6 and 2.7 at 10 (6): clamped and elastic ends of up to 4 modes take it."""
 
 
 def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
@@ -301,16 +334,23 @@ def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
 
 def polynomial_pays(tables: np.ndarray, polynomial: tuple[np.ndarray, ...]) -> bool:
     """Whether `polynomial` (`force_polynomial(tables)`) costs the right-hand side less than
-    the quadrature on `tables` (7, N, nodes), folded: POLYNOMIAL_ADVANTAGE."""
+    the quadrature on `tables` (7, N, nodes), folded: POLYNOMIAL_ADVANTAGE, POLYNOMIAL_LIMIT."""
     from ..kernels.modes import (G_ENERGY_CUBIC, G_ENERGY_QUINTIC, G_EQ17_CUBIC,
                                  G_EQ17_QUINTIC)
+
+    def terms(counts: np.ndarray) -> int:
+        """The terms of the larger of the two forms of the bending terms."""
+        total = counts.sum()
+        return max(total - counts[G_EQ17_CUBIC] - counts[G_EQ17_QUINTIC],
+                   total - counts[G_ENERGY_CUBIC] - counts[G_ENERGY_QUINTIC])
+
     n = tables.shape[1]
     nodes = mirrored_quadrature(tables).shape[2]
-    program, starts, _, _ = polynomial
-    counts = np.diff(starts, axis=1).sum(axis=0)
-    energy = counts.sum() - counts[G_EQ17_CUBIC] - counts[G_EQ17_QUINTIC]
-    eq17 = counts.sum() - counts[G_ENERGY_CUBIC] - counts[G_ENERGY_QUINTIC]
-    return program.shape[0] + max(energy, eq17) <= POLYNOMIAL_ADVANTAGE * nodes * n
+    program, starts, _, _, symmetric, pure = polynomial
+    every = program.shape[0] + terms(np.diff(starts, axis=1).sum(axis=0))
+    own = pure + terms((symmetric - starts[:, :-1]).sum(axis=0))
+    return (own <= POLYNOMIAL_ADVANTAGE * nodes * ((n + 1) // 2)
+            and every <= POLYNOMIAL_LIMIT * nodes * n)
 
 
 def pinned_sines(n_modes: int) -> Basis:
