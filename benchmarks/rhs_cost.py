@@ -13,8 +13,11 @@ excitation, sweep.models.transverse.modal_rows), for N in --modes:
   (energy, uniform tension: harness-clamps' physics);
 - per lane with 32 lanes side by side (the lanes driver) and with 1 (`derivative`, the scalar
   driver's one state), ns per evaluation, best of 5 loops of --calls calls, with the force
-  summed at the quadrature's nodes and as its polynomial (sweep.models.basis.force_polynomial),
-  and which of the two the basis chooses (`polynomial_pays`);
+  summed at the quadrature's nodes read one by one, folded about midspan
+  (sweep.models.basis.mirrored_quadrature) at states of every mode and at states whose
+  antisymmetric modes are at rest ("symmetric": what base excitation leaves), and as its
+  polynomial (sweep.models.basis.force_polynomial) at both kinds of state, and which form
+  the basis chooses (`polynomial_pays`);
 - the quadrature: the clamped basis' nonlinear force (the energy's cubic and quintic parts
   and the axial load's linear one, each projected on every mode) at 20 random modal states,
   with J Gauss-Legendre nodes against 300, largest error over the largest value; the rule in
