@@ -167,7 +167,8 @@ def main() -> None:
                               best_ns(lambda: one_state_loop(row, basis, 10 * args.calls,
                                                              symmetric), 10 * args.calls)))
             chosen = "polynomial" if md.uses_polynomial(arrays) else "quadrature"
-            rows.append([f"{n}", rotation, physics, f"{unfolded_tables(arrays[md.TABLES]).shape[2]}"]
+            nodes = unfolded_tables(arrays[md.TABLES]).shape[2]
+            rows.append([f"{n}", rotation, physics, f"{nodes}"]
                         + [f"{lane:.1f}" for lane, _ in cells] + [f"{one:.0f}" for _, one in cells]
                         + [chosen])
     forms = ["node by node", "folded", "folded, symmetric", "polynomial",

@@ -54,9 +54,9 @@ terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as b
 
 `basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives:
 (T, the shapes' derivatives at the nodes and the projection weights, folded about midspan
-(above; PARITY); stations, the shapes at stations
-along the span; midspan, phi_n(1/2); ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes,
-(N, 5): each mode's beam-function form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
+(above; PARITY); stations, the shapes at stations along the span; midspan, phi_n(1/2);
+ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes, (N, 5): each mode's beam-function
+form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
 uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
 polynomial: the force's polynomial, or None where the quadrature is used).
 Nothing here knows the shapes' kind.
@@ -502,8 +502,8 @@ def _field_rows(T, PY):
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def field_rows(basis):
     """The middle axis of the lanes' scratch FLD (4, rows, lanes) for `basis`: its quadrature
-    nodes (each pair's two: `_lanes_fields`), or room for the polynomial's monomials and group scales (`_polynomial_lanes`)
-    (callable from Python and from the kernels)."""
+    nodes (each pair's two: `_lanes_fields`), or room for the polynomial's monomials and
+    group scales (`_polynomial_lanes`) (callable from Python and from the kernels)."""
     return _field_rows(basis[TABLES], basis[POLYNOMIAL])
 
 
@@ -527,8 +527,9 @@ def _group_scale(g, linear, membrane, beta_b, beta_q, energy):
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
 def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     """The polynomial form of the force (POLYNOMIAL: program (K, 2), starts (N, N_GROUPS + 1),
-    monomials (T,), coefficients (T,), symmetric (N, N_GROUPS)) for every lane: R[0..K-1] the monomials (R[k] =
-    R[program[k, 0]] R[program[k, 1]] for k >= N, the q_n below), R[K + g] group g's scale;
+    monomials (T,), coefficients (T,), symmetric (N, N_GROUPS), pure; sweep.models.basis.
+    force_polynomial) for every lane: R[0..K-1] the monomials (R[k] = R[program[k, 0]]
+    R[program[k, 1]] for k >= N, the q_n below), R[K + g] group g's scale;
     returns the bit mask of the groups some lane has a non-zero scale in. Each mode's sum is
     `_polynomial_mode`'s. symmetric (`_symmetric_lanes`): the monomials of the symmetric modes
     alone, the first PY[5] (the others are 0 and unread)."""
@@ -655,9 +656,9 @@ def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
     the nodes of T's columns j < half, and at the mirror of each paired node j < paired
     (`folded_pairs`: all or none) in row half + j. A paired node's symmetric modes (even i)
     and its antisymmetric ones (odd i) are summed apart, e and o, over half the nodes; at the
-    mirror node the field is (-1)^order (e - o), order 1 for a and 3 for c, 2 for b and 4 for d. symmetric
-    (`_symmetric_lanes`): the antisymmetric modes are at rest, o = 0, and the mirror rows are
-    not written (the forces there are the nodes' own, mirrored)."""
+    mirror node the field is (-1)^order (e - o), order 1 for a and 3 for c, 2 for b and 4 for
+    d. symmetric (`_symmetric_lanes`): the antisymmetric modes are at rest, o = 0, and the
+    mirror rows are not written (the forces there are the nodes' own, mirrored)."""
     half = T.shape[2]
     mirrors = 0 if symmetric else folded_pairs(T)
     for j in range(mirrors):            # the rows mode 1 (symmetric) does not write
@@ -718,10 +719,10 @@ def _pair_forces(FLD, half, paired, parts, n_run, symmetric):
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _symmetric_lanes(T, X, n, n_run):
     """Whether every lane's antisymmetric modes (even n, in folded tables T) are exactly at
-    rest, q = 0: then the span's shape is symmetric
-    about midspan, the forces on the antisymmetric modes are exactly 0 and the mirror nodes'
-    exactly the nodes' own, so the right-hand side skips them (a symmetric span under a
-    symmetric load from rest stays so: the base excitation's usual case)."""
+    rest, q = 0: then the span's shape is symmetric about midspan, the forces on the
+    antisymmetric modes are exactly 0 and the mirror nodes' exactly the nodes' own, so the
+    right-hand side skips them (a symmetric span under a symmetric load from rest stays so:
+    the base excitation's usual case)."""
     if folded_pairs(T) == 0:
         return False
     for i in range(1, n, 2):
