@@ -281,8 +281,8 @@ def mirrored_quadrature(tables: np.ndarray) -> np.ndarray:
 
 
 def unfolded_tables(folded: np.ndarray) -> np.ndarray:
-    """The tables (7, N, J) that `mirrored_quadrature` folded, whole again (J even where no
-    column is its own mirror: the half weights of a middle node tell it)."""
+    """The tables (7, N, J) that `mirrored_quadrature` folded, whole again (an odd J where the
+    last column is a middle node, its own mirror: `_has_middle_node`)."""
     if not np.any(folded[7]):
         return folded[:7]
     parity = folded[7, :, 0]
