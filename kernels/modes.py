@@ -660,13 +660,14 @@ def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
     d. symmetric (`_symmetric_lanes`): the antisymmetric modes are at rest, o = 0, and the
     mirror rows are not written (the forces there are the nodes' own, mirrored)."""
     half = T.shape[2]
+    folded = folded_pairs(T) > 0
     mirrors = 0 if symmetric else folded_pairs(T)
     for j in range(mirrors):            # the rows mode 1 (symmetric) does not write
         for l in range(n_run):
             FLD[f, half + j, l] = 0.0
             FLD[f + 1, half + j, l] = 0.0
     for i in range(n):
-        odd = folded_pairs(T) > 0 and i % 2 == 1
+        odd = folded and i % 2 == 1
         if symmetric and odd:
             continue
         for j in range(half):
@@ -763,9 +764,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     sc = 3 * n
     half = T.shape[2]
     paired = folded_pairs(T)
-    nodes = half + paired
-    symmetric = False                   # (the quadrature's: `_symmetric_lanes`)
-    mirrors = paired
+    symmetric = _symmetric_lanes(T, X, n, n_run)
+    mirrors = 0 if symmetric else paired    # the mirror nodes' rows the fields fill
+    nodes = half + mirrors
     for l in range(n_run):
         x = PP[sc + S_OMEGA, l] * tt[l] + PP[sc + S_LOAD_PHASE, l]
         cw = math.cos(x) if fast is None else fast_cos(x)
@@ -796,15 +797,11 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
     if PY is not None:                  # (a switch: None where the basis has no polynomial,
         R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))   # each compiles its own)
-        symmetric = _symmetric_lanes(T, X, n, n_run)
         active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric)
     else:
         for l in range(n_run):
             energy = energy or PP[sc + S_ENERGY, l] != 0.0
             eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-        symmetric = _symmetric_lanes(T, X, n, n_run)
-        mirrors = 0 if symmetric else paired
-        nodes = half + mirrors
         for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
             _lanes_fields(T, f, X, FLD, n, n_run, symmetric)
         if energy and not eq17:
@@ -891,10 +888,13 @@ def row_scratch(row, basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, F):
+def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, symmetric,
+                      F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
-    monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's). Returns
+    monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's);
+    symmetric: the antisymmetric modes at rest, their monomials 0 and unread
+    (`_polynomial_mode`). Returns
     the quadrature nodes still to sum: none; or, PY None (no polynomial: a switch, so that the
     polynomial's code is not compiled), F zeroed and every column of the tables T."""
     if PY is None:
@@ -905,10 +905,6 @@ def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy,
     starts = PY[1]
     mono = PY[2]
     coef = PY[3]
-    # the antisymmetric modes at rest: their monomials are 0 and unread (`_polynomial_mode`)
-    symmetric = folded_pairs(T) > 0
-    for i in range(1, n, 2):
-        symmetric = symmetric and y[i] == 0.0
     for k in range(n):
         MB[k] = y[k]
     for k in range(n, PY[5] if symmetric else program.shape[0]):
@@ -1001,18 +997,18 @@ def derivative(t, y, dy, S, n_modes, T, base):
     beta_b = pp[sc + S_BETA_B]
     beta_q = pp[sc + S_BETA_Q]
     energy = pp[sc + S_ENERGY] != 0.0
-    # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
-    nodes = _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q,
-                              pp[sc + S_ENERGY], F)
-    # A paired node sums its symmetric modes (e) and antisymmetric ones (o) apart: the mirror
-    # node's fields are (-1)^order (e - o), and each mode projects both nodes' forces at once,
-    # their sum or difference. Where every antisymmetric mode is at rest the mirror nodes'
-    # forces are the nodes' own, mirrored, and the antisymmetric modes' are 0
-    # (`_symmetric_lanes`): skipped, the same bits.
+    # every antisymmetric mode at rest (`_symmetric_lanes`, one lane): skipped, the same bits
     paired = folded_pairs(T)
     symmetric = paired > 0
     for i in range(1, n, 2):
         symmetric = symmetric and y[i] == 0.0
+    # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
+    nodes = _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q,
+                              pp[sc + S_ENERGY], symmetric, F)
+    # A paired node sums its symmetric modes (e) and antisymmetric ones (o) apart: the mirror
+    # node's fields are (-1)^order (e - o), and each mode projects both nodes' forces at once,
+    # their sum or difference. Where every antisymmetric mode is at rest the mirror nodes'
+    # forces are the nodes' own, mirrored, and the antisymmetric modes' are 0.
     for j in range(nodes):
         pair = j < paired
         ae, ao, be, bo = _state_fields(T, 0, j, y, n, pair, symmetric)
