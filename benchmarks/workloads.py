@@ -22,12 +22,19 @@ overrides):
   `kernels.oscillator.acceleration` in Python, bench_common.scipy_rhs, as fast as a
   hand-written closure),
   at the method and rtol of the scalar driver's setting that reaches the shipped error (SciPy
-  then takes the same steps, so reaches the same error). numbalsoda and diffrax are not run by
-  this script yet (benchmarks/work_precision.py runs both on the one-mode reference sweep):
-  each is listed, as not importable with the line that installs it, or as not run. A sample
-  is too small to spread over threads: how two threads scale is measured on the whole scenes
-  (benchmarks/RESULTS.md gives the command). A stepped sine or a
-  sine sweep has no SciPy peer here (benchmarks/stepped_sweep.py, sine_sweep_cost.py);
+  then takes the same steps, so reaches the same error). A stepped sine or a sine sweep has
+  no SciPy peer here (benchmarks/stepped_sweep.py, sine_sweep_cost.py);
+- numbalsoda's dop853 and lsoda from a Numba prange loop on the same points with the System's
+  own right-hand side compiled into their cfunc (benchmarks/scene_peers.py; a sine sweep
+  too, each point to its own sweep end; not a stepped sine, whose dwells chain), each at
+  the loosest rtol whose final-state error (max |q - q_ref| / max |q_ref| at the run's end)
+  is at most the shipped run's, on 1 and 2 threads, against the shipped run's kernel call
+  (its solve without the dataset: `scene_peers.engine_run`) on 1 and 2 threads. The peers
+  integrate the trajectory only; the engine also tracks the scene's outputs (amplitudes,
+  peaks, settling, clamp loads). Skipped, with its install line, where numbalsoda does not
+  import. diffrax is listed, not run on the scenes (its peer would need the right-hand side
+  rewritten in JAX; benchmarks/work_precision.py runs it on the one-mode reference sweep).
+  A 4-12 point sample is too small to spread over two threads: --full runs the whole grids;
 - a random scene of one mode (its sample: one span, one level): a hand-written fixed-step
   RK4 loop in Numba on the same records (benchmarks/random_cost.py `rk4_rms_over`, the
   coefficients the engine takes), its RMS over each point's window of the reference run, at
@@ -38,16 +45,20 @@ overrides):
 Command
 -------
     PYTHONPATH=. python benchmarks/workloads.py [--scene NAME ...] [--check R] [--repeats 3]
-        [--shipped-only]
+        [--shipped-only] [--full]
 
-Prints one Markdown table per scene; with --check R it exits 1 when a scene's shipped run is
-less than R times faster than its fastest peer.
+Prints one or two Markdown tables per scene; with --check R it exits 1 when a scene's shipped
+run is less than R times faster than its fastest peer (SciPy's, RK4's, or numbalsoda's on 1 or
+2 threads, the lowest ratio). numbalsoda needs `pip install numbalsoda`, whose build needs
+cmake, a C++ compiler and gfortran (`apt-get install cmake g++ gfortran`); the project's
+`bench` extra lists it.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+from importlib import metadata
 import sys
 import time
 from pathlib import Path
@@ -58,6 +69,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # the checkout's sweep/kernels
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench_common
 
+import scene_peers  # noqa: E402
 from bench_common import machine, markdown_table  # noqa: E402
 
 import sweep  # noqa: E402
@@ -82,9 +94,7 @@ SAMPLES: dict[str, dict[str, Any]] = {
 RTOLS = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 HEADLINE = ("rms_deflection", "amplitude", "peak_amplitude")   # a random scene's: its RMS
 RK4_STEPS = (0.25, 0.5, 1.0, 2.0, 4.0)   # the RK4 peer's steps 1 / (m fs), widest first
-INSTALL = {"numbalsoda": "pip install numbalsoda (its build needs cmake, a C++ compiler and "
-                         "gfortran)",
-           "diffrax": "pip install diffrax jax"}
+INSTALL = {"numbalsoda": scene_peers.INSTALL, "diffrax": "pip install diffrax jax"}
 
 
 def headline(ds: Any) -> np.ndarray:
@@ -181,6 +191,13 @@ def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -
     return elapsed / len(rows)
 
 
+def is_swept(name: str, overrides: dict[str, Any]) -> bool:
+    """Whether the scene sweeps its base frequency (a sine sweep: numbalsoda's peer runs it)."""
+    from sweep.models import transverse as tm
+    inputs = tm.resolve(sweep.load_scene(name, overrides=overrides))
+    return bool(inputs.swept) and inputs.random is None
+
+
 def is_random(name: str, overrides: dict[str, Any]) -> bool:
     """Whether the scene is a random one of one mode (`rk4_peer` runs it)."""
     from sweep.models import transverse as tm
@@ -223,22 +240,63 @@ def rk4_peer(name: str, sample: dict[str, Any], ref: np.ndarray, ref_ds: Any, e_
 
 
 def optional_peers() -> list[str]:
-    """One line per optional peer: not importable (with its install line), or not run."""
+    """One line per optional peer: run, or skipped (not importable, with its install line)."""
     lines = []
     for module, line in INSTALL.items():
         try:
-            __import__(module)
-            lines.append(f"{module}: importable, not run by this script yet")
+            mod = __import__(module)
         except ImportError:
             lines.append(f"{module}: skipped (not importable; {line})")
+            continue
+        version = getattr(mod, "__version__", None) or metadata.version(module)
+        if module == "numbalsoda":
+            lines.append(f"numbalsoda {version}: dop853 and lsoda on each scene's sample "
+                         "(benchmarks/scene_peers.py)")
+        else:
+            lines.append(f"{module} {version}: importable; not run on the scenes (its peer "
+                         "needs the right-hand side rewritten in JAX; its one-mode "
+                         "work-precision curve is benchmarks/work_precision.py's)")
     return lines
 
 
-def scene_table(name: str, repeats: int,
-                shipped_only: bool = False) -> tuple[str, float | None]:
+def numbalsoda_table(name: str, sample: dict[str, Any], repeats: int) -> tuple[str, float | None]:
+    """The numbalsoda peers of scene `name` on its sample, at the shipped run's final-state
+    error (benchmarks/scene_peers.py): (a Markdown table, the shipped kernel's speed-up over
+    the fastest peer, the lower of 1 and 2 threads; None where no peer ran)."""
+    reference = {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
+                 "solver.driver": "scalar"}
+    pr = scene_peers.problem(name, sample)
+    ref, _ = scene_peers.engine_run(name, reference)
+    final, t_ship = scene_peers.engine_run(name, sample, max(repeats, 1))
+    e_ship = scene_peers.final_error(final, ref, pr.n_modes)
+    rows = [["as shipped (its kernel)", "", "", f"{e_ship:.2g}", f"{t_ship[1] * 1e3:.3g}",
+             f"{t_ship[2] * 1e3:.3g}", "1.00 / 1.00"]]
+    ratio = None
+    for solver in scene_peers.SOLVERS:
+        run = scene_peers.matched(pr, solver, ref, e_ship, max(repeats, 1))
+        if run.rtol is None:
+            rows.append([f"numbalsoda {solver}", solver, f">= {scene_peers.PEER_RTOLS[-1]:g}",
+                         f"{run.error:.2g} (above)", "-", "-", "-"])
+            continue
+        r1, r2 = run.per_point[1] / t_ship[1], run.per_point[2] / t_ship[2]
+        ratio = min(r1, r2) if ratio is None else min(ratio, r1, r2)
+        rows.append([f"numbalsoda {solver}", solver, f"{run.rtol:g}", f"{run.error:.2g}",
+                     f"{run.per_point[1] * 1e3:.3g}", f"{run.per_point[2] * 1e3:.3g}",
+                     f"{r1:.2f} / {r2:.2f}"])
+    table = markdown_table(["run", "method", "rtol", "final-state error",
+                            "ms per point (1 thread)", "(2 threads)",
+                            "shipped speed-up (1 / 2 threads)"], rows)
+    return (f"Against numbalsoda at the shipped run's final-state error (max |q - q_ref| / "
+            f"max |q_ref| at the run's end); times are the solve alone, the engine's without "
+            f"its dataset, the peers' without the scene's outputs:\n\n{table}\n"), ratio
+
+
+def scene_table(name: str, repeats: int, shipped_only: bool = False,
+                full: bool = False) -> tuple[str, float | None]:
     """The scene's Markdown table and its shipped run's ratio to its fastest peer; with
-    shipped_only, only the shipped run and its peers."""
-    sample = SAMPLES[name]
+    shipped_only, only the shipped run and its peers; with full, on the scene's whole grid
+    rather than its sample."""
+    sample = {} if full else SAMPLES[name]
     shipped = sweep.load_scene(name, overrides=sample).values
     _, ref, ref_ds = timed(name, {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
                                   "solver.driver": "scalar"}, 0)
@@ -272,9 +330,15 @@ def scene_table(name: str, repeats: int,
                      f"{t_peer * 1e3:.3g}", f"<= {e_ship:.2g}", f"{ratio:.1f}"])
     table = markdown_table(["run", "method", "rtol", "driver", "ms per point (1 thread)",
                             "error", "shipped speed-up"], rows)
-    return (f"### {name}\n\n{len(x)} points of the sample; error against DOP853 at rtol 1e-12 "
+    text = (f"### {name}\n\n{len(x)} points of the sample; error against DOP853 at rtol 1e-12 "
             f"(SciPy's steps). Fastest at the shipped error or better: {best[1]} "
-            f"({t_ship / best[0]:.2f}x the shipped run).\n\n{table}\n"), ratio
+            f"({t_ship / best[0]:.2f}x the shipped run).\n\n{table}\n")
+    if scene_peers.available() and (has_scipy_peer(name, sample) or is_swept(name, sample)):
+        more, r = numbalsoda_table(name, sample, repeats)
+        text += "\n" + more
+        if r is not None:
+            ratio = r if ratio is None else min(ratio, r)
+    return text, ratio
 
 
 def main() -> None:
@@ -284,6 +348,8 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--shipped-only", action="store_true",
                         help="only the shipped run and its peers")
+    parser.add_argument("--full", action="store_true",
+                        help="the scenes' whole grids rather than their samples")
     args = parser.parse_args()
     print(f"Machine: {machine()}\n")
     for line in optional_peers():
@@ -294,7 +360,7 @@ def main() -> None:
         if name not in SAMPLES:
             raise SystemExit(f"--scene {name}: not a built-in time-domain scene "
                              f"({', '.join(SAMPLES)})")
-        text, ratio = scene_table(name, args.repeats, args.shipped_only)
+        text, ratio = scene_table(name, args.repeats, args.shipped_only, args.full)
         print(text, flush=True)
         if args.check is not None and ratio is not None and ratio < args.check:
             failed.append(f"{name}: {ratio:.2f}x its fastest peer, below {args.check:g}")
