@@ -236,15 +236,16 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _reaches(Y, YN, K, H, REACH, n, n_run, eighth):
+def _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth):
     """REACH[c, l]: an upper bound (m) of |q_c(t) - q_c(t_0)| over lane l's attempt, on mode
     c's interpolant as the scalar path builds it (modal_driver._mode_interpolant: DOP853's
     quintic Hermite through the state and its rates at both ends, RK45's quartic from the
-    stages): the sum of its coefficients' sizes, as modal_driver.mode_reach (a value located
-    inside the step on the scalar path can never exceed |q_c(t_0)| + REACH[c, l]). K: the
-    stages; eighth: the method switch. The one rule behind the lanes' tests of whether a
-    step could hold a new largest deflection, mode amplitude, curvature or load
-    (`_mode_events`, `_span_events`)."""
+    stages): the sum of its coefficients' sizes (a value located inside the step on the
+    scalar path can never exceed |q_c(t_0)| + REACH[c, l]); QB[c, l]: an upper bound (m) of
+    |q_c(t)| over it, as modal_driver.mode_reach (modal_driver.chord_bound: the tighter of
+    |q_c(t_0)| + REACH and the chord's). K: the stages; eighth: the method switch. The one
+    rule behind the lanes' tests of whether a step could hold a new largest deflection, mode
+    amplitude, curvature or load (`_mode_events`, `_span_events`)."""
     last = K.shape[0] - 1                   # f(t + h, y_new)
     for c in range(n):
         for l in range(n_run):
@@ -252,17 +253,29 @@ def _reaches(Y, YN, K, H, REACH, n, n_run, eighth):
             if eighth:
                 c3, c4, c5 = dop853.hermite_terms(Y[c, l], Y[n + c, l], K[0, n + c, l],
                                                   YN[c, l], YN[n + c, l], K[last, n + c, l], h)
-                reach = (abs(h * Y[n + c, l]) + abs(0.5 * h * h * K[0, n + c, l]) + abs(c3)
-                         + abs(c4) + abs(c5))
+                a2 = 0.5 * h * h * K[0, n + c, l]
+                reach = abs(h * Y[n + c, l]) + abs(a2) + abs(c3) + abs(c4) + abs(c5)
+                total = h * Y[n + c, l] + a2 + c3 + c4 + c5
+                spread = (drv.CHORD[1] * abs(a2) + drv.CHORD[2] * abs(c3)
+                          + drv.CHORD[3] * abs(c4) + drv.CHORD[4] * abs(c5))
             else:
                 reach = 0.0
+                total = 0.0
+                spread = 0.0
                 for k in range(dopri5.QUARTIC_TERMS):
                     term = 0.0
                     for j in range(dopri5.N_STAGES + 1):
                         term += K[j, c, l] * dopri5.P[j, k]
                     reach += abs(term)
+                    total += term
+                    spread += drv.CHORD[k] * abs(term)
                 reach *= abs(h)
+                total *= h
+                spread *= abs(h)
             REACH[c, l] = reach * BOUND_MARGIN
+            QB[c, l] = drv.chord_bound(Y[c, l], Y[c, l] + total,
+                                       (abs(Y[c, l]) + reach) * BOUND_MARGIN,
+                                       spread * BOUND_MARGIN)
 
 
 BOUND_MARGIN = 1.0 + 1e-12
@@ -271,9 +284,9 @@ may round the sum an ulp or two below the scalar path's."""
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _span_events(W, Y, REACH, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES):
+def _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES):
     """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
-    the tail window and modal_driver._span_bound over the step (from REACH, `_reaches`)
+    the tail window and modal_driver._span_bound over the step (from QB, `_reaches`)
     exceeds the span's largest deflection so far (MOD's slot 2N), else 0: the step may hold
     a larger one, which `_span_lane` searches for (a step on the scalar path searches in
     modal_driver._observe_modes). SHAPES: the basis' mode shapes."""
@@ -283,7 +296,7 @@ def _span_events(W, Y, REACH, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES):
     for c in range(n):
         size = drv.shape_size(SHAPES, c)
         for l in range(n_run):
-            SPAN[l] += (abs(Y[c, l]) + REACH[c, l]) * size
+            SPAN[l] += QB[c, l] * size
     for l in range(n_run):
         ordinary = (MOVE[l] != 0.0) & (FLAG[l] == 0.0)
         tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
@@ -316,11 +329,11 @@ def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basi
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, REACH,
-                 QMAX, basis, base):
+                 QB, QMAX, basis, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, something the scalar path would locate
-    inside it that could beat its largest so far (REACH, `_reaches`: each mode's bound over
-    the step): an extremum of q_n in a mode not negligible beside the largest
+    inside it that could beat its largest so far (REACH and QB, `_reaches`: each mode's
+    bounds over the step): an extremum of q_n in a mode not negligible beside the largest
     (modal_driver.negligible; BIG: scratch, the largest mode's peak) whose bound exceeds the
     mode's tail amplitude, a crest of the curvature at a clamp or at midspan (CV: the basis'
     kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest) whose bound exceeds
@@ -347,7 +360,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
             v1 = YN[n + i, l]
             turns = ((((v0 > 0.0) & (v1 <= 0.0)) | ((v0 < 0.0) & (v1 >= 0.0)))
                      & (not drv.negligible(max(MOD[n + i, l], abs(YN[i, l])), BIG[l]))
-                     & (abs(Y[i, l]) + REACH[i, l] > MOD[i, l]))
+                     & (QB[i, l] > MOD[i, l]))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             bad = (not (abs(YN[i, l]) <= BOUNDS[l])) | (not (abs(v1) <= 1e308))
             EV[l] = 1.0 if (turns & tail) | bad else EV[l]
@@ -380,7 +393,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
         drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
                         P1L[l], base, b)
         for c in range(n):
-            QMAX[c] = abs(Y[c, l]) + REACH[c, l]
+            QMAX[c] = QB[c, l]
         for k in range(3):
             if not (drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0):
                 continue
@@ -773,6 +786,7 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     BOUNDS = np.zeros(L)
     BIG = np.zeros(L)
     REACH = np.zeros((n, L))
+    QB = np.zeros((n, L))
     QMAX = np.empty(n)
     pp = np.empty(md.prepared_size(n))
     yl = np.empty(dim)
@@ -842,16 +856,16 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                  n_run, base, CP, PY)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
-        _reaches(Y, YN, K, H, REACH, n, n_run, eighth)
+        _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth)
         _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, REACH,
-                     QMAX, basis, base)
+                     QB, QMAX, basis, base)
         _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
                            basis, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base)
-        _span_events(W, Y, REACH, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES)
+        _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES)
         for j in range(n_run):
             if SPAN[j] != 0.0:
                 _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis)

@@ -106,7 +106,8 @@ TABLES = 0          # (8, N, columns): the quadrature's tables, folded about mid
 STATIONS = 1        # (M + 1, N): the shapes at stations along the span
 MIDSPAN = 2         # (N,): phi_n(1/2)
 RATIOS = 3          # (2, N): w_n / w_p and Gamma_n / (4 / pi)
-SHAPES = 4          # (N, 5): each mode's beam-function form, for `shape_at`
+SHAPES = 4          # (N, 6): each mode's beam-function form (beta, A, B, C, D), for
+                    # `shape_at`, and an upper bound of max |phi_n| over the span (column 5)
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
 CLAMPS = 6          # (10, N): what the load observers watch per mode (rows below; s = x / l)
 POLYNOMIAL = 7      # the same force as a polynomial in q, or None (FORCE_TERMS, below)

@@ -82,7 +82,8 @@ class Basis:
     def kernel_arrays(self) -> tuple[Any, ...]:
         """(tables, stations, midspan, ratios, shapes, coupling, clamps, polynomial): the
         basis as kernels/modes.py reads it; tables: folded about midspan
-        (`mirrored_quadrature`); ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi);
+        (`mirrored_quadrature`); ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes
+        with each mode's bound of max |phi_n| (`shape_sizes`) as a sixth column;
         polynomial: the force as each mode's polynomial in q where that costs the right-hand
         side less than the quadrature (`force_polynomial`), else None (a switch: the kernels
         compile only the form a basis uses)."""
@@ -91,7 +92,9 @@ class Basis:
                                                     self.participation_ratio]), np.float64)
             arrays = (mirrored_quadrature(self.tables),) + tuple(
                 np.ascontiguousarray(a, np.float64) for a in (self.stations, self.midspan)) + (
-                ratios, np.ascontiguousarray(self.shapes, np.float64),
+                ratios, np.ascontiguousarray(np.column_stack([self.shapes,
+                                                              shape_sizes(self.shapes)]),
+                                             np.float64),
                 np.ascontiguousarray(self.coupling, np.float64),
                 np.ascontiguousarray(self.clamps, np.float64),
                 cheaper_polynomial(self.tables))
@@ -252,6 +255,29 @@ def _parities(tables: np.ndarray) -> np.ndarray | None:
     if np.any(parity != np.where(np.arange(n) % 2 == 0, 1.0, -1.0)):
         return None             # the kernels take mode n's parity as (-1)^(n + 1)
     return parity
+
+
+SIZE_SAMPLES = 4096
+"""Intervals of the span at whose ends `shape_sizes` samples each shape."""
+
+
+def shape_sizes(shapes: np.ndarray) -> np.ndarray:
+    """An upper bound of max |phi_n(s)| over s in [0, 1] for each beam-function row (beta, A,
+    B, C, D) of `shapes` (N, 5), phi = A cos(beta s) + B sin(beta s) + C e^(-beta s)
+    + D e^(-beta (1 - s)) (kernels.modes.shape_at): the largest |phi_n| at SIZE_SAMPLES + 1
+    equal steps, plus half a step times a bound of |phi_n'|, beta (sqrt(A^2 + B^2) + |C| +
+    |D|); at most sqrt(A^2 + B^2) + |C| + |D| (a bound everywhere), 1 (and a few parts in
+    1e4) for a pinned sine. The kernels' tests of whether a step could hold a new largest
+    deflection read it (kernels.modal_driver.shape_size): the closer it is to the maximum,
+    the fewer steps they search."""
+    beta, a, b, c, d = (shapes[:, k][:, None] for k in range(5))
+    s = np.linspace(0.0, 1.0, SIZE_SAMPLES + 1)[None, :]
+    phi = (a * np.cos(beta * s) + b * np.sin(beta * s) + c * np.exp(-beta * s)
+           + d * np.exp(-beta * (1.0 - s)))
+    everywhere = (np.hypot(shapes[:, 1], shapes[:, 2]) + np.abs(shapes[:, 3])
+                  + np.abs(shapes[:, 4]))
+    sampled = (np.max(np.abs(phi), axis=1) + 0.5 / SIZE_SAMPLES * shapes[:, 0] * everywhere)
+    return np.minimum(everywhere, sampled * (1.0 + 1e-12))
 
 
 def mirrored_quadrature(tables: np.ndarray) -> np.ndarray:
