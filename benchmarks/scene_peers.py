@@ -293,7 +293,8 @@ def matched(pr: Problem, solver: str, ref: np.ndarray, target: float, repeats: i
     """`solver`'s loosest rtol in PEER_RTOLS whose final-state error is at most `target`,
     timed (best of `repeats` after its first run) on each of `threads`: the scan starts at
     `start` (the shipped rtol), loosens while the error stays within the target and tightens
-    until it comes within (errors fall as rtol does)."""
+    until it comes within (errors fall as rtol does), or until two steps tighter have not
+    cut it by a fifth (the solver's floor: none reaches the target)."""
     n = pr.ends.size
     errors: dict[float, float] = {}
 
@@ -308,8 +309,11 @@ def matched(pr: Problem, solver: str, ref: np.ndarray, target: float, repeats: i
         while k > 0 and error_at(k - 1) <= target:
             k -= 1
     else:
+        first = k
         while k + 1 < len(PEER_RTOLS) and error_at(k) > target:
             k += 1
+            if k - first >= 2 and error_at(k) > 0.8 * error_at(k - 2):
+                break                # a floor: tightening no longer lowers the error
         if error_at(k) > target:
             return PeerRun(solver, None, error_at(k), {})
     rtol = PEER_RTOLS[k]
