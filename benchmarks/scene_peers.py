@@ -19,7 +19,10 @@ its run is the loosest r in PEER_RTOLS whose error is at most the engine's.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import sys
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -196,6 +199,21 @@ def problem(name: str, overrides: dict[str, Any]) -> Problem:
                    float(settings[tk.ATOL_SCALE]), n)
 
 
+@contextlib.contextmanager
+def _quiet_fortran():
+    """The process' standard output (file descriptor 1) sent to /dev/null: lsoda's Fortran
+    writes a line to it each time it switches to its stiff method."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    with open(os.devnull, "w") as null:
+        os.dup2(null.fileno(), 1)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 1)
+            os.close(saved)
+
+
 _LOOPS: dict[str, Any] = {}
 
 
@@ -232,9 +250,10 @@ def solve(pr: Problem, solver: str, rtol: float, threads: int) -> tuple[np.ndarr
         out = np.empty((g.points.size, 2 * pr.n_modes))
         ok = np.zeros(g.points.size, dtype=np.bool_)
         ends, atol = pr.ends[g.points], atols[g.points]
-        start = time.perf_counter()
-        loop(g.rhs.address, g.data, g.u0, ends, rtol, atol, out, ok)
-        wall += time.perf_counter() - start
+        with _quiet_fortran():
+            start = time.perf_counter()
+            loop(g.rhs.address, g.data, g.u0, ends, rtol, atol, out, ok)
+            wall += time.perf_counter() - start
         out[~ok] = math.nan
         final[g.points] = out
     return final, wall

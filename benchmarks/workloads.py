@@ -250,7 +250,7 @@ def optional_peers() -> list[str]:
             continue
         version = getattr(mod, "__version__", None) or metadata.version(module)
         if module == "numbalsoda":
-            lines.append(f"numbalsoda {version}: dop853 and lsoda on each scene's sample "
+            lines.append(f"numbalsoda {version}: dop853 and lsoda on each scene's points "
                          "(benchmarks/scene_peers.py)")
         else:
             lines.append(f"{module} {version}: importable; not run on the scenes (its peer "
