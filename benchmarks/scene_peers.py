@@ -272,8 +272,9 @@ def engine_run(name: str, overrides: dict[str, Any], repeats: int = 0,
                threads: tuple[int, ...] = (1, 2)) -> tuple[np.ndarray, dict[int, float]]:
     """(the engine's final states (n, 2N) (m, m/s) of the sample, as the scene's run solves it:
     its own method, tolerance and driver; the kernel call's time per point (s) on each of
-    `threads`, best of `repeats` after a first run, none with repeats 0). The kernel call is
-    the run's solve without its dataset (sweep.execute's chunk function on every point)."""
+    `threads`, best of `repeats` after a first run on every core, none with repeats 0). The
+    kernel call is the run's solve without its dataset (sweep.execute's chunk function on
+    every point)."""
     import sweep
     from sweep.kernels import layout as tk
     from sweep.models import transverse as tm
@@ -281,7 +282,7 @@ def engine_run(name: str, overrides: dict[str, Any], repeats: int = 0,
     inputs = tm.resolve(scene)
     system = tm._system(inputs, tm.settings_vector(scene))
     rows = system.rows_at(np.arange(int(np.prod(inputs.shape))))
-    out = system.chunk_fn(rows, *system.args, threads=1)         # (compiles, or loads)
+    out = system.chunk_fn(rows, *system.args, threads=0)   # (untimed: every core; compiles)
     times = {}
     for k in threads if repeats else ():
         best = math.inf

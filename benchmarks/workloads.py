@@ -116,8 +116,10 @@ def error(x: np.ndarray, ref: np.ndarray) -> float:
 def timed(name: str, overrides: dict[str, Any],
           repeats: int) -> tuple[float, np.ndarray, Any]:
     """(best wall time per point (s) on one thread over `repeats` runs after a first one, inf
-    with none; headline; the dataset) of scene `name`."""
-    scene = sweep.load_scene(name, overrides={**overrides, "run.threads": 1})
+    with none; headline; the dataset) of scene `name`. With repeats 0 (a run that is not
+    timed: a reference) on every core (the points are independent: the same results)."""
+    threads = 1 if repeats > 0 else 0
+    scene = sweep.load_scene(name, overrides={**overrides, "run.threads": threads})
     ds = sweep.run(scene, progress=False)                   # compile, or load the cache
     best = math.inf
     for _ in range(repeats):
