@@ -193,11 +193,12 @@ def scipy_peer(name: str, overrides: dict[str, Any], method: str, rtol: float) -
     return elapsed / len(rows)
 
 
-def is_swept(name: str, overrides: dict[str, Any]) -> bool:
-    """Whether the scene sweeps its base frequency (a sine sweep: numbalsoda's peer runs it)."""
+def has_numbalsoda_peer(name: str, overrides: dict[str, Any]) -> bool:
+    """Whether benchmarks/scene_peers.py runs the scene: not a stepped sine (its dwells chain)
+    nor random records."""
     from sweep.models import transverse as tm
     inputs = tm.resolve(sweep.load_scene(name, overrides=overrides))
-    return bool(inputs.swept) and inputs.random is None
+    return inputs.continuation is None and inputs.random is None
 
 
 def is_random(name: str, overrides: dict[str, Any]) -> bool:
@@ -261,13 +262,14 @@ def optional_peers() -> list[str]:
     return lines
 
 
-def numbalsoda_table(name: str, sample: dict[str, Any], repeats: int) -> tuple[str, float | None]:
+def numbalsoda_table(name: str, sample: dict[str, Any], shipped_rtol: float,
+                     repeats: int) -> tuple[str, float | None]:
     """The numbalsoda peers of scene `name` on its sample, at the shipped run's final-state
-    error (benchmarks/scene_peers.py): (a Markdown table, the shipped kernel's speed-up over
-    the fastest peer, the lower of 1 and 2 threads; None where no peer ran)."""
+    error (benchmarks/scene_peers.py), their rtol scan starting at the shipped rtol: (a
+    Markdown table, the shipped kernel's speed-up over the fastest peer, the lower of 1 and 2
+    threads; None where no peer ran)."""
     reference = {**sample, "solver.method": "dop853", "solver.rtol": 1e-12,
                  "solver.driver": "scalar"}
-    shipped_rtol = sweep.load_scene(name, overrides=sample).values["solver.rtol"]
     pr = scene_peers.problem(name, sample)
     ref, _ = scene_peers.engine_run(name, reference)
     final, t_ship = scene_peers.engine_run(name, sample, max(repeats, 1))
@@ -277,7 +279,7 @@ def numbalsoda_table(name: str, sample: dict[str, Any], repeats: int) -> tuple[s
     ratio = None
     for solver in scene_peers.SOLVERS:
         run = scene_peers.matched(pr, solver, ref, e_ship, max(repeats, 1),
-                                  start=float(shipped_rtol))
+                                  start=shipped_rtol)
         if run.rtol is None:
             rows.append([f"numbalsoda {solver}", solver, "none",
                          f"{run.error:.2g} (its floor, above)", "-", "-", "-"])
@@ -338,8 +340,8 @@ def scene_table(name: str, repeats: int, shipped_only: bool = False,
     text = (f"### {name}\n\n{len(x)} points ({which}); error against DOP853 at rtol 1e-12 "
             f"(SciPy's steps). Fastest at the shipped error or better: {best[1]} "
             f"({t_ship / best[0]:.2f}x the shipped run).\n\n{table}\n")
-    if scene_peers.available() and (has_scipy_peer(name, sample) or is_swept(name, sample)):
-        more, r = numbalsoda_table(name, sample, repeats)
+    if scene_peers.available() and has_numbalsoda_peer(name, sample):
+        more, r = numbalsoda_table(name, sample, float(shipped["solver.rtol"]), repeats)
         text += "\n" + more
         if r is not None:
             ratio = r if ratio is None else min(ratio, r)

@@ -55,8 +55,8 @@ terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as b
 `basis` in the kernels is the tuple sweep.models.basis.Basis.kernel_arrays() gives:
 (T, the shapes' derivatives at the nodes and the projection weights, folded about midspan
 (above; PARITY); stations, the shapes at stations along the span; midspan, phi_n(1/2);
-ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes, (N, 5): each mode's beam-function
-form, for `shape_at`; coupling, (N, N): A_ij / pi^2, the
+ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes, (N, 6): each mode's beam-function
+form, for `shape_at`, and a bound of max |phi_n|; coupling, (N, N): A_ij / pi^2, the
 uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
 polynomial: the force's polynomial, or None where the quadrature is used).
 Nothing here knows the shapes' kind.

@@ -266,8 +266,8 @@ def shape_sizes(shapes: np.ndarray) -> np.ndarray:
     B, C, D) of `shapes` (N, 5), phi = A cos(beta s) + B sin(beta s) + C e^(-beta s)
     + D e^(-beta (1 - s)) (kernels.modes.shape_at): the largest |phi_n| at SIZE_SAMPLES + 1
     equal steps, plus half a step times a bound of |phi_n'|, beta (sqrt(A^2 + B^2) + |C| +
-    |D|); at most sqrt(A^2 + B^2) + |C| + |D| (a bound everywhere), 1 (and a few parts in
-    1e4) for a pinned sine. The kernels' tests of whether a step could hold a new largest
+    |D|); at most sqrt(A^2 + B^2) + |C| + |D| (a bound everywhere); for a pinned sine at most
+    1 + beta / (2 SIZE_SAMPLES). The kernels' tests of whether a step could hold a new largest
     deflection read it (kernels.modal_driver.shape_size): the closer it is to the maximum,
     the fewer steps they search."""
     beta, a, b, c, d = (shapes[:, k][:, None] for k in range(5))
