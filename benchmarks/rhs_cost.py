@@ -71,6 +71,7 @@ def lanes_loop(row, basis, calls, lanes, symmetric):
     tt = np.zeros(lanes)
     FLD = np.empty((4, md.field_rows(basis), lanes))
     SC = np.empty((4, lanes))
+    LB = md.lane_basis(basis, lanes)
     total = 0.0
     for k in range(calls):
         for c in range(2 * n):
@@ -78,7 +79,7 @@ def lanes_loop(row, basis, calls, lanes, symmetric):
                 X[c, l] = 0.0 if symmetric and (c % n) % 2 == 1 else 1e-3 + k * 1e-12 + l * 1e-9
                 tt[l] = k * 1e-5
         md.lanes_derivative(tt, X, K, 0, PP, n, T, FLD, SC, lanes, True, True,
-                            basis[md.COUPLING], basis[md.POLYNOMIAL])
+                            basis[md.COUPLING], basis[md.POLYNOMIAL], LB)
         total += K[0, n, 0]
     return total
 

@@ -844,20 +844,22 @@ def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
     that search took two thirds of a three-mode run). q_max (N): scratch."""
     for c in range(n):
         q_max[c] = mode_reach(y, h, QA, c)
-    return load_bound_within(t, t_new, q_max, n, basis, modal, p1, base, k)
+    return load_bound_within(t, t_new, q_max, n, basis[md.CLAMPS], basis[md.COUPLING], modal,
+                             p1, base, k)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def load_bound_within(t, t_new, q_max, n, basis, modal, p1, base, k):
+def load_bound_within(t, t_new, q_max, n, rows, coupling, modal, p1, base, k):
     """`_load_bound` over the step [t, t_new] (s) from bounds q_max (N, m) of each mode's
-    |q_n| over it (the multi-mode lanes' own, modal_lanes._mode_events)."""
+    |q_n| over it (the multi-mode lanes' own, modal_lanes._mode_events); rows, coupling: the
+    basis' CLAMPS and COUPLING."""
     s = end_load_slot(n)
     inertia = 0.0
     if base is not None and k > 0:
         factor = modal[inertia_slot(n)]
         if factor != 0.0:
             inertia = abs(factor) * ex.peak_bound(t, t_new, p1, osc.EXCITATION, 1, base)
-    return md.span_load_bound(basis[md.CLAMPS], basis[md.COUPLING], q_max, n,
+    return md.span_load_bound(rows, coupling, q_max, n,
                               modal[factor_slot(n)], abs(modal[s]) + abs(modal[s + 1]),
                               inertia, k)
 

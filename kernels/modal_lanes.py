@@ -106,13 +106,13 @@ def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
-             base, CP, PY):
+             base, CP, PY, LB):
     """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
     rk_step: K[1..n_stages] and YN = y_new, K[n_stages] = f(t + h, y_new); K[0] = f(t, y)
     given) and SciPy's error norm over the 2N components (ERR): RK45's RMS, or DOP853's
     combination of its fifth- and third-order estimates (`eighth`). The absolute tolerances are
-    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY: the basis' coupling
-    and polynomial (kernels.modes.lanes_derivative)."""
+    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY, LB: the basis' coupling
+    and polynomial, each lane's own (kernels.modes.lanes_derivative)."""
     L = LANES
     dim = 2 * n
     n_stages = B.shape[0]
@@ -121,11 +121,12 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
         c = C[s]
         for l in range(n_run):
             TT[l] = W[tj.T * L + l] + c * H[l]
-        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY)
+        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY, LB)
     _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
     for l in range(n_run):
         TT[l] = W[tj.T * L + l] + H[l]
-    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP, PY)
+    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP, PY,
+                        LB)
     # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
     for l in range(n_run):
         ST[0, l] = 0.0
@@ -209,10 +210,13 @@ def _control(W, H, ERR, SC, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
+def _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run):
     """KM[s, 0, l], KM[s, 1, l]: the stages of lane l projected on the midspan deflection and
     its rate (modal_driver._project's sums, in order), for the stages record_step reads: all
-    for RK45, the last (f(t + h, y_new), at KM[1]) for DOP853; QV[0, l], QV[1, l]: y_new's."""
+    for RK45, the last (f(t + h, y_new), at KM[1]) for DOP853; QV[0, l], QV[1, l]: y_new's.
+    The weights phi_n(1/2) are each lane's (LB, kernels.modes.write_lane_basis); `weights`, a
+    basis' of the family, tells which are 0 (the same for all)."""
+    mid = md.lb_midspan(n)
     for s in range(n_stages + 2):
         if eighth and s < n_stages:
             continue
@@ -224,15 +228,14 @@ def _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run):
                 else:
                     QV[part, l] = 0.0
             for i in range(n):
-                w = weights[i]
-                if w == 0.0:
+                if weights[i] == 0.0:
                     continue
                 if s <= n_stages:
                     for l in range(n_run):
-                        KM[r, part, l] += w * K[s, part * n + i, l]
+                        KM[r, part, l] += LB[mid + i, l] * K[s, part * n + i, l]
                 else:
                     for l in range(n_run):
-                        QV[part, l] += w * YN[part * n + i, l]
+                        QV[part, l] += LB[mid + i, l] * YN[part * n + i, l]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -284,19 +287,20 @@ may round the sum an ulp or two below the scalar path's."""
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES):
+def _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, LB):
     """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
     the tail window and modal_driver._span_bound over the step (from QB, `_reaches`)
     exceeds the span's largest deflection so far (MOD's slot 2N), else 0: the step may hold
     a larger one, which `_span_lane` searches for (a step on the scalar path searches in
-    modal_driver._observe_modes). SHAPES: the basis' mode shapes."""
+    modal_driver._observe_modes). LB: each lane's basis (its shapes' sizes,
+    modal_driver.shape_size)."""
     L = LANES
     for l in range(n_run):
         SPAN[l] = 0.0                       # the bound, until the test below
+    sizes = md.lb_sizes(n)
     for c in range(n):
-        size = drv.shape_size(SHAPES, c)
         for l in range(n_run):
-            SPAN[l] += QB[c, l] * size
+            SPAN[l] += QB[c, l] * LB[sizes + c, l]
     for l in range(n_run):
         ordinary = (MOVE[l] != 0.0) & (FLAG[l] == 0.0)
         tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
@@ -328,17 +332,18 @@ def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basi
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, REACH,
-                 QB, QMAX, basis, base):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, BI, LD, P1L,
+                 REACH, QB, QMAX, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, something the scalar path would locate
     inside it that could beat its largest so far (REACH and QB, `_reaches`: each mode's
     bounds over the step): an extremum of q_n in a mode not negligible beside the largest
     (modal_driver.negligible; BIG: scratch, the largest mode's peak) whose bound exceeds the
-    mode's tail amplitude, a crest of the curvature at a clamp or at midspan (CV: the basis'
-    kernels.modes.CLAMPS rows; a pinned clamp's are all 0: never a crest) whose bound exceeds
-    its largest so far, or a maximum of the stretch or of a clamp's shear
-    (kernels.modes.span_loads, CP: the basis' coupling; MOD's shear factor; LD (2, 6):
+    mode's tail amplitude, a crest of the curvature at a clamp or at midspan (each lane's
+    basis' kernels.modes.CLAMPS rows, in LB; a pinned clamp's are all 0: never a crest) whose
+    bound exceeds its largest so far, or a maximum of the stretch or of a clamp's shear
+    (kernels.modes.span_loads with lane l's basis, basis BI[l] of the stacked `family`: its
+    CLAMPS and COUPLING; MOD's shear factor; LD (2, 6):
     scratch; P1L: the lanes' Observer rows, for the base inertia's part of the shear,
     modal_driver.inertia_at) whose bound (modal_driver.load_bound_within; QMAX (N): scratch)
     exceeds its largest so far, where the scene observes the loads (settings[LOADS], in
@@ -368,16 +373,18 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
         return
     slot = drv.clamp_slot(n)
     for e in range(md.N_BENDS):
+        bend = md.lb_bends(n) + e * n
         for l in range(n_run):
             r0 = 0.0
             r1 = 0.0
             c0 = 0.0
             reach = 0.0
             for i in range(n):
-                r0 += CV[e, i] * Y[n + i, l]
-                r1 += CV[e, i] * YN[n + i, l]
-                c0 += CV[e, i] * Y[i, l]
-                reach += abs(CV[e, i]) * REACH[i, l]
+                cv = LB[bend + i, l]
+                r0 += cv * Y[n + i, l]
+                r1 += cv * YN[n + i, l]
+                c0 += cv * Y[i, l]
+                reach += abs(cv) * REACH[i, l]
             crest = ((r0 > 0.0) & (r1 <= 0.0)) | ((r0 < 0.0) & (r1 >= 0.0))
             tail = W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]
             beats = abs(c0) + reach > MOD[slot + e, l]
@@ -388,6 +395,8 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
+        CV = family[md.CLAMPS][BI[l]]
+        CP = family[md.COUPLING][BI[l]]
         drv.state_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[:, l], W[tj.T * L + l],
                         P1L[l], base, a)
         drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
@@ -397,7 +406,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P
         for k in range(3):
             if not (drv._load_rises(a, k) > 0.0 and drv._load_rises(b, k) <= 0.0):
                 continue
-            if drv.load_bound_within(W[tj.T * L + l], W[tj.T_NEW * L + l], QMAX, n, basis,
+            if drv.load_bound_within(W[tj.T * L + l], W[tj.T_NEW * L + l], QMAX, n, CV, CP,
                                      MOD[:, l], P1L[l], base, k) > MOD[loads + k, l]:
                 EV[l] = 1.0
                 break
@@ -454,13 +463,13 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, BI, LD, P1L, base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
-    same once t_new >= the lane's tail start; so the curvatures (CV, as `_mode_events`) in
-    their slots (modal_driver.clamp_slot) and the stretch and shears (CP: the coupling) in
-    theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
+    same once t_new >= the lane's tail start; so the curvatures (LB, as `_mode_events`) in
+    their slots (modal_driver.clamp_slot) and the stretch and shears (lane l's basis BI[l] of
+    the stacked `family`) in theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
     the Observer rows, modal_driver.inertia_at's). base: the excitation switch."""
     L = LANES
     for i in range(n):
@@ -474,10 +483,11 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
         return
     slot = drv.clamp_slot(n)
     for e in range(md.N_BENDS):
+        bend = md.lb_bends(n) + e * n
         for l in range(n_run):
             c = 0.0
             for i in range(n):
-                c += CV[e, i] * YN[i, l]
+                c += LB[bend + i, l] * YN[i, l]
             take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
                     & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
             MOD[slot + e, l] = max(MOD[slot + e, l], abs(c)) if take else MOD[slot + e, l]
@@ -488,8 +498,8 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base):
                 & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
         if not take:
             continue
-        drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
-                        P1L[l], base, b)
+        drv.state_loads(family[md.CLAMPS][BI[l]], family[md.COUPLING][BI[l]], YN[:n, l],
+                        YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l], P1L[l], base, b)
         for k in range(3):
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 
@@ -507,8 +517,9 @@ def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states, reals,
-               counts, series, modal, final, T, pp, yl, fl, basis, base):
-    """Give lane j the trajectory of row `point`, set up by the scalar driver's own
+               counts, series, modal, final, pp, yl, fl, basis, LB, base):
+    """Give lane j the trajectory of row `point` on `basis` (its column of LB too), set up by
+    the scalar driver's own
     modal_driver.start (f(0), SciPy's initial step, the midspan accumulator, each mode's tail
     amplitude and divergence at t = 0). An invalid row is answered at once
     (modal_driver.solve_point): returns False."""
@@ -532,13 +543,14 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states,
     S = md.scratch(pp, n, basis)
     for c in range(pp.shape[0]):
         PP[c, j] = pp[c]
+    md.write_lane_basis(basis, LB, j)
     p1 = drv.observer_row(row, n, pp)
     for c in range(N_PARAMS):
         P1[c * L + j] = p1[c]
         P1L[j, c] = p1[c]
     mod = np.empty(MOD.shape[0])
-    drv.start(row, n, settings, yl, fl, pp, S, T, p1, W[j::L], series[point], mod,
-              basis[md.MIDSPAN], basis, base)
+    drv.start(row, n, settings, yl, fl, pp, S, basis[md.TABLES], p1, W[j::L], series[point],
+              mod, basis[md.MIDSPAN], basis, base)
     for c in range(dim):
         Y[c, j] = yl[c]
         K[0, c, j] = fl[c]
@@ -548,10 +560,10 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states,
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _move_lane(k, i, W, Y, K, MOD, PP, P1, P1L, BOUNDS, H):
+def _move_lane(k, i, W, Y, K, MOD, PP, P1, P1L, BOUNDS, H, LB, BI):
     """Lane k's trajectory into the idle lane i: every array that carries a lane's state from
     one attempt to the next (its accumulator, state, stages (K[0] = f(t, y)), modes'
-    accumulator, prepared and Observer rows, bound, step); lane k is left idle. A lane's
+    accumulator, prepared and Observer rows, bound, step, basis); lane k is left idle. A lane's
     arithmetic does not depend on its place, so neither do its results."""
     L = LANES
     for c in range(W.shape[0] // L):
@@ -565,6 +577,9 @@ def _move_lane(k, i, W, Y, K, MOD, PP, P1, P1L, BOUNDS, H):
         MOD[c, i] = MOD[c, k]
     for c in range(PP.shape[0]):
         PP[c, i] = PP[c, k]
+    for c in range(LB.shape[0]):
+        LB[c, i] = LB[c, k]
+    BI[i] = BI[k]
     for c in range(P1.shape[0] // L):
         P1[c * L + i] = P1[c * L + k]
         P1L[i, c] = P1L[k, c]
@@ -668,16 +683,16 @@ def _keep_start(W, START, n_run, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, basis,
-                  yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
+def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, family,
+                  BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
     """A random record's ordinary accepted steps (MOVE 1, FLAG 0: `_finish` moved them to
     their ends, with the step-end sample of the absolute acceleration; the others are the
     scalar path's, `_flagged_lane`): what the scalar path adds for such a step, on the
     scalar path's types, lane by lane: the midspan's statistics over the step
     (trajectory.record_statistics, as record_step calls it; START: the step's start,
     `_keep_start`) and, where the scene observes the loads, the curvature squares
-    (modal_driver.observe_random_modes on copies of the lane's columns; yl, ynl, Kl, ml:
-    scratch); with DOP853, the time series' samples in the step (for the spectra) on the
+    (modal_driver.observe_random_modes on copies of the lane's columns and its basis, BI[j] of
+    the stacked `family`; yl, ynl, Kl, ml: scratch); with DOP853, the time series' samples in the step (for the spectra) on the
     midspan's quintic Hermite through both ends, as record_step takes them
     (trajectory.take_hermite_samples into series[point[j]]; Qc: scratch; RK45's samples are its
     quartic's, from the stages: `_finish` leaves those steps to the scalar path, and
@@ -711,7 +726,8 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
             Kl[last, c] = K[last, c, j]
         for c in range(MOD.shape[0]):
             ml[c] = MOD[c, j]
-        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, basis, ml, base)
+        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, md.member(family, BI[j]),
+                                 ml, base)
         for c in range(MOD.shape[0]):
             MOD[c, j] = ml[c]
 
@@ -724,17 +740,22 @@ _record_statistics = ex.by_kind(None, _record_steps)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, modal, final,
-                base, eighth, steady, halt):
+def solve_block(params, family, which, settings, lo, hi, states, reals, counts, series, modal,
+                final, base, eighth, steady, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
-    state). basis: the span's mode shapes (kernels.modes; N = its number of modes). base:
+    state). family: the spans' mode shapes, bases of N modes stacked item by item
+    (sweep.models.basis.stacked; kernels.modes.member), row i's basis which[i]: the lanes of
+    one call may each run their own (elastic clamps whose K differs from point to point), as
+    far as the right-hand side and the observers read them lane by lane (their polynomials'
+    structure and the zeros of their coupling and midspan weights are the same). base:
     None, or True when settings[BASE] is 1; eighth: None, or True when
     settings[METHOD] is 1 (DOP853); steady: None, or True when settings[STOP_STEADY] is 1 (the
     early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows
     in flight unsolved). Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
+    basis = md.member(family, 0)     # the family's structure: every basis' the same
     n = md.basis_modes(basis)
     dim = 2 * n
     rtol = max(settings[RTOL], dopri5.MIN_RTOL)
@@ -748,11 +769,9 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     C = dop853.C if eighth else dopri5.C
     T = basis[md.TABLES]
     rows = md.field_rows(basis)
-    weights = basis[md.MIDSPAN]
-    CV = basis[md.CLAMPS]            # (the basis' arrays taken once: a tuple's item taken in
+    weights = basis[md.MIDSPAN]      # (the basis' arrays taken once: a tuple's item taken in
     CP = basis[md.COUPLING]          # the loop costs a reference count update a call)
     PY = basis[md.POLYNOMIAL]
-    SHAPES = basis[md.SHAPES]
     record = ex.is_record(base)      # a random record: the accumulator has its
     slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
     # a record's samples (the spectra's) on DOP853's quintic Hermite: `_record_steps`' in an
@@ -772,6 +791,8 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
     for l in range(L):
         MOD[drv.factor_slot(n) + 1, l] = settings[LOADS]     # as modal_driver.start sets it
     PP = np.zeros((md.prepared_size(n), L))
+    LB = np.zeros((md.lane_basis_size(basis), L))   # each lane's basis, read across the lanes
+    BI = np.zeros(L, np.int64)                      # and its index into the family
     P1 = np.zeros(N_PARAMS * L)
     P1L = np.zeros((L, N_PARAMS))       # the same rows, a lane's contiguous (the scalar path)
     FLD = np.zeros((4, rows, L))
@@ -827,14 +848,15 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                     if step > 0.0:
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
-                              counts, series, modal, final, bufs[j], yl, ml, basis,
-                              base)
+                              counts, series, modal, final, bufs[j], yl, ml,
+                              md.member(family, BI[j]), base)
                     point[j] = -1
                 if next_point >= hi:
                     break
                 if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, P1L,
-                              MOD, states, reals, counts, series, modal, final, T, pp, yl,
-                              fl, basis, base):
+                              MOD, states, reals, counts, series, modal, final, pp, yl, fl,
+                              md.member(family, which[next_point]), LB, base):
+                    BI[j] = which[next_point]
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()
                     capacity[j] = bufs[j].shape[0]
@@ -849,26 +871,27 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
             n_moves, top = tj.lane_moves(H, top, MOVES)
             for m in range(n_moves):
                 _move_lane(MOVES[m, 0], MOVES[m, 1], W, Y, K, MOD, PP, P1, P1L, BOUNDS,
-                           H)
+                           H, LB, BI)
                 tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
-                 n_run, base, CP, PY)
+                 n_run, base, CP, PY, LB)
         _control(W, H, ERR, SC, settings, n_run)
-        _midspan(K, YN, KM, QV, weights, n, n_stages, eighth, n_run)
+        _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run)
         _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, CV, CP, LD, P1L, REACH,
-                     QB, QMAX, basis, base)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, BI, LD,
+                     P1L, REACH, QB, QMAX, base)
         _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
-                           basis, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, CV, CP, LD, P1L, base)
-        _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, SHAPES)
+                           family, BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, BI, LD, P1L, base)
+        _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, LB)
         for j in range(n_run):
             if SPAN[j] != 0.0:
-                _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basis)
+                _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx,
+                           md.member(family, BI[j]))
         if base is not None:
             _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema
         if n_flagged > 0:
@@ -878,9 +901,10 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
                 if W[tj.N_EXT * L + j] >= capacity[j]:
                     bufs[j] = tj.with_room(bufs[j], W[j::L])
                     capacity[j] = bufs[j].shape[0]
+                mine = md.member(family, BI[j])
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, BOUNDS[j],
-                                 weights, bufs[j], series, point[j], track, thr_rel, eighth,
-                                 n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis, Kmid,
+                                 mine[md.MIDSPAN], bufs[j], series, point[j], track, thr_rel,
+                                 eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, mine, Kmid,
                                  Qc, base, steady):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)

@@ -71,6 +71,8 @@ import math
 
 import numba as nb
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from . import excitation as ex
 from .vecmath import fast_cos, fast_sin
@@ -262,6 +264,107 @@ def shear_factor(pp, n_modes):
 def basis_modes(basis):
     """N, the number of modes of a basis tuple (callable from Python and from the kernels)."""
     return basis[RATIOS].shape[1]
+
+
+# What of its basis a lane of the lock-step driver reads across the lanes (kernels.modal_lanes:
+# the lanes of one call may each carry their own basis of a family, `member`): one column of LB
+# (lane_basis_size(basis), lanes), written by `write_lane_basis`. Rows, for N modes:
+#   0 ..                basis[COUPLING], N x N, row by row (the uniform tension's A_ij / pi^2)
+#   lb_midspan(N) ..    basis[MIDSPAN], N (phi_n(1/2): the midspan deflection's weights)
+#   lb_bends(N) ..      basis[CLAMPS] rows 0..N_BENDS-1, N each (the curvatures watched)
+#   lb_sizes(N) ..      basis[SHAPES][:, 5], N (each mode's bound of max |phi_n|)
+#   lb_coefficients(N) .. the polynomial's coefficients (basis[POLYNOMIAL][3]; none without)
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def lb_midspan(n_modes):
+    return n_modes * n_modes
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def lb_bends(n_modes):
+    return n_modes * n_modes + n_modes
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def lb_sizes(n_modes):
+    return n_modes * n_modes + (1 + N_BENDS) * n_modes
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def lb_coefficients(n_modes):
+    return n_modes * n_modes + (2 + N_BENDS) * n_modes
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def lane_basis_size(basis):
+    """Rows of a lane's column of LB for `basis` (the layout above)."""
+    n = basis_modes(basis)
+    return lb_coefficients(n) + _coefficients_size(basis[POLYNOMIAL])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _coefficients_size(PY):
+    """The coefficients of polynomial PY (none for None: a switch, pruned on the argument)."""
+    if PY is None:
+        return 0
+    return PY[3].shape[0]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def write_lane_basis(basis, LB, j):
+    """Column j of LB: what of `basis` the lanes read across the lanes (the layout above)."""
+    n = basis_modes(basis)
+    CP = basis[COUPLING]
+    for i in range(n):
+        for k in range(n):
+            LB[i * n + k, j] = CP[i, k]
+        LB[lb_midspan(n) + i, j] = basis[MIDSPAN][i]
+        for e in range(N_BENDS):
+            LB[lb_bends(n) + e * n + i, j] = basis[CLAMPS][e, i]
+        LB[lb_sizes(n) + i, j] = basis[SHAPES][i, 5]
+    _write_coefficients(basis[POLYNOMIAL], LB, lb_coefficients(n), j)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _write_coefficients(PY, LB, row, j):
+    """LB[row.., j] = polynomial PY's coefficients (none for None)."""
+    if PY is None:
+        return
+    coef = PY[3]
+    for t in range(coef.shape[0]):
+        LB[row + t, j] = coef[t]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def lane_basis(basis, lanes):
+    """LB (lane_basis_size(basis), lanes) with every lane's column `basis`' (tests and
+    benchmarks that call `lanes_derivative` on one basis)."""
+    LB = np.zeros((lane_basis_size(basis), lanes))
+    for j in range(lanes):
+        write_lane_basis(basis, LB, j)
+    return LB
+
+
+def _member_polynomial(PY, b):
+    """Polynomial b of a family's stacked polynomials, or None for None (compiled code only:
+    chosen from PY's type, as a branch on `PY is None` would leave an optional type)."""
+    raise TypeError("kernels.modes._member_polynomial runs only in compiled code")
+
+
+@overload(_member_polynomial)
+def _choose_member_polynomial(PY, b):
+    if isinstance(PY, types.NoneType):
+        return lambda PY, b: None
+    return lambda PY, b: (PY[0][b], PY[1][b], PY[2][b], PY[3][b], PY[4][b], PY[5][b])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def member(family, b):
+    """Basis b of a family stacked item by item along a first axis (sweep.models.basis.
+    stacked: every item of every basis the same shape, the polynomials' structure the same):
+    the basis tuple the kernels take, its arrays views of the family's."""
+    return (family[TABLES][b], family[STATIONS][b], family[MIDSPAN][b], family[RATIOS][b],
+            family[SHAPES][b], family[COUPLING][b], family[CLAMPS][b],
+            _member_polynomial(family[POLYNOMIAL], b))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -557,15 +660,15 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_mode(i, PY, R, active, out, n_run, symmetric):
+def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, cf):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
     the sum over the groups in `active` of the group's scale R[K + g] times its terms'
-    coefficients x monomials (`_polynomial_lanes` filled R); symmetric (`_symmetric_lanes`):
-    the terms of symmetric modes alone, the others being 0 (sweep.models.basis.
-    force_polynomial), and none for an antisymmetric mode."""
+    coefficients x monomials (`_polynomial_lanes` filled R), each lane's coefficients its own
+    (LB rows cf.., `write_lane_basis`; the structure, PY's, is every lane's); symmetric
+    (`_symmetric_lanes`): the terms of symmetric modes alone, the others being 0
+    (sweep.models.basis.force_polynomial), and none for an antisymmetric mode."""
     starts = PY[1]
     mono = PY[2]
-    coef = PY[3]
     n_mono = PY[0].shape[0]
     for l in range(n_run):
         out[l] = 0.0
@@ -574,15 +677,13 @@ def _polynomial_mode(i, PY, R, active, out, n_run, symmetric):
         hi = PY[4][i, g] if symmetric else starts[i, g + 1]
         if lo == hi or not (active >> g) & 1:
             continue
-        c = coef[lo]
         k = mono[lo]
         for l in range(n_run):
-            R[n_mono + N_GROUPS, l] = c * R[k, l]
+            R[n_mono + N_GROUPS, l] = LB[cf + lo, l] * R[k, l]
         for t in range(lo + 1, hi):
-            c = coef[t]
             k = mono[t]
             for l in range(n_run):
-                R[n_mono + N_GROUPS, l] += c * R[k, l]
+                R[n_mono + N_GROUPS, l] += LB[cf + t, l] * R[k, l]
         for l in range(n_run):
             out[l] += R[n_mono + g, l] * R[n_mono + N_GROUPS, l]
 
@@ -735,7 +836,7 @@ def _symmetric_lanes(T, X, n, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY):
+def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY, LB):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
     (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis'
@@ -745,9 +846,12 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     sin) or True (vecmath's vectorisable ones); base: None (no base excitation term), True
     (a sine kind) or the records of a random base acceleration (kernels.excitation: read lane
     by lane, fast or not);
-    CP: the basis' coupling A_ij / pi^2 (basis[COUPLING]), for the uniform stretching tension
-    N = k_s e, e = (k^2 l / 2) sum CP_ij q_i q_j, which adds -N k^2 b / rho A to F (a lane whose
-    TENSION is 0 has none; when no lane has one it is not computed). A lane whose S_ENERGY is
+    LB (`lane_basis_size`, lanes): each lane's own coupling and polynomial coefficients
+    (`write_lane_basis`: the lanes may carry different bases of one family, whose zeros and
+    polynomial structure are the same); CP: a basis' coupling A_ij / pi^2 (basis[COUPLING]),
+    read for its zeros only. The uniform stretching tension N = k_s e, e = (k^2 l / 2) sum
+    CP_ij q_i q_j, adds -N k^2 b / rho A to F (a lane whose TENSION is 0 has none; when no lane
+    has one it is not computed). A lane whose S_ENERGY is
     1 takes its bending terms from the span's energy (module docstring), projected on the
     shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL; where it
     is not None, the same force is evaluated as each mode's polynomial in q
@@ -781,11 +885,11 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             SC[3, l] = 0.0
         for i in range(n):
             for k in range(n):
-                a_ik = CP[i, k]
-                if a_ik == 0.0:
+                if CP[i, k] == 0.0:
                     continue
+                r = i * n + k
                 for l in range(n_run):
-                    SC[3, l] += a_ik * X[i, l] * X[k, l]
+                    SC[3, l] += LB[r, l] * X[i, l] * X[k, l]
         for l in range(n_run):
             SC[0, l] -= PP[sc + S_TENSION, l] * SC[3, l]
     if base is not None:
@@ -823,7 +927,8 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
         if PY is not None:
-            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric)
+            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB,
+                             lb_coefficients(n))
         elif symmetric and i % 2 == 1:
             for l in range(n_run):
                 SC[3, l] = 0.0

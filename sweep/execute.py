@@ -193,11 +193,18 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     sweep.models.basis.Basis.kernel_arrays()); outputs by name (`modes_outputs`); driver
     "lanes" or "scalar" (threads.solve_modes); n_bands, per_point_end, on_block and stop as
     `transverse_chunk`'s. `basis` a list (a BasisFamily's): each row's last column is its
-    basis' index, and the rows of each basis go to the kernel together."""
+    basis' index; on the lanes every row goes to one call where the bases stack
+    (sweep.models.basis.stacked), else the rows of each basis go to the kernel together."""
     from sweep.kernels import modes as md
+
+    from .models.basis import stacked
+    which = None
     if isinstance(basis, list):
-        return _family_chunk(params, settings, n_samples, basis, driver, n_bands,
-                             per_point_end, records, threads, on_block, stop)
+        if driver != "lanes" or stacked(basis) is None:
+            return _family_chunk(params, settings, n_samples, basis, driver, n_bands,
+                                 per_point_end, records, threads, on_block, stop)
+        which = params[:, -1].astype(np.int64)
+        params = np.ascontiguousarray(params[:, :-1])
 
     from .threads import solve_modes
     out = modes_outputs(params.shape[0], n_samples, modes_of(basis), n_bands)
@@ -206,7 +213,7 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
                 out["series"], out["modal"], out["final"], driver=driver, threads=threads,
                 on_block=report, stop=stop, envelope=out.get("envelope"),
                 durations=_ends(params, md.EXCITATION) if per_point_end else None,
-                records=records)
+                records=records, which=which)
     return out
 
 

@@ -175,18 +175,20 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                tick=watch.ticker(), lanes=driver == "lanes")
 
 
-def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.ndarray,
+def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settings: np.ndarray,
                 states: np.ndarray,
                 reals: np.ndarray, counts: np.ndarray, series: np.ndarray, modal: np.ndarray,
                 final: np.ndarray, *, driver: str = "lanes", threads: int = 0,
                 on_block: Callable[[int, int], None] | None = None,
                 stop: threading.Event | None = None, envelope: np.ndarray | None = None,
                 durations: np.ndarray | None = None,
-                records: np.ndarray | None = None) -> None:
+                records: np.ndarray | None = None, which: np.ndarray | None = None) -> None:
     """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for the N
     modes of `basis` in (the mode shapes as the kernels take them:
     sweep.models.basis.Basis.kernel_arrays()), the same outputs plus modal (n, N), each mode's
-    tail amplitude (m), and final (n, 2 N), the final state (m, m/s).
+    tail amplitude (m), and final (n, 2 N), the final state (m, m/s). On the lanes `basis` may
+    be a list of such bases that sweep.models.basis.stacked can stack (a BasisFamily's), row
+    i's basis[which[i]]: every row in one call, whatever its basis.
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
     (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off. A swept base
     frequency takes the scalar driver, with envelope and durations as `solve_transverse`'s;
@@ -196,10 +198,22 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
     from sweep.kernels import modal_driver
     if driver not in ("lanes", "scalar"):
         raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
+    from .models.basis import stacked
+    bases = basis if isinstance(basis, list) else [basis]
+    which = (np.zeros(params.shape[0], np.int64) if which is None
+             else np.ascontiguousarray(which, np.int64))
     if driver == "lanes":
         from sweep.kernels import modal_lanes as kernel
+        family = stacked(bases)
+        if family is None:
+            raise ValueError("these bases cannot share one lanes call "
+                             "(sweep.models.basis.stacked)")
+        first: tuple = (family, which)
     else:
         kernel = modal_driver
+        if len(bases) != 1:
+            raise ValueError("the scalar driver takes one basis a call")
+        first = (bases[0],)
     base = _random_base(records, True if settings[tk.BASE] != 0.0 else None)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
@@ -210,11 +224,11 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         watch.begin(lo, hi)
         if swept:
             for i in range(lo, hi):
-                call(modal_driver.solve_swept_block, params, basis,
+                call(modal_driver.solve_swept_block, params, bases[0],
                      swept_settings(settings, durations, i), i, i + 1, states, reals, counts,
                      series, modal, final, envelope, base, eighth, steady)
         else:
-            call(kernel.solve_block, params, basis, settings, lo, hi, states, reals,
+            call(kernel.solve_block, params, *first, settings, lo, hi, states, reals,
                  counts, series, modal, final, base, eighth, steady, watch.halt)
         if watch.halted():
             watch.end(lo)                # the follow-up passes are left to a resume
@@ -222,14 +236,19 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...], settings: np.
         if records is not None:          # a record's state is final (COMPLETED or failed)
             watch.end(lo)
             return
-        off = bool(np.any((states[lo:hi] == mt.OFF_MIDSPAN)
-                          | (states[lo:hi] == mt.HIDDEN_MODE)))
-        _follow_up(modal_driver.judge_off_midspan, off, params[lo:hi], basis, settings,
-                   states[lo:hi], reals[lo:hi], counts[lo:hi], modal[lo:hi], base, eighth,
-                   steady)
-        second = bool(np.any(states[lo:hi] == mt.SECOND_PASS))
-        _follow_up(modal_driver.settle_second_pass, second, params[lo:hi], basis, settings,
-                   states[lo:hi], reals[lo:hi], counts[lo:hi], base, eighth, steady)
+        for b in np.unique(which[lo:hi]):      # each basis' rows (all of them: one basis)
+            at = lo + np.flatnonzero(which[lo:hi] == b)
+            rows = slice(lo, hi) if at.size == hi - lo else at
+            row, state, real, count, mode = (params[rows], states[rows], reals[rows],
+                                              counts[rows], modal[rows])
+            off = bool(np.any((state == mt.OFF_MIDSPAN) | (state == mt.HIDDEN_MODE)))
+            _follow_up(modal_driver.judge_off_midspan, off, row, bases[b], settings, state,
+                       real, count, mode, base, eighth, steady)
+            second = bool(np.any(state == mt.SECOND_PASS))
+            _follow_up(modal_driver.settle_second_pass, second, row, bases[b], settings, state,
+                       real, count, base, eighth, steady)
+            if not isinstance(rows, slice):     # copies of the rows: their results back
+                states[rows], reals[rows], counts[rows], modal[rows] = state, real, count, mode
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)

@@ -277,3 +277,34 @@ def test_the_modes_share_of_a_uniform_loads_reaction_tends_to_one_half(stiffness
         rest.append(0.5 - basis.clamps[7].sum())
     assert 0.0 < rest[2] < rest[1] < rest[0] < 0.2
     assert rest[2] < 0.03 and rest[1] / rest[2] > 3.0
+
+
+@pytest.mark.parametrize("n_modes", [1, 2, 3, 4])
+def test_elastic_bases_of_every_k_stack_into_one_lanes_call(n_modes):
+    """Elastic clamps give each span its own K = k_t l / EI and basis; up to 4 modes each
+    carries the force's polynomial, whose structure (program, starts, monomials, symmetric
+    ends) and the zeros of whose coupling and midspan weights do not depend on K, so a grid's
+    bases stack (sweep.models.basis.stacked) and the lanes run them in one call; each stacked
+    item is the basis' own array."""
+    from sweep.models.basis import elastic_bases_stack, span_basis, stacked
+    ks = np.geomspace(1e-3, 1e4, 9)
+    bases = [span_basis(k, n_modes).kernel_arrays() for k in ks]
+    family = stacked(bases)
+    assert family is not None and elastic_bases_stack(n_modes)
+    for b, arrays in enumerate(bases):
+        for item in range(7):
+            np.testing.assert_array_equal(family[item][b], arrays[item])
+        for k in range(5):
+            np.testing.assert_array_equal(family[7][k][b], arrays[7][k])
+        assert family[7][5][b] == arrays[7][5]
+
+
+def test_bases_that_cannot_share_a_lanes_call_do_not_stack():
+    """Pinned sines (the quadrature, no polynomial) beside elastic ends, different numbers of
+    modes, and 5 elastic modes (no polynomial: each basis' tables would differ lane by lane)."""
+    from sweep.models.basis import elastic_bases_stack, span_basis, stacked
+    assert stacked([span_basis(0.0, 3).kernel_arrays(), span_basis(1.0, 3).kernel_arrays()]) is None
+    assert stacked([span_basis(1.0, 2).kernel_arrays(), span_basis(1.0, 3).kernel_arrays()]) is None
+    assert stacked([span_basis(1.0, 5).kernel_arrays(), span_basis(2.0, 5).kernel_arrays()]) is None
+    assert not elastic_bases_stack(5)
+    assert stacked([span_basis(0.0, 5).kernel_arrays()]) is not None     # one basis: always

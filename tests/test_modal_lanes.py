@@ -22,7 +22,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
 from sweep.models import transverse as tm
-from sweep.models.basis import clamped, pinned_sines
+from sweep.models.basis import clamped, pinned_sines, stacked
 from sweep.specialise import call
 from sweep.threads import early_stop, method_switch
 
@@ -35,13 +35,21 @@ def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
     return rows, inputs.settings.copy(), inputs.sample_times.size
 
 
+def one_basis(basis, rows: np.ndarray) -> tuple:
+    """The lanes' (family, which) of `rows` all on one Basis: a family of one."""
+    return stacked([basis.kernel_arrays()]), np.zeros(rows.shape[0], np.int64)
+
+
 def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int) -> tuple:
     """(states, reals, counts, series, modal, final) of driver.solve_block over every row."""
     n = rows.shape[0]
     out = (np.full(n, 99, np.int8), np.full((n, tk.N_REALS), -1.0),
            np.full((n, tk.N_COUNTS), -1, np.int64), np.full((n, n_samples), -1.0),
            np.full((n, n_modes), -1.0), np.full((n, 2 * n_modes), -1.0))
-    call(driver.solve_block, rows, pinned_sines(n_modes).kernel_arrays(), s, 0, n, *out,
+    basis = pinned_sines(n_modes)
+    first = (one_basis(basis, rows) if driver is modal_lanes
+             else (basis.kernel_arrays(),))
+    call(driver.solve_block, rows, *first, s, 0, n, *out,
          True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
          np.zeros(1, np.int8))
     return out
@@ -188,7 +196,8 @@ def test_a_block_inside_a_table_and_idle_lanes():
     rows, n, s, n_samples = case_rows("n3-base-dop853")
     whole = solve(modal_lanes, rows, n, s, n_samples)
     part = tuple(np.full_like(x, 7) for x in whole)
-    call(modal_lanes.solve_block, rows, pinned_sines(n).kernel_arrays(), s, 5, 12, *part, True, method_switch(s),
+    call(modal_lanes.solve_block, rows, *one_basis(pinned_sines(n), rows), s, 5, 12, *part,
+         True, method_switch(s),
          early_stop(s), np.zeros(1, np.int8))
     for x, y in zip(whole, part):
         np.testing.assert_array_equal(y[5:12], x[5:12])
@@ -206,10 +215,10 @@ def test_packed_lanes_give_each_point_its_own_results(name):
     whole = solve(modal_lanes, rows, n, s, n_samples)
     steps = whole[2][:, tk.STEPS]
     assert steps.max() > 3 * steps[steps > 0].min()
-    arrays = pinned_sines(n).kernel_arrays()
+    arrays = one_basis(pinned_sines(n), rows)
     for i in range(rows.shape[0]):
         alone = tuple(np.full_like(x, 7) for x in whole)
-        call(modal_lanes.solve_block, rows, arrays, s, i, i + 1, *alone,
+        call(modal_lanes.solve_block, rows, *arrays, s, i, i + 1, *alone,
              True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
              np.zeros(1, np.int8))
         for x, y in zip(whole, alone):
@@ -243,9 +252,46 @@ def test_the_lanes_right_hand_side_is_vectorised(base, ends):
     fresh(np.zeros(lanes), np.zeros((2 * n, lanes)), np.zeros((2, 2 * n, lanes)), 1,
           np.zeros((md.prepared_size(n), lanes)), n, T,
           np.zeros((4, md.field_rows(arrays), lanes)), np.zeros((4, lanes)), lanes, True, base,
-          CP, arrays[md.POLYNOMIAL])
+          CP, arrays[md.POLYNOMIAL], md.lane_basis(arrays, lanes))
     mnemonics = [line.split()[0] for text in fresh.inspect_asm().values()
                  for line in text.splitlines() if line.startswith("\t") and line.split()]
     packed = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+pd", m))
     scalar = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+sd", m))
     assert packed >= 20 and packed >= 0.25 * scalar, (packed, scalar)
+
+
+def _elastic_family_rows(**overrides):
+    """(rows with each row's basis index last, the family's kernel arrays, settings, samples)
+    of harness-clamps on a small grid: six spans, each its own K = k_t l / EI, at and off
+    their resonance, clamp loads observed."""
+    scene = sweep.load_scene("harness-clamps", {
+        "axes.length": [0.15, 0.3, 0.45], "axes.clamp_rotational_stiffness": [0.1, 10.0],
+        "axes.base_frequency_ratio": [0.6, 1.0], "solver.t_end": 0.6, **overrides})
+    inputs = tm.resolve(scene)
+    rows = tm.modal_rows(inputs, np.arange(int(np.prod(inputs.shape))))
+    return rows, inputs.basis.kernel_arrays(), inputs.settings.copy(), inputs.sample_times.size
+
+
+@pytest.mark.parametrize("method", ["dop853", "rk45"])
+def test_a_family_of_bases_shares_one_lanes_call(method):
+    """Elastic clamps give every span its own basis (harness-clamps: 35 spans, 35 bases); the
+    lanes run them in one call, each lane reading its own basis (kernels.modes.member,
+    write_lane_basis). Each point's results are bit for bit those of its basis' points solved
+    on the lanes alone (a lane's arithmetic does not depend on its neighbours: a lane reading
+    another's coupling, coefficients, midspan weights, curvature rows or shapes would change
+    them), and equal the scalar driver's to round-off."""
+    from sweep.execute import _family_chunk, modes_chunk
+    rows, family, s, n_samples = _elastic_family_rows(**{"solver.method": method})
+    assert len(family) == 6 and stacked(family) is not None
+    args = (s, n_samples, family)
+    together = modes_chunk(rows, *args, driver="lanes", threads=1)
+    alone = _family_chunk(rows, *args, "lanes", -1, False, None, 1, None, None)
+    scalar = _family_chunk(rows, *args, "scalar", -1, False, None, 1, None, None)
+    assert set(together["states"]) <= {km.STEADY, km.MODULATED, km.UNSETTLED}
+    for name in together:
+        np.testing.assert_array_equal(together[name], alone[name], err_msg=name)
+    np.testing.assert_array_equal(together["states"], scalar["states"])
+    for name in ("reals", "modal", "final"):
+        got, want = together[name], scalar[name]
+        np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-12 * np.nanmax(np.abs(want)),
+                                   err_msg=name)

@@ -574,7 +574,8 @@ def _both_kernel():
         tt = np.full(1, t)
         md.lanes_derivative(tt, X, K, 0, PP, n, T,
                             np.empty((4, md.field_rows(basis), 1)), np.empty((4, 1)), 1,
-                            None, base, basis[md.COUPLING], basis[md.POLYNOMIAL])
+                            None, base, basis[md.COUPLING], basis[md.POLYNOMIAL],
+                            md.lane_basis(basis, 1))
         return dy, K[0, :, 0].copy()
     return both
 

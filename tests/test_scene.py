@@ -996,16 +996,25 @@ ELASTIC = '[model]\nmodes = 3\n[clamps]\nrotation = "elastic"\nrotational_stiffn
     ("[model]\nmodes = 3", {}, "scalar"),                                   # one span
     ("[model]\nmodes = 3", {"axes.length": [0.3, 0.4, 0.5]}, "scalar"),
     ("[model]\nmodes = 3", {"axes.length": [0.3, 0.4, 0.5, 0.6]}, "lanes"),
-    # elastic clamps: K = k_t l / EI, a basis per length and per stiffness
-    (ELASTIC, {"axes.length": [0.2, 0.3, 0.4, 0.5, 0.6]}, "scalar"),
+    # elastic clamps: K = k_t l / EI, a basis per length and per stiffness, all of them in
+    # one lanes call up to 4 modes (sweep.models.basis.stacked); 5 modes do not stack, nor
+    # does k_t = 0 (the pinned span's basis)
+    (ELASTIC, {"axes.length": [0.2, 0.3, 0.4, 0.5, 0.6]}, "lanes"),
+    (ELASTIC, {"axes.length": [0.2, 0.3, 0.4]}, "scalar"),
+    (ELASTIC.replace("modes = 3", "modes = 5"), {"axes.length": [0.2, 0.3, 0.4, 0.5, 0.6]},
+     "scalar"),
+    (ELASTIC.replace("rotational_stiffness = 1.0\n", ""),
+     {"axes.clamp_rotational_stiffness": [0.0, 1.0, 10.0, 100.0]}, "scalar"),
     (ELASTIC, {"axes.length": [0.2, 0.3], "axes.load_amplitude": [0.0, 1.0, 2.0, 3.0]},
      "lanes"),
     (ELASTIC, {"axes.length": [0.2, 0.3], "axes.load_amplitude": [1.0, 2.0],
                "axes.damping_ratio": [0.01, 0.02]}, "lanes"),
-    (ELASTIC, {"axes.length": [0.2, 0.3], "axes.youngs_modulus": [1e11, 2e11],
-               "axes.load_amplitude": [1.0, 2.0]}, "scalar"),
+    (ELASTIC.replace("modes = 3", "modes = 5"), {"axes.length": [0.2, 0.3],
+     "axes.youngs_modulus": [1e11, 2e11], "axes.load_amplitude": [1.0, 2.0]}, "scalar"),
+    (ELASTIC.replace("modes = 3", "modes = 5"), {"axes.length": [0.2, 0.3],
+     "axes.load_amplitude": [1.0, 2.0, 3.0, 4.0]}, "lanes"),
     (ELASTIC.replace("rotational_stiffness = 1.0\n", ""),
-     {"axes.clamp_rotational_stiffness": [0.1, 1.0, 10.0, 100.0]}, "scalar"),
+     {"axes.clamp_rotational_stiffness": [0.1, 1.0, 10.0, 100.0]}, "lanes"),
     ('[model]\nmodes = 3\n[clamps]\nrotation = "clamped"', {"axes.length": [0.2, 0.3, 0.4, 0.5]},
      "lanes"),
     # one mode: always the lanes (their cost barely depends on how many run)
@@ -1020,15 +1029,17 @@ def test_default_driver_follows_the_points_that_share_a_basis(text, overrides, e
 
 def test_default_driver_with_points_that_vary_together():
     text = ELASTIC + "[points]\nlength = [0.2, 0.3, 0.4, 0.5]\nload_amplitude = [1.0, 2.0, 3.0, 4.0]\n"
-    assert load_scene_text(text).get("solver.driver") == "scalar"      # every point its own K
+    assert load_scene_text(text).get("solver.driver") == "lanes"       # four K, one call
+    five = ELASTIC.replace("modes = 3", "modes = 5")
+    assert load_scene_text(five + text[len(ELASTIC):]).get("solver.driver") == "scalar"
     text = ELASTIC + "[points]\nload_amplitude = [1.0, 2.0, 3.0, 4.0]\ndamping_ratio = [0.01, 0.02, 0.03, 0.04]\n"
     assert load_scene_text(text).get("solver.driver") == "lanes"       # one K for all four
 
 
-def test_harness_clamps_runs_on_the_scalar_driver():
-    """35 points, each its own K = k_t l / EI (benchmarks/lanes_occupancy.py: 4x faster)."""
+def test_harness_clamps_runs_on_the_lanes():
+    """35 points, each its own K = k_t l / EI, in one lanes call (the bases stack)."""
     from sweep import load_scene
-    assert load_scene("harness-clamps").get("solver.driver") == "scalar"
+    assert load_scene("harness-clamps").get("solver.driver") == "lanes"
 
 
 @pytest.mark.parametrize("overrides, expected", [
@@ -1044,6 +1055,8 @@ def test_harness_clamps_runs_on_the_scalar_driver():
     ({"model.modes": 3, "base.realisations": 1, "axes.length": [0.1]}, "scalar"),   # 2 records
     ({"model.modes": 3, "base.realisations": 4}, "lanes"),                          # 9 x 2 x 4
     ({"model.modes": 3, "base.realisations": 1, "clamps.rotation": "elastic",
+      "clamps.rotational_stiffness": 1.0, "cable.diameter": "3 mm"}, "lanes"),      # one call
+    ({"model.modes": 5, "base.realisations": 1, "clamps.rotation": "elastic",
       "clamps.rotational_stiffness": 1.0, "cable.diameter": "3 mm"}, "scalar"),     # 2 a basis
     ({"model.modes": 3, "base.realisations": 2, "clamps.rotation": "elastic",
       "clamps.rotational_stiffness": 1.0, "cable.diameter": "3 mm"}, "lanes"),      # 4 a basis

@@ -1047,11 +1047,13 @@ def _shared_defaults(values: dict[str, Any], mentioned: set[str]) -> None:
 
 
 def points_per_basis(values: Mapping[str, Any], swept: Swept, skip: str | None = None) -> int:
-    """How many points of the grid share one set of mode shapes (at least): all of them, but
-    with elastic clamps only the points along the axes (and [points]) that leave K = k_t l /
-    EI as it is (`BASIS_KEYS_EXEMPT`, and every key outside [cable] and the clamps' rotational
+    """How many points of the grid share one kernel call on the lanes (at least): all of them,
+    but with elastic clamps whose bases do not stack into one call (`family_shares_lanes`)
+    only the points along the axes (and [points]) that leave K = k_t l / EI as it is
+    (`BASIS_KEYS_EXEMPT`, and every key outside [cable] and the clamps' rotational
     stiffness); the axis `skip` not counted (a stepped sweep's: its lines share a call)."""
-    elastic = values["clamps.rotation"] == "elastic"
+    elastic = (values["clamps.rotation"] == "elastic"
+               and not family_shares_lanes(values, swept))
 
     def moves_basis(name: str) -> bool:
         dotted = schema.BY_AXIS[name].dotted
@@ -1065,6 +1067,18 @@ def points_per_basis(values: Mapping[str, Any], swept: Swept, skip: str | None =
     if swept.zipped and not any(moves_basis(name) for name in swept.zipped):
         count *= len(swept[next(iter(swept.zipped))])
     return count
+
+
+def family_shares_lanes(values: Mapping[str, Any], swept: Swept) -> bool:
+    """Whether the spans of a scene with elastic clamps, each K = k_t l / EI its own basis,
+    run in one lanes call (sweep.models.basis.stacked: bases of the same polynomial structure,
+    model.modes where `basis.elastic_bases_stack`, every k_t > 0; k_t = 0 is the pinned span's
+    closed-form basis, of another form)."""
+    from .basis import elastic_bases_stack
+    name = schema.BY_DOTTED["clamps.rotational_stiffness"].axis
+    stiffness = swept[name] if name in swept else values["clamps.rotational_stiffness"]
+    return (stiffness is not None and elastic_bases_stack(int(values["model.modes"]))
+            and bool(np.all(np.asarray(stiffness, float) > 0.0)))
 
 
 def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
