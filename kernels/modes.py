@@ -344,6 +344,36 @@ def lane_basis(basis, lanes):
     return LB
 
 
+def stacked(bases):
+    """The kernel arrays of `bases` (sweep.models.basis.Basis.kernel_arrays() each, N modes)
+    stacked item by item along a new first axis: a family as kernels.modal_lanes takes it,
+    all of whose points run in one call whatever their basis (`member` picks one out; plain
+    NumPy, called from Python). None where the lanes cannot: items of different shapes, a
+    polynomial in some bases and not in others (the quadrature's tables, read alike by every
+    lane, would differ) or of a different structure (its program, starts, monomials,
+    symmetric ends and pure count: only its coefficients may differ), or different zeros in
+    the coupling or the midspan weights (the lanes skip a family's zeros). Elastic ends of up
+    to 4 modes with K > 0 stack (sweep.models.basis.elastic_bases_stack)."""
+    first = bases[0]
+    for other in bases[1:]:
+        if any(a.shape != b.shape for a, b in zip(first[:POLYNOMIAL], other[:POLYNOMIAL])):
+            return None
+        if first[POLYNOMIAL] is None or other[POLYNOMIAL] is None or not all(
+                np.array_equal(first[POLYNOMIAL][k], other[POLYNOMIAL][k])
+                for k in (0, 1, 2, 4, 5)):
+            return None
+        if not all(np.array_equal(first[k] == 0, other[k] == 0) for k in (COUPLING, MIDSPAN)):
+            return None
+    arrays = tuple(np.ascontiguousarray(np.stack([b[k] for b in bases]))
+                   for k in range(POLYNOMIAL))
+    if first[POLYNOMIAL] is None:
+        return arrays + (None,)
+    polynomial = tuple(np.ascontiguousarray(np.stack([b[POLYNOMIAL][k] for b in bases]))
+                       for k in range(5)) + (
+        np.array([b[POLYNOMIAL][5] for b in bases], np.int64),)
+    return arrays + (polynomial,)
+
+
 def _member_polynomial(PY, b):
     """Polynomial b of a family's stacked polynomials, or None for None (compiled code only:
     chosen from PY's type, as a branch on `PY is None` would leave an optional type)."""

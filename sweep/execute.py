@@ -194,10 +194,10 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     "lanes" or "scalar" (threads.solve_modes); n_bands, per_point_end, on_block and stop as
     `transverse_chunk`'s. `basis` a list (a BasisFamily's): each row's last column is its
     basis' index; on the lanes every row goes to one call where the bases stack
-    (sweep.models.basis.stacked), else the rows of each basis go to the kernel together."""
+    (kernels.modes.stacked), else the rows of each basis go to the kernel together."""
     from sweep.kernels import modes as md
 
-    from .models.basis import stacked
+    from sweep.kernels.modes import stacked
     which = None
     if isinstance(basis, list):
         if driver != "lanes" or stacked(basis) is None:

@@ -187,7 +187,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
     modes of `basis` in (the mode shapes as the kernels take them:
     sweep.models.basis.Basis.kernel_arrays()), the same outputs plus modal (n, N), each mode's
     tail amplitude (m), and final (n, 2 N), the final state (m, m/s). On the lanes `basis` may
-    be a list of such bases that sweep.models.basis.stacked can stack (a BasisFamily's), row
+    be a list of such bases that kernels.modes.stacked can stack (a BasisFamily's), row
     i's basis[which[i]]: every row in one call, whatever its basis.
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
     (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off. A swept base
@@ -198,7 +198,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
     from sweep.kernels import modal_driver
     if driver not in ("lanes", "scalar"):
         raise ValueError(f"driver {driver!r}: expected 'lanes' or 'scalar'")
-    from .models.basis import stacked
+    from sweep.kernels.modes import stacked
     bases = basis if isinstance(basis, list) else [basis]
     which = (np.zeros(params.shape[0], np.int64) if which is None
              else np.ascontiguousarray(which, np.int64))
@@ -207,7 +207,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
         family = stacked(bases)
         if family is None:
             raise ValueError("these bases cannot share one lanes call "
-                             "(sweep.models.basis.stacked)")
+                             "(kernels.modes.stacked)")
         first: tuple = (family, which)
     else:
         kernel = modal_driver

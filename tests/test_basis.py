@@ -284,9 +284,10 @@ def test_elastic_bases_of_every_k_stack_into_one_lanes_call(n_modes):
     """Elastic clamps give each span its own K = k_t l / EI and basis; up to 4 modes each
     carries the force's polynomial, whose structure (program, starts, monomials, symmetric
     ends) and the zeros of whose coupling and midspan weights do not depend on K, so a grid's
-    bases stack (sweep.models.basis.stacked) and the lanes run them in one call; each stacked
+    bases stack (kernels.modes.stacked) and the lanes run them in one call; each stacked
     item is the basis' own array."""
-    from sweep.models.basis import elastic_bases_stack, span_basis, stacked
+    from sweep.kernels.modes import stacked
+    from sweep.models.basis import elastic_bases_stack, span_basis
     ks = np.geomspace(1e-3, 1e4, 9)
     bases = [span_basis(k, n_modes).kernel_arrays() for k in ks]
     family = stacked(bases)
@@ -302,7 +303,8 @@ def test_elastic_bases_of_every_k_stack_into_one_lanes_call(n_modes):
 def test_bases_that_cannot_share_a_lanes_call_do_not_stack():
     """Pinned sines (the quadrature, no polynomial) beside elastic ends, different numbers of
     modes, and 5 elastic modes (no polynomial: each basis' tables would differ lane by lane)."""
-    from sweep.models.basis import elastic_bases_stack, span_basis, stacked
+    from sweep.kernels.modes import stacked
+    from sweep.models.basis import elastic_bases_stack, span_basis
     assert stacked([span_basis(0.0, 3).kernel_arrays(), span_basis(1.0, 3).kernel_arrays()]) is None
     assert stacked([span_basis(1.0, 2).kernel_arrays(), span_basis(1.0, 3).kernel_arrays()]) is None
     assert stacked([span_basis(1.0, 5).kernel_arrays(), span_basis(2.0, 5).kernel_arrays()]) is None

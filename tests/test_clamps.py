@@ -249,12 +249,14 @@ def test_the_linear_elastic_span_is_the_closed_form_response(modes, ratio):
                                                       rel=1e-3)
 
 
-def test_an_elastic_grid_is_its_points_run_alone():
+@pytest.mark.parametrize("driver", ["lanes", "scalar"])
+def test_an_elastic_grid_is_its_points_run_alone(driver):
     """Where K varies over the grid (lengths x spring stiffness) each point's modes are its
-    own: every point of the grid equals the same point run alone, to the bit, and f1 rises
+    own: every point of the grid equals the same point run alone on the same driver, to the
+    bit (the lanes run the grid's four bases in one call, each lane on its own), and f1 rises
     with the spring from the pinned span's towards the clamped one's."""
     base = {"clamps.rotation": "elastic", "model.modes": 3, "solver.t_end": 0.6,
-            "base.acceleration_g": 0.5, "base.frequency_ratio": 0.9}
+            "base.acceleration_g": 0.5, "base.frequency_ratio": 0.9, "solver.driver": driver}
     text = scene_text("elastic", modes=3)
     grid = sweep.run(sweep.load_scene_text(text, overrides={
         **base, "axes.length": [0.3, 0.45], "axes.clamp_rotational_stiffness": [0.1, 10.0]}),

@@ -22,7 +22,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import modal_driver, modal_lanes
 from sweep.kernels import modes as md
 from sweep.models import transverse as tm
-from sweep.models.basis import clamped, pinned_sines, stacked
+from sweep.models.basis import clamped, pinned_sines
 from sweep.specialise import call
 from sweep.threads import early_stop, method_switch
 
@@ -37,7 +37,7 @@ def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
 
 def one_basis(basis, rows: np.ndarray) -> tuple:
     """The lanes' (family, which) of `rows` all on one Basis: a family of one."""
-    return stacked([basis.kernel_arrays()]), np.zeros(rows.shape[0], np.int64)
+    return md.stacked([basis.kernel_arrays()]), np.zeros(rows.shape[0], np.int64)
 
 
 def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int) -> tuple:
@@ -282,7 +282,7 @@ def test_a_family_of_bases_shares_one_lanes_call(method):
     them), and equal the scalar driver's to round-off."""
     from sweep.execute import _family_chunk, modes_chunk
     rows, family, s, n_samples = _elastic_family_rows(**{"solver.method": method})
-    assert len(family) == 6 and stacked(family) is not None
+    assert len(family) == 6 and md.stacked(family) is not None
     args = (s, n_samples, family)
     together = modes_chunk(rows, *args, driver="lanes", threads=1)
     alone = _family_chunk(rows, *args, "lanes", -1, False, None, 1, None, None)

@@ -997,7 +997,7 @@ ELASTIC = '[model]\nmodes = 3\n[clamps]\nrotation = "elastic"\nrotational_stiffn
     ("[model]\nmodes = 3", {"axes.length": [0.3, 0.4, 0.5]}, "scalar"),
     ("[model]\nmodes = 3", {"axes.length": [0.3, 0.4, 0.5, 0.6]}, "lanes"),
     # elastic clamps: K = k_t l / EI, a basis per length and per stiffness, all of them in
-    # one lanes call up to 4 modes (sweep.models.basis.stacked); 5 modes do not stack, nor
+    # one lanes call up to 4 modes (kernels.modes.stacked); 5 modes do not stack, nor
     # does k_t = 0 (the pinned span's basis)
     (ELASTIC, {"axes.length": [0.2, 0.3, 0.4, 0.5, 0.6]}, "lanes"),
     (ELASTIC, {"axes.length": [0.2, 0.3, 0.4]}, "scalar"),

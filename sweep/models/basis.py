@@ -32,7 +32,6 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
-from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -776,39 +775,12 @@ def span_ends(stiffness: Any) -> dict[str, Any]:
     return out
 
 
-def stacked(bases: Sequence[tuple[Any, ...]]) -> tuple[Any, ...] | None:
-    """The kernel arrays of `bases` (Basis.kernel_arrays() each, N modes) stacked item by item
-    along a new first axis: a family as kernels.modal_lanes takes it, all of whose points run
-    in one call whatever their basis (kernels.modes.member picks one out). None where the lanes
-    cannot: items of different shapes, a polynomial in some bases and not in others (the
-    quadrature's tables, read alike by every lane, would differ) or of a different structure
-    (its program, starts, monomials and symmetric ends: only its coefficients may differ), or
-    different zeros in the coupling or the midspan weights (the lanes skip a family's zeros).
-    Elastic ends of up to POLYNOMIAL_MAX_MODES modes with K > 0 stack (tests/test_basis.py)."""
-    first = bases[0]
-    pattern = (first[5] == 0, first[2] == 0)
-    for other in bases[1:]:
-        if any(a.shape != b.shape for a, b in zip(first[:7], other[:7])):
-            return None
-        if (first[7] is None or other[7] is None
-                or not all(np.array_equal(first[7][k], other[7][k]) for k in (0, 1, 2, 4, 5))):
-            return None
-        if not (np.array_equal(pattern[0], other[5] == 0)
-                and np.array_equal(pattern[1], other[2] == 0)):
-            return None
-    arrays = tuple(np.ascontiguousarray(np.stack([b[k] for b in bases])) for k in range(7))
-    if first[7] is None:
-        return arrays + (None,)
-    polynomial = tuple(np.ascontiguousarray(np.stack([b[7][k] for b in bases]))
-                       for k in range(5)) + (np.array([b[7][5] for b in bases], np.int64),)
-    return arrays + (polynomial,)
-
-
 @lru_cache(maxsize=None)
 def elastic_bases_stack(n_modes: int) -> bool:
     """Whether the bases of N modes of spans with elastic clamps (K > 0) stack into one lanes
-    call (`stacked`): they do where each carries the force's polynomial, whose structure does
+    call (kernels.modes.stacked): they do where each carries the force's polynomial, whose structure does
     not depend on K (up to 4 modes; tests/test_basis.py checks it over K)."""
+    from ..kernels.modes import stacked
     return stacked([span_basis(k, n_modes).kernel_arrays() for k in (0.5, 50.0)]) is not None
 
 

@@ -1071,7 +1071,7 @@ def points_per_basis(values: Mapping[str, Any], swept: Swept, skip: str | None =
 
 def family_shares_lanes(values: Mapping[str, Any], swept: Swept) -> bool:
     """Whether the spans of a scene with elastic clamps, each K = k_t l / EI its own basis,
-    run in one lanes call (sweep.models.basis.stacked: bases of the same polynomial structure,
+    run in one lanes call (kernels.modes.stacked: bases of the same polynomial structure,
     model.modes where `basis.elastic_bases_stack`, every k_t > 0; k_t = 0 is the pinned span's
     closed-form basis, of another form)."""
     from .basis import elastic_bases_stack
