@@ -78,8 +78,9 @@ def instrumented(rdtsc: ctypes._CFuncPtr) -> types.ModuleType:
     src = (ROOT / "kernels" / "modal_lanes.py").read_text()
     src = src.replace("from . import", "from sweep.kernels import").replace(
         "from .", "from sweep.kernels.").replace("cache=True", "cache=False")
-    src = src.replace("                base, eighth, steady, halt):",
-                      "                base, eighth, steady, halt, cycles):", 1)
+    if src.count(" steady, halt):\n") != 1:
+        sys.exit("lanes_phases: kernels/modal_lanes.py changed: solve_block's signature")
+    src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n", 1)
     head, loop = src.split("    while True:\n        if halt[0] != 0:", 1)
     loop = "    while True:\n        if halt[0] != 0:" + loop
     for k, (text, _) in enumerate(PHASES):
@@ -121,7 +122,12 @@ def main() -> None:
     threads.call = original
     if not calls:
         sys.exit(f"lanes_phases: {args.scene} ran no multi-mode lanes (model.modes >= 2?)")
-    block = max(calls, key=lambda a: a[4] - a[3])
+    import inspect
+
+    from sweep.kernels import modal_lanes
+    names = list(inspect.signature(modal_lanes.solve_block.py_func).parameters)
+    lo, hi = names.index("lo"), names.index("hi")
+    block = max(calls, key=lambda a: a[hi] - a[lo])
     module = instrumented(timer())
     cycles = np.zeros(len(PHASES) + 1, np.uint64)
     for timed in (False, True):
@@ -133,7 +139,7 @@ def main() -> None:
         wall = time.perf_counter() - start
     names = [name for _, name in PHASES] + ["lanes' advance"]
     total = float(cycles.sum())
-    print(f"{args.scene}: block of rows {block[3]}..{block[4]}, {wall * 1e3:.0f} ms")
+    print(f"{args.scene}: block of rows {block[lo]}..{block[hi]}, {wall * 1e3:.0f} ms")
     for name, value in zip(names, cycles):
         print(f"  {name:40s} {100.0 * float(value) / total:5.1f} %")
     print("\n    PYTHONPATH=. python benchmarks/lanes_phases.py " + " ".join(sys.argv[1:]))
