@@ -262,10 +262,10 @@ KEYS: tuple[Key, ...] = (
     Key("solver", "driver", "str", "lanes", choices=("lanes", "scalar"),
         long_name="transverse kernel driver: lock-step SIMD lanes (fast) or one trajectory per "
                   "thread (SciPy's arithmetic exactly, the reference); default lanes, but scalar "
-                  "for a sine sweep, for several modes where fewer than 4 points share one set "
-                  "of mode shapes (a single span; elastic clamps whose K differs at every "
-                  "point), and for a random scene where fewer than 4 points x records share one "
-                  "(2 with one mode)"),
+                  "for a sine sweep, for several modes where fewer than 4 points share one lanes "
+                  "call (a single span; elastic clamps of 5 or more modes whose K differs at "
+                  "every point: up to 4 modes every span's own modes share one call), and for a "
+                  "random scene where fewer than 4 points x records share one (2 with one mode)"),
     Key("solver", "method", "str", "rk45", choices=("rk45", "dop853"),
         long_name="transverse integrator: Dormand-Prince 5(4) step for step as SciPy's RK45, or "
                   "8(5,3) step for step as SciPy's DOP853 (longer steps; faster at equal error); "

@@ -147,10 +147,12 @@ DEFAULT_TRANSITS = 8.0
 """solver.transits of a longitudinal scene that gives neither solver.t_end nor transits."""
 
 LANES_LEAST_POINTS = 4
-"""Points that share one set of mode shapes, at least, for a scene of several modes to run on the
-lock-step lanes by default; with fewer (a single span; elastic clamps whose K = k_t l / EI
-differs at every point, each K its own basis and so its own kernel call) the scalar driver is
-the default. A stepped sweep counts its lines (a kernel call takes one dwell of every line of a
+"""Points that share one lanes call, at least, for a scene of several modes to run on the
+lock-step lanes by default; with fewer (a single span; elastic clamps of 5 modes or more, whose
+K = k_t l / EI differs at every point, each K its own basis and so its own kernel call) the
+scalar driver is the default. Elastic clamps of up to 4 modes count every point: their bases
+stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.40x the
+scalar driver's time on one thread, 0.59x on two, benchmarks/RESULTS.md). A stepped sweep counts its lines (a kernel call takes one dwell of every line of a
 direction). Measured (benchmarks/lanes_occupancy.py, 2026-12-04, with a draining block's
 lanes packed): the lanes took 3.4x the scalar driver's time with 1 point a basis, 1.0x with 4,
 0.70x with 8, 0.52x with 16 (their vector loops and per-step bookkeeping cost nearly as much
