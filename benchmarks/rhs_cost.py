@@ -79,7 +79,7 @@ def lanes_loop(row, basis, calls, lanes, symmetric):
                 X[c, l] = 0.0 if symmetric and (c % n) % 2 == 1 else 1e-3 + k * 1e-12 + l * 1e-9
                 tt[l] = k * 1e-5
         md.lanes_derivative(tt, X, K, 0, PP, n, T, FLD, SC, lanes, True, True,
-                            basis[md.COUPLING], basis[md.POLYNOMIAL], LB)
+                            basis[md.COUPLING], basis[md.POLYNOMIAL], LB, False)
         total += K[0, n, 0]
     return total
 

@@ -106,13 +106,13 @@ def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
-             base, CP, PY, LB):
+             base, CP, PY, LB, own):
     """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
     rk_step: K[1..n_stages] and YN = y_new, K[n_stages] = f(t + h, y_new); K[0] = f(t, y)
     given) and SciPy's error norm over the 2N components (ERR): RK45's RMS, or DOP853's
     combination of its fifth- and third-order estimates (`eighth`). The absolute tolerances are
-    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY, LB: the basis' coupling
-    and polynomial, each lane's own (kernels.modes.lanes_derivative)."""
+    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY, LB, own: the basis' coupling
+    and polynomial, or each lane's own (kernels.modes.lanes_derivative)."""
     L = LANES
     dim = 2 * n
     n_stages = B.shape[0]
@@ -121,12 +121,13 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
         c = C[s]
         for l in range(n_run):
             TT[l] = W[tj.T * L + l] + c * H[l]
-        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY, LB)
+        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY, LB,
+                            own)
     _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
     for l in range(n_run):
         TT[l] = W[tj.T * L + l] + H[l]
     md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP, PY,
-                        LB)
+                        LB, own)
     # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
     for l in range(n_run):
         ST[0, l] = 0.0
@@ -772,6 +773,7 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
     weights = basis[md.MIDSPAN]      # (the basis' arrays taken once: a tuple's item taken in
     CP = basis[md.COUPLING]          # the loop costs a reference count update a call)
     PY = basis[md.POLYNOMIAL]
+    own = family[md.RATIOS].shape[0] > 1          # the lanes carry bases of their own
     record = ex.is_record(base)      # a random record: the accumulator has its
     slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
     # a record's samples (the spectra's) on DOP853's quintic Hermite: `_record_steps`' in an
@@ -875,7 +877,7 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
                 tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
-                 n_run, base, CP, PY, LB)
+                 n_run, base, CP, PY, LB, own)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run)
         _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth)

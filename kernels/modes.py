@@ -693,12 +693,13 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
 def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, cf):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
     the sum over the groups in `active` of the group's scale R[K + g] times its terms'
-    coefficients x monomials (`_polynomial_lanes` filled R), each lane's coefficients its own
-    (LB rows cf.., `write_lane_basis`; the structure, PY's, is every lane's); symmetric
-    (`_symmetric_lanes`): the terms of symmetric modes alone, the others being 0
+    coefficients x monomials (`_polynomial_lanes` filled R): PY's coefficients (cf < 0), or
+    each lane's own (LB rows cf.., `write_lane_basis`; the structure, PY's, is every lane's);
+    symmetric (`_symmetric_lanes`): the terms of symmetric modes alone, the others being 0
     (sweep.models.basis.force_polynomial), and none for an antisymmetric mode."""
     starts = PY[1]
     mono = PY[2]
+    coef = PY[3]
     n_mono = PY[0].shape[0]
     for l in range(n_run):
         out[l] = 0.0
@@ -708,12 +709,22 @@ def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, cf):
         if lo == hi or not (active >> g) & 1:
             continue
         k = mono[lo]
-        for l in range(n_run):
-            R[n_mono + N_GROUPS, l] = LB[cf + lo, l] * R[k, l]
-        for t in range(lo + 1, hi):
-            k = mono[t]
+        if cf < 0:                      # (the shared coefficient stays in a register)
+            c = coef[lo]
             for l in range(n_run):
-                R[n_mono + N_GROUPS, l] += LB[cf + t, l] * R[k, l]
+                R[n_mono + N_GROUPS, l] = c * R[k, l]
+            for t in range(lo + 1, hi):
+                c = coef[t]
+                k = mono[t]
+                for l in range(n_run):
+                    R[n_mono + N_GROUPS, l] += c * R[k, l]
+        else:
+            for l in range(n_run):
+                R[n_mono + N_GROUPS, l] = LB[cf + lo, l] * R[k, l]
+            for t in range(lo + 1, hi):
+                k = mono[t]
+                for l in range(n_run):
+                    R[n_mono + N_GROUPS, l] += LB[cf + t, l] * R[k, l]
         for l in range(n_run):
             out[l] += R[n_mono + g, l] * R[n_mono + N_GROUPS, l]
 
@@ -866,7 +877,8 @@ def _symmetric_lanes(T, X, n, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY, LB):
+def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY, LB,
+                     own):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
     K[s, :, l] = f(tt[l], X[:, l]), X[:, l] = (q_1..q_N, q_1'..q_N') (m, m/s), K[s, :, l] =
     (q', q'') (m/s, m/s^2). PP[:, l]: lane l's prepared row (`prepare`); T: the basis'
@@ -876,12 +888,13 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     sin) or True (vecmath's vectorisable ones); base: None (no base excitation term), True
     (a sine kind) or the records of a random base acceleration (kernels.excitation: read lane
     by lane, fast or not);
-    LB (`lane_basis_size`, lanes): each lane's own coupling and polynomial coefficients
-    (`write_lane_basis`: the lanes may carry different bases of one family, whose zeros and
-    polynomial structure are the same); CP: a basis' coupling A_ij / pi^2 (basis[COUPLING]),
-    read for its zeros only. The uniform stretching tension N = k_s e, e = (k^2 l / 2) sum
-    CP_ij q_i q_j, adds -N k^2 b / rho A to F (a lane whose TENSION is 0 has none; when no lane
-    has one it is not computed). A lane whose S_ENERGY is
+    CP: the basis' coupling A_ij / pi^2 (basis[COUPLING]). own: whether the lanes carry bases
+    of their own (a family's, whose zeros and polynomial structure are the same): then each
+    lane's coupling and polynomial coefficients are LB's (`lane_basis_size`, lanes;
+    `write_lane_basis`) and CP is read for its zeros only; else every lane's are CP's and PY's
+    (one basis: no per-lane loads). The uniform stretching tension N = k_s e, e = (k^2 l / 2)
+    sum CP_ij q_i q_j, adds -N k^2 b / rho A to F (a lane whose TENSION is 0 has none; when no
+    lane has one it is not computed). A lane whose S_ENERGY is
     1 takes its bending terms from the span's energy (module docstring), projected on the
     shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL; where it
     is not None, the same force is evaluated as each mode's polynomial in q
@@ -915,11 +928,16 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             SC[3, l] = 0.0
         for i in range(n):
             for k in range(n):
-                if CP[i, k] == 0.0:
+                a_ik = CP[i, k]
+                if a_ik == 0.0:
                     continue
-                r = i * n + k
-                for l in range(n_run):
-                    SC[3, l] += LB[r, l] * X[i, l] * X[k, l]
+                if own:
+                    r = i * n + k
+                    for l in range(n_run):
+                        SC[3, l] += LB[r, l] * X[i, l] * X[k, l]
+                else:
+                    for l in range(n_run):
+                        SC[3, l] += a_ik * X[i, l] * X[k, l]
         for l in range(n_run):
             SC[0, l] -= PP[sc + S_TENSION, l] * SC[3, l]
     if base is not None:
@@ -958,7 +976,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     for i in range(n):
         if PY is not None:
             _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB,
-                             lb_coefficients(n))
+                             lb_coefficients(n) if own else -1)
         elif symmetric and i % 2 == 1:
             for l in range(n_run):
                 SC[3, l] = 0.0

@@ -252,7 +252,7 @@ def test_the_lanes_right_hand_side_is_vectorised(base, ends):
     fresh(np.zeros(lanes), np.zeros((2 * n, lanes)), np.zeros((2, 2 * n, lanes)), 1,
           np.zeros((md.prepared_size(n), lanes)), n, T,
           np.zeros((4, md.field_rows(arrays), lanes)), np.zeros((4, lanes)), lanes, True, base,
-          CP, arrays[md.POLYNOMIAL], md.lane_basis(arrays, lanes))
+          CP, arrays[md.POLYNOMIAL], md.lane_basis(arrays, lanes), False)
     mnemonics = [line.split()[0] for text in fresh.inspect_asm().values()
                  for line in text.splitlines() if line.startswith("\t") and line.split()]
     packed = sum(1 for m in mnemonics if re.fullmatch(r"v?[a-z0-9]+pd", m))

@@ -548,8 +548,11 @@ def test_bad_modes_input_is_refused_with_one_line(values, key):
 
 def _both_right_hand_sides(row, basis, y, t, base):
     """(derivative's dy, lanes_derivative's with one lane) of a raw row on kernel arrays
-    `basis` at state y, time t."""
-    return _both_kernel()(row, basis, y, t, base)
+    `basis` at state y, time t; the lanes' with the basis' coefficients and with the lane's
+    own copy of them (a family's lanes, kernels.modes.write_lane_basis), the same bits."""
+    dy, shared, own = _both_kernel()(row, basis, y, t, base)
+    np.testing.assert_array_equal(own, shared)
+    return dy, shared
 
 
 @functools.cache
@@ -572,11 +575,15 @@ def _both_kernel():
         X[:, 0] = y
         K = np.empty((1, 2 * n, 1))
         tt = np.full(1, t)
-        md.lanes_derivative(tt, X, K, 0, PP, n, T,
-                            np.empty((4, md.field_rows(basis), 1)), np.empty((4, 1)), 1,
-                            None, base, basis[md.COUPLING], basis[md.POLYNOMIAL],
-                            md.lane_basis(basis, 1))
-        return dy, K[0, :, 0].copy()
+        FLD = np.empty((4, md.field_rows(basis), 1))
+        LB = md.lane_basis(basis, 1)
+        md.lanes_derivative(tt, X, K, 0, PP, n, T, FLD, np.empty((4, 1)), 1, None, base,
+                            basis[md.COUPLING], basis[md.POLYNOMIAL], LB, False)
+        shared = K[0, :, 0].copy()
+        # the lane's own copy of the basis (a family's lanes): the same bits
+        md.lanes_derivative(tt, X, K, 0, PP, n, T, FLD, np.empty((4, 1)), 1, None, base,
+                            basis[md.COUPLING], basis[md.POLYNOMIAL], LB, True)
+        return dy, shared, K[0, :, 0].copy()
     return both
 
 
