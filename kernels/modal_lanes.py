@@ -282,6 +282,21 @@ def _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth):
                                        spread * BOUND_MARGIN)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _basis_of(family, basis, own, b):
+    """Basis b of the stacked `family` (kernels.modes.member) where the lanes carry bases of
+    their own (own), else `basis`, every lane's (nothing to build at each step)."""
+    return md.member(family, b) if own else basis
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always", _nrt=False)
+def _load_rows(family, basis, own, b):
+    """(CLAMPS, COUPLING) of basis b of `family`, or of `basis` (`_basis_of`)."""
+    if own:
+        return family[md.CLAMPS][b], family[md.COUPLING][b]
+    return basis[md.CLAMPS], basis[md.COUPLING]
+
+
 BOUND_MARGIN = 1.0 + 1e-12
 """REACH's margin over the coefficients' sum: the lanes' arithmetic (fused multiply-adds)
 may round the sum an ulp or two below the scalar path's."""
@@ -333,8 +348,8 @@ def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basi
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, BI, LD, P1L,
-                 REACH, QB, QMAX, base):
+def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, basis, own,
+                 BI, LD, P1L, REACH, QB, QMAX, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
     q_n' not finite), or, ending in the tail window, something the scalar path would locate
     inside it that could beat its largest so far (REACH and QB, `_reaches`: each mode's
@@ -343,8 +358,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, B
     mode's tail amplitude, a crest of the curvature at a clamp or at midspan (each lane's
     basis' kernels.modes.CLAMPS rows, in LB; a pinned clamp's are all 0: never a crest) whose
     bound exceeds its largest so far, or a maximum of the stretch or of a clamp's shear
-    (kernels.modes.span_loads with lane l's basis, basis BI[l] of the stacked `family`: its
-    CLAMPS and COUPLING; MOD's shear factor; LD (2, 6):
+    (kernels.modes.span_loads with lane l's basis, `_load_rows`: its CLAMPS and COUPLING; MOD's shear factor; LD (2, 6):
     scratch; P1L: the lanes' Observer rows, for the base inertia's part of the shear,
     modal_driver.inertia_at) whose bound (modal_driver.load_bound_within; QMAX (N): scratch)
     exceeds its largest so far, where the scene observes the loads (settings[LOADS], in
@@ -396,8 +410,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, B
     for l in range(n_run):
         if not (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]) or EV[l] != 0.0:
             continue
-        CV = family[md.CLAMPS][BI[l]]
-        CP = family[md.COUPLING][BI[l]]
+        CV, CP = _load_rows(family, basis, own, BI[l])
         drv.state_loads(CV, CP, Y[:n, l], Y[n:, l], n, MOD[:, l], W[tj.T * L + l],
                         P1L[l], base, a)
         drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
@@ -464,13 +477,14 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, BI, LD, P1L, base):
+def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD, P1L,
+                base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
     same once t_new >= the lane's tail start; so the curvatures (LB, as `_mode_events`) in
-    their slots (modal_driver.clamp_slot) and the stretch and shears (lane l's basis BI[l] of
-    the stacked `family`) in theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
+    their slots (modal_driver.clamp_slot) and the stretch and shears (lane l's basis,
+    `_load_rows`) in theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
     the Observer rows, modal_driver.inertia_at's). base: the excitation switch."""
     L = LANES
     for i in range(n):
@@ -499,8 +513,9 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, BI, LD, P1L, base)
                 & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
         if not take:
             continue
-        drv.state_loads(family[md.CLAMPS][BI[l]], family[md.COUPLING][BI[l]], YN[:n, l],
-                        YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l], P1L[l], base, b)
+        CV, CP = _load_rows(family, basis, own, BI[l])
+        drv.state_loads(CV, CP, YN[:n, l], YN[n:, l], n, MOD[:, l], W[tj.T_NEW * L + l],
+                        P1L[l], base, b)
         for k in range(3):
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 
@@ -685,15 +700,15 @@ def _keep_start(W, START, n_run, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, family,
-                  BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
+                  basis, own, BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
     """A random record's ordinary accepted steps (MOVE 1, FLAG 0: `_finish` moved them to
     their ends, with the step-end sample of the absolute acceleration; the others are the
     scalar path's, `_flagged_lane`): what the scalar path adds for such a step, on the
     scalar path's types, lane by lane: the midspan's statistics over the step
     (trajectory.record_statistics, as record_step calls it; START: the step's start,
     `_keep_start`) and, where the scene observes the loads, the curvature squares
-    (modal_driver.observe_random_modes on copies of the lane's columns and its basis, BI[j] of
-    the stacked `family`; yl, ynl, Kl, ml: scratch); with DOP853, the time series' samples in the step (for the spectra) on the
+    (modal_driver.observe_random_modes on copies of the lane's columns and its basis
+    (`_basis_of`); yl, ynl, Kl, ml: scratch); with DOP853, the time series' samples in the step (for the spectra) on the
     midspan's quintic Hermite through both ends, as record_step takes them
     (trajectory.take_hermite_samples into series[point[j]]; Qc: scratch; RK45's samples are its
     quartic's, from the stages: `_finish` leaves those steps to the scalar path, and
@@ -727,8 +742,8 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
             Kl[last, c] = K[last, c, j]
         for c in range(MOD.shape[0]):
             ml[c] = MOD[c, j]
-        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, md.member(family, BI[j]),
-                                 ml, base)
+        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n,
+                                 _basis_of(family, basis, own, BI[j]), ml, base)
         for c in range(MOD.shape[0]):
             MOD[c, j] = ml[c]
 
@@ -851,13 +866,13 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
                         break
                     _end_lane(params, n, settings, point[j], j, W, Y, MOD, states, reals,
                               counts, series, modal, final, bufs[j], yl, ml,
-                              md.member(family, BI[j]), base)
+                              _basis_of(family, basis, own, BI[j]), base)
                     point[j] = -1
                 if next_point >= hi:
                     break
                 if _load_lane(params, n, settings, next_point, j, W, Y, K, PP, P1, P1L,
                               MOD, states, reals, counts, series, modal, final, pp, yl, fl,
-                              md.member(family, which[next_point]), LB, base):
+                              _basis_of(family, basis, own, which[next_point]), LB, base):
                     BI[j] = which[next_point]
                     point[j] = next_point
                     bufs[j] = tj.new_buffer()
@@ -881,19 +896,21 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run)
         _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth)
-        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, BI, LD,
-                     P1L, REACH, QB, QMAX, base)
+        _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, basis, own,
+                     BI, LD, P1L, REACH, QB, QMAX, base)
         _keep_record_start(W, START, n_run, base)
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
-                           family, BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base)
-        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, BI, LD, P1L, base)
+                           family, basis, own, BI, yl, ynl, Kl, ml, series, point, Qc,
+                           sampled_here, base)
+        _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD, P1L,
+                    base)
         _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, LB)
         for j in range(n_run):
             if SPAN[j] != 0.0:
                 _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx,
-                           md.member(family, BI[j]))
+                           _basis_of(family, basis, own, BI[j]))
         if base is not None:
             _sine_refine_marked(W, P1L, n_run, base)     # ordinary steps' extrema
         if n_flagged > 0:
@@ -903,7 +920,7 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
                 if W[tj.N_EXT * L + j] >= capacity[j]:
                     bufs[j] = tj.with_room(bufs[j], W[j::L])
                     capacity[j] = bufs[j].shape[0]
-                mine = md.member(family, BI[j])
+                mine = _basis_of(family, basis, own, BI[j])
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, BOUNDS[j],
                                  mine[md.MIDSPAN], bufs[j], series, point[j], track, thr_rel,
                                  eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, mine, Kmid,
