@@ -296,13 +296,12 @@ def square_slot(n_modes):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
+def _observe_bend_squares(y, y_new, f, f_new, h, n, curvature, modal):
     """The accepted step's integrals of c^2, c'^2 and c''^2 for the clamp's curvature at
     s = 0 and midspan's (kernels.modes BEND_0, BEND_MID; c = sum phi_n''(s) q_n, times l^2:
     m), on the quintic Hermite through c, c' and c'' at both ends (trajectory's, as the
     midspan's mean squares): f, f_new the right-hand side at the step's ends (q_n'' =
-    f[N + n])."""
-    curvature = basis[md.CLAMPS]
+    f[N + n]); curvature: the basis' CLAMPS rows."""
     slot = square_slot(n)
     for k in range(2):
         e = md.BEND_0 if k == 0 else md.BEND_MID
@@ -327,13 +326,13 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, basis, modal):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _observe_record_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base):
+def _observe_record_modes(t, t_tail, y, y_new, K, h, n, curvature, modal, base):
     """The record kind's modal statistics of the accepted step [t, t + h] (K: its stages, the
     last f(t + h, y_new)), as trajectory.observe_random's for the midspan: the curvature
     squares at the clamp and midspan (`_observe_bend_squares`) once the step starts in the
-    statistics window, where the scene observes the loads."""
+    statistics window, where the scene observes the loads. curvature: the basis' CLAMPS rows."""
     if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
-        _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, basis, modal)
+        _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, curvature, modal)
 
 
 # `_observe_record_modes` for a random record, nothing for the sine kinds (not compiled there)
@@ -1122,7 +1121,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                        basis, Qc, p1, base)
-        observe_random_modes(t, t_tail, y, y_new, K, h, n, basis, modal, base)
+        observe_random_modes(t, t_tail, y, y_new, K, h, n, basis[md.CLAMPS], modal, base)
         for j in range(n_stages + 1):
             K_mid[j, 0] = _project(K[j], weights, 0, n)
             K_mid[j, 1] = _project(K[j], weights, n, n)

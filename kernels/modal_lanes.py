@@ -211,12 +211,12 @@ def _control(W, H, ERR, SC, settings, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run):
+def _midspan(K, YN, KM, QV, weights, LB, own, n, n_stages, eighth, n_run):
     """KM[s, 0, l], KM[s, 1, l]: the stages of lane l projected on the midspan deflection and
     its rate (modal_driver._project's sums, in order), for the stages record_step reads: all
     for RK45, the last (f(t + h, y_new), at KM[1]) for DOP853; QV[0, l], QV[1, l]: y_new's.
-    The weights phi_n(1/2) are each lane's (LB, kernels.modes.write_lane_basis); `weights`, a
-    basis' of the family, tells which are 0 (the same for all)."""
+    The weights phi_n(1/2) are `weights`, or each lane's (own: LB, kernels.modes.
+    write_lane_basis), whose zeros are `weights`' (the same for all)."""
     mid = md.lb_midspan(n)
     for s in range(n_stages + 2):
         if eighth and s < n_stages:
@@ -229,14 +229,21 @@ def _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run):
                 else:
                     QV[part, l] = 0.0
             for i in range(n):
-                if weights[i] == 0.0:
+                w = weights[i]
+                if w == 0.0:
                     continue
-                if s <= n_stages:
+                if s <= n_stages and own:
                     for l in range(n_run):
                         KM[r, part, l] += LB[mid + i, l] * K[s, part * n + i, l]
-                else:
+                elif s <= n_stages:
+                    for l in range(n_run):
+                        KM[r, part, l] += w * K[s, part * n + i, l]
+                elif own:
                     for l in range(n_run):
                         QV[part, l] += LB[mid + i, l] * YN[part * n + i, l]
+                else:
+                    for l in range(n_run):
+                        QV[part, l] += w * YN[part * n + i, l]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -355,11 +362,12 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, b
     inside it that could beat its largest so far (REACH and QB, `_reaches`: each mode's
     bounds over the step): an extremum of q_n in a mode not negligible beside the largest
     (modal_driver.negligible; BIG: scratch, the largest mode's peak) whose bound exceeds the
-    mode's tail amplitude, a crest of the curvature at a clamp or at midspan (each lane's
-    basis' kernels.modes.CLAMPS rows, in LB; a pinned clamp's are all 0: never a crest) whose
-    bound exceeds its largest so far, or a maximum of the stretch or of a clamp's shear
-    (kernels.modes.span_loads with lane l's basis, `_load_rows`: its CLAMPS and COUPLING; MOD's shear factor; LD (2, 6):
-    scratch; P1L: the lanes' Observer rows, for the base inertia's part of the shear,
+    mode's tail amplitude, a crest of the curvature at a clamp or at midspan (the
+    kernels.modes.CLAMPS rows of `basis`, every lane's, or with `own` of each lane's, in LB; a
+    pinned clamp's are all 0: never a crest) whose bound exceeds its largest so far, or a
+    maximum of the stretch or of a clamp's shear (kernels.modes.span_loads with lane l's
+    basis, `_load_rows`: its CLAMPS and COUPLING; MOD's shear factor; LD (2, 6): scratch;
+    P1L: the lanes' Observer rows, for the base inertia's part of the shear,
     modal_driver.inertia_at) whose bound (modal_driver.load_bound_within; QMAX (N): scratch)
     exceeds its largest so far, where the scene observes the loads (settings[LOADS], in
     MOD): the scalar path's turn; else 0. A step whose events could not beat the largest
@@ -387,6 +395,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, b
     if not observe:
         return
     slot = drv.clamp_slot(n)
+    CVs = basis[md.CLAMPS]
     for e in range(md.N_BENDS):
         bend = md.lb_bends(n) + e * n
         for l in range(n_run):
@@ -395,7 +404,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, b
             c0 = 0.0
             reach = 0.0
             for i in range(n):
-                cv = LB[bend + i, l]
+                cv = LB[bend + i, l] if own else CVs[e, i]
                 r0 += cv * Y[n + i, l]
                 r1 += cv * YN[n + i, l]
                 c0 += cv * Y[i, l]
@@ -482,9 +491,9 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
     accepted step (MOVE 1, FLAG 0), as modal_driver._observe_modes there: each mode's peak
     MOD[N + i, l] = max(MOD[N + i, l], |q_i(t_new)|), and its tail amplitude MOD[i, l] the
-    same once t_new >= the lane's tail start; so the curvatures (LB, as `_mode_events`) in
-    their slots (modal_driver.clamp_slot) and the stretch and shears (lane l's basis,
-    `_load_rows`) in theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
+    same once t_new >= the lane's tail start; so the curvatures (as `_mode_events`) in their
+    slots (modal_driver.clamp_slot) and the stretch and shears (lane l's basis, `_load_rows`)
+    in theirs (modal_driver.load_slot), where the scene observes the loads (LD: scratch; P1L:
     the Observer rows, modal_driver.inertia_at's). base: the excitation switch."""
     L = LANES
     for i in range(n):
@@ -497,12 +506,13 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD
     if MOD[drv.factor_slot(n) + 1, 0] == 0.0:          # settings[LOADS]: none observed
         return
     slot = drv.clamp_slot(n)
+    CVs = basis[md.CLAMPS]
     for e in range(md.N_BENDS):
         bend = md.lb_bends(n) + e * n
         for l in range(n_run):
             c = 0.0
             for i in range(n):
-                c += LB[bend + i, l] * YN[i, l]
+                c += (LB[bend + i, l] if own else CVs[e, i]) * YN[i, l]
             take = ((MOVE[l] != 0.0) & (FLAG[l] == 0.0)
                     & (W[tj.T_NEW * L + l] >= W[tj.T_TAIL * L + l]))
             MOD[slot + e, l] = max(MOD[slot + e, l], abs(c)) if take else MOD[slot + e, l]
@@ -660,7 +670,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
     t_tail = acc[tj.T_TAIL]
     drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, basis,
                        Qc, P1L[j], base)
-    drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis, ml, base)
+    drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis[md.CLAMPS], ml, base)
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
         Kmid[r, 1] = KM[r, 1, j]
@@ -700,15 +710,15 @@ def _keep_start(W, START, n_run, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run, family,
-                  basis, own, BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
+                  BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here, base):
     """A random record's ordinary accepted steps (MOVE 1, FLAG 0: `_finish` moved them to
     their ends, with the step-end sample of the absolute acceleration; the others are the
     scalar path's, `_flagged_lane`): what the scalar path adds for such a step, on the
     scalar path's types, lane by lane: the midspan's statistics over the step
     (trajectory.record_statistics, as record_step calls it; START: the step's start,
     `_keep_start`) and, where the scene observes the loads, the curvature squares
-    (modal_driver.observe_random_modes on copies of the lane's columns and its basis
-    (`_basis_of`); yl, ynl, Kl, ml: scratch); with DOP853, the time series' samples in the step (for the spectra) on the
+    (modal_driver.observe_random_modes on copies of the lane's columns and its basis' curvature
+    rows, basis BI[j] of the stacked `family`; yl, ynl, Kl, ml: scratch); with DOP853, the time series' samples in the step (for the spectra) on the
     midspan's quintic Hermite through both ends, as record_step takes them
     (trajectory.take_hermite_samples into series[point[j]]; Qc: scratch; RK45's samples are its
     quartic's, from the stages: `_finish` leaves those steps to the scalar path, and
@@ -742,8 +752,8 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
             Kl[last, c] = K[last, c, j]
         for c in range(MOD.shape[0]):
             ml[c] = MOD[c, j]
-        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n,
-                                 _basis_of(family, basis, own, BI[j]), ml, base)
+        drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, family[md.CLAMPS][BI[j]],
+                                 ml, base)
         for c in range(MOD.shape[0]):
             MOD[c, j] = ml[c]
 
@@ -894,7 +904,7 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
         _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
                  n_run, base, CP, PY, LB, own)
         _control(W, H, ERR, SC, settings, n_run)
-        _midspan(K, YN, KM, QV, weights, LB, n, n_stages, eighth, n_run)
+        _midspan(K, YN, KM, QV, weights, LB, own, n, n_stages, eighth, n_run)
         _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth)
         _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, basis, own,
                      BI, LD, P1L, REACH, QB, QMAX, base)
@@ -902,8 +912,8 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
         n_flagged = _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last,
                             n_run, sampled_here, base)
         _record_statistics(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_run,
-                           family, basis, own, BI, yl, ynl, Kl, ml, series, point, Qc,
-                           sampled_here, base)
+                           family, BI, yl, ynl, Kl, ml, series, point, Qc, sampled_here,
+                           base)
         _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD, P1L,
                     base)
         _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, LB)
