@@ -111,8 +111,8 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
     rk_step: K[1..n_stages] and YN = y_new, K[n_stages] = f(t + h, y_new); K[0] = f(t, y)
     given) and SciPy's error norm over the 2N components (ERR): RK45's RMS, or DOP853's
     combination of its fifth- and third-order estimates (`eighth`). The absolute tolerances are
-    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY, LB, own: the basis' coupling
-    and polynomial, or each lane's own (kernels.modes.lanes_derivative)."""
+    each lane's accumulator's (ATOL_Q for q_n, ATOL_V for q_n'). CP, PY, LB, own: the basis'
+    coupling and polynomial, or each lane's own (kernels.modes.lanes_derivative)."""
     L = LANES
     dim = 2 * n
     n_stages = B.shape[0]
@@ -718,8 +718,9 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
     (trajectory.record_statistics, as record_step calls it; START: the step's start,
     `_keep_start`) and, where the scene observes the loads, the curvature squares
     (modal_driver.observe_random_modes on copies of the lane's columns and its basis' curvature
-    rows, basis BI[j] of the stacked `family`; yl, ynl, Kl, ml: scratch); with DOP853, the time series' samples in the step (for the spectra) on the
-    midspan's quintic Hermite through both ends, as record_step takes them
+    rows, basis BI[j] of the stacked `family`; yl, ynl, Kl, ml: scratch); with DOP853, the
+    time series' samples in the step (for the spectra) on the midspan's quintic Hermite
+    through both ends, as record_step takes them
     (trajectory.take_hermite_samples into series[point[j]]; Qc: scratch; RK45's samples are its
     quartic's, from the stages: `_finish` leaves those steps to the scalar path, and
     sampled_here is False). Before

@@ -196,11 +196,9 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     basis' index; on the lanes every row goes to one call where the bases stack
     (kernels.modes.stacked), else the rows of each basis go to the kernel together."""
     from sweep.kernels import modes as md
-
-    from sweep.kernels.modes import stacked
     which = None
     if isinstance(basis, list):
-        if driver != "lanes" or stacked(basis) is None:
+        if driver != "lanes" or md.stacked(basis) is None:
             return _family_chunk(params, settings, n_samples, basis, driver, n_bands,
                                  per_point_end, records, threads, on_block, stop)
         which = params[:, -1].astype(np.int64)

@@ -778,8 +778,8 @@ def span_ends(stiffness: Any) -> dict[str, Any]:
 @lru_cache(maxsize=None)
 def elastic_bases_stack(n_modes: int) -> bool:
     """Whether the bases of N modes of spans with elastic clamps (K > 0) stack into one lanes
-    call (kernels.modes.stacked): they do where each carries the force's polynomial, whose structure does
-    not depend on K (up to 4 modes; tests/test_basis.py checks it over K)."""
+    call (kernels.modes.stacked): they do where each carries the force's polynomial, whose
+    structure does not depend on K (up to 4 modes; tests/test_basis.py checks it over K)."""
     from ..kernels.modes import stacked
     return stacked([span_basis(k, n_modes).kernel_arrays() for k in (0.5, 50.0)]) is not None
 

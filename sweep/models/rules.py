@@ -152,12 +152,13 @@ lock-step lanes by default; with fewer (a single span; elastic clamps of 5 modes
 K = k_t l / EI differs at every point, each K its own basis and so its own kernel call) the
 scalar driver is the default. Elastic clamps of up to 4 modes count every point: their bases
 stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.40x the
-scalar driver's time on one thread, 0.59x on two, benchmarks/RESULTS.md). A stepped sweep counts its lines (a kernel call takes one dwell of every line of a
-direction). Measured (benchmarks/lanes_occupancy.py, 2026-12-04, with a draining block's
-lanes packed): the lanes took 3.4x the scalar driver's time with 1 point a basis, 1.0x with 4,
-0.70x with 8, 0.52x with 16 (their vector loops and per-step bookkeeping cost nearly as much
-for one running lane as for sixteen); harness-stepped-sine's 3 lines a direction, one thread:
-5.0 s on the lanes, 4.1 s on the scalar driver."""
+scalar driver's time on one thread, 0.58x on two, benchmarks/RESULTS.md). A stepped sweep
+counts its lines (a kernel call takes one dwell of every line of a direction). Measured
+(benchmarks/lanes_occupancy.py, 2026-12-04, with a draining block's lanes packed): the lanes
+took 3.4x the scalar driver's time with 1 point a basis, 1.0x with 4, 0.70x with 8, 0.52x with
+16 (their vector loops and per-step bookkeeping cost nearly as much for one running lane as for
+sixteen); harness-stepped-sine's 3 lines a direction, one thread: 5.0 s on the lanes, 4.1 s on
+the scalar driver."""
 RANDOM_LANES_LEAST_POINTS = 4
 """The same for a random scene, counting each record (base.realisations) as a point. Measured
 (3 modes, one 100 mm span at -10 dB, 2 s GEVS records, one thread, 2026-12-06, once a record's
