@@ -773,7 +773,7 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
     state). family: the spans' mode shapes, bases of N modes stacked item by item
-    (sweep.models.basis.stacked; kernels.modes.member), row i's basis which[i]: the lanes of
+    (kernels.modes.stacked and member), row i's basis which[i]: the lanes of
     one call may each run their own (elastic clamps whose K differs from point to point), as
     far as the right-hand side and the observers read them lane by lane (their polynomials'
     structure and the zeros of their coupling and midspan weights are the same). base:

@@ -389,8 +389,8 @@ def _choose_member_polynomial(PY, b):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def member(family, b):
-    """Basis b of a family stacked item by item along a first axis (sweep.models.basis.
-    stacked: every item of every basis the same shape, the polynomials' structure the same):
+    """Basis b of a family stacked item by item along a first axis (`stacked`: every item of
+    every basis the same shape, the polynomials' structure the same):
     the basis tuple the kernels take, its arrays views of the family's."""
     return (family[TABLES][b], family[STATIONS][b], family[MIDSPAN][b], family[RATIOS][b],
             family[SHAPES][b], family[COUPLING][b], family[CLAMPS][b],
@@ -690,17 +690,18 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
-def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, cf):
+def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
     the sum over the groups in `active` of the group's scale R[K + g] times its terms'
-    coefficients x monomials (`_polynomial_lanes` filled R): PY's coefficients (cf < 0), or
-    each lane's own (LB rows cf.., `write_lane_basis`; the structure, PY's, is every lane's);
+    coefficients x monomials (`_polynomial_lanes` filled R): PY's coefficients, or with `own`
+    each lane's (LB, `write_lane_basis`; the structure, PY's, is every lane's);
     symmetric (`_symmetric_lanes`): the terms of symmetric modes alone, the others being 0
     (sweep.models.basis.force_polynomial), and none for an antisymmetric mode."""
     starts = PY[1]
     mono = PY[2]
     coef = PY[3]
     n_mono = PY[0].shape[0]
+    cf = lb_coefficients(starts.shape[0])      # LB's row of the first coefficient
     for l in range(n_run):
         out[l] = 0.0
     for g in range(N_GROUPS):
@@ -709,7 +710,7 @@ def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, cf):
         if lo == hi or not (active >> g) & 1:
             continue
         k = mono[lo]
-        if cf < 0:                      # (the shared coefficient stays in a register)
+        if not own:                     # (the shared coefficient stays in a register)
             c = coef[lo]
             for l in range(n_run):
                 R[n_mono + N_GROUPS, l] = c * R[k, l]
@@ -975,8 +976,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
         if PY is not None:
-            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB,
-                             lb_coefficients(n) if own else -1)
+            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB, own)
         elif symmetric and i % 2 == 1:
             for l in range(n_run):
                 SC[3, l] = 0.0

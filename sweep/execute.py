@@ -196,9 +196,10 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
     basis' index; on the lanes every row goes to one call where the bases stack
     (kernels.modes.stacked), else the rows of each basis go to the kernel together."""
     from sweep.kernels import modes as md
-    which = None
+    which = family = None
     if isinstance(basis, list):
-        if driver != "lanes" or md.stacked(basis) is None:
+        family = md.stacked(basis) if driver == "lanes" else None
+        if family is None:
             return _family_chunk(params, settings, n_samples, basis, driver, n_bands,
                                  per_point_end, records, threads, on_block, stop)
         which = params[:, -1].astype(np.int64)
@@ -211,7 +212,7 @@ def modes_chunk(params: np.ndarray, settings: np.ndarray, n_samples: int,
                 out["series"], out["modal"], out["final"], driver=driver, threads=threads,
                 on_block=report, stop=stop, envelope=out.get("envelope"),
                 durations=_ends(params, md.EXCITATION) if per_point_end else None,
-                records=records, which=which)
+                records=records, which=which, family=family)
     return out
 
 

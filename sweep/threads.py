@@ -182,13 +182,15 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
                 on_block: Callable[[int, int], None] | None = None,
                 stop: threading.Event | None = None, envelope: np.ndarray | None = None,
                 durations: np.ndarray | None = None,
-                records: np.ndarray | None = None, which: np.ndarray | None = None) -> None:
+                records: np.ndarray | None = None, which: np.ndarray | None = None,
+                family: tuple | None = None) -> None:
     """`solve_transverse` for the multi-mode System: rows of kernels.modes columns for the N
     modes of `basis` in (the mode shapes as the kernels take them:
     sweep.models.basis.Basis.kernel_arrays()), the same outputs plus modal (n, N), each mode's
     tail amplitude (m), and final (n, 2 N), the final state (m, m/s). On the lanes `basis` may
     be a list of such bases that kernels.modes.stacked can stack (a BasisFamily's), row
-    i's basis[which[i]]: every row in one call, whatever its basis.
+    i's basis[which[i]]: every row in one call, whatever its basis (`family`: the list
+    stacked, where the caller has it).
     driver: "lanes" (kernels.modal_lanes, lock-step SIMD lanes) or "scalar"
     (kernels.modal_driver, SciPy's arithmetic); the two agree to round-off. A swept base
     frequency takes the scalar driver, with envelope and durations as `solve_transverse`'s;
@@ -204,7 +206,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
              else np.ascontiguousarray(which, np.int64))
     if driver == "lanes":
         from sweep.kernels import modal_lanes as kernel
-        family = stacked(bases)
+        family = stacked(bases) if family is None else family
         if family is None:
             raise ValueError("these bases cannot share one lanes call "
                              "(kernels.modes.stacked)")
