@@ -214,7 +214,7 @@ E5[10] = 0.8192320648511571246570742613e-1
 E5[11] = -0.2235530786388629525884427845e-1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def rk_step(t, y, h, p, K, y_new, parametric, base):
     """One DOP853 step of size h (s) from (t, y); K (N_STAGES + 1, 2), K[0] must hold f(t, y).
 
@@ -238,7 +238,7 @@ def combined_error_norm(e5q, e5v, e3q, e3v, h, sq, sv):
     return 0.0 if (e5 == 0.0) & (e3 == 0.0) else err     # a select: vectorises in the lanes
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def error_norm(K, h, y, y_new, rtol, atol_q, atol_v):
     """SciPy DOP853's error norm of the attempt in K (see `combined_error_norm`); absolute
     tolerances atol_q (m) for q and atol_v (m/s) for q'."""

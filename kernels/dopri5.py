@@ -87,7 +87,7 @@ def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base):
     K[n_stages, 1] = acceleration(t + h, y_new[0], y_new[1], p, 0, 1, None, parametric, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def rk_step(t, y, h, p, K, y_new, parametric, base):
     """One Dormand-Prince step of size h (s) from (t, y); K[0] must hold f(t, y).
 
@@ -97,7 +97,7 @@ def rk_step(t, y, h, p, K, y_new, parametric, base):
     explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def error_norm(K, h, y, y_new, rtol, atol_q, atol_v):
     """SciPy's RMS norm of the embedded error estimate, scaled by atol + rtol max(|y|, |y_new|)
     per component: atol_q (m) for q, atol_v (m/s) for q' (SciPy's atol as a 2-vector)."""
@@ -115,7 +115,7 @@ def error_norm(K, h, y, y_new, rtol, atol_q, atol_v):
     return math.sqrt(rq * rq + rv * rv) / math.sqrt(2.0)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def step_factor(err, rejected_before, exponent):
     """SciPy's step-size factor for an error norm `err`; `exponent` is -1/(order + 1) of the
     method's error estimator (ERROR_EXPONENT: -1/5 for RK45, dop853.ERROR_EXPONENT: -1/8).
@@ -165,12 +165,12 @@ def pi_log2_err(err):
     return log2_fast(max(err, PI_MIN_ERR_PREV))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _rms2(a, b):
     return math.sqrt(a * a + b * b) / math.sqrt(2.0)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def initial_step(t0, y, f, t_bound, max_step, rtol, atol_q, atol_v, p, o, s, order, parametric,
                  base):
     """SciPy's `select_initial_step` (Hairer, Norsett & Wanner, Sec. II.4) for a method whose

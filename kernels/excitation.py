@@ -120,7 +120,7 @@ def _ramped(t, ramp, a, rate):
     return a, rate
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def acceleration_and_rate(t, p, o, s):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the sine kinds: A' sin(phi) + A w(t) cos(phi), A'
     = A SLOPE[k] lam on a level segment, plus the ramp's rise (for the loads' observers,
@@ -148,7 +148,7 @@ def acceleration(t, p, o, s):
     return level(t, p, o, s) * math.sin(phase(t, p, o, s))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def frequency(t, p, o, s):
     """The excitation frequency f(t) (Hz) of the block at p[o + column * s] at time t (s)."""
     return p[o + OMEGA * s] / (2.0 * math.pi) * math.exp(p[o + RATE * s] * t)
@@ -344,7 +344,7 @@ def _is_record(base):
     return lambda base: False
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _true(base):
     return True
 

@@ -199,7 +199,7 @@ _chain8, _chain8_p, _chain8_b, _chain8_pb, _chain8_r, _chain8_pr = _chains(
     dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "dop853_chain")
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, rtol, n_run, parametric, base, record):
     """One Dormand-Prince attempt in every lane of W (record: `excitation.record_switch`,
     True for a random record's chains): the stages (`_chain5`, from dopri5.A,
@@ -255,7 +255,7 @@ def _attempt(W, rtol, n_run, parametric, base, record):
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt8(W, rtol, n_run, parametric, base, record):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
@@ -321,7 +321,7 @@ def _attempt8(W, rtol, n_run, parametric, base, record):
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _pi_factors(W, n_run):
     """The PI controller's step-size factor for every lane's attempt (W_FACTOR), and the
     memory of an accepted attempt's error (LOG2_ERR_PREV). Its own loop: `_finish` stays as
@@ -437,7 +437,7 @@ def _observe_acceleration(W, settings, n_run):
     return n_turns
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _sine_acceleration(W, settings, n_run, n_near, series, point, Qc, base):
     """With a sine base excitation (`base` True), and ordinary steps near or in the tail
     window (n_near of them, `_finish`): `_observe_acceleration`, and the acceleration's peaks
@@ -541,7 +541,7 @@ def _record_samples(W, settings, n_run, series, point, Qc):
                                     dt_sample)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_statistics(W, settings, n_run, n_near, series, point, Qc, base):
     """A record's ordinary accepted steps (`_finish` moved them to their ends; the others go to
     trajectory.record_step): what record_step adds for a record's step with no extremum or
@@ -605,7 +605,7 @@ def _newton_extremum(v0, v1, h, c0, c1, c2, c3):
     return x, abs(g) <= NEWTON_RESIDUAL * (abs(v0) + abs(v1))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _locate_extrema(W, n_run):
     """For lanes flagged HAS_EXTREMUM after an RK45 attempt: the x in [0, 1] where the step's
     interpolated q' vanishes (W_XE, by `_newton_extremum`) and q there (W_QE). Where the

@@ -60,7 +60,7 @@ def observer_row(row, n_modes, pp):
     return p
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def valid(row, n_modes):
     """Whether a raw multi-mode row can be integrated: finite, w1^2 > 0 and bound > 0."""
     for j in range(md.n_columns(n_modes)):
@@ -78,7 +78,7 @@ def _project(v, weights, offset, n):
     return s
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def rk_step(t, y, h, S, n_modes, T, K, y_new, stage, A, B, C, base):
     """One step of size h (s) of the explicit tableau (A, B, C) from (t, y), SciPy's
     `rk_step` on the 2N-component state; K[0] must hold f(t, y). Fills K[1..n_stages] (the
@@ -101,7 +101,7 @@ def rk_step(t, y, h, S, n_modes, T, K, y_new, stage, A, B, C, base):
     md.derivative(t + h, y_new, K[n_stages], S, n_modes, T, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def error_norm(K, h, y, y_new, rtol, atol_q, atol_v, n_modes, eighth):
     """SciPy's error norm of the attempt over all 2N components: RK45's RMS of h K^T E / scale,
     or DOP853's combination of its fifth- and third-order estimates; scale = atol +
@@ -182,7 +182,7 @@ def _mode_interpolant(y, y_new, K, h, i, n_modes, eighth, Km, Qm):
         dopri5.dense_coefficients(Km, Qm)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def modal_size(n_modes):
     """Length of the modes' accumulator `modal` of both multi-mode drivers: each mode's tail
     amplitude max |q_n| over the tail window (slots 0..N-1, m), each mode's peak max |q_n| at
@@ -205,7 +205,7 @@ def modal_size(n_modes):
     return 3 * n_modes + 21
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def observer_scratch(n_modes):
     """Length of the observers' scratch qx: the modes' values at an instant (0..N-1, for
     `observe_span`; N..N+7: its `_span_spread`'s), then `_observe_loads`' (N..3N-1: q and
@@ -339,7 +339,7 @@ def _observe_record_modes(t, t_tail, y, y_new, K, h, n, curvature, modal, base):
 observe_random_modes = ex.by_kind(None, _observe_record_modes)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def curvature_moments(modal, n, acc, reals):
     """reals' CURVATURE_M0.. and MID_CURVATURE_M0.. (mean squares, `modal_size`) over the
     statistics window of a random trajectory (acc: its watched accumulator), where the loads
@@ -919,7 +919,7 @@ def restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n_modes, eighth, modal,
                    qx, basis, Qp, p1, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def span_state(state, modal, y, n_modes, settings, reals, basis):
     """The state judged from the whole response, and reals[SPAN_MAX]: a point whose midspan
     deflection decayed (DECAYED), or moved by less than HIDDEN_FLOOR x the largest mode's peak
@@ -954,7 +954,7 @@ def span_state(state, modal, y, n_modes, settings, reals, basis):
     return state
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def span_columns(modal, y, n_modes, reals, basis):
     """reals[SPAN_MAX], the largest deflection over the span in the tail window (m; a sine
     sweep's: over the whole sweep), and reals[SPAN_PLACE], its place x* / l: modal[2N] at
@@ -976,7 +976,7 @@ def span_columns(modal, y, n_modes, reals, basis):
     load_columns(modal, n, reals)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def load_columns(modal, n, reals):
     """reals' CLAMP_BEND, MID_BEND, STRETCH and CLAMP_SHEAR from the modes' accumulator
     (`modal_size`): the loads' peaks, the larger of the two clamps'."""
@@ -986,7 +986,7 @@ def load_columns(modal, n, reals):
     reals[CLAMP_SHEAR] = max(modal[load_slot(n) + 1], modal[load_slot(n) + 2])
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _hidden(basis, i):
     """Whether mode i has a node at midspan (an even mode of a symmetric span): the midspan
     deflection does not see it."""

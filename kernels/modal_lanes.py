@@ -585,7 +585,7 @@ def _load_lane(params, n, settings, point, j, W, Y, K, PP, P1, P1L, MOD, states,
     return True
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _move_lane(k, i, W, Y, K, MOD, PP, P1, P1L, BOUNDS, H, LB, BI):
     """Lane k's trajectory into the idle lane i: every array that carries a lane's state from
     one attempt to the next (its accumulator, state, stages (K[0] = f(t, y)), modes'
@@ -685,7 +685,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
     return True                  # (a midspan divergence moves on, as in the scalar driver)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _refine_marked(W, P1L, n_run, base):
     """trajectory.refine_marked_lanes on the scalar path's types (a lane's accumulator
     W[j::LANES], its Observer row P1L[j]), so that the refinement compiles once for both

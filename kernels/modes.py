@@ -214,7 +214,7 @@ def span_load_bound(rows, coupling, q_max, n_modes, kappa, load_max, inertia_max
     return s3 + (abs(kappa) * e + load_max) * s1 + inertia_max
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def inertia_factor(row, n_modes, rows):
     """r (rho A l^4 / EI) (s^2) of a raw row, times a_b(t) (m/s^2) the `span_loads` inertia
     (m): r = 1/2 - sum_n rows[INERTIA, n], the share of a uniform load's reaction at a clamp
@@ -226,7 +226,7 @@ def inertia_factor(row, n_modes, rows):
     return r * math.pi ** 4 / row[W1_SQ]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def end_load_factors(pp, n_modes):
     """The end load P(t) = P_mean + P_cos cos(W t + phi_W) of a prepared row as
     (P_mean l^2 / EI, P_cos l^2 / EI, W (rad/s), phi_W (rad)) for `end_load`: pi^2 times the
@@ -249,7 +249,7 @@ def end_load(mean, amplitude, omega, phase, t):
     return mean + amplitude * math.cos(x), -amplitude * omega * math.sin(x)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def shear_factor(pp, n_modes):
     """kappa = k_s pi^2 l / (2 EI) (1/m^2) of a prepared row (`span_loads`): pi^2 S_TENSION /
     w_p^2, w_p^2 = S_BETA_B^2 / S_BETA_Q; 0 without the uniform tension."""
@@ -294,14 +294,14 @@ def lb_coefficients(n_modes):
     return n_modes * n_modes + (2 + N_BENDS) * n_modes
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def lane_basis_size(basis):
     """Rows of a lane's column of LB for `basis` (the layout above)."""
     n = basis_modes(basis)
     return lb_coefficients(n) + _coefficients_size(basis[POLYNOMIAL])
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _coefficients_size(PY):
     """The coefficients of polynomial PY (none for None: a switch, pruned on the argument)."""
     if PY is None:
@@ -309,7 +309,7 @@ def _coefficients_size(PY):
     return PY[3].shape[0]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def write_lane_basis(basis, LB, j):
     """Column j of LB: what of `basis` the lanes read across the lanes (the layout above)."""
     n = basis_modes(basis)
@@ -324,7 +324,7 @@ def write_lane_basis(basis, LB, j):
     _write_coefficients(basis[POLYNOMIAL], LB, lb_coefficients(n), j)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _write_coefficients(PY, LB, row, j):
     """LB[row.., j] = polynomial PY's coefficients (none for None)."""
     if PY is None:
@@ -523,7 +523,7 @@ def span_argmax(q, n_modes, basis):
     return top, where
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def prepare(row, n_modes, pp, ratios):
     """Write the prepared row pp (prepared_size(N)) of raw row `row` (columns above) for a
     basis whose ratios are `ratios` (2, N): w_n / w_p and Gamma_n / (4 / pi)
@@ -550,7 +550,7 @@ def prepare(row, n_modes, pp, ratios):
         pp[s + S_EXCITATION + c] = row[EXCITATION + c]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def base_acceleration(t, pp, n_modes, base):
     """a_b(t) (m/s^2) of a prepared row (kernels.excitation.signal: `base` True for the sine
     kinds, the records for the record kind)."""
@@ -624,7 +624,7 @@ def uses_polynomial(basis):
     return basis[POLYNOMIAL] is not None
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _field_rows(T, PY):
     """`field_rows` of tables T and polynomial PY."""
     nodes = T.shape[2] + folded_pairs(T)
@@ -658,7 +658,7 @@ def _group_scale(g, linear, membrane, beta_b, beta_q, energy):
     return (1.0 - energy) * beta_q
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     """The polynomial form of the force (POLYNOMIAL: program (K, 2), starts (N, N_GROUPS + 1),
     monomials (T,), coefficients (T,), symmetric (N, N_GROUPS), pure; sweep.models.basis.
@@ -689,7 +689,7 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     return active
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
     the sum over the groups in `active` of the group's scale R[K + g] times its terms'
@@ -730,7 +730,7 @@ def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
             out[l] += R[n_mono + g, l] * R[n_mono + N_GROUPS, l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
     """The nonlinear forces at the nodes (per unit rho A, in the fields' units) of lanes
     whose bending terms may come from the span's energy (S_ENERGY 1) or Eq.17 (0), from the
@@ -755,7 +755,7 @@ def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
             FLD[2, j, l] = e * g2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
     """`_energy_forces` where every lane's bending terms come from the span's energy: from
     the fields FLD[0..1] = (a, b) alone (c and d are not computed then), the same three
@@ -780,7 +780,7 @@ def _lanes_signal(tt, PP, sc, SC, n_run, base):
         SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _lanes_sine(tt, PP, sc, SC, n_run, base):
     """`_lanes_signal` for the lanes' fixed-frequency, fixed-level sine, vectorised
     (vecmath.fast_sin)."""
@@ -793,7 +793,7 @@ def _lanes_sine(tt, PP, sc, SC, n_run, base):
 _lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
     """Fields f and f + 1 (0: a and b, 2: c and d) of every lane at every node of the basis'
     folded tables T (sweep.models.basis.mirrored_quadrature): FLD[f, j] and FLD[f + 1, j] at
@@ -840,7 +840,7 @@ def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
             FLD[f + 1, half + j, l] = e - o
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _pair_forces(FLD, half, paired, parts, n_run, symmetric):
     """The forces FLD[0..parts-1] at each paired node j (row j) and its mirror (row half + j)
     replaced by their sum (row j) and difference (row half + j): what a mode of either parity
@@ -877,7 +877,7 @@ def _symmetric_lanes(T, X, n, n_run):
     return True
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY, LB,
                      own):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
@@ -1041,7 +1041,7 @@ def row_scratch(row, basis):
     return scratch(pp, n, basis)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, symmetric,
                       F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
@@ -1120,7 +1120,7 @@ def _state_fields(T, f, j, y, n, split, symmetric):
     return e0, o0, e1, o1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s), dy = (q', q'') (m/s,
     m/s^2): `lanes_derivative`'s right-hand side for the scalar driver, libm's cos and sin,

@@ -105,7 +105,7 @@ def prepare(row, p, o, s):
         p[o + c * s] = row[c] * minus_inv_m
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _excitation_signal(t, p, o, s, base):
     """kernels.excitation's a_b(t) of the row's block (a sine kind, fixed or swept, or, where
     `base` is an array of records, the record kind: `excitation.signal`): a call of its own, so
@@ -114,7 +114,7 @@ def _excitation_signal(t, p, o, s, base):
     return ex.inlined_signal(t, p, o + EXCITATION * s, s, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4))
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4), _nrt=False)
 def base_acceleration(t, p, o, s, fast, base):
     """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation
     block's own (kernels.excitation: fixed or swept frequency, constant or tabled level, or a
@@ -127,7 +127,7 @@ def base_acceleration(t, p, o, s, fast, base):
     return p[o + BASE_ACCEL * s] * fast_sin(x)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(6))
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(6), _nrt=False)
 def acceleration(t, q, v, p, o, s, fast, parametric, base):
     """q'' (m/s^2) at time t (s) for deflection q (m) and velocity v (m/s), from a prepared
     row (`prepare`) at p[o + column * s]; `fast`, `parametric`, `base`: the module's switches.

@@ -124,7 +124,7 @@ def with_room(buf, acc):
     return bigger
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def point_atol(p, o, s, settings, rtol):
     """The absolute tolerances (atol_q in m, atol_v in m/s) of the point with parameter row p:
     settings[ATOL] plus settings[ATOL_SCALE] x rtol x the point's own scales (p[Q_SCALE],
@@ -174,7 +174,7 @@ def new_accumulator(slots):
     return np.zeros((slots, 1))[:, 0]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def delay_window(acc, start):
     """A random record's own statistics window: the tail window starts no earlier than
     `start` (s, the row's start-up transient's end), so that a point's statistics depend on
@@ -192,7 +192,7 @@ def delay_window(acc, start):
     acc[ACC_AMP] = 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, bound):
     """Write a trajectory's accumulator at t = 0 for any system whose observed quantity is q
     (m) with rate v (m/s) and second derivative fv (m/s^2): `start`'s for the oscillator, and
@@ -247,7 +247,7 @@ def begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, bou
         acc[T_STOP] = 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def next_attempt(settings, acc):
     """The step h (s) to attempt from acc[T], as SciPy's RK45 chooses it; 0.0 when the
     trajectory has ended (reached t_end, or failed: STATUS says which)."""
@@ -281,7 +281,7 @@ def next_attempt(settings, acc):
     return h
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def next_attempts(W, L, H, FLAG, settings, n_run):
     """`next_attempt` across the lanes of a lock-step driver (W: the lanes' accumulators,
     slot k of lane l at W[k * L + l]) whose step is ordinary: running, before their own end
@@ -312,7 +312,7 @@ def next_attempts(W, L, H, FLAG, settings, n_run):
         FLAG[l] = 0.0 if ok else 1.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def lane_moves(H, top, moves):
     """How a lock-step driver packs its running lanes (H[l] > 0: a step to attempt) among
     lanes 0..top-1 into the lowest ones, once its block has no more points to load (the
@@ -345,7 +345,7 @@ def move_books(k, i, bufs, capacity, point):
     point[k] = -1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def settle(second, reals, counts):
     """A point's outputs (its rows of reals and counts) after its second pass, the run that
     tracked |q - final| against the band tol * amplitude (`second`, its accumulator): the
@@ -357,7 +357,7 @@ def settle(second, reals, counts):
     return mt.STEADY
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr):
     """Where in the step |q - centre| last fell to thr, as a bracket for the root finder.
 
@@ -374,7 +374,7 @@ def _above_bracket(q_old, q_new, has_ext, xe, qe, centre, thr):
     return -1.0, 1.0, 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def control(settings, acc, err):
     """Accept or reject an attempt with error norm `err` and update the step size: SciPy's
     controller (for RK45 or DOP853, settings[METHOD]), or the PI controller (RK45 only) when
@@ -520,7 +520,7 @@ def observe_acceleration(acc, a, sa, t_new, q_new, v_new, fv_new, a3, t_tail, ta
     return turn
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def samples_interpolant(acc, a, sa):
     """The polynomial through q, q' and q'' at the last step-end samples (ACC_SAMPLES), written
     to the INTERP slots: Newton coefficients over x = (t - t_first) / span on the nodes
@@ -599,7 +599,7 @@ def samples_interpolant(acc, a, sa):
     acc[a + INTERP_X1 * sa] = x1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def absolute_acceleration_at(acc, a, sa, p, o, s, t, base):
     """q'' + a_b (m/s^2) at time t (s) on the samples' interpolant (`samples_interpolant`'s
     INTERP slots), a_b(t) exact (oscillator.base_acceleration of the row at
@@ -623,7 +623,7 @@ PEAK_VALUE_TOL = 1e-12  # ... until one changes the extremum's value by less tha
                         # (1e-8 stopped short: 6.5e-9 off at rtol 1e-10, measured)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def refine_acceleration_peak(acc, a, sa, p, o, s, base):
     """Where `observe_acceleration` set ACC_TURN: the extremum of q'' + a_b between the oldest
     and newest of the last three step-end samples (two consecutive steps), found by successive
@@ -671,7 +671,7 @@ def refine_acceleration_peak(acc, a, sa, p, o, s, base):
     acc[a + ACC_AMP * sa] = max(acc[a + ACC_AMP * sa], best)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def refine_marked_lanes(W, L, p, p_first, n_run):
     """`refine_acceleration_peak` for each of the first n_run lanes of a lock-step driver that
     `observe_acceleration` marked (ACC_TURN), one by one, outside the vector loops: lane j's
@@ -681,7 +681,7 @@ def refine_marked_lanes(W, L, p, p_first, n_run):
             refine_acceleration_peak(W, j, L, p, p_first + j, L, True)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv, base):
     """The absolute acceleration |q'' + a_b| (m/s^2) where the tail window starts, at t_tail
     (s) inside the step just sampled, from t (s) where the state was (q m, q' = v m/s,
@@ -874,7 +874,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
     acc[FV] = K[last, 1]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def take_samples(acc, series, t, t_new, h, q_old, Qc, dt_sample):
     """The time series' samples k dt_sample (s) that fall in the accepted step (t, t_new] of
     size h (s) from q_old (m), on its dense output Qc (`interpolant`), into series[k] (m), the
@@ -1074,7 +1074,7 @@ def observe_level_crossings(settings, acc, a, sa, k, q_old, qe, q_new, has_ext, 
     acc[a + (UP_LEVEL + k) * sa] += up if window else 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _stop_when_steady(settings, acc, buf, te, qe, t_tail, damping):
     """At a maximum of q at te (s, q = qe m), with settings[STOP_STEADY]: if the extrema say
     the response is steady or has decayed (`metrics.steady_period`), move the trajectory's
@@ -1107,7 +1107,7 @@ def _stop_when_steady(settings, acc, buf, te, qe, t_tail, damping):
     return te
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy")
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def end_series(acc, series):
     """NaN for the samples a trajectory that stopped early never reached."""
     for j in range(int(acc[SAMPLE]), series.shape[0]):
