@@ -125,3 +125,41 @@ def test_the_layers_know_what_the_architecture_says_they_know():
     assert "sweep.models.rules" in scene_uses
     assert any("sweep.scene" in graph[n] or any(d.startswith("sweep.scene.") for d in graph[n])
                for n in models)
+
+
+# What every step of the scalar drivers calls: compiled without Numba's reference counting
+# (atomic updates of every array argument's count at each call; with them the multi-mode
+# scalar driver took 1.5x as long, benchmarks/RESULTS.md, twenty-ninth session). A kernel
+# compiled so allocates nothing (Numba refuses to compile it otherwise) and must not hand an
+# array it made to a caller that counts references (kernels.modes.member keeps them).
+PER_STEP_UNCOUNTED = {
+    "dopri5.py": ["rk_step", "error_norm", "step_factor"],
+    "dop853.py": ["rk_step", "error_norm"],
+    "oscillator.py": ["acceleration", "base_acceleration"],
+    "modes.py": ["derivative", "lanes_derivative", "_polynomial_lanes", "_polynomial_mode",
+                 "_energy_forces", "_lanes_fields", "prepare"],
+    "modal_driver.py": ["rk_step", "error_norm", "_observe_modes", "restart_modes"],
+    "trajectory.py": ["next_attempt", "control", "record_step"],
+    "lanes.py": ["_attempt", "_attempt8"],
+    "modal_lanes.py": ["_attempt", "_combine", "_control"],
+}
+
+
+def _decorator_keywords(tree: ast.Module) -> dict[str, dict[str, ast.expr]]:
+    """{function name: its Numba decorator's keywords} of a module's top-level functions."""
+    found = {}
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef):
+            for deco in node.decorator_list:
+                if isinstance(deco, ast.Call):
+                    found[node.name] = {k.arg: k.value for k in deco.keywords}
+    return found
+
+
+def test_the_per_step_kernels_keep_no_reference_counts():
+    for module, names in PER_STEP_UNCOUNTED.items():
+        keywords = _decorator_keywords(ast.parse((ROOT / "kernels" / module).read_text()))
+        for name in names:
+            flag = keywords[name].get("_nrt")
+            assert isinstance(flag, ast.Constant) and flag.value is False, (
+                f"kernels/{module}: {name} is compiled with reference counting")
