@@ -79,6 +79,28 @@ def _project(v, weights, offset, n):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _project_stages(K, weights, n, n_stages, K_mid):
+    """K_mid[j] = the midspan's (deflection, velocity) rates of stage j (K's rows projected on
+    the weights), j = 0..n_stages."""
+    for j in range(n_stages + 1):
+        q = 0.0
+        v = 0.0
+        for i in range(n):
+            q += weights[i] * K[j, i]
+            v += weights[i] * K[j, n + i]
+        K_mid[j, 0] = q
+        K_mid[j, 1] = v
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _next_step(y, y_new, K, dim, n_stages):
+    """The accepted step's end as the next step's start: y = y_new, K[0] = K[n_stages]."""
+    for i in range(dim):
+        y[i] = y_new[i]
+        K[0, i] = K[n_stages, i]
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def rk_step(t, y, h, S, n_modes, T, K, y_new, stage, A, B, C, base):
     """One step of size h (s) of the explicit tableau (A, B, C) from (t, y), SciPy's
     `rk_step` on the 2N-component state; K[0] must hold f(t, y). Fills K[1..n_stages] (the
@@ -1122,9 +1144,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                        basis, Qc, p1, base)
         observe_random_modes(t, t_tail, y, y_new, K, h, n, basis[md.CLAMPS], modal, base)
-        for j in range(n_stages + 1):
-            K_mid[j, 0] = _project(K[j], weights, 0, n)
-            K_mid[j, 1] = _project(K[j], weights, n, n)
+        _project_stages(K, weights, n, n_stages, K_mid)
         if acc[tj.N_EXT] >= buf.shape[0]:
             buf = tj.with_room(buf, acc)
         q_mid = _project(y_new, weights, 0, n)
@@ -1133,9 +1153,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
                        centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                       basis, Qc, p1, base)
-        for i in range(dim):
-            y[i] = y_new[i]
-        K[0, :] = K[n_stages, :]
+        _next_step(y, y_new, K, dim, n_stages)
     tj.end_series(acc, series)
     return acc, buf, y
 

@@ -7,8 +7,9 @@ buffer, so a driver can advance many of them side by side:
                                        tolerances (`point_atol`), SciPy's initial step
     h = next_attempt(settings, acc)    the step to try now (0.0: the trajectory has ended)
     ... the driver computes one attempt of size h (RK45 or DOP853) and its error norm ...
-    buf = finish_attempt(...)          SciPy's accept/reject and step-size update (`control`);
-                                       on acceptance the in-kernel metrics (`record_step`)
+    control(settings, acc, err)        SciPy's accept/reject and step-size update; on
+    record_step(...)                   acceptance the in-kernel metrics (the extrema
+                                       buffer regrown first where full: `with_room`)
     transverse.classify(...)           state, amplitude, settling time, period, counts
 
 Each point's attempts are SciPy's RK45's or DOP853's (settings[METHOD]), in SciPy's order,
@@ -396,24 +397,6 @@ def control(settings, acc, err):
     if settings[CONTROLLER] != 0.0:
         acc[LOG2_ERR_PREV] = pi_log2_err(err)
     return True
-
-
-@nb.njit(cache=True, nogil=True, error_model="numpy")
-def finish_attempt(p, settings, acc, K, q_new, v_new, err, h, Qc, buf, series,
-                   track, centre, thr_fixed, thr_rel, parametric, base, eighth, steady):
-    """Accept or reject the attempt of size h (K: its stage derivatives, the last f(t + h,
-    y_new); (q_new, v_new): its solution; err: its error norm) and update the step size as
-    SciPy does (`control`); on acceptance reduce the step's metrics (`record_step`). Returns
-    the extrema buffer (regrown when full). Qc is scratch for the interpolant, shape
-    (2, QUARTIC_TERMS) for RK45, (2, DENSE_TERMS) for DOP853 (`interpolant`). p: the point's
-    prepared row (oscillator.prepare); eighth, steady: `record_step`'s switches.
-    """
-    if control(settings, acc, err):
-        if acc[N_EXT] >= buf.shape[0]:
-            buf = with_room(buf, acc)
-        record_step(p, 0, 1, settings, acc, K, q_new, v_new, h, Qc, buf, series, track,
-                    centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth, steady)
-    return buf
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

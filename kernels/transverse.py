@@ -70,9 +70,13 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
         else:
             dop853.rk_step(acc[tj.T], y, h, p, K, y_new, parametric, base)
             err = dop853.error_norm(K, h, y, y_new, rtol, acc[tj.ATOL_Q], acc[tj.ATOL_V])
-        buf = tj.finish_attempt(p, settings, acc, K, y_new[0], y_new[1], err, h, Qc, buf,
-                                series, track, centre, thr_fixed, thr_rel, parametric, base,
-                                eighth, steady)
+        if not tj.control(settings, acc, err):
+            continue
+        if acc[tj.N_EXT] >= buf.shape[0]:
+            buf = tj.with_room(buf, acc)
+        tj.record_step(p, 0, 1, settings, acc, K, y_new[0], y_new[1], h, Qc, buf, series,
+                       track, centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth,
+                       steady)
     tj.end_series(acc, series)
     return acc, buf
 
