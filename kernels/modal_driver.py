@@ -69,7 +69,7 @@ def valid(row, n_modes):
     return row[md.W1_SQ] > 0.0 and row[md.BOUND] > 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline="always")
 def _project(v, weights, offset, n):
     """sum_i weights[i] v[offset + i]."""
     s = 0.0
@@ -81,20 +81,17 @@ def _project(v, weights, offset, n):
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _project_stages(K, weights, n, n_stages, K_mid):
     """K_mid[j] = the midspan's (deflection, velocity) rates of stage j (K's rows projected on
-    the weights), j = 0..n_stages."""
+    the weights by `_project`), j = 0..n_stages. Uncounted, so its rows K[j] cost no
+    reference counts (the counted integrate loop paid two a stage)."""
     for j in range(n_stages + 1):
-        q = 0.0
-        v = 0.0
-        for i in range(n):
-            q += weights[i] * K[j, i]
-            v += weights[i] * K[j, n + i]
-        K_mid[j, 0] = q
-        K_mid[j, 1] = v
+        K_mid[j, 0] = _project(K[j], weights, 0, n)
+        K_mid[j, 1] = _project(K[j], weights, n, n)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _next_step(y, y_new, K, dim, n_stages):
-    """The accepted step's end as the next step's start: y = y_new, K[0] = K[n_stages]."""
+    """The accepted step's end as the next step's start: y = y_new, K[0] = K[n_stages] (a
+    loop: a slice assignment within one array may copy, which needs Numba's allocator)."""
     for i in range(dim):
         y[i] = y_new[i]
         K[0, i] = K[n_stages, i]
