@@ -151,21 +151,25 @@ LANES_LEAST_POINTS = 4
 lock-step lanes by default; with fewer (a single span; elastic clamps of 5 modes or more, whose
 K = k_t l / EI differs at every point, each K its own basis and so its own kernel call) the
 scalar driver is the default. Elastic clamps of up to 4 modes count every point: their bases
-stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.40x the
-scalar driver's time on one thread, 0.58x on two, benchmarks/RESULTS.md). A stepped sweep
-counts its lines (a kernel call takes one dwell of every line of a direction). Measured
-(benchmarks/lanes_occupancy.py, 2026-12-04, with a draining block's lanes packed): the lanes
-took 3.4x the scalar driver's time with 1 point a basis, 1.0x with 4, 0.70x with 8, 0.52x with
-16 (their vector loops and per-step bookkeeping cost nearly as much for one running lane as for
-sixteen); harness-stepped-sine's 3 lines a direction, one thread: 5.0 s on the lanes, 4.1 s on
-the scalar driver."""
+stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.60x the
+scalar driver's time on one thread, 0.85x on two, since the scalar driver's step lost its
+reference counts, benchmarks/RESULTS.md). A stepped sweep counts its lines (a kernel call
+takes one dwell of every line of a direction). Measured (benchmarks/lanes_occupancy.py,
+2026-12-06, twenty-ninth session): the lanes took 1.39x the scalar driver's time with 1 point a
+basis, 0.90x with 4, 0.59x with 8, 0.45x with 16 (their vector loops and per-step bookkeeping
+cost nearly as much for one running lane as for sixteen; 3.4x, 1.0x, 0.70x and 0.52x on
+2026-12-04, before the scalar step lost its counts); harness-stepped-sine's 3 lines a
+direction, one thread: 4.2 s on the lanes, 2.9 s on the scalar driver (5.0 s and 4.1 s
+before)."""
 RANDOM_LANES_LEAST_POINTS = 4
 """The same for a random scene, counting each record (base.realisations) as a point. Measured
 (3 modes, one 100 mm span at -10 dB, 2 s GEVS records, one thread, 2026-12-06, once a record's
 ordinary steps stayed in the lanes; benchmarks/random_lanes.py --occupancy for pinned ends):
 the lanes took 1.7-2.2x the scalar driver's time with 2 records a basis, 0.81x (pinned), 0.87x
 (clamped) and 0.88x (elastic, K = 1) with 4, 0.55-0.73x with 8. (8 until then, when every
-step of a record went to the lanes' scalar path: 1.23x with 4, 0.77x with 8.)"""
+step of a record went to the lanes' scalar path: 1.23x with 4, 0.77x with 8.) Measured again
+once the scalar step lost its reference counts (twenty-ninth session, pinned): 4.96x with 1
+record, 2.70x with 2, 1.04x with 4, 0.73x with 8, 0.55x with 16."""
 RANDOM_ONE_MODE_LANES_LEAST_POINTS = 2
 """The same for a random scene of one mode (no basis: one kernel call takes every point),
 counting each record as a point. Measured (benchmarks/random_lanes.py --one-mode, GEVS at
