@@ -129,9 +129,9 @@ def flops_per_attempt(method: str, parametric: bool, base: bool) -> dict:
     """Flops of one attempt of the lanes driver's stage chain for `method` and the System's
     terms: the chain's own sums plus its right-hand sides."""
     from sweep.kernels import lanes
-    terms = ("p" if parametric else "") + ("b" if base else "")     # lanes._chain5_pb, ...
-    name = ("_chain5" if method == "rk45" else "_chain8") + (f"_{terms}" if terms else "")
-    chain = getattr(lanes, name).py_func
+    terms = ("p" if parametric else "") + ("b" if base else "")     # lanes._chains' kinds
+    chains = lanes._chain5 if method == "rk45" else lanes._chain8
+    chain = chains.kinds[f"_{terms}" if terms else ""].py_func
     rhs = chain.__globals__["rhs"].py_func
     own, calls = count_flops(chain.__doc__)
     per_rhs, _ = count_flops(rhs.__doc__)

@@ -35,7 +35,7 @@ for bit: to what a trajectory makes of round-off, which on strongly nonlinear po
 driver).
 
 A random base acceleration (kernels.excitation's record kind: `base` is the records) runs here
-too, on stage chains of its own (`_chain5_r`, `_chain8_r`, written out from the tableau as
+too, on stage chains of its own (`_chains`' kind r, written out from the tableau as
 the others): each lane's record is read at the attempt's stage times before the attempt, in a
 scalar loop (`_stage_reads`), and the chain's right-hand side (`_accel_read`) reads those
 values from W, so the chain's loop across the lanes vectorises as the sine kinds' does. A
@@ -52,6 +52,8 @@ import math
 
 import numba as nb
 import numpy as np
+from numba.core import types
+from numba.extending import overload
 
 from . import dop853
 from . import excitation as ex
@@ -177,26 +179,45 @@ def _stage_reads(W, n_run, eighth, base):
 # of its tableau; DOP853 leaves out the zeros of its sparse one. One chain per combination of
 # the System's optional terms (suffix p: parametric, b: a sine base excitation, r: a random
 # record: the right-hand side `_accel_read`, which takes the stage's number and reads the
-# stage's a_b from W), its right-hand side written out for those terms alone: `_attempt`
-# picks one by its switches, in branches on its own
-# arguments, which Numba prunes before it inlines, so it copies only the chain it uses, and
-# only the code of those terms (each copy costs compile time).
+# stage's a_b from W), its right-hand side written out for those terms alone; `_chains`
+# makes them one function that the attempts call, which inlines only the chain of the
+# caller's switches (each copy costs compile time).
 _KINDS = (({"parametric": None, "base": None}, ""), ({"parametric": True, "base": None}, "_p"),
           ({"parametric": None, "base": True}, "_b"), ({"parametric": True, "base": True}, "_pb"),
           ({"parametric": None}, "_r"), ({"parametric": True}, "_pr"))
 
 
 def _chains(A, B, C, sums, skip_zeros, name):
-    return tuple(stages.make_chain(A, B, C, _accel_read if "base" not in switches else _accel,
-                                   sums, skip_zeros, f"{name}{suffix}", switches,
-                                   stage_argument="base" not in switches)
-                 for switches, suffix in _KINDS)
+    """The stage chains of tableau (A, B, C) (`stages.make_chain`), one a kind of _KINDS, as
+    one function for compiled code, chain(W, j, t, q, v, h, fq, fv, parametric, base,
+    record), that calls the chain of the switches' types as its caller compiles (parametric,
+    base: None where the System has no such term; record True: base is a random record's
+    array), inlined: so the caller copies that chain alone, as branches on the switches
+    would only in the function that owns them."""
+    chains = {suffix: stages.make_chain(A, B, C, _accel_read if "base" not in switches
+                                        else _accel, sums, skip_zeros, f"{name}{suffix}",
+                                        switches, stage_argument="base" not in switches)
+              for switches, suffix in _KINDS}
+
+    def chain(W, j, t, q, v, h, fq, fv, parametric, base, record):
+        raise TypeError(f"kernels.lanes {name} runs only in compiled code")
+
+    @overload(chain, prefer_literal=True, jit_options={"forceinline": True})
+    def _choose(W, j, t, q, v, h, fq, fv, parametric, base, record):
+        terms = ("" if isinstance(parametric, types.NoneType) else "p") + (
+            "r" if not isinstance(record, types.NoneType)
+            else "" if isinstance(base, types.NoneType) else "b")
+        chosen = chains[f"_{terms}" if terms else ""]
+        return lambda W, j, t, q, v, h, fq, fv, parametric, base, record: chosen(
+            W, j, t, q, v, h, fq, fv, parametric, base)
+
+    chain.__name__ = chain.__qualname__ = name
+    chain.kinds = chains               # by suffix (benchmarks/fma_peak.py counts their flops)
+    return chain
 
 
-_chain5, _chain5_p, _chain5_b, _chain5_pb, _chain5_r, _chain5_pr = _chains(
-    A, B, C, (E,), False, "rk45_chain")
-_chain8, _chain8_p, _chain8_b, _chain8_pb, _chain8_r, _chain8_pr = _chains(
-    dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "dop853_chain")
+_chain5 = _chains(A, B, C, (E,), False, "rk45_chain")
+_chain8 = _chains(dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "dop853_chain")
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
@@ -217,20 +238,7 @@ def _attempt(W, rtol, n_run, parametric, base, record):
         h = W[W_H * L + j]
         fq = W[tj.FQ * L + j]
         fv = W[tj.FV * L + j]
-        if record is not None:
-            if parametric is None:
-                stages_ = _chain5_r(W, j, t, q, v, h, fq, fv, parametric, base)
-            else:
-                stages_ = _chain5_pr(W, j, t, q, v, h, fq, fv, parametric, base)
-        elif parametric is None:
-            if base is None:
-                stages_ = _chain5(W, j, t, q, v, h, fq, fv, parametric, base)
-            else:
-                stages_ = _chain5_b(W, j, t, q, v, h, fq, fv, parametric, base)
-        elif base is None:
-            stages_ = _chain5_p(W, j, t, q, v, h, fq, fv, parametric, base)
-        else:
-            stages_ = _chain5_pb(W, j, t, q, v, h, fq, fv, parametric, base)
+        stages_ = _chain5(W, j, t, q, v, h, fq, fv, parametric, base, record)
         kq, kv, qn, vn, eq, ev = stages_
         rq = (eq * h) / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
         rv = (ev * h) / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
@@ -271,20 +279,7 @@ def _attempt8(W, rtol, n_run, parametric, base, record):
         h = W[W_H * L + j]
         fq = W[tj.FQ * L + j]
         fv = W[tj.FV * L + j]
-        if record is not None:
-            if parametric is None:
-                stages_ = _chain8_r(W, j, t, q, v, h, fq, fv, parametric, base)
-            else:
-                stages_ = _chain8_pr(W, j, t, q, v, h, fq, fv, parametric, base)
-        elif parametric is None:
-            if base is None:
-                stages_ = _chain8(W, j, t, q, v, h, fq, fv, parametric, base)
-            else:
-                stages_ = _chain8_b(W, j, t, q, v, h, fq, fv, parametric, base)
-        elif base is None:
-            stages_ = _chain8_p(W, j, t, q, v, h, fq, fv, parametric, base)
-        else:
-            stages_ = _chain8_pb(W, j, t, q, v, h, fq, fv, parametric, base)
+        stages_ = _chain8(W, j, t, q, v, h, fq, fv, parametric, base, record)
         kq, kv, qn, vn, e5q, e5v, e3q, e3v = stages_
         sq = W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol
         sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
