@@ -189,27 +189,35 @@ _KINDS = (({"parametric": None, "base": None}, ""), ({"parametric": True, "base"
 
 def _chains(A, B, C, sums, skip_zeros, name):
     """The stage chains of tableau (A, B, C) (`stages.make_chain`), one a kind of _KINDS, as
-    one function for compiled code, chain(W, j, t, q, v, h, fq, fv, parametric, base,
-    record), that calls the chain of the switches' types as its caller compiles (parametric,
+    one function for compiled code, chain(W, j, parametric, base, record): the stages of lane
+    j's attempt from its t, q, v, h, f(t, y) in W, by the chain of the switches' types as its
+    caller compiles (parametric,
     base: None where the System has no such term; record True: base is a random record's
-    array), inlined: so the caller copies that chain alone, as branches on the switches
-    would only in the function that owns them."""
+    array), inlined by LLVM (forceinline: the attempt's loop stays vectorised; Numba's own
+    inlining of an overload typed the chain twice, 5 s more compile): so the caller copies
+    that chain alone, as branches on the switches would only in the function that owns
+    them."""
     chains = {suffix: stages.make_chain(A, B, C, _accel_read if "base" not in switches
                                         else _accel, sums, skip_zeros, f"{name}{suffix}",
                                         switches, stage_argument="base" not in switches)
               for switches, suffix in _KINDS}
 
-    def chain(W, j, t, q, v, h, fq, fv, parametric, base, record):
+    def chain(W, j, parametric, base, record):
         raise TypeError(f"kernels.lanes {name} runs only in compiled code")
 
     @overload(chain, prefer_literal=True, jit_options={"forceinline": True})
-    def _choose(W, j, t, q, v, h, fq, fv, parametric, base, record):
+    def _choose(W, j, parametric, base, record):
         terms = ("" if isinstance(parametric, types.NoneType) else "p") + (
             "r" if not isinstance(record, types.NoneType)
             else "" if isinstance(base, types.NoneType) else "b")
         chosen = chains[f"_{terms}" if terms else ""]
-        return lambda W, j, t, q, v, h, fq, fv, parametric, base, record: chosen(
-            W, j, t, q, v, h, fq, fv, parametric, base)
+        L = LANES
+
+        def lane_chain(W, j, parametric, base, record):
+            return chosen(W, j, W[tj.T * L + j], W[tj.Q * L + j], W[tj.V * L + j],
+                          W[W_H * L + j], W[tj.FQ * L + j], W[tj.FV * L + j], parametric,
+                          base)
+        return lane_chain
 
     chain.__name__ = chain.__qualname__ = name
     chain.kinds = chains               # by suffix (benchmarks/fma_peak.py counts their flops)
@@ -232,14 +240,8 @@ def _attempt(W, rtol, n_run, parametric, base, record):
     """
     L = LANES
     for j in range(n_run):
-        t = W[tj.T * L + j]
-        q = W[tj.Q * L + j]
-        v = W[tj.V * L + j]
-        h = W[W_H * L + j]
-        fq = W[tj.FQ * L + j]
-        fv = W[tj.FV * L + j]
-        stages_ = _chain5(W, j, t, q, v, h, fq, fv, parametric, base, record)
-        kq, kv, qn, vn, eq, ev = stages_
+        kq, kv, qn, vn, eq, ev = _chain5(W, j, parametric, base, record)
+        t, q, v, h = W[tj.T * L + j], W[tj.Q * L + j], W[tj.V * L + j], W[W_H * L + j]
         rq = (eq * h) / (W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol)
         rv = (ev * h) / (W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol)
         W[(W_K + 2) * L + j] = kq[1]
@@ -273,14 +275,8 @@ def _attempt8(W, rtol, n_run, parametric, base, record):
     """
     L = LANES
     for j in range(n_run):
-        t = W[tj.T * L + j]
-        q = W[tj.Q * L + j]
-        v = W[tj.V * L + j]
-        h = W[W_H * L + j]
-        fq = W[tj.FQ * L + j]
-        fv = W[tj.FV * L + j]
-        stages_ = _chain8(W, j, t, q, v, h, fq, fv, parametric, base, record)
-        kq, kv, qn, vn, e5q, e5v, e3q, e3v = stages_
+        kq, kv, qn, vn, e5q, e5v, e3q, e3v = _chain8(W, j, parametric, base, record)
+        t, q, v, h = W[tj.T * L + j], W[tj.Q * L + j], W[tj.V * L + j], W[W_H * L + j]
         sq = W[tj.ATOL_Q * L + j] + max(abs(q), abs(qn)) * rtol
         sv = W[tj.ATOL_V * L + j] + max(abs(v), abs(vn)) * rtol
         W[(W_K + 12) * L + j] = vn
