@@ -116,18 +116,15 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
     L = LANES
     dim = 2 * n
     n_stages = B.shape[0]
-    for s in range(1, n_stages):
-        _combine(K, s, A[s], Y, H, ST, dim, n_run, eighth)
-        c = C[s]
+    for s in range(1, n_stages + 1):   # the stages, then f(t + h, y_new) (one call site:
+        last = s == n_stages            # md.lanes_derivative is inlined, once)
+        X = YN if last else ST
+        _combine(K, s, B if last else A[s], Y, H, X, dim, n_run, eighth)
+        c = 1.0 if last else C[s]
         for l in range(n_run):
             TT[l] = W[tj.T * L + l] + c * H[l]
-        md.lanes_derivative(TT, ST, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY, LB,
+        md.lanes_derivative(TT, X, K, s, PP, n, T, FLD, SC, n_run, True, base, CP, PY, LB,
                             own)
-    _combine(K, n_stages, B, Y, H, YN, dim, n_run, eighth)
-    for l in range(n_run):
-        TT[l] = W[tj.T * L + l] + H[l]
-    md.lanes_derivative(TT, YN, K, n_stages, PP, n, T, FLD, SC, n_run, True, base, CP, PY,
-                        LB, own)
     # the error norm: ST[0], ST[1] accumulate the sums of squares, SC[0], SC[1] the estimates
     for l in range(n_run):
         ST[0, l] = 0.0

@@ -658,7 +658,8 @@ def _group_scale(g, linear, membrane, beta_b, beta_q, energy):
     return (1.0 - energy) * beta_q
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     """The polynomial form of the force (POLYNOMIAL: program (K, 2), starts (N, N_GROUPS + 1),
     monomials (T,), coefficients (T,), symmetric (N, N_GROUPS), pure; sweep.models.basis.
@@ -689,7 +690,8 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     return active
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
     the sum over the groups in `active` of the group's scale R[K + g] times its terms'
@@ -730,7 +732,8 @@ def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
             out[l] += R[n_mono + g, l] * R[n_mono + N_GROUPS, l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
     """The nonlinear forces at the nodes (per unit rho A, in the fields' units) of lanes
     whose bending terms may come from the span's energy (S_ENERGY 1) or Eq.17 (0), from the
@@ -755,7 +758,8 @@ def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
             FLD[2, j, l] = e * g2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
     """`_energy_forces` where every lane's bending terms come from the span's energy: from
     the fields FLD[0..1] = (a, b) alone (c and d are not computed then), the same three
@@ -770,7 +774,8 @@ def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
             FLD[2, j, l] = g2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _lanes_signal(tt, PP, sc, SC, n_run, base):
     """SC[2, l] = a_b(tt[l]) (m/s^2) of each lane's excitation block (rows sc + S_EXCITATION..
     of PP), any kind (kernels.excitation: libm's sine, or a record read lane by lane)."""
@@ -780,7 +785,8 @@ def _lanes_signal(tt, PP, sc, SC, n_run, base):
         SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _lanes_sine(tt, PP, sc, SC, n_run, base):
     """`_lanes_signal` for the lanes' fixed-frequency, fixed-level sine, vectorised
     (vecmath.fast_sin)."""
@@ -793,7 +799,8 @@ def _lanes_sine(tt, PP, sc, SC, n_run, base):
 _lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
     """Fields f and f + 1 (0: a and b, 2: c and d) of every lane at every node of the basis'
     folded tables T (sweep.models.basis.mirrored_quadrature): FLD[f, j] and FLD[f + 1, j] at
@@ -840,7 +847,8 @@ def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
             FLD[f + 1, half + j, l] = e - o
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def _pair_forces(FLD, half, paired, parts, n_run, symmetric):
     """The forces FLD[0..parts-1] at each paired node j (row j) and its mirror (row half + j)
     replaced by their sum (row j) and difference (row half + j): what a mode of either parity
@@ -877,7 +885,8 @@ def _symmetric_lanes(T, X, n, n_run):
     return True
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY, LB,
                      own):
     """The System's right-hand side for n_run states side by side (lanes l < n_run):
@@ -908,7 +917,10 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
 
     The lane is every array's last, contiguous axis and every loop over modes and quadrature
     nodes sits outside the loop across the lanes, which is straight-line arithmetic, so LLVM
-    vectorises it. The one-state `derivative` is this with one lane."""
+    vectorises it. It and its callees are compiled `forceinline` (LLVM inlines them into
+    modal_lanes._attempt's one call site; Numba's IR is not copied, so the first compile is
+    unchanged): a call passes every array as its 7-11 words, about 100 here, which cost
+    ~50 ns of a 3-mode clamped evaluation's 360 and 8 % of harness-clamps' run."""
     n = n_modes
     sc = 3 * n
     half = T.shape[2]
