@@ -151,13 +151,13 @@ LANES_LEAST_POINTS = 4
 lock-step lanes by default; with fewer (a single span; elastic clamps of 5 modes or more, whose
 K = k_t l / EI differs at every point, each K its own basis and so its own kernel call) the
 scalar driver is the default. Elastic clamps of up to 4 modes count every point: their bases
-stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.60x the
-scalar driver's time on one thread, 0.85x on two, since the scalar driver's step lost its
-reference counts, benchmarks/RESULTS.md). A stepped sweep counts its lines (a kernel call
+stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.55x the
+scalar driver's time on one thread, 0.81x on two, thirtieth session, benchmarks/RESULTS.md). A stepped sweep counts its lines (a kernel call
 takes one dwell of every line of a direction). Measured (benchmarks/lanes_occupancy.py,
-2026-12-06, twenty-ninth session): the lanes took 1.39x the scalar driver's time with 1 point a
-basis, 0.90x with 4, 0.59x with 8, 0.45x with 16 (their vector loops and per-step bookkeeping
-cost nearly as much for one running lane as for sixteen; 3.4x, 1.0x, 0.70x and 0.52x on
+2026-12-06, thirtieth session, once the lanes' right-hand side was inlined): the lanes took
+1.36x the scalar driver's time with 1 point a basis, 0.75x with 4, 0.56x with 8, 0.42x with 16
+(their vector loops and per-step bookkeeping cost nearly as much for one running lane as for
+sixteen; 1.39x, 0.90x, 0.59x and 0.45x the session before; 3.4x, 1.0x, 0.70x and 0.52x on
 2026-12-04, before the scalar step lost its counts); harness-stepped-sine's 3 lines a
 direction, one thread: 4.2 s on the lanes, 2.9 s on the scalar driver (5.0 s and 4.1 s
 before)."""
