@@ -191,9 +191,8 @@ def _chains(A, B, C, sums, skip_zeros, name):
     """The stage chains of tableau (A, B, C) (`stages.make_chain`), one a kind of _KINDS, as
     one function for compiled code, chain(W, j, parametric, base, record): the stages of lane
     j's attempt from its t, q, v, h, f(t, y) in W, by the chain of the switches' types as its
-    caller compiles (parametric,
-    base: None where the System has no such term; record True: base is a random record's
-    array), inlined by LLVM (forceinline: the attempt's loop stays vectorised; Numba's own
+    caller compiles (parametric, base: None where the System has no such term; record True:
+    base is a random record's array), inlined by LLVM (forceinline: the attempt's loop stays vectorised; Numba's own
     inlining of an overload typed the chain twice, 5 s more compile): so the caller copies
     that chain alone, as branches on the switches would only in the function that owns
     them."""

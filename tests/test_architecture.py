@@ -163,3 +163,30 @@ def test_the_per_step_kernels_keep_no_reference_counts():
             flag = keywords[name].get("_nrt")
             assert isinstance(flag, ast.Constant) and flag.value is False, (
                 f"kernels/{module}: {name} is compiled with reference counting")
+
+
+LLVM_INLINED = ["lanes_derivative", "_polynomial_lanes", "_polynomial_mode", "_lanes_fields",
+                "_energy_forces", "_energy_only_forces", "_pair_forces", "_lanes_signal",
+                "_lanes_sine"]
+
+
+def _calls_of(function: ast.FunctionDef, name: str) -> int:
+    """How many calls of `name` (plain or an attribute) a function's body makes."""
+    return sum(1 for node in ast.walk(function) if isinstance(node, ast.Call)
+               and getattr(node.func, "attr", getattr(node.func, "id", None)) == name)
+
+
+def test_the_lanes_right_hand_side_is_inlined_by_llvm_from_one_call_site():
+    """docs/architecture.md: the multi-mode lanes' right-hand side and its helpers are compiled
+    forceinline (no call passing ~100 words of array structs 6-12 times an attempt), and
+    modal_lanes._attempt calls it from one site (each site is one more inlined copy to
+    compile)."""
+    keywords = _decorator_keywords(ast.parse((ROOT / "kernels" / "modes.py").read_text()))
+    for name in LLVM_INLINED:
+        flag = keywords[name].get("forceinline")
+        assert isinstance(flag, ast.Constant) and flag.value is True, (
+            f"kernels/modes.py: {name} is not compiled forceinline")
+    tree = ast.parse((ROOT / "kernels" / "modal_lanes.py").read_text())
+    attempt = next(node for node in tree.body
+                   if isinstance(node, ast.FunctionDef) and node.name == "_attempt")
+    assert _calls_of(attempt, "lanes_derivative") == 1
