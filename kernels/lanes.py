@@ -192,10 +192,10 @@ def _chains(A, B, C, sums, skip_zeros, name):
     one function for compiled code, chain(W, j, parametric, base, record): the stages of lane
     j's attempt from its t, q, v, h, f(t, y) in W, by the chain of the switches' types as its
     caller compiles (parametric, base: None where the System has no such term; record True:
-    base is a random record's array), inlined by LLVM (forceinline: the attempt's loop stays vectorised; Numba's own
-    inlining of an overload typed the chain twice, 5 s more compile): so the caller copies
-    that chain alone, as branches on the switches would only in the function that owns
-    them."""
+    base is a random record's array), inlined by LLVM (forceinline: the attempt's loop stays
+    vectorised; Numba's own inlining of an overload typed the chain twice, 5 s more compile):
+    so the caller copies that chain alone, as branches on the switches would only in the
+    function that owns them."""
     chains = {suffix: stages.make_chain(A, B, C, _accel_read if "base" not in switches
                                         else _accel, sums, skip_zeros, f"{name}{suffix}",
                                         switches, stage_argument="base" not in switches)

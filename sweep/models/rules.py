@@ -152,15 +152,17 @@ lock-step lanes by default; with fewer (a single span; elastic clamps of 5 modes
 K = k_t l / EI differs at every point, each K its own basis and so its own kernel call) the
 scalar driver is the default. Elastic clamps of up to 4 modes count every point: their bases
 stack into one call (`family_shares_lanes`; harness-clamps' 35 spans, 35 bases: 0.55x the
-scalar driver's time on one thread, 0.81x on two, thirtieth session, benchmarks/RESULTS.md). A stepped sweep counts its lines (a kernel call
-takes one dwell of every line of a direction). Measured (benchmarks/lanes_occupancy.py,
+scalar driver's time on one thread, 0.81x on two, thirtieth session, benchmarks/RESULTS.md).
+A stepped sweep counts its lines (a kernel call takes one dwell of every line of a
+direction). Measured (benchmarks/lanes_occupancy.py,
 2026-12-06, thirtieth session, once the lanes' right-hand side was inlined): the lanes took
 1.36x the scalar driver's time with 1 point a basis, 0.75x with 4, 0.56x with 8, 0.42x with 16
 (their vector loops and per-step bookkeeping cost nearly as much for one running lane as for
 sixteen; 1.39x, 0.90x, 0.59x and 0.45x the session before; 3.4x, 1.0x, 0.70x and 0.52x on
 2026-12-04, before the scalar step lost its counts); harness-stepped-sine's 3 lines a
-direction, one thread: 4.2 s on the lanes, 2.9 s on the scalar driver (5.0 s and 4.1 s
-before)."""
+direction, one thread: 3.6 s on the lanes, 2.7 s on the scalar driver (`python
+benchmarks/thread_scaling.py harness-stepped-sine [--set 'solver.driver="lanes"']`, thirtieth
+session; 4.2 s and 2.9 s the session before, 5.0 s and 4.1 s before that)."""
 RANDOM_LANES_LEAST_POINTS = 4
 """The same for a random scene, counting each record (base.realisations) as a point. Measured
 (3 modes, one 100 mm span at -10 dB, 2 s GEVS records, one thread, 2026-12-06, once a record's
