@@ -58,7 +58,7 @@ RECORD_SCALE = ACCEL   # the level factor on the record (1), 10^(dB / 20) of a l
 RECORD_RATE = OMEGA    # fs, the records' sample rate (Hz)
 RECORD = PHASE         # r, which record (realisation) the row follows (an index, as a float)
 RECORD_START = END     # the row's statistics start no earlier than this (s): its start-up
-                       # transient's end (kernels.trajectory.delay_window)
+                       # transient's end (kernels.trajectory.record_window)
                        # (RAMP, as the sweeps': the record's level rises from 0 over RAMP s)
 
 NAMES = (("base_accel", "base_omega", "base_phase", "sweep_rate", "level_segments",
@@ -155,22 +155,70 @@ def frequency(t, p, o, s):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _record_interval(t, p, o, s, records):
-    """The sample interval of the record kind's row at time t (s): its two samples and their
-    derivatives (y0, d0, y1, d1), the fraction u of the interval, its length dt = 1 / fs (s)
-    and the level factor (`record_acceleration`)."""
-    n = records.shape[2]
-    r = int(p[o + RECORD * s])
-    fs = p[o + RECORD_RATE * s]
+def _sample_index(t, fs, n):
+    """Where time t (s) falls among a record's n samples at fs (Hz): the interval's first and
+    second sample k, k1, the fraction u of the interval, and whether t is past one period."""
     x = t * fs
     kf = math.floor(x)
     u = x - kf
     k = int(kf)
-    k = k - n if k >= n else k     # t in [0, 2 N / fs): a run never passes the period N / fs
+    lap = k >= n
+    k = k - n if lap else k         # t in [0, 2 N / fs): a run never passes the period N / fs
     k1 = k + 1 if k + 1 < n else 0  # (not `% n`: an integer division per stage and lane, which
                                     # took half a one-mode record's run on the lanes)
+    return k, k1, u, lap
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _record_interval(t, p, o, s, records):
+    """The sample interval of the record kind's row at time t (s): its two samples and their
+    derivatives (y0, d0, y1, d1), the fraction u of the interval, its length dt = 1 / fs (s)
+    and the level factor (`record_acceleration`)."""
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    k, k1, u, _ = _sample_index(t, fs, records.shape[2])
     return (records[r, 0, k], records[r, 1, k], records[r, 0, k1], records[r, 1, k1], u,
             1.0 / fs, p[o + RECORD_SCALE * s])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _piece_integrals(y0, d0, y1, d1, u, dt):
+    """The integrals of the cubic Hermite interpolant through (y0, d0) and (y1, d1) over the
+    first fraction u of its interval dt (s), and of its square: the closed forms of
+    sweep.models.random.with_integrals' whole pieces, at u."""
+    b = dt * d0
+    c = 3.0 * (y1 - y0) - 2.0 * b - dt * d1
+    d = 2.0 * (y0 - y1) + b + dt * d1
+    first = u * (y0 + u * (b / 2.0 + u * (c / 3.0 + u * d / 4.0)))
+    square = u * (y0 * y0 + u * (y0 * b + u * ((b * b + 2.0 * y0 * c) / 3.0 + u * (
+        (y0 * d + b * c) / 2.0 + u * ((c * c + 2.0 * b * d) / 5.0 + u * (
+            c * d / 3.0 + u * d * d / 7.0))))))
+    return dt * first, dt * square
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def record_integrals(t, p, o, s, records):
+    """(integral of a_b, integral of a_b^2) from 0 to t (s) (m/s, m^2/s^3) of the record kind's
+    row, on its cubic Hermite interpolant times the level factor, the ramp left out (exact
+    once t is past it: a record's statistics start after it): the running integrals the
+    records carry to each sample (rows 2 and 3, sweep.models.random.with_integrals) and the
+    partial interval in closed form. The difference of two such calls is the integral over
+    the stretch between them."""
+    n = records.shape[2]
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    scale = p[o + RECORD_SCALE * s]
+    k, k1, u, lap = _sample_index(t, fs, n)
+    first, square = _piece_integrals(records[r, 0, k], records[r, 1, k], records[r, 0, k1],
+                                     records[r, 1, k1], u, 1.0 / fs)
+    first += records[r, 2, k]
+    square += records[r, 3, k]
+    if lap:                         # a whole period before it
+        whole, whole_sq = _piece_integrals(records[r, 0, n - 1], records[r, 1, n - 1],
+                                           records[r, 0, 0], records[r, 1, 0], 1.0, 1.0 / fs)
+        first += whole + records[r, 2, n - 1]
+        square += whole_sq + records[r, 3, n - 1]
+    return scale * first, scale * scale * square
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -185,7 +233,7 @@ def _hermite(y0, d0, y1, d1, u, dt):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def record_value(t, p, o, s, records):
-    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 2, N)
+    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 4, N)
     at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
     fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
     p[o + RECORD_SCALE * s], and over the first RAMP seconds (base.ramp; 0: none) by the

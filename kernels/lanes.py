@@ -101,7 +101,9 @@ W_A_OLD = W_START + 5   # q'' + a_b at its start where no step-end sample holds 
 W_AB_STAGES = W_START + 6   # a record's a_b (m/s^2) at the attempt's stage s = 1 .. n (the
                             # last at t + h) in row W_AB_STAGES + s - 1, read before the
                             # attempt (`_stage_reads`)
-W_ROWS = W_AB_STAGES + dop853.N_STAGES
+W_B1 = W_AB_STAGES + dop853.N_STAGES   # a record's integrals of a_b and a_b^2 over an ordinary
+W_B2 = W_B1 + 1                         # step (m/s, m^2/s^3; `_record_reads`)
+W_ROWS = W_B2 + 1
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -460,8 +462,9 @@ def _ordinary(W, j):
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_reads(W, n_run, base):
     """The record's values a record's ordinary steps in the statistics window need (a scalar
-    loop: each lane reads its own record): a_b at the step's middle into W_A_MID, and q'' + a_b
-    at its start into W_A_OLD where the step-end samples will not hold it
+    loop: each lane reads its own record): a_b at the step's middle into W_A_MID, the
+    integrals of a_b and a_b^2 over the step into W_B1, W_B2 (trajectory.step_integrals), and
+    q'' + a_b at its start into W_A_OLD where the step-end samples will not hold it
     (trajectory.record_statistics' a_old: the step before was not sampled). Before
     `_record_sums`, which takes the step-end samples."""
     L = LANES
@@ -470,8 +473,9 @@ def _record_reads(W, n_run, base):
         if not (_ordinary(W, j) and t >= W[tj.T_TAIL * L + j]):
             continue
         o = W_P * L + j
-        h = W[tj.T * L + j] - t
-        W[W_A_MID * L + j] = base_acceleration(t + 0.5 * h, W, o, L, None, base)
+        t_new = W[tj.T * L + j]
+        W[W_A_MID * L + j] = base_acceleration(0.5 * (t + t_new), W, o, L, None, base)
+        W[W_B1 * L + j], W[W_B2 * L + j] = tj.step_integrals(t, t_new, W, o, L, base)
         consecutive = W[tj.ACC_STEP * L + j] == W[tj.STEPS * L + j] - 1.0
         if not consecutive or math.isnan(W[(tj.ACC_SAMPLES + tj.S_A) * L + j]):
             W[W_A_OLD * L + j] = (W[(W_START + 3) * L + j]
@@ -500,14 +504,12 @@ def _record_sums(W, settings, n_run):
         q_old = W[(W_START + 1) * L + j]
         v_old = W[(W_START + 2) * L + j]
         fv_old = W[(W_START + 3) * L + j]
-        h = t_new - t
         a_new = W[(tj.ACC_SAMPLES + tj.S_A) * L + j]
         a_old = W[(tj.ACC_SAMPLES + tj.SAMPLE_SIZE + tj.S_A) * L + j]
         a_old = W[W_A_OLD * L + j] if a_old != a_old else a_old
-        a_mid = (tj.quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
-                 + W[W_A_MID * L + j])
         tj.observe_random(W, j, L, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
-                          a_old, a_mid, a_new, False, 0.0, take)
+                          a_old, a_new, W[W_A_MID * L + j], W[W_B1 * L + j],
+                          W[W_B2 * L + j], False, 0.0, take)
     for k in range(int(settings[N_LEVELS])):
         for j in range(n_run):
             window = _ordinary(W, j) & (W[W_START * L + j] >= W[tj.T_TAIL * L + j])

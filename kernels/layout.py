@@ -87,3 +87,9 @@ STEPS = 0           # accepted steps
 REJECTED = 1        # rejected step attempts
 RHS_EVALS = 2       # right-hand-side evaluations
 N_COUNTS = 3
+
+# A random base acceleration's records (sweep.models.random.Records, the kernels' `base`
+# switch of the record kind), (R, RECORD_ROWS, N): per record its samples a_b (m/s^2), their
+# derivatives (m/s^3), and the running integrals of its cubic Hermite interpolant and of the
+# interpolant's square from 0 to each sample (m/s, m^2/s^3; kernels.excitation.record_integrals).
+RECORD_ROWS = 4

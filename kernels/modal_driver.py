@@ -220,8 +220,9 @@ def modal_size(n_modes):
     load's factors for the clamp's reaction (end_load_slot(N) + 0..3: kernels.modes
     `end_load_factors`); the base inertia's factor for it (inertia_slot(N), s^2:
     kernels.modes.inertia_factor; 0 without base excitation); the place of slot 2N's
-    deflection, x* / l (place_slot(N); 1/2 until one is found)."""
-    return 3 * n_modes + 21
+    deflection, x* / l (place_slot(N); 1/2 until one is found); the other carrier of the
+    curvatures' second derivatives under a random base acceleration (carrier_slot(N) + 0..5)."""
+    return 3 * n_modes + 27
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -274,6 +275,15 @@ def place_slot(n_modes):
     return 3 * n_modes + 20
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def carrier_slot(n_modes):
+    """The first of the six slots of the other carrier of the curvatures' second derivatives
+    (`_observe_bend_squares`): for the clamp (k = 0) and midspan (k = 1) the integrals of
+    r_k^2 and r_k a_b (carrier_slot + 2 k, + 2 k + 1; m^2/s^3), r_k = c_k'' + G_k a_b, and
+    G_k (carrier_slot + 4 + k: sum_n phi_n''(s) Gamma_n times l^2, m; set by `start`)."""
+    return 3 * n_modes + 21
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def inertia_at(factor, t, p1, base):
     """(inertia, its rate) (m, m/s) for kernels.modes.span_loads at t (s): `factor` (the
@@ -315,13 +325,21 @@ def square_slot(n_modes):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _observe_bend_squares(y, y_new, f, f_new, h, n, curvature, modal):
+def _observe_bend_squares(y, y_new, f, f_new, h, n, curvature, modal, acc):
     """The accepted step's integrals of c^2, c'^2 and c''^2 for the clamp's curvature at
     s = 0 and midspan's (kernels.modes BEND_0, BEND_MID; c = sum phi_n''(s) q_n, times l^2:
     m), on the quintic Hermite through c, c' and c'' at both ends (trajectory's, as the
     midspan's mean squares): f, f_new the right-hand side at the step's ends (q_n'' =
-    f[N + n]); curvature: the basis' CLAMPS rows."""
+    f[N + n]); curvature: the basis' CLAMPS rows. And the other carrier of c'', r = c'' +
+    G a_b (`carrier_slot`), as trajectory.observe_random's for the midspan: the integrals of
+    r^2 and r a_b by Simpson's rule through the middle value of r that its exact integral
+    gives, from the step's a_b that trajectory.record_statistics kept in acc (STEP_AB)."""
     slot = square_slot(n)
+    other = carrier_slot(n)
+    ab_old = acc[tj.STEP_AB]
+    ab_mid = acc[tj.STEP_AB + 1]
+    ab_new = acc[tj.STEP_AB + 2]
+    b1 = acc[tj.STEP_AB + 3]
     for k in range(2):
         e = md.BEND_0 if k == 0 else md.BEND_MID
         c0 = 0.0
@@ -342,16 +360,23 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, curvature, modal):
         modal[slot + 3 * k] += square
         modal[slot + 3 * k + 1] += slope
         modal[slot + 3 * k + 2] += curve
+        g = modal[other + 4 + k]
+        s0 = a0 + g * ab_old
+        s1 = a1 + g * ab_new
+        sm = (6.0 * (r1 - r0 + g * b1) / h - s0 - s1) / 4.0
+        modal[other + 2 * k] += h / 6.0 * (s0 * s0 + 4.0 * sm * sm + s1 * s1)
+        modal[other + 2 * k + 1] += h / 6.0 * (s0 * ab_old + 4.0 * sm * ab_mid + s1 * ab_new)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _observe_record_modes(t, t_tail, y, y_new, K, h, n, curvature, modal, base):
+def _observe_record_modes(t, t_tail, y, y_new, K, h, n, curvature, modal, acc, base):
     """The record kind's modal statistics of the accepted step [t, t + h] (K: its stages, the
     last f(t + h, y_new)), as trajectory.observe_random's for the midspan: the curvature
     squares at the clamp and midspan (`_observe_bend_squares`) once the step starts in the
-    statistics window, where the scene observes the loads. curvature: the basis' CLAMPS rows."""
+    statistics window, where the scene observes the loads. curvature: the basis' CLAMPS rows;
+    acc: the midspan's accumulator, after trajectory.record_statistics took the step."""
     if t >= t_tail and modal[factor_slot(n) + 1] != 0.0:
-        _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, curvature, modal)
+        _observe_bend_squares(y, y_new, K[0], K[K.shape[0] - 1], h, n, curvature, modal, acc)
 
 
 # `_observe_record_modes` for a random record, nothing for the sine kinds (not compiled there)
@@ -366,8 +391,16 @@ def curvature_moments(modal, n, acc, reals):
     span = acc[tj.W_END] - acc[tj.W_START]
     if modal[factor_slot(n) + 1] == 0.0 or acc[tj.IN_WINDOW] == 0.0 or not span > 0.0:
         return
+    b2 = acc[tj.SUM_B2]
     for k in range(6):
         reals[CURVATURE_M0 + k] = modal[square_slot(n) + k] / span
+    for k in range(2):          # the second derivative's mean square through its smaller carrier
+        f2 = modal[square_slot(n) + 3 * k + 2]
+        r2 = modal[carrier_slot(n) + 2 * k]
+        rb = modal[carrier_slot(n) + 2 * k + 1]
+        g = modal[carrier_slot(n) + 4 + k]
+        if tj.carried(f2, r2):
+            reals[CURVATURE_M0 + 3 * k + 2] = max(r2 - 2.0 * g * rb + g * g * b2, 0.0) / span
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -1044,7 +1077,11 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
              fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
     if ex.is_record(base):
-        tj.delay_window(acc, row[md.EXCITATION + ex.RECORD_START])
+        share = 0.0                         # the watched deflection's participation
+        for i in range(n):
+            share -= weights[i] * pp[md.P_FORCE * n + i]
+        tj.record_window(acc, row[md.EXCITATION + ex.RECORD_START],
+                         row[md.EXCITATION + ex.RAMP], share)
         t_tail = acc[tj.T_TAIL]
     for i in range(n):
         modal[i] = abs(y[i]) if t_tail <= 0.0 else 0.0
@@ -1074,6 +1111,11 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     for k in range(6):
         modal[square_slot(n) + k] = 0.0
+        modal[carrier_slot(n) + k] = 0.0
+    for k in range(2):                  # the curvature's share G_k of a_b (c'' = r - G_k a_b)
+        e = md.BEND_0 if k == 0 else md.BEND_MID
+        for i in range(n):
+            modal[carrier_slot(n) + 4 + k] -= curvature[e, i] * pp[md.P_FORCE * n + i]
     for i in range(n):
         modal[2 * n + 1 + i] = 0.0
     for i in range(n):
@@ -1140,7 +1182,6 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         t_tail = acc[tj.T_TAIL]            # the trajectory's own (solver.stop_when_steady)
         _observe_modes(t, t_new, t_tail, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                        basis, Qc, p1, base)
-        observe_random_modes(t, t_tail, y, y_new, K, h, n, basis[md.CLAMPS], modal, base)
         _project_stages(K, weights, n, n_stages, K_mid)
         if acc[tj.N_EXT] >= buf.shape[0]:
             buf = tj.with_room(buf, acc)
@@ -1148,6 +1189,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         v_mid = _project(y_new, weights, n, n)
         tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series, track,
                        centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
+        observe_random_modes(t, t_tail, y, y_new, K, h, n, basis[md.CLAMPS], modal, acc, base)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                       basis, Qc, p1, base)
         _next_step(y, y_new, K, dim, n_stages)

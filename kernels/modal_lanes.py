@@ -667,7 +667,6 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
     t_tail = acc[tj.T_TAIL]
     drv._observe_modes(t, t_new, t_tail, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx, basis,
                        Qc, P1L[j], base)
-    drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis[md.CLAMPS], ml, base)
     for r in range(Kmid.shape[0]):
         Kmid[r, 0] = KM[r, 0, j]
         Kmid[r, 1] = KM[r, 1, j]
@@ -675,6 +674,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
     v_new = drv._project(ynl, weights, n, n)
     tj.record_step(P1L[j], 0, 1, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
                    track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
+    drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis[md.CLAMPS], ml, acc, base)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx,
                       basis, Qc, P1L[j], base)
     for c in range(MOD.shape[0]):
@@ -751,7 +751,7 @@ def _record_steps(W, START, Y, YN, K, H, MOVE, FLAG, MOD, P1L, settings, n, n_ru
         for c in range(MOD.shape[0]):
             ml[c] = MOD[c, j]
         drv.observe_random_modes(t, t_tail, yl, ynl, Kl, H[j], n, family[md.CLAMPS][BI[j]],
-                                 ml, base)
+                                 ml, acc, base)
         for c in range(MOD.shape[0]):
             MOD[c, j] = ml[c]
 

@@ -33,8 +33,8 @@ from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STE
                      LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
                      STEADY_PERIODS, STEADY_TOL, TAIL, T_END)
 from .layout import RHS_EVALS as EVALS_COLUMN, SETTLING
-from .oscillator import (BOUND, DAMPING, EXCITATION, Q0, Q_SCALE, V0, V_SCALE, acceleration,
-                         base_acceleration)
+from .oscillator import (BOUND, DAMPING, EXCITATION, PARTICIPATION, Q0, Q_SCALE, V0, V_SCALE,
+                         acceleration, base_acceleration)
 from .stages import InlineWhereTrue
 from .vecmath import log2_fast
 
@@ -86,17 +86,26 @@ T_FINAL = T_TAIL + 1    # this trajectory's end time (s): t_end, or the moved ta
 N_SLOTS = T_FINAL + 1
 # The record kind's statistics (a random base acceleration, kernels.excitation), after the
 # slots every driver keeps: the drivers that run records (the scalar ones, the multi-mode
-# lanes) allocate SCALAR_SLOTS, and `delay_window` zeroes them. The window starts with the
+# lanes) allocate SCALAR_SLOTS, and `record_window` zeroes them. The window starts with the
 # first step that starts at or after the tail window's start and ends with the run; over it
-# (`observe_random`):
+# (`observe_random`; the accelerations' parts: `acceleration_squares`):
 IN_WINDOW = N_SLOTS      # 1.0 once the window has started
 W_START = IN_WINDOW + 1  # when it started (s)
 W_END = W_START + 1      # the last step end in it (s)
 SUM_Q2 = W_END + 1       # integral of q^2 dt (m^2 s), on the step's quintic Hermite
 SUM_V2 = SUM_Q2 + 1      # integral of q'^2 dt (m^2/s), on the same quintic's slope
-SUM_A2 = SUM_V2 + 1      # integral of (q'' + a_b)^2 dt (m^2/s^3), Simpson's rule on each step
-SUM_F2 = SUM_A2 + 1      # integral of q''^2 dt (m^2/s^3), on the quintic's second derivative
-UP_ZERO = SUM_F2 + 1     # up-crossings of q = 0
+SUM_F2 = SUM_V2 + 1      # integral of q''^2 dt (m^2/s^3), on the quintic's second derivative
+SUM_FB = SUM_F2 + 1      # integral of q'' a_b dt (m^2/s^3), Simpson's rule, the quintic's q''
+SUM_R2 = SUM_FB + 1      # integral of r^2 dt (m^2/s^3), r = q'' + G a_b the acceleration the
+                         # span's own forces give (G: a_b's share of q''), Simpson's rule on
+                         # each step through r's middle value that its exact integral gives
+SUM_RB = SUM_R2 + 1      # integral of r a_b dt (m^2/s^3), Simpson's rule on the same nodes
+SUM_B2 = SUM_RB + 1      # integral of a_b^2 dt (m^2/s^3), exact on the record's interpolant
+SHARE = SUM_B2 + 1       # G (1): q'' = r - G a_b (the participation of the watched deflection)
+STEP_AB = SHARE + 1      # the last step's a_b at its start, middle and end (m/s^2) and its
+                         # integral over it (m/s) in STEP_AB + 0..3 (`record_statistics`; the
+                         # modes' curvature squares read them: modal_driver)
+UP_ZERO = STEP_AB + 4    # up-crossings of q = 0
 UP_LEVEL = UP_ZERO + 1   # level k's crossings of |q| upwards through settings[LEVEL_0 + k]
 SCALAR_SLOTS = UP_LEVEL + MAX_LEVELS
 
@@ -164,7 +173,8 @@ def start(p, o, s, settings, acc, series, parametric, base):
         a0 += base_acceleration(0.0, p, o, s, None, base)
     begin(settings, acc, series, q, v, fv, a0, atol_q, atol_v, h_abs, evals, p[o + BOUND * s])
     if ex.is_record(base):
-        delay_window(acc, p[o + (EXCITATION + ex.RECORD_START) * s])
+        record_window(acc, p[o + (EXCITATION + ex.RECORD_START) * s],
+                      p[o + (EXCITATION + ex.RAMP) * s], p[o + PARTICIPATION * s])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -176,14 +186,17 @@ def new_accumulator(slots):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def delay_window(acc, start):
+def record_window(acc, start, ramp, share):
     """A random record's own statistics window: the tail window starts no earlier than
     `start` (s, the row's start-up transient's end), so that a point's statistics depend on
-    its own row only, not on the grid's slowest point; and the statistics' slots (IN_WINDOW
-    .. SCALAR_SLOTS) zeroed, for a lanes driver's accumulator that held a row before. Called
-    right after `begin`."""
+    its own row only, not on the grid's slowest point, nor before the record's level ramp
+    (s) has ended; the statistics' slots (IN_WINDOW .. SCALAR_SLOTS) zeroed, for a lanes
+    driver's accumulator that held a row before, and SHARE set to `share`, the participation
+    G of the watched deflection (q'' = r - G a_b). Called right after `begin`."""
     for k in range(N_SLOTS, SCALAR_SLOTS):
         acc[k] = 0.0
+    acc[SHARE] = share
+    start = max(start, ramp)
     if start <= acc[T_TAIL]:
         return
     acc[T_TAIL] = start
@@ -991,7 +1004,8 @@ def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_
     """`observe_random` and `observe_level_crossings` for record_step's accepted step
     [t, t_new] (s) of a record, with the absolute acceleration at both ends (the newest
     sample's at t_new, the step before's end at t, evaluated here where there is none) and at
-    its middle (q'' on the quintic Hermite, plus a_b there). Call it after
+    its middle, and a_b's integrals over the step (`step_integrals`; a_b at both ends and
+    middle and its integral are kept in STEP_AB for the modes' curvature squares). Call it after
     `observe_acceleration` has taken the step's end as its newest sample. (The one-mode lanes
     call the two observers in their own vector loops: kernels.lanes `_record_sums`.)"""
     if t < acc[T_TAIL]:
@@ -1000,11 +1014,14 @@ def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_
     a_old = acc[ACC_SAMPLES + SAMPLE_SIZE + S_A]     # at t: the step before's end
     if math.isnan(a_old):
         a_old = fv_old + base_acceleration(t, p, o, s, None, base)
-    h = t_new - t
-    a_mid = (quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
-             + base_acceleration(t + 0.5 * h, p, o, s, None, base))
+    ab_mid = base_acceleration(0.5 * (t + t_new), p, o, s, None, base)
+    b1, b2 = step_integrals(t, t_new, p, o, s, base)
+    acc[STEP_AB] = a_old - fv_old
+    acc[STEP_AB + 1] = ab_mid
+    acc[STEP_AB + 2] = a_new - fv_new
+    acc[STEP_AB + 3] = b1
     window = observe_random(acc, 0, 1, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new,
-                            a_old, a_mid, a_new, has_ext, qe, True)
+                            a_old, a_new, ab_mid, b1, b2, has_ext, qe, True)
     for k in range(int(settings[N_LEVELS])):
         observe_level_crossings(settings, acc, 0, 1, k, q_old, qe, q_new, has_ext, window)
 
@@ -1015,20 +1032,30 @@ _refine_sine_peak = ex.by_kind(refine_acceleration_peak, None)
 _observe_record_step = ex.by_kind(None, record_statistics)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def step_integrals(t, t_new, p, o, s, base):
+    """The integrals of a_b and of a_b^2 over the step [t, t_new] (s) of a record's row
+    (m/s, m^2/s^3; excitation.record_integrals: exact on the record's interpolant)."""
+    first0, square0 = ex.record_integrals(t, p, o + EXCITATION * s, s, base)
+    first1, square1 = ex.record_integrals(t_new, p, o + EXCITATION * s, s, base)
+    return first1 - first0, square1 - square0
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def observe_random(acc, a, sa, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_new, a_old,
-                   a_mid, a_new, has_ext, qe, take):
+                   a_new, ab_mid, b1, b2, has_ext, qe, take):
     """The record kind's statistics of the accepted step [t, t_new] (s) of the watched
     deflection q (m; q' = v, q'' = fv at both ends, a the absolute acceleration q'' + a_b,
-    m/s^2, at both ends and a_mid at the middle; qe its extremum inside the step where has_ext),
+    m/s^2, at both ends, ab_mid a_b at the middle, b1 and b2 the integrals of a_b and a_b^2
+    over the step: `step_integrals`; qe its extremum inside the step where has_ext),
     accumulator at acc[a + slot * sa] as `observe_step_end`'s, where `take` and the step
     starts at or after the tail window's start (returned: whether it did): the window's start
-    and end, the integrals of q^2, q'^2 and q''^2 on the quintic Hermite through q, q', q'' at
-    both ends (`quintic_squares`) and of (q'' + a_b)^2 by Simpson's rule (SCALAR_SLOTS; the
-    trapezoidal rule on the ends read a reviewer's clamped span's RMS 0.24-0.29 % high where
-    the steps are long), and the up-crossings of zero on the step's monotone pieces, q_old to
-    qe to q_new (the levels': `observe_level_crossings`). Straight-line selects, so that the
-    lanes' loop vectorises; adding 0.0 where not taken leaves a sum's bits as they were."""
+    and end, the integrals of q^2 and q'^2 on the quintic Hermite through q, q', q'' at both
+    ends (`quintic_squares`), the accelerations' parts (`acceleration_squares`: the
+    integrals of r^2 and r a_b by Simpson's rule, of a_b^2 exact), and the up-crossings of
+    zero on the step's monotone pieces, q_old to qe to q_new (the levels':
+    `observe_level_crossings`). Straight-line selects, so that the lanes' loop vectorises;
+    adding 0.0 where not taken leaves a sum's bits as they were."""
     window = take & (t >= acc[a + T_TAIL * sa])
     opened = acc[a + IN_WINDOW * sa]
     acc[a + W_START * sa] = t if window & (opened == 0.0) else acc[a + W_START * sa]
@@ -1036,14 +1063,54 @@ def observe_random(acc, a, sa, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_
     acc[a + W_END * sa] = t_new if window else acc[a + W_END * sa]
     h = t_new - t
     square, slope, curve = quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
-    area = h / 6.0 * (a_old * a_old + 4.0 * a_mid * a_mid + a_new * a_new)
+    g = acc[a + SHARE * sa]
+    ab_old = a_old - fv_old
+    ab_new = a_new - fv_new
+    r_old = fv_old + g * ab_old           # r = q'' + G a_b: the span's own forces, smooth
+    r_new = fv_new + g * ab_new
+    r_mid = (6.0 * (v_new - v_old + g * b1) / h - r_old - r_new) / 4.0   # its integral, exact
+    r2 = h / 6.0 * (r_old * r_old + 4.0 * r_mid * r_mid + r_new * r_new)
+    rb = h / 6.0 * (r_old * ab_old + 4.0 * r_mid * ab_mid + r_new * ab_new)
+    f_mid = quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
+    fb = h / 6.0 * (fv_old * ab_old + 4.0 * f_mid * ab_mid + fv_new * ab_new)
     acc[a + SUM_Q2 * sa] += square if window else 0.0
     acc[a + SUM_V2 * sa] += slope if window else 0.0
     acc[a + SUM_F2 * sa] += curve if window else 0.0
-    acc[a + SUM_A2 * sa] += area if window else 0.0
+    acc[a + SUM_FB * sa] += fb if window else 0.0
+    acc[a + SUM_R2 * sa] += r2 if window else 0.0
+    acc[a + SUM_RB * sa] += rb if window else 0.0
+    acc[a + SUM_B2 * sa] += b2 if window else 0.0
     up = (_up_zero(q_old, qe) + _up_zero(qe, q_new)) if has_ext else _up_zero(q_old, q_new)
     acc[a + UP_ZERO * sa] += up if window else 0.0
     return window
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def acceleration_squares(acc):
+    """The integrals over a record's statistics window of the absolute acceleration's square,
+    (q'' + a_b)^2, and of the relative one's, q''^2 (m^2/s^3), from `observe_random`'s parts.
+    Each is a smooth part plus a multiple of a_b, whose square is integrated exactly on the
+    record's interpolant; of the two smooth parts, r = q'' + G a_b (the span's own forces, G
+    its participation: SHARE; q'' + a_b = r + (1 - G) a_b, q'' = r - G a_b) and q'' itself on
+    the step's quintic Hermite (q'' + a_b = q'' + a_b), the smaller carries it (`carried`):
+    r for a span below the spectrum's band, which the base moves while its own forces stay
+    small (Simpson's rule on the whole square with steps long beside the record's samples
+    read such a span's RMS 1.8 % low), q'' for a span above it, which follows the base (r is
+    then nearly G a_b)."""
+    g = acc[SHARE]
+    f2, fb, r2, rb, b2 = acc[SUM_F2], acc[SUM_FB], acc[SUM_R2], acc[SUM_RB], acc[SUM_B2]
+    if carried(f2, r2):
+        return (max(r2 + 2.0 * (1.0 - g) * rb + (1.0 - g) ** 2 * b2, 0.0),
+                max(r2 - 2.0 * g * rb + g * g * b2, 0.0))
+    return max(f2 + 2.0 * fb + b2, 0.0), f2
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def carried(f2, r2):
+    """Whether a second derivative x = r - G a_b of a record's response is integrated through
+    r (the span's own forces; its square's integral r2) rather than on the steps' quintic
+    Hermite (f2): where r is the smaller (`acceleration_squares`)."""
+    return r2 <= f2
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -290,8 +290,9 @@ def random_outputs(settings, acc, reals):
         return mt.COMPLETED
     reals[RMS_DEFLECTION] = math.sqrt(acc[tj.SUM_Q2] / span)
     reals[RMS_VELOCITY] = math.sqrt(acc[tj.SUM_V2] / span)
-    reals[RMS_ACCELERATION] = math.sqrt(acc[tj.SUM_A2] / span)
-    reals[RMS_RELATIVE] = math.sqrt(acc[tj.SUM_F2] / span)
+    absolute, relative = tj.acceleration_squares(acc)
+    reals[RMS_ACCELERATION] = math.sqrt(absolute / span)
+    reals[RMS_RELATIVE] = math.sqrt(relative / span)
     reals[ZERO_RATE] = acc[tj.UP_ZERO] / span
     for k in range(int(settings[N_LEVELS])):
         reals[LEVEL_RATE + k] = acc[tj.UP_LEVEL + k] / span

@@ -422,8 +422,9 @@ def _say_interpolated(counts: dict[str, int], results: list[xr.Dataset]) -> None
     if counts["frequency"]:
         one = "" if len(results) == 1 else " (on that result alone)"
         print(f"{counts['frequency']} min_frequency span(s) interpolated as log f against "
-              "log l, which is exact for pinned or clamped ends but not for elastic ones "
-              f"(K = k_t l / EI grows with the span); --refine{one} gives the exact span, "
+              "log l, which is exact for unloaded pinned or clamped ends but not for elastic "
+              "ones (K = k_t l / EI grows with the span) nor under a constant end load (its "
+              f"share of the stiffness grows as l^2); --refine{one} gives the exact span, "
               "without an engine run")
 
 

@@ -6,7 +6,9 @@ and, for every combination of its other swept axes, returns the largest span bef
 grid length that fails, interpolated between that length and the last passing one on the
 margin of the criterion that binds. A length fails when
 
-* ``min_frequency``: its first natural frequency `natural_frequency` (Hz) is below the limit;
+* ``min_frequency``: its first natural frequency (Hz) is below the limit: `loaded_frequency`,
+  the loaded span's, where the result's end load is constant (a compressive load lowers it),
+  else `natural_frequency` (`frequency_of`);
 * ``max_amplitude``: its response (`peak_amplitude` of a swept result, one with
   `peak_frequency`; else `amplitude`; or the response named by ``quantity``, one of
   RESPONSES, m) is above the limit, or is missing (NaN);
@@ -379,7 +381,7 @@ def _check(ds: xr.Dataset, min_frequency: float | None, max_amplitude: float | N
         raise UserError(NO_CRITERION)
     axes = check_result(ds)
     _refuse_sine_limits_of_a_random_result(ds, max_amplitude, max_deflection, max_strain)
-    if min_frequency is not None and "natural_frequency" not in ds:
+    if min_frequency is not None and frequency_of(ds) not in ds:
         raise UserError("design: --min-frequency needs the variable 'natural_frequency' (Hz), "
                         "which this result lacks (a transverse result has it)")
     if quantity is not None and max_amplitude is None:
@@ -466,6 +468,13 @@ def _broadcast(var: xr.DataArray, like: xr.DataArray) -> np.ndarray:
     return np.asarray(var.broadcast_like(like).transpose(*like.dims).values, float)
 
 
+def frequency_of(ds: xr.Dataset) -> str:
+    """The variable --min-frequency judges a result by: `loaded_frequency` (Hz, the span's
+    first natural frequency under a constant end load) where the result has it, else
+    `natural_frequency` (the unloaded span's)."""
+    return "loaded_frequency" if "loaded_frequency" in ds else "natural_frequency"
+
+
 def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
              max_amplitude: Limit = None, quantity: str | None = None,
              max_deflection: Limit = None, max_strain: Limit = None,
@@ -479,7 +488,8 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     ----------
     ds : a result of `sweep.run` (or `sweep.plot.load_result`) with a `length` axis in m (or
         mm, cm, km or their spelled-out names, as its units attribute says: converted to m).
-    min_frequency : Hz; a length passes when `natural_frequency` >= min_frequency.
+    min_frequency : Hz; a length passes when its first natural frequency (`frequency_of`:
+        the loaded span's under a constant end load) >= min_frequency.
     max_amplitude : m; a length passes when the response <= max_amplitude. The response is
         `quantity` (one of RESPONSES, in m over the swept axes), by default `peak_amplitude` for a
         swept result (one with `peak_frequency`) and `amplitude` otherwise; its worst
@@ -595,7 +605,7 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
                        if c != POINT_DIM and ds[c].dims == (POINT_DIM,)})
     title = str(ds.attrs.get("title", ""))
     criteria = "; ".join(
-        ([f"natural_frequency >= {fmin:g} Hz"] if fmin is not None else [])
+        ([f"{frequency_of(ds)} >= {fmin:g} Hz"] if fmin is not None else [])
         + [f"{name} <= {limit:g} {_shown_units(ds[name])}".rstrip()
            if level is None else f"{name} at clearance {level:g} m (pooled over the "
            f"realisations) <= {limit:g}" for name, limit, level in limits.values()]
@@ -923,7 +933,7 @@ def _margins(ds: xr.Dataset, fmin: float | None, limits: Limits,
     shape = like.shape
     margins: dict[str, tuple[np.ndarray, np.ndarray, str]] = {}
     if fmin is not None:
-        f = _broadcast(_worst(ds["natural_frequency"], "min"), like)
+        f = _broadcast(_worst(ds[frequency_of(ds)], "min"), like)
         margins["min_frequency"] = (f - fmin, f, "log")
     for criterion, (name, limit, level) in limits.items():
         q = _broadcast(_limited(ds, name, level), like)
@@ -974,10 +984,11 @@ def interpolated(result: xr.Dataset, sources: dict[str, xr.Dataset]) -> dict[str
     grid lengths of the result they bind in (`sources`: name -> result; `limited_in` names
     it, else the one source), by kind: "response" (a response criterion or the growth rate
     interpolated linearly in l: a resonance or a tongue between the lengths can put the true
-    limit shorter) and "frequency" (log f against log l with elastic ends, not exact). A
+    limit shorter) and "frequency" (log f against log l with elastic ends or under a constant
+    end load, not exact). A
     span that is a grid length (a state failure, a limit not crossed in the bracket, the
-    grid's longest, a NaN) is not counted, nor is a frequency span of pinned or clamped ends
-    (exact, f1 ~ l^-2)."""
+    grid's longest, a NaN) is not counted, nor is a frequency span of unloaded pinned or
+    clamped ends (exact, f1 ~ l^-2)."""
     spans = np.asarray(result["max_span"].values, dtype=float).ravel()
     limited = np.asarray(result["limited_by"].values, dtype=str).ravel()
     where = (np.asarray(result["limited_in"].values, dtype=str).ravel()
@@ -992,7 +1003,7 @@ def interpolated(result: xr.Dataset, sources: dict[str, xr.Dataset]) -> dict[str
             continue
         if by != "min_frequency":
             counts["response"] += 1
-        elif elastic_ends(sources[name]):
+        elif elastic_ends(sources[name]) or frequency_of(sources[name]) == "loaded_frequency":
             counts["frequency"] += 1
     return counts
 
@@ -1098,7 +1109,9 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     The frequency criterion needs no run: natural_frequency is the closed form of the
     unloaded span, f1 ~ l^-2 with pinned or clamped ends, so interpolating log f against
     log l between the grid lengths is exact there; with elastic ends (K = k_t l / EI, f1 not
-    ~ l^-2) the length where the closed-form f1 crosses the limit is bisected instead. Where
+    ~ l^-2) or a constant end load (`loaded_frequency`, sweep.models.stability: the load's
+    share grows as l^2) the length where the closed-form frequency crosses the limit is
+    bisected instead. Where
     only it fails at l_b the span is that length (no run; with only min_frequency the
     refinement costs no run at all). Where another criterion fails at
     l_b too and the frequency span l_f lies inside the bracket, one run at l_f decides:
@@ -1144,6 +1157,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
     # the reader's machine decides how the runs execute, never the file's scene
     here = {"run.backend": "threads", "run.workers": 0, "run.threads": 0}
     stored = load_scene_text(text, source="the result's scene", overrides=here)
+    loaded = frequency_of(ds) == "loaded_frequency"
     scene_axes = set(stored.axes) | ({POINT_DIM} if stored.points else set())
     stepped = ds.attrs.get("continuation_axis")
     stepped = stepped if isinstance(stepped, str) and stepped in ds.dims else None
@@ -1208,7 +1222,12 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         from .models.modal import oscillator
         scene = load_scene_text(text, source="the result's scene", overrides=scene_at(
             point, length))
-        f1 = oscillator(parameters(scene, coordinates(scene)))["natural_frequency"]
+        coeffs = oscillator(parameters(scene, coordinates(scene)))
+        if loaded:
+            from .models.stability import loaded_frequency
+            f1 = loaded_frequency(coeffs, int(scene.get("model.modes")))
+        else:
+            f1 = coeffs["natural_frequency"]
         return float(np.min(np.asarray(f1, float)))
 
     spans = grid["max_span"].values.copy().reshape(-1)
@@ -1233,7 +1252,7 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         if "min_frequency" in failing:
             f = margins["min_frequency"][1]
             l_f = _interpolate(lo, hi, f[a], f[b], fmin, "log")
-            if stored.get("clamps.rotation") == "elastic":    # f1 not ~ l^-2: K ~ l
+            if loaded or stored.get("clamps.rotation") == "elastic":   # f1 not ~ l^-2
                 l_f = _frequency_span(lambda length: frequency_at(point, length), lo, hi,
                                       fmin, tol)
         others_fail = [k for k in failing if k != "min_frequency"]

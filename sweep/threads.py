@@ -113,8 +113,9 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
     A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
     for its response envelope and durations (n,), each point's end time (s; `swept_settings`).
-    records: a random base acceleration's (R, 2, N) records, which the kernels take as their
-    `base` switch (kernels.excitation's record kind), on either driver.
+    records: a random base acceleration's (R, 4, N) records (sweep.models.random.Records'
+    values), which the kernels take as their `base` switch (kernels.excitation's record kind),
+    on either driver.
 
     driver: "lanes" (lock-step SIMD lanes, the default) or "scalar" (SciPy's arithmetic, one
     trajectory after another); threads: 0 for all (see thread_count). on_block(lo, hi) is
@@ -263,6 +264,10 @@ def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
     takes them), else `base` as it is (None or True: a sine kind)."""
     if records is None:
         return base
+    from sweep.kernels.layout import RECORD_ROWS
+    if records.ndim != 3 or records.shape[1] != RECORD_ROWS:
+        raise ValueError(f"records of shape {records.shape}: expected (R, {RECORD_ROWS}, N), "
+                         "the samples with their integrals (sweep.models.random.with_integrals)")
     return np.ascontiguousarray(records, dtype=np.float64)
 
 

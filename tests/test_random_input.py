@@ -84,7 +84,8 @@ def test_mean_square_flat_and_minus_one_slopes_in_closed_form():
 def test_ensemble_mean_square_matches_the_spectrum_within_three_standard_errors(gevs):
     f, W = gevs
     rec = rnd.synthesise(f, W, 1.0, 20000.0, 64, 11)
-    assert rec.values.shape == (64, 2, 20000) and rec.values.dtype == np.float64
+    assert rec.values.shape == (64, rnd.RECORD_ROWS, 20000)
+    assert rec.values.dtype == np.float64
     assert rec.values.flags.c_contiguous
     assert (rec.realisations, rec.samples, rec.period, rec.sample_rate) == (64, 20000, 1.0,
                                                                           20000.0)
@@ -144,7 +145,7 @@ def test_derivative_record_is_the_analytic_derivative():
     fs, n = rec.sample_rate, rec.samples
     t = np.arange(n) / fs
     for r in range(2):
-        x, dx = rec.values[r]
+        x, dx = rec.values[r, :2]
         np.testing.assert_allclose(_cosine_sum(x, fs, t, False), x, atol=1e-10 * np.abs(x).max())
         np.testing.assert_allclose(_cosine_sum(x, fs, t, True), dx,
                                    atol=1e-10 * np.abs(dx).max())
@@ -217,6 +218,49 @@ def test_records_are_periodic_under_hermite(gevs):
     x = rec.values[0]
     end = rnd.hermite(x, rec.sample_rate, np.array([rec.period - 1e-12, rec.period]))
     np.testing.assert_allclose(end, x[0, 0], atol=1e-6 * np.abs(x[0]).max())
+
+
+def test_record_integrals_are_the_interpolants_integrals(gevs):
+    """The running integrals a record carries (rows 2 and 3: of its cubic Hermite interpolant
+    and of its square, from 0 to each sample) and the kernels' integrals between any two
+    times (kernels.excitation.record_integrals: those rows and the partial intervals in closed
+    form, times the level factor and its square) against adaptive quadrature of the
+    interpolant (`rnd.hermite`), over stretches from a fraction of a sample to most of the
+    period, across its end (t below two periods: a run never passes one) and with a negative
+    level factor."""
+    from sweep.kernels import excitation as ex
+    f, W = gevs
+    fs = 20000.0
+    rec = rnd.synthesise(f, W, 0.01, fs, 2, 5)
+    values = rec.values
+    rng = np.random.default_rng(3)
+    for r in range(2):
+        a = lambda t: float(rnd.hermite(values[r, :2], fs, np.array([t]))[0])   # noqa: E731
+        for k in rng.integers(1, rec.samples, 4):
+            edges = np.arange(k + 1) / fs
+            first = sum(integrate.quad(a, x0, x1, epsabs=0, epsrel=1e-12)[0]
+                        for x0, x1 in zip(edges[:-1], edges[1:]))
+            square = sum(integrate.quad(lambda t: a(t) ** 2, x0, x1, epsabs=0,
+                                        epsrel=1e-12)[0] for x0, x1 in zip(edges[:-1], edges[1:]))
+            scale1 = np.abs(values[r, 2]).max() + abs(first)
+            assert values[r, 2, k] == pytest.approx(first, abs=1e-11 * scale1)
+            assert values[r, 3, k] == pytest.approx(square, rel=1e-11)
+        p = np.zeros(ex.SIZE)
+        p[ex.RECORD], p[ex.RECORD_RATE], p[ex.RECORD_SCALE] = r, fs, -0.7
+        for _ in range(12):
+            t0 = rng.uniform(0.0, 2.0 * rec.period - 1e-4)
+            t1 = min(t0 + rng.choice([0.3, 3.0, 30.0, 150.0]) / fs, 2.0 * rec.period - 1e-9)
+            edges = np.unique(np.concatenate([[t0, t1], np.arange(np.ceil(t0 * fs),
+                                                                   t1 * fs) / fs]))
+            first = sum(integrate.quad(a, x0, x1, epsabs=0, epsrel=1e-12)[0]
+                        for x0, x1 in zip(edges[:-1], edges[1:]))
+            square = sum(integrate.quad(lambda t: a(t) ** 2, x0, x1, epsabs=0,
+                                        epsrel=1e-12)[0] for x0, x1 in zip(edges[:-1], edges[1:]))
+            v0, e0 = ex.record_integrals(t0, p, 0, 1, values)
+            v1, e1 = ex.record_integrals(t1, p, 0, 1, values)
+            size = (t1 - t0) * np.abs(values[r, 0]).max()
+            assert v1 - v0 == pytest.approx(-0.7 * first, abs=1e-9 * size)
+            assert e1 - e0 == pytest.approx(0.49 * square, rel=1e-9, abs=1e-12 * size ** 2)
 
 
 # ---- hermite --------------------------------------------------------------------------------

@@ -33,7 +33,8 @@ of damped modes (deflection, velocity or absolute acceleration) by composite Gau
 quadrature graded around each resonance; `miles_rms` and `miles_grms` are Miles' white-noise
 single-mode formulas.
 
-Pure NumPy: no Numba, no SciPy.
+Pure NumPy: no Numba, no SciPy (the records' layout, kernels.layout.RECORD_ROWS, is a
+plain constant).
 """
 
 from __future__ import annotations
@@ -47,12 +48,15 @@ from typing import Any, Sequence
 import numpy as np
 
 from ..errors import UserError, one_line
+from ..kernels.layout import RECORD_ROWS
 from ..schema import STANDARD_GRAVITY
 
 DEFAULT_RATE_FACTOR = 10.0
 """`default_sample_rate`: the sample rate is 10 x the spectrum's top frequency."""
-MAX_RECORD_BYTES = 2 ** 31
-"""Largest records `synthesise` builds: 2 GiB of float64 (R x 2 x N x 8 bytes)."""
+MAX_RECORD_BYTES = 2 ** 32
+"""Largest records `synthesise` builds: 4 GiB of float64 (R x RECORD_ROWS x N x 8 bytes, the
+samples, their derivatives and their running integrals)."""
+
 GRADING = 2.0 ** np.arange(-3, 11)
 """`linear_mean_square`: quadrature edges at f_n (1 +/- zeta_n x these) around each mode."""
 BACKGROUND_PER_DECADE = 24
@@ -146,10 +150,13 @@ def default_sample_rate(f: np.ndarray) -> float:
 
 @dataclass(frozen=True, eq=False)
 class Records:
-    """Sampled base accelerations: values (R, 2, N) float64, C-contiguous, values[r, 0, k] the
-    acceleration a_b (m/s^2) of realisation r at t = k / sample_rate and values[r, 1, k] its
-    exact time derivative (m/s^3); sample_rate (Hz). Each record is periodic with `period`.
-    eq=False: records compare by identity (compare `values` with np.array_equal)."""
+    """Sampled base accelerations: values (R, RECORD_ROWS, N) float64, C-contiguous,
+    values[r, 0, k] the acceleration a_b (m/s^2) of realisation r at t = k / sample_rate,
+    values[r, 1, k] its exact time derivative (m/s^3), and values[r, 2, k], values[r, 3, k]
+    the integrals of the record's cubic Hermite interpolant (the kernels' a_b) and of its
+    square from 0 to that sample (m/s, m^2/s^3: `with_integrals`); sample_rate (Hz). Each
+    record is periodic with `period`. eq=False: records compare by identity (compare `values`
+    with np.array_equal)."""
     values: np.ndarray
     sample_rate: float
 
@@ -167,6 +174,35 @@ class Records:
     def samples(self) -> int:
         """N, the samples of a record (even)."""
         return int(self.values.shape[2])
+
+
+def with_integrals(values: np.ndarray, sample_rate: float) -> np.ndarray:
+    """(R, RECORD_ROWS, N): records given as their samples and derivatives (R, 2, N) (m/s^2,
+    m/s^3; sample_rate Hz) with the running integrals of their cubic Hermite interpolant and of its
+    square from t = 0 to each sample appended as rows 2 and 3 (m/s, m^2/s^3). A record is
+    periodic, so its last piece runs from sample N - 1 to sample 0. The kernels read the
+    integral over any stretch of time from these and the partial pieces at its ends in closed
+    form (kernels.excitation.record_integrals)."""
+    out = np.empty((values.shape[0], RECORD_ROWS, values.shape[2]))
+    out[:, :2] = values[:, :2]
+    for r in range(values.shape[0]):
+        _fill_integrals(out[r], 1.0 / float(sample_rate))
+    return out
+
+
+def _fill_integrals(record: np.ndarray, dt: float) -> None:
+    """Rows 2 and 3 of one record (RECORD_ROWS, N) from its rows 0 and 1 (`with_integrals`);
+    dt: the sample interval (s)."""
+    x, d = record[0], record[1] * dt
+    x1, d1 = np.roll(x, -1), np.roll(d, -1)
+    a2 = 3.0 * (x1 - x) - 2.0 * d - d1      # the piece's cubic x + d u + a2 u^2 + a3 u^3,
+    a3 = 2.0 * (x - x1) + d + d1            # u = (t - t_k) / dt from 0 to 1
+    first = dt * (x + d / 2.0 + a2 / 3.0 + a3 / 4.0)
+    square = dt * (x * x + x * d + (d * d + 2.0 * x * a2) / 3.0 + (x * a3 + d * a2) / 2.0
+                   + (a2 * a2 + 2.0 * d * a3) / 5.0 + a2 * a3 / 3.0 + a3 * a3 / 7.0)
+    record[2, 0] = record[3, 0] = 0.0
+    np.cumsum(first[:-1], out=record[2, 1:])
+    np.cumsum(square[:-1], out=record[3, 1:])
 
 
 def record_length(duration: float, sample_rate: float) -> int:
@@ -209,11 +245,12 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
     duration, sample_rate = float(duration), float(sample_rate)
     realisations, seed = int(realisations), int(seed)
     n = record_length(duration, sample_rate)
-    size = realisations * 2 * n * 8
+    size = realisations * RECORD_ROWS * n * 8
     if size > MAX_RECORD_BYTES:
         raise UserError(one_line(
                     "scene keys 'base.duration', 'base.sample_rate', 'base.realisations': "
-                    f"{realisations} records of {n:,} samples and their derivatives take "
+                    f"{realisations} records of {n:,} samples, their derivatives and "
+                    f"integrals take "
                     f"{size / 2 ** 30:.3g} GiB, over the {MAX_RECORD_BYTES / 2 ** 30:g} GiB "
                     "limit; shorten the duration, lower the sample rate or take fewer "
                     "realisations"))
@@ -228,7 +265,7 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
                                      f"{1.0 / (top - f[0]):.3g} s")
     scale = 0.5 * n * np.sqrt(variance)
     derivative = 2j * np.pi * fk
-    values = np.empty((realisations, 2, n))
+    values = np.empty((realisations, RECORD_ROWS, n))
 
     def make(r: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(r,)))
@@ -236,6 +273,7 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
         X = scale * (a - 1j * b)
         values[r, 0] = np.fft.irfft(X, n=n)
         values[r, 1] = np.fft.irfft(derivative * X, n=n)
+        _fill_integrals(values[r], 1.0 / sample_rate)
 
     workers = min(int(threads), realisations)
     if workers > 1:

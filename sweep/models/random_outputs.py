@@ -93,9 +93,9 @@ class RandomInputs:
                    ramp=random_scene.ramp_time(values))
 
     def records(self, threads: int = 1) -> np.ndarray:
-        """The records the kernels take as their `base` switch: (R, 2, N) samples of a_b at
-        0 dB and their derivatives (sweep/models/random.py), made on `threads` threads (the
-        same bits on any number)."""
+        """The records the kernels take as their `base` switch: (R, 4, N) samples of a_b at
+        0 dB, their derivatives and running integrals (sweep/models/random.py, `Records`),
+        made on `threads` threads (the same bits on any number)."""
         from .random import synthesise
         f, w = self.spectrum
         return synthesise(f, w, self.duration, self.sample_rate, self.realisations,

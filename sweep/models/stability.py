@@ -271,3 +271,39 @@ def stability_outputs(coeffs: dict[str, Any], dims: tuple[str, ...], shape: tupl
         out["floquet_mode"] = xr.DataArray(mode.astype(np.int32).reshape(shape), dims=dims,
                                            attrs={"units": "1", "long_name": text})
     return out
+
+
+def loaded_frequency(coeffs: dict[str, Any], n_modes: int) -> Any:
+    """The first natural frequency (Hz) of the straight span under its constant end load:
+    the lowest of the run's own linearised model about q = 0 with the load's stiffness in, so
+    the frequency a `sweep design --min-frequency` judges the loaded span by. coeffs are
+    modal.oscillator's for a constant load (k0 with the load's part, mass, natural_frequency
+    the unloaded f1; end_stiffness where the clamps are not pins), scalars or DataArrays on
+    their axes; NaN where the load buckles the straight span (no positive stiffness).
+
+    One mode, or pinned sines (the load does not couple them, and mode 1 stays the lowest):
+    sqrt(k0 / m) / 2 pi. Clamped or elastic ends with several modes: the load couples modes
+    1 and 3 (and 2 and 4, ...), so the lowest eigenvalue of diag(w_n^2) + (k0 / m - w_1^2)
+    L / L_11 (`coupled_matrices` of the basis of each distinct K; k0 / m - w_1^2 is mode 1's
+    load stiffness)."""
+    stiffness = coeffs["k0"] / coeffs["mass"]
+    if n_modes == 1 or "end_stiffness" not in coeffs:
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(stiffness.where(stiffness > 0.0) if isinstance(
+                stiffness, xr.DataArray) else np.where(stiffness > 0.0, stiffness, np.nan)) / (
+                2.0 * np.pi)
+    from .basis import span_basis
+    w1_sq = (2.0 * np.pi * coeffs["natural_frequency"]) ** 2
+    k, w, ends = xr.broadcast(*(xr.DataArray(v) for v in (stiffness, w1_sq,
+                                                            coeffs["end_stiffness"])))
+    flat_k, flat_w, flat_e = (np.asarray(a.values, float).reshape(-1) for a in (k, w, ends))
+    lowest = np.full(flat_k.shape, np.nan)
+    for value in np.unique(flat_e[~np.isnan(flat_e)]):
+        ratio, load = coupled_matrices(span_basis(float(value), n_modes))
+        at = flat_e == value
+        matrices = (np.diag(ratio * ratio)[None] * flat_w[at, None, None]
+                    + (flat_k[at] - flat_w[at])[:, None, None] * load[None])
+        lowest[at] = np.linalg.eigvals(matrices).real.min(axis=1)
+    with np.errstate(invalid="ignore"):
+        f = np.sqrt(np.where(lowest > 0.0, lowest, np.nan)) / (2.0 * np.pi)
+    return xr.DataArray(f.reshape(k.shape), dims=k.dims, coords=k.coords)

@@ -77,6 +77,12 @@ _DERIVED = {
                             "for the mean (harmonic) or constant load; NaN: no barrier, or one "
                             "beyond the model's range (mode slope pi q_b / l > 1)"),
 }
+# Scenes with a constant end load: the frequency `sweep design --min-frequency` judges.
+_LOADED = {
+    "loaded_frequency": ("Hz", "first linear natural frequency of the straight span under the "
+                               "constant end load (the run's modes, which the load couples "
+                               "where the clamps are not pins); NaN: the load buckles it"),
+}
 # Scenes with [base] (docs/model.md sec. 5): the excitation in both spellings (each stored
 # only where it is not an axis: then the axis is its coordinate) and closed forms.
 _BASE_DERIVED = {
@@ -335,6 +341,9 @@ def run(scene: Scene, options: RunOptions) -> xr.Dataset:
     if "outputs.stability" not in inputs.wanted or time_domain(inputs):
         _check_time_domain_memory(inputs)      # before anything is computed over the grid
     coeffs = modal.oscillator(inputs.params)   # derived quantities, on the axes they need
+    if inputs.params["load_type"] == "constant" and np.any(np.asarray(coeffs["load_ratio"]) != 0):
+        from .stability import loaded_frequency
+        coeffs["loaded_frequency"] = loaded_frequency(coeffs, inputs.n_modes)
     if "outputs.stability" not in inputs.wanted:
         return _warn_steep(_run_time_domain(inputs, coeffs, options), inputs)
     from .stability import stability_outputs
@@ -450,6 +459,8 @@ def _derived_table(coeffs: dict[str, Any], has_base: bool) -> dict[str, tuple[st
     table = dict(_DERIVED)
     if not np.any(np.asarray(coeffs["load_ratio"]) != 0.0):
         table.pop("load_frequency")
+    if "loaded_frequency" in coeffs:
+        table.update(_LOADED)
     return table | (_BASE_DERIVED if has_base else {})
 
 
