@@ -118,7 +118,7 @@ class Case:
     def rhs(self, r: int):
         """f(t, [q, v, z]) for solve_ivp, z' = q^2: scalar Python, the record as lists."""
         C, K, G3, H5, B = self.coef
-        x, dx = self.records[r, 0].tolist(), self.records[r, 1].tolist()
+        x, dx = self.records[r, :, 0].tolist(), self.records[r, :, 1].tolist()
         n, fs, dt = len(x), self.fs, 1.0 / self.fs
 
         def f(t, y):
@@ -322,7 +322,7 @@ def main() -> None:
 
     # accuracy, realisation 0 of the short record
     acc = Case(args.length, args.level, 1, args.accuracy_duration)
-    x, dx = acc.records[0, 0], acc.records[0, 1]
+    x, dx = acc.records[0, :, 0], acc.records[0, :, 1]
     probe = np.random.default_rng(0).uniform(0.0, acc.t_end, 1000)
     mine = np.array([_hermite(x, dx, acc.fs, t) for t in probe])
     f = acc.rhs(0)
@@ -352,7 +352,7 @@ def main() -> None:
 
     def rk4_all(m: float) -> None:
         for r in range(args.realisations):
-            rk4_rms(cost.records[r, 0], cost.records[r, 1], cost.fs, cost.coef, cost.t_end,
+            rk4_rms(cost.records[r, :, 0], cost.records[r, :, 1], cost.fs, cost.coef, cost.t_end,
                     t_tail, m)
 
     rows = []

@@ -228,7 +228,7 @@ def rk4_peer(name: str, sample: dict[str, Any], ref: np.ndarray, ref_ds: Any, e_
         raise SystemExit(f"{name}: expected one point per record in the sample")
 
     def run(m: float) -> np.ndarray:
-        return np.array([random_cost.rk4_rms_over(case.records[r, 0], case.records[r, 1],
+        return np.array([random_cost.rk4_rms_over(case.records[r, :, 0], case.records[r, :, 1],
                                                   case.fs, case.coef, t_end, starts[r], m)
                          for r in range(starts.size)])
     for m in RK4_STEPS:

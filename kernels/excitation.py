@@ -17,8 +17,9 @@ over its first RAMP seconds, as a shaker's does, by the factor (1 - cos(pi t / R
 (RAMP = 0: full level from t = 0).
 
 A random base acceleration is the excitation kind `record` (docs/model.md sec. 11): a_b(t)
-sampled at fs on a grid, records[r, 0, k] = a_b(k / fs) and records[r, 1, k] its time
-derivative (m/s^3, exact from the spectrum), interpolated between samples by the cubic
+sampled at fs on a grid, records[r, k, 0] = a_b(k / fs) and records[r, k, 1] its time
+derivative (m/s^3, exact from the spectrum; a sample's values side by side, so that a read
+touches one or two cache lines, kernels.layout.RECORD_ROWS), interpolated between samples by the cubic
 Hermite polynomial through both (so the forcing is continuous with its rate, as the adaptive
 step wants), periodic with the record's period N / fs. The records are shared by every grid
 point (common random numbers): the kernels take them as the `base` switch itself, an array
@@ -176,8 +177,8 @@ def _record_interval(t, p, o, s, records):
     and the level factor (`record_acceleration`)."""
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
-    k, k1, u, _ = _sample_index(t, fs, records.shape[2])
-    return (records[r, 0, k], records[r, 1, k], records[r, 0, k1], records[r, 1, k1], u,
+    k, k1, u, _ = _sample_index(t, fs, records.shape[1])
+    return (records[r, k, 0], records[r, k, 1], records[r, k1, 0], records[r, k1, 1], u,
             1.0 / fs, p[o + RECORD_SCALE * s])
 
 
@@ -196,28 +197,28 @@ def _piece_integrals(y0, d0, y1, d1, u, dt):
     return dt * first, dt * square
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, forceinline=True)
 def record_integrals(t, p, o, s, records):
     """(integral of a_b, integral of a_b^2) from 0 to t (s) (m/s, m^2/s^3) of the record kind's
     row, on its cubic Hermite interpolant times the level factor, the ramp left out (exact
     once t is past it: a record's statistics start after it): the running integrals the
-    records carry to each sample (rows 2 and 3, sweep.models.random.with_integrals) and the
+    records carry to each sample (columns 2 and 3, sweep.models.random.with_integrals) and the
     partial interval in closed form. The difference of two such calls is the integral over
     the stretch between them."""
-    n = records.shape[2]
+    n = records.shape[1]
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
     scale = p[o + RECORD_SCALE * s]
     k, k1, u, lap = _sample_index(t, fs, n)
-    first, square = _piece_integrals(records[r, 0, k], records[r, 1, k], records[r, 0, k1],
-                                     records[r, 1, k1], u, 1.0 / fs)
-    first += records[r, 2, k]
-    square += records[r, 3, k]
+    first, square = _piece_integrals(records[r, k, 0], records[r, k, 1], records[r, k1, 0],
+                                     records[r, k1, 1], u, 1.0 / fs)
+    first += records[r, k, 2]
+    square += records[r, k, 3]
     if lap:                         # a whole period before it
-        whole, whole_sq = _piece_integrals(records[r, 0, n - 1], records[r, 1, n - 1],
-                                           records[r, 0, 0], records[r, 1, 0], 1.0, 1.0 / fs)
-        first += whole + records[r, 2, n - 1]
-        square += whole_sq + records[r, 3, n - 1]
+        whole, whole_sq = _piece_integrals(records[r, n - 1, 0], records[r, n - 1, 1],
+                                           records[r, 0, 0], records[r, 0, 1], 1.0, 1.0 / fs)
+        first += whole + records[r, n - 1, 2]
+        square += whole_sq + records[r, n - 1, 3]
     return scale * first, scale * scale * square
 
 
@@ -233,7 +234,7 @@ def _hermite(y0, d0, y1, d1, u, dt):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def record_value(t, p, o, s, records):
-    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, 4, N)
+    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, N, 4)
     at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
     fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
     p[o + RECORD_SCALE * s], and over the first RAMP seconds (base.ramp; 0: none) by the
@@ -294,7 +295,7 @@ def record_bound(t0, t1, p, o, s, records):
     most max(|y0|, |y1|) + 4/27 dt (|d0| + |d1|) (its value weights are >= 0 and sum to 1, its
     slope weights u (1 - u)^2 and u^2 (1 - u) are at most 4/27), times the level factor (the
     ramp's rise is at most 1)."""
-    n = records.shape[2]
+    n = records.shape[1]
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
     dt = 1.0 / fs
@@ -304,8 +305,8 @@ def record_bound(t0, t1, p, o, s, records):
     for k in range(first, last + 1):
         k0 = k - n if k >= n else k          # t < 2 N / fs, as `_record_interval`
         k1 = k0 + 1 if k0 + 1 < n else 0
-        top = max(top, max(abs(records[r, 0, k0]), abs(records[r, 0, k1]))
-                  + 4.0 / 27.0 * dt * (abs(records[r, 1, k0]) + abs(records[r, 1, k1])))
+        top = max(top, max(abs(records[r, k0, 0]), abs(records[r, k1, 0]))
+                  + 4.0 / 27.0 * dt * (abs(records[r, k0, 1]) + abs(records[r, k1, 1])))
     return abs(p[o + RECORD_SCALE * s]) * top
 
 

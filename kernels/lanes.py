@@ -475,7 +475,7 @@ def _record_reads(W, n_run, base):
         o = W_P * L + j
         t_new = W[tj.T * L + j]
         W[W_A_MID * L + j] = base_acceleration(0.5 * (t + t_new), W, o, L, None, base)
-        W[W_B1 * L + j], W[W_B2 * L + j] = tj.step_integrals(t, t_new, W, o, L, base)
+        W[W_B1 * L + j], W[W_B2 * L + j] = tj.step_integrals(W, j, L, t, t_new, W, o, L, base)
         consecutive = W[tj.ACC_STEP * L + j] == W[tj.STEPS * L + j] - 1.0
         if not consecutive or math.isnan(W[(tj.ACC_SAMPLES + tj.S_A) * L + j]):
             W[W_A_OLD * L + j] = (W[(W_START + 3) * L + j]

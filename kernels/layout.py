@@ -89,7 +89,8 @@ RHS_EVALS = 2       # right-hand-side evaluations
 N_COUNTS = 3
 
 # A random base acceleration's records (sweep.models.random.Records, the kernels' `base`
-# switch of the record kind), (R, RECORD_ROWS, N): per record its samples a_b (m/s^2), their
-# derivatives (m/s^3), and the running integrals of its cubic Hermite interpolant and of the
-# interpolant's square from 0 to each sample (m/s, m^2/s^3; kernels.excitation.record_integrals).
+# switch of the record kind), (R, N, RECORD_ROWS): per record and sample its a_b (m/s^2), its
+# derivative (m/s^3), and the running integrals of the record's cubic Hermite interpolant and
+# of the interpolant's square from 0 to that sample (m/s, m^2/s^3;
+# kernels.excitation.record_integrals), side by side: a read touches one or two cache lines.
 RECORD_ROWS = 4

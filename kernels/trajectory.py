@@ -105,7 +105,9 @@ SHARE = SUM_B2 + 1       # G (1): q'' = r - G a_b (the participation of the watc
 STEP_AB = SHARE + 1      # the last step's a_b at its start, middle and end (m/s^2) and its
                          # integral over it (m/s) in STEP_AB + 0..3 (`record_statistics`; the
                          # modes' curvature squares read them: modal_driver)
-UP_ZERO = STEP_AB + 4    # up-crossings of q = 0
+AT_END = STEP_AB + 4     # the time (s) of the last step end whose integrals of a_b and a_b^2
+                         # from 0 (m/s, m^2/s^3) AT_END + 1, + 2 hold (`step_integrals`)
+UP_ZERO = AT_END + 3     # up-crossings of q = 0
 UP_LEVEL = UP_ZERO + 1   # level k's crossings of |q| upwards through settings[LEVEL_0 + k]
 SCALAR_SLOTS = UP_LEVEL + MAX_LEVELS
 
@@ -1015,7 +1017,7 @@ def record_statistics(settings, acc, p, o, s, t, t_new, q_old, v_old, fv_old, q_
     if math.isnan(a_old):
         a_old = fv_old + base_acceleration(t, p, o, s, None, base)
     ab_mid = base_acceleration(0.5 * (t + t_new), p, o, s, None, base)
-    b1, b2 = step_integrals(t, t_new, p, o, s, base)
+    b1, b2 = step_integrals(acc, 0, 1, t, t_new, p, o, s, base)
     acc[STEP_AB] = a_old - fv_old
     acc[STEP_AB + 1] = ab_mid
     acc[STEP_AB + 2] = a_new - fv_new
@@ -1033,11 +1035,19 @@ _observe_record_step = ex.by_kind(None, record_statistics)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def step_integrals(t, t_new, p, o, s, base):
+def step_integrals(acc, a, sa, t, t_new, p, o, s, base):
     """The integrals of a_b and of a_b^2 over the step [t, t_new] (s) of a record's row
-    (m/s, m^2/s^3; excitation.record_integrals: exact on the record's interpolant)."""
-    first0, square0 = ex.record_integrals(t, p, o + EXCITATION * s, s, base)
+    (m/s, m^2/s^3; excitation.record_integrals: exact on the record's interpolant), the
+    accumulator at acc[a + slot * sa]: those from 0 to t_new are kept (AT_END), so that the
+    next step, which starts there, reads its start's instead of evaluating them again."""
+    if acc[a + AT_END * sa] == t:
+        first0, square0 = acc[a + (AT_END + 1) * sa], acc[a + (AT_END + 2) * sa]
+    else:
+        first0, square0 = ex.record_integrals(t, p, o + EXCITATION * s, s, base)
     first1, square1 = ex.record_integrals(t_new, p, o + EXCITATION * s, s, base)
+    acc[a + AT_END * sa] = t_new
+    acc[a + (AT_END + 1) * sa] = first1
+    acc[a + (AT_END + 2) * sa] = square1
     return first1 - first0, square1 - square0
 
 

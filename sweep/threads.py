@@ -113,7 +113,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
     A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
     for its response envelope and durations (n,), each point's end time (s; `swept_settings`).
-    records: a random base acceleration's (R, 4, N) records (sweep.models.random.Records'
+    records: a random base acceleration's (R, N, 4) records (sweep.models.random.Records'
     values), which the kernels take as their `base` switch (kernels.excitation's record kind),
     on either driver.
 
@@ -265,8 +265,8 @@ def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
     if records is None:
         return base
     from sweep.kernels.layout import RECORD_ROWS
-    if records.ndim != 3 or records.shape[1] != RECORD_ROWS:
-        raise ValueError(f"records of shape {records.shape}: expected (R, {RECORD_ROWS}, N), "
+    if records.ndim != 3 or records.shape[2] != RECORD_ROWS:
+        raise ValueError(f"records of shape {records.shape}: expected (R, N, {RECORD_ROWS}), "
                          "the samples with their integrals (sweep.models.random.with_integrals)")
     return np.ascontiguousarray(records, dtype=np.float64)
 

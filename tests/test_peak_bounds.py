@@ -74,12 +74,12 @@ def test_a_records_bound_holds_on_every_interval_and_is_within_a_third_of_its_pe
     fs, n = 100.0, 400
     rng = np.random.default_rng(7)
     tk = np.arange(n) / fs
-    records = np.empty((2, 2, n))
+    records = np.empty((2, n, 2))
     for r in range(2):
         w = 2.0 * math.pi * rng.integers(1, n // 10, 24) * fs / n    # periodic in n / fs
         a, phase = rng.normal(0.0, 1.0, 24), rng.uniform(0.0, 2.0 * math.pi, 24)
-        records[r, 0] = (a * np.sin(np.outer(tk, w) + phase)).sum(axis=1)
-        records[r, 1] = (a * w * np.cos(np.outer(tk, w) + phase)).sum(axis=1)
+        records[r, :, 0] = (a * np.sin(np.outer(tk, w) + phase)).sum(axis=1)
+        records[r, :, 1] = (a * w * np.cos(np.outer(tk, w) + phase)).sum(axis=1)
     p = np.zeros(ex.SIZE)
     p[ex.RECORD] = 1
     p[ex.RECORD_RATE] = fs

@@ -84,24 +84,24 @@ def test_mean_square_flat_and_minus_one_slopes_in_closed_form():
 def test_ensemble_mean_square_matches_the_spectrum_within_three_standard_errors(gevs):
     f, W = gevs
     rec = rnd.synthesise(f, W, 1.0, 20000.0, 64, 11)
-    assert rec.values.shape == (64, rnd.RECORD_ROWS, 20000)
+    assert rec.values.shape == (64, 20000, rnd.RECORD_ROWS)
     assert rec.values.dtype == np.float64
     assert rec.values.flags.c_contiguous
     assert (rec.realisations, rec.samples, rec.period, rec.sample_rate) == (64, 20000, 1.0,
                                                                           20000.0)
-    per_record = np.mean(rec.values[:, 0] ** 2, axis=1)
+    per_record = np.mean(rec.values[:, :, 0] ** 2, axis=1)
     standard_error = per_record.std(ddof=1) / math.sqrt(per_record.size)
     assert abs(per_record.mean() - rnd.mean_square(f, W)) < 3 * standard_error
     # and the spread is a Gaussian record's (Rayleigh amplitudes), not zero (random phases)
     assert per_record.std() > 0.005 * per_record.mean()
     # zero mean: DC carries nothing
-    assert np.max(np.abs(rec.values[:, 0].mean(axis=1))) < 1e-12 * math.sqrt(per_record.max())
+    assert np.max(np.abs(rec.values[:, :, 0].mean(axis=1))) < 1e-12 * math.sqrt(per_record.max())
 
 
 def test_welch_estimate_matches_the_asd_in_the_flat_band(gevs):
     f, W = gevs
     rec = rnd.synthesise(f, W, 2.0, 20000.0, 16, 3)
-    freq, psd = signal.welch(rec.values[:, 0], fs=20000.0, window="hann", nperseg=2048,
+    freq, psd = signal.welch(rec.values[:, :, 0], fs=20000.0, window="hann", nperseg=2048,
                              detrend=False, axis=-1)
     band = (freq >= 60.0) & (freq <= 780.0)
     mean = psd[:, band].mean(axis=0)
@@ -117,7 +117,7 @@ def test_welch_estimate_matches_the_asd_in_the_flat_band(gevs):
 def test_coefficients_dc_nyquist_and_out_of_band_are_zero():
     f, W = rnd.spectrum([[100, 0.1], [400, 0.1]])
     rec = rnd.synthesise(f, W, 0.25, 2000.0, 2, 5)
-    X = np.fft.rfft(rec.values[0, 0])
+    X = np.fft.rfft(rec.values[0, :, 0])
     fk = np.fft.rfftfreq(rec.samples, 1 / rec.sample_rate)
     big = np.max(np.abs(X))
     assert abs(X[0]) < 1e-12 * big and abs(X[-1]) < 1e-12 * big
@@ -145,7 +145,7 @@ def test_derivative_record_is_the_analytic_derivative():
     fs, n = rec.sample_rate, rec.samples
     t = np.arange(n) / fs
     for r in range(2):
-        x, dx = rec.values[r, :2]
+        x, dx = rec.values[r, :, :2].T
         np.testing.assert_allclose(_cosine_sum(x, fs, t, False), x, atol=1e-10 * np.abs(x).max())
         np.testing.assert_allclose(_cosine_sum(x, fs, t, True), dx,
                                    atol=1e-10 * np.abs(dx).max())
@@ -177,8 +177,8 @@ def test_records_follow_the_documented_draws(threads):
         arg = 2 * np.pi * np.outer(t, fk)
         x = np.cos(arg) @ a + np.sin(arg) @ b
         dx = 2 * np.pi * ((-np.sin(arg) * fk) @ a + (np.cos(arg) * fk) @ b)
-        np.testing.assert_allclose(rec.values[r, 0], x, atol=1e-11 * np.abs(x).max())
-        np.testing.assert_allclose(rec.values[r, 1], dx, atol=1e-11 * np.abs(dx).max())
+        np.testing.assert_allclose(rec.values[r, :, 0], x, atol=1e-11 * np.abs(x).max())
+        np.testing.assert_allclose(rec.values[r, :, 1], dx, atol=1e-11 * np.abs(dx).max())
 
 
 def test_records_are_deterministic_and_realisations_are_stable(gevs):
@@ -191,7 +191,7 @@ def test_records_are_deterministic_and_realisations_are_stable(gevs):
     assert np.array_equal(a.values, b.values)
     assert np.array_equal(a.values, e.values)                 # the same bits on 2 threads
     assert np.array_equal(a.values, c.values[:3])
-    assert not np.any(a.values[:, 0] == d.values[:, 0])
+    assert not np.any(a.values[:, :, 0] == d.values[:, :, 0])
     assert not np.allclose(a.values[0], a.values[1])          # realisations differ
 
 
@@ -210,14 +210,14 @@ def test_records_are_periodic_under_hermite(gevs):
     t = np.random.default_rng(0).uniform(0, rec.period, 500)
     for r in range(2):
         here = rnd.hermite(rec.values[r], rec.sample_rate, t)
-        scale = np.abs(rec.values[r, 0]).max()
+        scale = np.abs(rec.values[r, :, 0]).max()
         for shift in (rec.period, 3 * rec.period, -rec.period):
             np.testing.assert_allclose(rnd.hermite(rec.values[r], rec.sample_rate, t + shift),
                                        here, atol=1e-9 * scale)
     # the last interval joins the last sample to the first
     x = rec.values[0]
     end = rnd.hermite(x, rec.sample_rate, np.array([rec.period - 1e-12, rec.period]))
-    np.testing.assert_allclose(end, x[0, 0], atol=1e-6 * np.abs(x[0]).max())
+    np.testing.assert_allclose(end, x[0, 0], atol=1e-6 * np.abs(x[:, 0]).max())
 
 
 def test_record_integrals_are_the_interpolants_integrals(gevs):
@@ -235,16 +235,16 @@ def test_record_integrals_are_the_interpolants_integrals(gevs):
     values = rec.values
     rng = np.random.default_rng(3)
     for r in range(2):
-        a = lambda t: float(rnd.hermite(values[r, :2], fs, np.array([t]))[0])   # noqa: E731
+        a = lambda t: float(rnd.hermite(values[r], fs, np.array([t]))[0])   # noqa: E731
         for k in rng.integers(1, rec.samples, 4):
             edges = np.arange(k + 1) / fs
             first = sum(integrate.quad(a, x0, x1, epsabs=0, epsrel=1e-12)[0]
                         for x0, x1 in zip(edges[:-1], edges[1:]))
             square = sum(integrate.quad(lambda t: a(t) ** 2, x0, x1, epsabs=0,
                                         epsrel=1e-12)[0] for x0, x1 in zip(edges[:-1], edges[1:]))
-            scale1 = np.abs(values[r, 2]).max() + abs(first)
-            assert values[r, 2, k] == pytest.approx(first, abs=1e-11 * scale1)
-            assert values[r, 3, k] == pytest.approx(square, rel=1e-11)
+            scale1 = np.abs(values[r, :, 2]).max() + abs(first)
+            assert values[r, k, 2] == pytest.approx(first, abs=1e-11 * scale1)
+            assert values[r, k, 3] == pytest.approx(square, rel=1e-11)
         p = np.zeros(ex.SIZE)
         p[ex.RECORD], p[ex.RECORD_RATE], p[ex.RECORD_SCALE] = r, fs, -0.7
         for _ in range(12):
@@ -258,7 +258,7 @@ def test_record_integrals_are_the_interpolants_integrals(gevs):
                                         epsrel=1e-12)[0] for x0, x1 in zip(edges[:-1], edges[1:]))
             v0, e0 = ex.record_integrals(t0, p, 0, 1, values)
             v1, e1 = ex.record_integrals(t1, p, 0, 1, values)
-            size = (t1 - t0) * np.abs(values[r, 0]).max()
+            size = (t1 - t0) * np.abs(values[r, :, 0]).max()
             assert v1 - v0 == pytest.approx(-0.7 * first, abs=1e-9 * size)
             assert e1 - e0 == pytest.approx(0.49 * square, rel=1e-9, abs=1e-12 * size ** 2)
 
@@ -269,7 +269,7 @@ def test_hermite_on_a_tone_is_accurate_to_the_fourth_order():
     fs, f0 = 20000.0, 100.0
     t = np.arange(20000) / fs                          # 1 s: 100 whole cycles, periodic
     w = 2 * np.pi * f0
-    values = np.stack([np.cos(w * t), -w * np.sin(w * t)])
+    values = np.stack([np.cos(w * t), -w * np.sin(w * t)], axis=1)
     tq = np.random.default_rng(4).uniform(0, 1.0, 2000)
     err = np.max(np.abs(rnd.hermite(values, fs, tq) - np.cos(w * tq)))
     assert err < 1e-6
@@ -281,22 +281,22 @@ def test_hermite_is_exact_for_a_cubic_and_c1_at_the_nodes():
     n = 40
     t = np.arange(n) / fs
     p = np.polynomial.Polynomial([0.3, -1.2, 2.5, -4.0])
-    values = np.stack([p(t), p.deriv()(t)])
+    values = np.stack([p(t), p.deriv()(t)], axis=1)
     tq = np.linspace(t[1], t[-2], 777)                 # inside: no wrap
     np.testing.assert_allclose(rnd.hermite(values, fs, tq), p(tq), atol=1e-13)
     # at the nodes: the samples; either side of a node: the same value and slope
-    np.testing.assert_allclose(rnd.hermite(values, fs, t), values[0], atol=1e-14)
+    np.testing.assert_allclose(rnd.hermite(values, fs, t), values[:, 0], atol=1e-14)
     rng = np.random.default_rng(5)
-    rough = rng.normal(size=(2, n))                    # any samples and derivatives, at 2 Hz
+    rough = rng.normal(size=(2, n)).T                  # any samples and derivatives, at 2 Hz
     k = np.arange(1, n)
     tk = k / 2.0
     h = 1e-7
     for side in (-h, h):
-        np.testing.assert_allclose(rnd.hermite(rough, 2.0, tk + side), rough[0, k], atol=1e-5)
+        np.testing.assert_allclose(rnd.hermite(rough, 2.0, tk + side), rough[k, 0], atol=1e-5)
     # the one-sided slopes either side of each node agree with the given derivative (C1)
     for side in (-1.0, 1.0):
-        slope = side * (rnd.hermite(rough, 2.0, tk + side * h) - rough[0, k]) / h
-        np.testing.assert_allclose(slope, rough[1, k], atol=1e-5)
+        slope = side * (rnd.hermite(rough, 2.0, tk + side * h) - rough[k, 0]) / h
+        np.testing.assert_allclose(slope, rough[k, 1], atol=1e-5)
 
 
 # ---- linear_mean_square and Miles -----------------------------------------------------------

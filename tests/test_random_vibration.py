@@ -115,7 +115,7 @@ def test_one_realisation_matches_scipy_on_the_same_record(n_modes, drivers, ramp
         transient = math.log(1.0 / float(sc.values["metrics.tolerance"])) / (
             cable.damping_ratio * cable.w1)
         assert window == pytest.approx(random.t_end - ramp - transient, rel=1e-3)
-        samples = record[0, :int(math.floor(random.t_end * fs)) + 1]
+        samples = record[:int(math.floor(random.t_end * fs)) + 1, 0]
         t_k = np.arange(samples.size) / fs
         rise = 0.5 - 0.5 * np.cos(np.pi * t_k / max(ramp, 1e-300))
         shaken = samples * np.where(t_k < ramp, rise, 1.0)
@@ -550,7 +550,7 @@ def _steady_state(ds, l: float, level_db: float, n_modes: int):
     w1 = 2 * np.pi * float(ds.natural_frequency.sel(length=l))
     out = []
     for r in range(2):
-        X = np.fft.rfft(records.values[r, 0]) * 10 ** (level_db / 20)
+        X = np.fft.rfft(records.values[r, :, 0]) * 10 ** (level_db / 20)
         Q = np.zeros_like(X)
         for m in range(1, n_modes + 1, 2):                   # even modes: a node at midspan
             wn = w1 * m * m
@@ -625,7 +625,7 @@ def test_the_clamp_strain_moments_meet_the_exact_steady_state_record_by_record(d
         strain = 0.5 * 2.76e-3 / l ** 2
         for place, s in (("clamp", 0.0), ("midspan", 0.5)):
             for r in range(2):
-                X = np.fft.rfft(records.values[r, 0]) * 0.1
+                X = np.fft.rfft(records.values[r, :, 0]) * 0.1
                 C = sum(_clamped_beam(b, s)[1] * g * X
                         / ((w1 * (b / betas[0]) ** 2) ** 2 - omega ** 2
                            + 2j * 0.05 * w1 * (b / betas[0]) ** 2 * omega)

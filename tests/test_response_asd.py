@@ -70,8 +70,8 @@ def test_the_absolute_acceleration_asd_is_welchs_of_the_exact_signal():
     t_rec = np.arange(n_rec) / fs
     w = 2 * np.pi * freqs
     a_b = (ab * np.sin(np.outer(t_rec, w) + pb)).sum(1)
-    records = np.zeros((2, 2, n_rec))
-    records[1, 0] = a_b                                  # record 1, level factor 0.5
+    records = np.zeros((2, n_rec, 2))
+    records[1, :, 0] = a_b                                  # record 1, level factor 0.5
     t = np.arange(int(t_end * rate) + 1) / rate
     q = (aq * np.sin(np.outer(t, w) + pq)).sum(1)
     q2 = (-aq * w * w * np.sin(np.outer(t, w) + pq)).sum(1)

@@ -150,9 +150,9 @@ def default_sample_rate(f: np.ndarray) -> float:
 
 @dataclass(frozen=True, eq=False)
 class Records:
-    """Sampled base accelerations: values (R, RECORD_ROWS, N) float64, C-contiguous,
-    values[r, 0, k] the acceleration a_b (m/s^2) of realisation r at t = k / sample_rate,
-    values[r, 1, k] its exact time derivative (m/s^3), and values[r, 2, k], values[r, 3, k]
+    """Sampled base accelerations: values (R, N, RECORD_ROWS) float64, C-contiguous,
+    values[r, k, 0] the acceleration a_b (m/s^2) of realisation r at t = k / sample_rate,
+    values[r, k, 1] its exact time derivative (m/s^3), and values[r, k, 2], values[r, k, 3]
     the integrals of the record's cubic Hermite interpolant (the kernels' a_b) and of its
     square from 0 to that sample (m/s, m^2/s^3: `with_integrals`); sample_rate (Hz). Each
     record is periodic with `period`. eq=False: records compare by identity (compare `values`
@@ -173,36 +173,36 @@ class Records:
     @property
     def samples(self) -> int:
         """N, the samples of a record (even)."""
-        return int(self.values.shape[2])
+        return int(self.values.shape[1])
 
 
 def with_integrals(values: np.ndarray, sample_rate: float) -> np.ndarray:
-    """(R, RECORD_ROWS, N): records given as their samples and derivatives (R, 2, N) (m/s^2,
+    """(R, N, RECORD_ROWS): records given as their samples and derivatives (R, N, 2) (m/s^2,
     m/s^3; sample_rate Hz) with the running integrals of their cubic Hermite interpolant and of its
-    square from t = 0 to each sample appended as rows 2 and 3 (m/s, m^2/s^3). A record is
+    square from t = 0 to each sample beside them as columns 2 and 3 (m/s, m^2/s^3). A record is
     periodic, so its last piece runs from sample N - 1 to sample 0. The kernels read the
     integral over any stretch of time from these and the partial pieces at its ends in closed
     form (kernels.excitation.record_integrals)."""
-    out = np.empty((values.shape[0], RECORD_ROWS, values.shape[2]))
-    out[:, :2] = values[:, :2]
+    out = np.empty((values.shape[0], values.shape[1], RECORD_ROWS))
+    out[:, :, :2] = values[:, :, :2]
     for r in range(values.shape[0]):
         _fill_integrals(out[r], 1.0 / float(sample_rate))
     return out
 
 
 def _fill_integrals(record: np.ndarray, dt: float) -> None:
-    """Rows 2 and 3 of one record (RECORD_ROWS, N) from its rows 0 and 1 (`with_integrals`);
-    dt: the sample interval (s)."""
-    x, d = record[0], record[1] * dt
+    """Columns 2 and 3 of one record (N, RECORD_ROWS) from its columns 0 and 1
+    (`with_integrals`); dt: the sample interval (s)."""
+    x, d = record[:, 0], record[:, 1] * dt
     x1, d1 = np.roll(x, -1), np.roll(d, -1)
     a2 = 3.0 * (x1 - x) - 2.0 * d - d1      # the piece's cubic x + d u + a2 u^2 + a3 u^3,
     a3 = 2.0 * (x - x1) + d + d1            # u = (t - t_k) / dt from 0 to 1
     first = dt * (x + d / 2.0 + a2 / 3.0 + a3 / 4.0)
     square = dt * (x * x + x * d + (d * d + 2.0 * x * a2) / 3.0 + (x * a3 + d * a2) / 2.0
                    + (a2 * a2 + 2.0 * d * a3) / 5.0 + a2 * a3 / 3.0 + a3 * a3 / 7.0)
-    record[2, 0] = record[3, 0] = 0.0
-    np.cumsum(first[:-1], out=record[2, 1:])
-    np.cumsum(square[:-1], out=record[3, 1:])
+    record[0, 2] = record[0, 3] = 0.0
+    record[1:, 2] = np.cumsum(first[:-1])
+    record[1:, 3] = np.cumsum(square[:-1])
 
 
 def record_length(duration: float, sample_rate: float) -> int:
@@ -265,14 +265,14 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
                                      f"{1.0 / (top - f[0]):.3g} s")
     scale = 0.5 * n * np.sqrt(variance)
     derivative = 2j * np.pi * fk
-    values = np.empty((realisations, RECORD_ROWS, n))
+    values = np.empty((realisations, n, RECORD_ROWS))
 
     def make(r: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(r,)))
         a, b = rng.standard_normal((2, n // 2 + 1))
         X = scale * (a - 1j * b)
-        values[r, 0] = np.fft.irfft(X, n=n)
-        values[r, 1] = np.fft.irfft(derivative * X, n=n)
+        values[r, :, 0] = np.fft.irfft(X, n=n)
+        values[r, :, 1] = np.fft.irfft(derivative * X, n=n)
         _fill_integrals(values[r], 1.0 / sample_rate)
 
     workers = min(int(threads), realisations)
@@ -287,8 +287,8 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
 
 
 def hermite(values_r: np.ndarray, sample_rate: float, t: Any) -> np.ndarray:
-    """The record values_r ((2, N): samples (m/s^2) and their time derivatives (m/s^3) at
-    k / sample_rate (Hz)) at times t (s, any shape; modulo the period N / sample_rate): the
+    """The record values_r ((N, 2) or more columns: samples (m/s^2) and their time derivatives
+    (m/s^3) at k / sample_rate (Hz)) at times t (s, any shape; modulo the period N / sample_rate): the
     cubic Hermite interpolant on each interval, with k = floor(t fs) mod N, u = t fs -
     floor(t fs), dt = 1 / fs and sample k + 1 wrapping to 0,
 
@@ -296,7 +296,7 @@ def hermite(values_r: np.ndarray, sample_rate: float, t: Any) -> np.ndarray:
 
     h00 = 2u^3 - 3u^2 + 1, h10 = u^3 - 2u^2 + u, h01 = 3u^2 - 2u^3, h11 = u^3 - u^2. This is
     the reference of what the kernel evaluates."""
-    x, dx = values_r[0], values_r[1]
+    x, dx = values_r[:, 0], values_r[:, 1]
     n = x.shape[0]
     s = np.asarray(t, float) * sample_rate
     whole = np.floor(s)

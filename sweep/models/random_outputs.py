@@ -93,7 +93,7 @@ class RandomInputs:
                    ramp=random_scene.ramp_time(values))
 
     def records(self, threads: int = 1) -> np.ndarray:
-        """The records the kernels take as their `base` switch: (R, 4, N) samples of a_b at
+        """The records the kernels take as their `base` switch: (R, N, 4) samples of a_b at
         0 dB, their derivatives and running integrals (sweep/models/random.py, `Records`),
         made on `threads` threads (the same bits on any number)."""
         from .random import synthesise
@@ -346,7 +346,7 @@ def realised_grms(records: np.ndarray, random: RandomInputs) -> np.ndarray:
     span is shaken: with base.ramp, the samples of its first `ramp` seconds at the ramp's
     level (1 - cos(pi t / ramp)) / 2."""
     last = int(math.floor(random.t_end * random.sample_rate))
-    run = records[:, 0, :last + 1]
+    run = records[:, :last + 1, 0]
     if random.ramp > 0.0:
         t = np.arange(run.shape[1]) / random.sample_rate
         run = run * np.where(t < random.ramp, 0.5 - 0.5 * np.cos(np.pi * t / random.ramp), 1.0)

@@ -199,7 +199,7 @@ class Reduction:
         with np.errstate(divide="ignore", invalid="ignore"):
             gain = np.where(x > 0.0, (x / np.sin(x)) ** 2, 1.0)   # (sin x / x)^-2
         series = solved["series"]
-        n_rec = records.shape[2]
+        n_rec = records.shape[1]
         for i in range(lo, hi):
             length = solved["reals"][i, self.window_column]
             if not np.isfinite(length):
@@ -211,7 +211,7 @@ class Reduction:
             a_rel = (q[2:] - 2.0 * q[1:-1] + q[:-2]) * (self.rate * self.rate)
             m = self.decimation                # a_b at the samples k = first + 1 .. q's last - 1
             start, last = (first + 1) * m, (first + q.size - 2) * m
-            record = records[int(params[i, self.record_column]), 0]
+            record = records[int(params[i, self.record_column]), :, 0]
             base = (record[start:last + 1:m] if last < n_rec      # a view: no gather
                     else record[np.arange(start, last + 1, m) % n_rec])
             a_base = params[i, self.scale_column] * base
