@@ -91,8 +91,8 @@ KEYS: tuple[Key, ...] = (
                   "sin(n pi x/l)), all of it (clamped) or a rotational spring (elastic, "
                   "clamps.rotational_stiffness)"),
     Key("clamps", "rotational_stiffness", "float", None, units="N m rad-1", minimum=0.0,
-        long_name="rotational stiffness k_t of each clamp (rotation = 'elastic'); K = k_t l / EI "
-                  "runs from pinned (0) to clamped (infinite)",
+        long_name="rotational stiffness k_t of each clamp (rotation = 'elastic'), K = k_t l / EI: "
+                  "0 pinned, inf clamped",
         axis="clamp_rotational_stiffness"),
     Key("clamps", "axial_stiffness", "float", None, units="N m-1", minimum=0.0,
         long_name="axial stiffness k_a of each clamp, in series with the span's EA / l for the "

@@ -420,6 +420,7 @@ def test_a_hostile_breakpoint_is_quoted_on_one_line():
     ({"sample_rate": 4000.0}, "base.sample_rate",
      "4000 Hz cannot carry the spectrum up to 2000 Hz; give at least 2.5 x"),
     ({"sample_rate": 3000.0}, "base.sample_rate", "the default is 10 x"),
+    ({"sample_rate": 4900.0}, "base.sample_rate", "give at least 2.5 x"),   # over 2 x: lossy
     ({"sample_rate": float("inf")}, "base.sample_rate", "up to 2000 Hz"),
     ({"duration": 1e4, "sample_rate": 1e5}, "base.sample_rate", "GiB"),
     ({"duration": 1.0, "realisations": 10 ** 5}, "base.realisations", "GiB"),

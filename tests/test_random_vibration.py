@@ -274,6 +274,7 @@ def test_the_dataset_has_a_realisation_dimension_and_means():
     ({"base.frequency": 20.0}, "replaces the sine"),
     ({"solver.t_end": 2.0}, "longer than the record"),
     ({"base.sample_rate": 900.0}, "cannot carry the spectrum"),
+    ({"base.sample_rate": 1200.0}, "give at least 1250 Hz"),
     ({"outputs.clearance": [1e-3] * 5}, "1 to 4 levels"),
     ({"base.asd": [[10.0, 1.0], [500.0, 1.0]], "base.asd_g2": [[10.0, 0.1], [500.0, 0.1]]},
      "give one, not both"),
@@ -642,7 +643,8 @@ def test_escapes_in_the_start_up_transient_are_warned_in_one_line():
     """A realisation that escaped before its point's start-up ended (its level ramp and
     transient: the row's own, not the survivors' window, so a point where every record
     escaped counts too) escaped in the start-up kick: one warning line names how many and
-    when, and what to do with or without a ramp; none for later escapes."""
+    when, and what to do with or without a ramp; none for later escapes. A span loaded at or
+    past its buckling load escapes whatever the ramp: the line says so instead."""
     import warnings
 
     import xarray as xr
@@ -655,12 +657,16 @@ def test_escapes_in_the_start_up_transient_are_warned_in_one_line():
     early = xr.DataArray([[0.05, 0.1], [np.nan, 1.5]], dims=dims)
     with pytest.warns(CableSweepWarning, match=r"2 of 3 escaped realisations escaped in the "
                       r"start-up \(0\.05-0\.1 s.*e\.g\. base\.ramp = 1\.0"):
-        _warn_startup_escapes(escaped, early, startup, 0.0)
+        _warn_startup_escapes(escaped, early, startup, 0.0, xr.DataArray(False))
     with pytest.warns(CableSweepWarning, match=r"rise over base\.ramp = 0\.3 s"):
-        _warn_startup_escapes(escaped, early, startup, 0.3)
+        _warn_startup_escapes(escaped, early, startup, 0.3, xr.DataArray(False))
+    buckled = xr.DataArray([True, False], dims="length")
+    with pytest.warns(CableSweepWarning, match=r"at or past the buckling load.*whatever the ramp"):
+        _warn_startup_escapes(escaped, early, startup, 0.3, buckled)
     with warnings.catch_warnings():
         warnings.simplefilter("error", CableSweepWarning)
-        _warn_startup_escapes(escaped, early.where(~escaped, 2.5), startup, 0.0)
+        _warn_startup_escapes(escaped, early.where(~escaped, 2.5), startup, 0.0,
+                              xr.DataArray(False))
 
 
 @pytest.mark.slow

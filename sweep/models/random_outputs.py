@@ -370,14 +370,16 @@ def pooled_crossings(rate: xr.DataArray, window: xr.DataArray, kept: xr.DataArra
 
 
 def _warn_startup_escapes(escaped: xr.DataArray, failed_at: xr.DataArray,
-                          startup: Any, ramp: float) -> None:
+                          startup: Any, ramp: float, buckled: xr.DataArray) -> None:
     """Warn (one line) where realisations escaped in their point's start-up (`startup`, s:
     the ramp and the transient, random_scene.transient_time, the row's RECORD_START), before
     its statistics could start. A record switched on at full level at t = 0 on a span at rest
     gives a span whose first mode lies below the spectrum's band the base's velocity at t = 0
     as a kick of the transient's size (a reviewer: every escape of a span loaded to 0.95-0.98
     Pcr fell at 0.03-0.09 s, none later, and none with the same records ramped up over 1 s).
-    escape_probability counts them; they say how the test starts, not how the span fares."""
+    escape_probability counts them; they say how the test starts, not how the span fares.
+    Where a constant end load is at or past the buckling load (`buckled`), the straight span
+    is unstable and leaves it at once: no ramp helps, and the warning says so."""
     import warnings
 
     from ..errors import CableSweepWarning
@@ -386,6 +388,14 @@ def _warn_startup_escapes(escaped: xr.DataArray, failed_at: xr.DataArray,
     if count == 0:
         return
     times = failed_at.where(early)
+    if bool((early & buckled).any()):
+        warnings.warn(f"{count} of {int(escaped.sum())} escaped realisations escaped in the "
+                      f"start-up ({float(times.min()):.3g}-{float(times.max()):.3g} s): their "
+                      "spans' constant end load is at or past the buckling load (load_ratio "
+                      ">= 1), so the straight span is unstable and leaves it at once, whatever "
+                      "the ramp; lower load.amplitude below buckling_load to shake a straight "
+                      "span (docs/model.md sec. 11)", CableSweepWarning, stacklevel=5)
+        return
     how = (f"the records rise over base.ramp = {ramp:g} s, and the kick is still there: a "
            "longer ramp eases it" if ramp > 0.0 else
            "the record starts at full level on a span at rest, which kicks a span whose first "
@@ -445,7 +455,9 @@ def outputs(reals: np.ndarray, states: np.ndarray, dims: tuple[str, ...],
     startup = random_scene.transient_time(
         2.0 * math.pi * derived(coeffs["natural_frequency"], coords),
         derived(params["damping_ratio"], coords), params["statistics_tolerance"], random.ramp)
-    _warn_startup_escapes(escaped, failed_at, startup, random.ramp)
+    buckled = (derived(coeffs["load_ratio"], coords) >= 1.0) if params.get(
+        "load_type") == "constant" else xr.DataArray(False)
+    _warn_startup_escapes(escaped, failed_at, startup, random.ramp, buckled)
     data["escape_time_mean"] = failed_at.where(escaped).mean(REALISATION_DIM).assign_attrs(
         units="s", long_name="mean time of escape (divergence) over the realisations that "
         "escaped; NaN where none did")

@@ -143,14 +143,18 @@ def _check_spectra(given: Mapping[str, Any]) -> None:
 
 
 def _check_sampling(given: Mapping[str, Any], key: str) -> None:
-    """The records' sample rate must carry the spectrum (above twice its top frequency)."""
+    """The records' sample rate must carry the spectrum: at least MIN_RATE_FACTOR times its
+    top frequency (sweep.models.random: the interpolant between samples, which the kernels
+    integrate, loses more of the spectrum's top below it)."""
+    from .random import DEFAULT_RATE_FACTOR, MIN_RATE_FACTOR
     top = float(given[key][-1][0])
     rate = given.get("base.sample_rate")
-    if rate is not None and not rate > 2.0 * top:
+    if rate is not None and not rate >= MIN_RATE_FACTOR * top:
         _fail("scene key 'base.sample_rate'", f"{_show(rate)} Hz cannot carry the spectrum "
-              f"up to {top:g} Hz (it must be above twice its top frequency)",
-              f"give at least {2.5 * top:g} Hz, or remove it (the default is 10 x, "
-              f"{10.0 * top:g} Hz)")
+              f"up to {top:g} Hz (the records' interpolation between samples would lose "
+              f"more than 5 % of it near its top)",
+              f"give at least {MIN_RATE_FACTOR * top:g} Hz, or remove it (the default is "
+              f"{DEFAULT_RATE_FACTOR:g} x, {DEFAULT_RATE_FACTOR * top:g} Hz)")
 
 
 def defaults(values: dict[str, Any], mentioned: set[str]) -> None:
