@@ -19,9 +19,9 @@ over its first RAMP seconds, as a shaker's does, by the factor (1 - cos(pi t / R
 A random base acceleration is the excitation kind `record` (docs/model.md sec. 11): a_b(t)
 sampled at fs on a grid, records[r, k, 0] = a_b(k / fs) and records[r, k, 1] its time
 derivative (m/s^3, exact from the spectrum; a sample's values side by side, so that a read
-touches one or two cache lines, kernels.layout.RECORD_ROWS), interpolated between samples by the cubic
-Hermite polynomial through both (so the forcing is continuous with its rate, as the adaptive
-step wants), periodic with the record's period N / fs. The records are shared by every grid
+touches one or two cache lines, kernels.layout.RECORD_ROWS), interpolated between samples by
+the cubic Hermite polynomial through both (so the forcing is continuous with its rate, as the
+adaptive step wants), periodic with the record's period N / fs. The records are shared by every grid
 point (common random numbers): the kernels take them as the `base` switch itself, an array
 where the sine kinds take True (`signal`), and a row's block names its record: RECORD (its
 realisation r), RECORD_RATE (fs, Hz) and RECORD_SCALE (the level factor, 1: the spectrum as

@@ -292,9 +292,9 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
 
 def hermite(values_r: np.ndarray, sample_rate: float, t: Any) -> np.ndarray:
     """The record values_r ((N, 2) or more columns: samples (m/s^2) and their time derivatives
-    (m/s^3) at k / sample_rate (Hz)) at times t (s, any shape; modulo the period N / sample_rate): the
-    cubic Hermite interpolant on each interval, with k = floor(t fs) mod N, u = t fs -
-    floor(t fs), dt = 1 / fs and sample k + 1 wrapping to 0,
+    (m/s^3) at k / sample_rate (Hz)) at times t (s, any shape; modulo the period
+    N / sample_rate): the cubic Hermite interpolant on each interval, with k = floor(t fs)
+    mod N, u = t fs - floor(t fs), dt = 1 / fs and sample k + 1 wrapping to 0,
 
         a = h00(u) x_k + h10(u) dt x'_k + h01(u) x_k+1 + h11(u) dt x'_k+1,
 
