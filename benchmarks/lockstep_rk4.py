@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
 
 import numba as nb
@@ -26,7 +25,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from random_cost import _force, rk4_rms_over  # noqa: E402
+from random_cost import _force, best, rk4_rms_over  # noqa: E402
 
 GEVS = [[20.0, 0.026], [50.0, 0.16], [800.0, 0.16], [2000.0, 0.026]]
 
@@ -80,16 +79,6 @@ def rk4_lanes(X, DX, fs, coef, t_end, m):
             v[j] = v1 + h / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4)
             a0[j] = a1[j]
     return z
-
-
-def best(fn, repeats: int) -> float:
-    fn()
-    out = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - start)
-    return min(out)
 
 
 def main() -> None:
