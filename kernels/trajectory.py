@@ -1060,10 +1060,10 @@ def observe_random(acc, a, sa, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_
     over the step: `step_integrals`; qe its extremum inside the step where has_ext),
     accumulator at acc[a + slot * sa] as `observe_step_end`'s, where `take` and the step
     starts at or after the tail window's start (returned: whether it did): the window's start
-    and end, the integrals of q^2 and q'^2 on the quintic Hermite through q, q', q'' at both
-    ends (`quintic_squares`), the accelerations' parts (`acceleration_squares`: the
-    integrals of r^2 and r a_b by Simpson's rule, of a_b^2 exact), and the up-crossings of
-    zero on the step's monotone pieces, q_old to qe to q_new (the levels':
+    and end, the integrals of q^2, q'^2 and q''^2 on the quintic Hermite through q, q', q''
+    at both ends (`quintic_squares`), the accelerations' other parts (`acceleration_squares`:
+    the integrals of q'' a_b, r^2 and r a_b by Simpson's rule, of a_b^2 exact), and the
+    up-crossings of zero on the step's monotone pieces, q_old to qe to q_new (the levels':
     `observe_level_crossings`). Straight-line selects, so that the lanes' loop vectorises;
     adding 0.0 where not taken leaves a sum's bits as they were."""
     window = take & (t >= acc[a + T_TAIL * sa])
