@@ -200,7 +200,7 @@ def test_record_length_is_even_and_covers_the_duration(gevs):
     assert rnd.synthesise(f, W, 0.10001, 5000.0, 1, 0).samples == 502   # 500.05 -> 502
     assert rnd.synthesise(f, W, 0.1003, 5000.0, 1, 0).samples == 502    # 501.5 -> 502
     assert rnd.synthesise(f, W, 0.1, 3000.0 * 2, 1, 0).samples == 600   # float product exact
-    rec = rnd.synthesise(f, W, 0.0999, 4999.0, 1, 0)
+    rec = rnd.synthesise(f, W, 0.0999, 5003.0, 1, 0)                    # 499.8 -> 500
     assert rec.samples % 2 == 0 and rec.period >= 0.0999
 
 
