@@ -25,7 +25,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from random_cost import _force, best, rk4_rms_over  # noqa: E402
+from random_cost import _force, best, hermite_weights, rk4_rms_over  # noqa: E402
 
 GEVS = [[20.0, 0.026], [50.0, 0.16], [800.0, 0.16], [2000.0, 0.026]]
 
@@ -52,15 +52,7 @@ def rk4_lanes(X, DX, fs, coef, t_end, m):
     for i in range(steps):
         t = i * h
         for which in range(2):
-            s = (t + 0.5 * h * (which + 1)) * fs
-            kf = math.floor(s)
-            u = s - kf
-            k = int(kf) % n
-            k1 = k + 1 if k + 1 < n else 0
-            u2 = u * u
-            u3 = u2 * u
-            w0, w1 = 2.0 * u3 - 3.0 * u2 + 1.0, (u3 - 2.0 * u2 + u) / fs
-            w2, w3 = 3.0 * u2 - 2.0 * u3, (u3 - u2) / fs
+            k, k1, w0, w1, w2, w3 = hermite_weights(fs, t + 0.5 * h * (which + 1), n)
             out = ah if which == 0 else a1
             for j in range(L):
                 out[j] = w0 * X[k, j] + w1 * DX[k, j] + w2 * X[k1, j] + w3 * DX[k1, j]

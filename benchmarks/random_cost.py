@@ -181,17 +181,24 @@ class Case:
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _hermite(x, dx, fs, t):
+def hermite_weights(fs, t, n):
+    """The cubic Hermite's samples k, k1 (of n, periodic) and its weights on x[k], dx[k],
+    x[k1], dx[k1] at time t (s) of a record sampled at fs (Hz)."""
     s = t * fs
     kf = math.floor(s)
     u = s - kf
-    n = x.size
     k = int(kf) % n
     k1 = k + 1 if k + 1 < n else 0
     u2 = u * u
     u3 = u2 * u
-    return ((2.0 * u3 - 3.0 * u2 + 1.0) * x[k] + (u3 - 2.0 * u2 + u) / fs * dx[k]
-            + (3.0 * u2 - 2.0 * u3) * x[k1] + (u3 - u2) / fs * dx[k1])
+    return (k, k1, 2.0 * u3 - 3.0 * u2 + 1.0, (u3 - 2.0 * u2 + u) / fs, 3.0 * u2 - 2.0 * u3,
+            (u3 - u2) / fs)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _hermite(x, dx, fs, t):
+    k, k1, w0, w1, w2, w3 = hermite_weights(fs, t, x.size)
+    return w0 * x[k] + w1 * dx[k] + w2 * x[k1] + w3 * dx[k1]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -360,12 +360,10 @@ def _observe_bend_squares(y, y_new, f, f_new, h, n, curvature, modal, acc):
         modal[slot + 3 * k] += square
         modal[slot + 3 * k + 1] += slope
         modal[slot + 3 * k + 2] += curve
-        g = modal[other + 4 + k]
-        s0 = a0 + g * ab_old
-        s1 = a1 + g * ab_new
-        sm = (6.0 * (r1 - r0 + g * b1) / h - s0 - s1) / 4.0
-        modal[other + 2 * k] += h / 6.0 * (s0 * s0 + 4.0 * sm * sm + s1 * s1)
-        modal[other + 2 * k + 1] += h / 6.0 * (s0 * ab_old + 4.0 * sm * ab_mid + s1 * ab_new)
+        r2, rb = tj.carrier_step(a0, a1, r0, r1, modal[other + 4 + k], ab_old, ab_mid, ab_new,
+                                 b1, h)
+        modal[other + 2 * k] += r2
+        modal[other + 2 * k + 1] += rb
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -391,16 +389,13 @@ def curvature_moments(modal, n, acc, reals):
     span = acc[tj.W_END] - acc[tj.W_START]
     if modal[factor_slot(n) + 1] == 0.0 or acc[tj.IN_WINDOW] == 0.0 or not span > 0.0:
         return
-    b2 = acc[tj.SUM_B2]
     for k in range(6):
         reals[CURVATURE_M0 + k] = modal[square_slot(n) + k] / span
-    for k in range(2):          # the second derivative's mean square through its smaller carrier
-        f2 = modal[square_slot(n) + 3 * k + 2]
-        r2 = modal[carrier_slot(n) + 2 * k]
-        rb = modal[carrier_slot(n) + 2 * k + 1]
-        g = modal[carrier_slot(n) + 4 + k]
-        if tj.carried(f2, r2):
-            reals[CURVATURE_M0 + 3 * k + 2] = max(r2 - 2.0 * g * rb + g * g * b2, 0.0) / span
+    other = carrier_slot(n)
+    for k in range(2):          # the second derivative's, through its smaller carrier
+        reals[CURVATURE_M0 + 3 * k + 2] = tj.carried_square(
+            modal[square_slot(n) + 3 * k + 2], modal[other + 2 * k], modal[other + 2 * k + 1],
+            acc[tj.SUM_B2], modal[other + 4 + k]) / span
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -1073,14 +1073,10 @@ def observe_random(acc, a, sa, t, t_new, q_old, v_old, fv_old, q_new, v_new, fv_
     acc[a + W_END * sa] = t_new if window else acc[a + W_END * sa]
     h = t_new - t
     square, slope, curve = quintic_squares(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
-    g = acc[a + SHARE * sa]
     ab_old = a_old - fv_old
     ab_new = a_new - fv_new
-    r_old = fv_old + g * ab_old           # r = q'' + G a_b: the span's own forces, smooth
-    r_new = fv_new + g * ab_new
-    r_mid = (6.0 * (v_new - v_old + g * b1) / h - r_old - r_new) / 4.0   # its integral, exact
-    r2 = h / 6.0 * (r_old * r_old + 4.0 * r_mid * r_mid + r_new * r_new)
-    rb = h / 6.0 * (r_old * ab_old + 4.0 * r_mid * ab_mid + r_new * ab_new)
+    r2, rb = carrier_step(fv_old, fv_new, v_old, v_new, acc[a + SHARE * sa], ab_old, ab_mid,
+                          ab_new, b1, h)
     f_mid = quintic_midpoint_curvature(h, q_old, v_old, fv_old, q_new, v_new, fv_new)
     fb = h / 6.0 * (fv_old * ab_old + 4.0 * f_mid * ab_mid + fv_new * ab_new)
     acc[a + SUM_Q2 * sa] += square if window else 0.0
@@ -1102,25 +1098,42 @@ def acceleration_squares(acc):
     Each is a smooth part plus a multiple of a_b, whose square is integrated exactly on the
     record's interpolant; of the two smooth parts, r = q'' + G a_b (the span's own forces, G
     its participation: SHARE; q'' + a_b = r + (1 - G) a_b, q'' = r - G a_b) and q'' itself on
-    the step's quintic Hermite (q'' + a_b = q'' + a_b), the smaller carries it (`carried`):
-    r for a span below the spectrum's band, which the base moves while its own forces stay
-    small (Simpson's rule on the whole square with steps long beside the record's samples
-    read such a span's RMS 1.8 % low), q'' for a span above it, which follows the base (r is
-    then nearly G a_b)."""
+    the step's quintic Hermite (q'' + a_b = q'' + a_b), the smaller carries it
+    (`carried_square`): r for a span below the spectrum's band, which the base moves while
+    its own forces stay small (Simpson's rule on the whole square with steps long beside the
+    record's samples read such a span's RMS 1.8 % low), q'' for a span above it, which
+    follows the base (r is then nearly G a_b)."""
     g = acc[SHARE]
     f2, fb, r2, rb, b2 = acc[SUM_F2], acc[SUM_FB], acc[SUM_R2], acc[SUM_RB], acc[SUM_B2]
-    if carried(f2, r2):
-        return (max(r2 + 2.0 * (1.0 - g) * rb + (1.0 - g) ** 2 * b2, 0.0),
-                max(r2 - 2.0 * g * rb + g * g * b2, 0.0))
-    return max(f2 + 2.0 * fb + b2, 0.0), f2
+    relative = carried_square(f2, r2, rb, b2, g)
+    if r2 <= f2:
+        return max(r2 + 2.0 * (1.0 - g) * rb + (1.0 - g) ** 2 * b2, 0.0), relative
+    return max(f2 + 2.0 * fb + b2, 0.0), relative
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def carried(f2, r2):
-    """Whether a second derivative x = r - G a_b of a record's response is integrated through
-    r (the span's own forces; its square's integral r2) rather than on the steps' quintic
-    Hermite (f2): where r is the smaller (`acceleration_squares`)."""
-    return r2 <= f2
+def carrier_step(x_old, x_new, rate_old, rate_new, g, ab_old, ab_mid, ab_new, b1, h):
+    """One step's integrals of r^2 and r a_b (Simpson's rule), r = x + g a_b the smooth part
+    of a record's response's second derivative x (x_old, x_new at the step's ends; rate_old,
+    rate_new its first derivative there; g its participation: x = r - g a_b), a_b at the
+    step's ends and middle and its integral b1 over the step of h (s): r's middle value is
+    the one its exact integral, rate_new - rate_old + g b1, gives with its ends."""
+    r_old = x_old + g * ab_old
+    r_new = x_new + g * ab_new
+    r_mid = (6.0 * (rate_new - rate_old + g * b1) / h - r_old - r_new) / 4.0
+    return (h / 6.0 * (r_old * r_old + 4.0 * r_mid * r_mid + r_new * r_new),
+            h / 6.0 * (r_old * ab_old + 4.0 * r_mid * ab_mid + r_new * ab_new))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def carried_square(f2, r2, rb, b2, g):
+    """The integral of x^2 over a record's window, x = r - g a_b a second derivative of its
+    response: through r (its integrals r2 of r^2 and rb of r a_b, `carrier_step`, and b2 of
+    a_b^2, exact) where r is the smaller part, else f2, x^2's integral on the steps' quintic
+    Hermite (`acceleration_squares`)."""
+    if r2 <= f2:
+        return max(r2 - 2.0 * g * rb + g * g * b2, 0.0)
+    return f2
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

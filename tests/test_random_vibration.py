@@ -534,32 +534,39 @@ def test_the_poisson_upper_bound_is_the_chi_square_quantile(count):
     assert math.isnan(poisson_upper(math.nan)) and math.isnan(poisson_upper(-1.0))
 
 
-def _steady_state(ds, l: float, level_db: float, n_modes: int):
-    """The exact periodic steady state at midspan of a linear pinned span (length l m) under
-    each of `scene`'s records at level_db: the records repeat with their period, so the
-    response to record r is the inverse FFT of -sum_n phi_n(1/2) Gamma_n H_n X_r, with
-    Gamma_n = 4 / (n pi), w_n = n^2 w_1 and the scene's damping ratio on every mode, on a grid
-    four times as fine as the samples (the trigonometric interpolant of the record, within
-    about 1e-5 of the kernels' cubic Hermite one). Returns t (s) and, per record, the
-    deflection, the relative acceleration q'' and the absolute one q'' + a_b."""
+def _spectra(level_db: float):
+    """`scene`'s two records of 8 s at level_db as their FFTs X_r, the bins' angular
+    frequencies (rad/s), a grid four times as fine as the samples (s) and `fine(Z)`, a
+    spectrum's signal on that grid (the trigonometric interpolant, within about 1e-5 of the
+    kernels' cubic Hermite one): the records repeat with their period, so a linear span's
+    steady response to one is the inverse FFT of its transfer function times X_r."""
     f, w = rnd.spectrum(FLAT)
     fs = 10.0 * FLAT[-1][0]
     records = rnd.synthesise(f, w, 8.0, fs, 2, 3)
-    n = records.samples
-    up = 4
-    omega = 2 * np.pi * np.fft.rfftfreq(n, 1.0 / fs)
+    n, up = records.samples, 4
+    X = [np.fft.rfft(records.values[r, :, 0]) * 10 ** (level_db / 20) for r in range(2)]
+    return (X, 2 * np.pi * np.fft.rfftfreq(n, 1.0 / fs), np.arange(n * up) / (fs * up),
+            lambda Z: np.fft.irfft(Z, n=n * up) * up)
+
+
+def _steady_state(ds, l: float, level_db: float, n_modes: int):
+    """The exact periodic steady state at midspan of a linear pinned span (length l m) under
+    each of `scene`'s records at level_db (`_spectra`): the response to record r is the
+    inverse FFT of -sum_n phi_n(1/2) Gamma_n H_n X_r, with Gamma_n = 4 / (n pi),
+    w_n = n^2 w_1 and the scene's damping ratio on every mode. Returns t (s) and, per record,
+    the deflection, the relative acceleration q'' and the absolute one q'' + a_b."""
+    spectra, omega, t, fine = _spectra(level_db)
     w1 = 2 * np.pi * float(ds.natural_frequency.sel(length=l))
     out = []
-    for r in range(2):
-        X = np.fft.rfft(records.values[r, :, 0]) * 10 ** (level_db / 20)
+    for X in spectra:
         Q = np.zeros_like(X)
         for m in range(1, n_modes + 1, 2):                   # even modes: a node at midspan
             wn = w1 * m * m
             H = 1.0 / (wn ** 2 - omega ** 2 + 2j * 0.05 * wn * omega)
             Q -= math.sin(m * math.pi / 2) * 4.0 / (m * math.pi) * H * X
-        fine = [np.fft.irfft(Z, n=n * up) * up for Z in (Q, -omega ** 2 * Q, X)]
-        out.append((fine[0], fine[1], fine[1] + fine[2]))
-    return np.arange(n * up) / (fs * up), out
+        q, relative, base = (fine(Z) for Z in (Q, -omega ** 2 * Q, X))
+        out.append((q, relative, relative + base))
+    return t, out
 
 
 @pytest.mark.parametrize("n_modes, driver", [
@@ -614,26 +621,20 @@ def test_the_clamp_strain_moments_meet_the_exact_steady_state_record_by_record(d
     betas = (4.730040745, 7.853204624, 10.99560784)
     gammas = [quad(lambda s: _clamped_beam(b, s)[0], 0, 1)[0]
               / quad(lambda s: _clamped_beam(b, s)[0] ** 2, 0, 1)[0] for b in betas]
-    f, w = rnd.spectrum(FLAT)
-    fs = 10.0 * FLAT[-1][0]
-    records = rnd.synthesise(f, w, 8.0, fs, 2, 3)
-    n, up = records.samples, 4
-    omega = 2 * np.pi * np.fft.rfftfreq(n, 1.0 / fs)
-    t = np.arange(n * up) / (fs * up)
+    spectra, omega, t, fine = _spectra(-20.0)
     for l in lengths:
         point = ds.sel(length=l, base_asd_scale=-20.0)
         w1 = 2 * np.pi * float(point.natural_frequency)
         strain = 0.5 * 2.76e-3 / l ** 2
         for place, s in (("clamp", 0.0), ("midspan", 0.5)):
-            for r in range(2):
-                X = np.fft.rfft(records.values[r, :, 0]) * 0.1
+            for r, X in enumerate(spectra):
                 C = sum(_clamped_beam(b, s)[1] * g * X
                         / ((w1 * (b / betas[0]) ** 2) ** 2 - omega ** 2
                            + 2j * 0.05 * w1 * (b / betas[0]) ** 2 * omega)
                         for b, g in zip(betas, gammas))
                 window = t >= t[-1] + t[1] - float(point.statistics_window[r])
                 for k in range(3):
-                    c = np.fft.irfft((1j * omega) ** k * C, n=n * up) * up
+                    c = fine((1j * omega) ** k * C)
                     exact = strain ** 2 * np.mean(c[window] ** 2)
                     got = float(point[f"{place}_strain_m{2 * k}"][r])
                     assert got == pytest.approx(exact, rel=1e-3), (l, place, r, k, got, exact)
