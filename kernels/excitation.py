@@ -197,6 +197,27 @@ def _piece_integrals(y0, d0, y1, d1, u, dt):
     return dt * first, dt * square
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def fill_record_integrals(record, dt):
+    """Columns 2 and 3 of one record (N, RECORD_ROWS), in place: the running integrals of its
+    cubic Hermite interpolant and of its square from t = 0 to each sample (m/s, m^2/s^3), summed
+    piece by piece in order from `_piece_integrals`' closed forms over whole pieces; columns 0
+    and 1 hold the samples and their derivatives (m/s^2, m/s^3), dt is the sample interval (s).
+    The last piece, from sample N - 1 round to sample 0, is not summed: `record_integrals`
+    adds it for a time past a whole period."""
+    n = record.shape[0]
+    first = 0.0
+    square = 0.0
+    for k in range(n):
+        record[k, 2] = first
+        record[k, 3] = square
+        if k + 1 < n:
+            a, b = _piece_integrals(record[k, 0], record[k, 1], record[k + 1, 0],
+                                    record[k + 1, 1], 1.0, dt)
+            first += a
+            square += b
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, forceinline=True)
 def record_integrals(t, p, o, s, records):
     """(integral of a_b, integral of a_b^2) from 0 to t (s) (m/s, m^2/s^3) of the record kind's
@@ -242,6 +263,31 @@ def record_value(t, p, o, s, records):
     called (`inlined_signal`); `record_acceleration` is the same as a call."""
     y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
     return scale * _hermite(y0, d0, y1, d1, u, dt) * _rise(t, p[o + RAMP * s])
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, forceinline=True)
+def record_at_nodes(t, h, nodes, p, o, s, records, out, out_o, out_s):
+    """`record_value` at the times t + nodes[i] h (s), i = 1 .. len(nodes) - 1, into
+    out[out_o + (i - 1) * out_s], and at t + h into the slot after them (a copy of the last
+    where nodes[-1] is 1): a step's stage reads of one row, the row's columns read once for
+    them all (the lanes' `_stage_reads`: 11 reads a DOP853 step, most of a one-mode record's
+    run when each was a call of its own)."""
+    r = int(p[o + RECORD * s])
+    fs = p[o + RECORD_RATE * s]
+    scale = p[o + RECORD_SCALE * s]
+    ramp = p[o + RAMP * s]
+    dt = 1.0 / fs
+    n = records.shape[1]
+    m = len(nodes)
+    for i in range(1, m + 1):
+        if i == m and nodes[m - 1] == 1.0:
+            out[out_o + (m - 1) * out_s] = out[out_o + (m - 2) * out_s]
+            break
+        at = t + nodes[i] * h if i < m else t + h
+        k, k1, u, _ = _sample_index(at, fs, n)
+        out[out_o + (i - 1) * out_s] = scale * _hermite(
+            records[r, k, 0], records[r, k, 1], records[r, k1, 0], records[r, k1, 1], u,
+            dt) * _rise(at, ramp)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -64,7 +64,8 @@ from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, 
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
 from .layout import N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
-from .oscillator import BOUND, N_PARAMS, acceleration, base_acceleration, prepare, shaken
+from .oscillator import (BOUND, N_PARAMS, acceleration, base_acceleration, prepare,
+                         record_stages, shaken)
 from .transverse import classify, reject_point, valid
 from .vecmath import inv_fifth_root
 
@@ -156,24 +157,21 @@ def _accel_read(W, j, t, q, v, parametric, base, stage):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _stage_reads(W, n_run, eighth, base):
+def _read_stages(W, n_run, eighth, base):
     """Each lane's a_b (m/s^2) at its attempt's stage times t + C[s] h, s = 1 .. n - 1, and at
     t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads, before the attempt,
-    so that its chain's loop has none and vectorises (5-8 % of a one-mode random run,
-    benchmarks/RESULTS.md). The reads themselves stay a scalar loop: LLVM will not vectorise
-    a gather from the records beside a store into W, which it cannot prove apart."""
+    so that its chain's loop has none and vectorises. The reads stay a scalar loop, lane by
+    lane (oscillator.record_stages reads a lane's columns once for its stages): LLVM will not
+    vectorise a gather from the records beside a store into W, which it cannot prove apart."""
     L = LANES
     nodes = dop853.C if eighth is not None else C
-    n = len(nodes)
-    for s in range(1, n):
-        for j in range(n_run):
-            at = W[tj.T * L + j] + nodes[s] * W[W_H * L + j]
-            W[(W_AB_STAGES + s - 1) * L + j] = base_acceleration(at, W, W_P * L + j, L, True,
-                                                                 base)
-    for j in range(n_run):               # f(t + h, y_new): both methods' last stage is there
-        W[(W_AB_STAGES + n - 1) * L + j] = (
-            W[(W_AB_STAGES + n - 2) * L + j] if nodes[n - 1] == 1.0 else base_acceleration(
-                W[tj.T * L + j] + W[W_H * L + j], W, W_P * L + j, L, True, base))
+    for j in range(n_run):       # f(t + h, y_new): both methods' last stage is at t + h
+        record_stages(W[tj.T * L + j], W[W_H * L + j], nodes, W, W_P * L + j, L, base, W,
+                      W_AB_STAGES * L + j, L)
+
+
+# compiled for the record kind only (the sine kinds have no reads to make)
+_stage_reads = ex.by_kind(None, _read_stages)
 
 
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in

@@ -114,6 +114,14 @@ def _excitation_signal(t, p, o, s, base):
     return ex.inlined_signal(t, p, o + EXCITATION * s, s, base)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, forceinline=True)
+def record_stages(t, h, nodes, p, o, s, records, out, out_o, out_s):
+    """A random record's a_b (m/s^2) at a step's stage times t + nodes[i] h (s) and at t + h
+    for the row at p[o + column * s] (kernels.excitation.record_at_nodes on its excitation
+    block): the same values as `base_acceleration` at each."""
+    ex.record_at_nodes(t, h, nodes, p, o + EXCITATION * s, s, records, out, out_o, out_s)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4), _nrt=False)
 def base_acceleration(t, p, o, s, fast, base):
     """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation

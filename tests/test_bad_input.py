@@ -173,8 +173,8 @@ def _mkdir(name: str):
     return lambda work: (work / name).mkdir()
 
 
-def _existing(name: str):
-    return lambda work: (work / name).write_text("keep me")
+def _existing(name: str, data: bytes = b"keep me"):
+    return lambda work: (work / name).write_bytes(data)
 
 
 def _unreadable(work: Path) -> None:
@@ -283,6 +283,13 @@ CLI_CASES = [
      ["--threads -2"], None),
     ("threads-not-a-number", ["run", "paper-fig5", "-o", "out.nc", "--threads", "two"],
      ["--threads", "'two'"], None),
+    ("set-list-not-toml", ["run", "paper-fig5", "-o", "out.nc",
+                           "--set", "axes.length=[200 mm, 300 mm]"],
+     ["'axes.length'", "not a valid toml list"], None),
+    ("set-list-unclosed", ["run", "paper-fig5", "-o", "out.nc", "--set", "axes.length=[0.3, 0.5"],
+     ["'axes.length'", "not a valid toml list"], None),
+    ("result-as-scene", ["run", "result.nc", "-o", "out.nc"], ["result.nc", "netcdf"],
+     _existing("result.nc", b"\x89HDF\r\n\x1a\n" + bytes(64))),
     ("unknown-subcommand", ["fly"], ["'fly'", "choose from"], None),
     ("run-without-scene", ["run"], ["scene", "usage"], None),
     ("no-subcommand", [], ["command", "usage"], None),

@@ -278,6 +278,19 @@ def test_an_angle_where_the_key_has_none_is_refused_and_data_sheet_spellings_rea
     assert to_si("k", bending, "0.31515 Nm^2") == pytest.approx(0.31515, rel=1e-14)
 
 
+def test_a_number_typed_in_full_keeps_its_bits_and_a_short_one_loses_the_noise():
+    """A unit string is rounded to 15 significant digits ('33.3 g/m' is 0.0333, not 33.3 x
+    0.001's 0.033299999999999996) only when it was typed with 15 or fewer: a value pasted with
+    all 17 digits of a float is that float, as the plain number would be."""
+    inertia = schema.BY_DOTTED["cable.inertia"]
+    assert to_si("k", inertia, "2.8647889756541167e-12 m^4") == 2.8647889756541167e-12
+    length = schema.BY_DOTTED["cable.length"]
+    assert to_si("k", length, "0.30000000000000004 m") == 0.30000000000000004
+    assert to_si("k", length, "300.00000000000004 mm") == 300.00000000000004 * 1e-3
+    mass = schema.BY_DOTTED["cable.linear_mass"]
+    assert to_si("k", mass, "33.3 g/m") == 0.0333 != 33.3 * 0.001
+
+
 @pytest.mark.parametrize("text, words", [
     ("53,4 g/m", "comma"), ("1,000 g/m", "comma"), ("53.4 g/m 2", "inside its unit"),
     ("53.4 g/m + 1 g/m", "inside its unit"), ("53.4 g/m - 1 g/m", "inside its unit"),

@@ -187,26 +187,12 @@ def with_integrals(values: np.ndarray, sample_rate: float) -> np.ndarray:
     periodic, so its last piece runs from sample N - 1 to sample 0. The kernels read the
     integral over any stretch of time from these and the partial pieces at its ends in closed
     form (kernels.excitation.record_integrals)."""
+    from ..kernels.excitation import fill_record_integrals
     out = np.empty((values.shape[0], values.shape[1], RECORD_ROWS))
     out[:, :, :2] = values[:, :, :2]
     for r in range(values.shape[0]):
-        _fill_integrals(out[r], 1.0 / float(sample_rate))
+        fill_record_integrals(out[r], 1.0 / float(sample_rate))
     return out
-
-
-def _fill_integrals(record: np.ndarray, dt: float) -> None:
-    """Columns 2 and 3 of one record (N, RECORD_ROWS) from its columns 0 and 1
-    (`with_integrals`); dt: the sample interval (s)."""
-    x, d = record[:, 0], record[:, 1] * dt
-    x1, d1 = np.roll(x, -1), np.roll(d, -1)
-    a2 = 3.0 * (x1 - x) - 2.0 * d - d1      # the piece's cubic x + d u + a2 u^2 + a3 u^3,
-    a3 = 2.0 * (x - x1) + d + d1            # u = (t - t_k) / dt from 0 to 1
-    first = dt * (x + d / 2.0 + a2 / 3.0 + a3 / 4.0)
-    square = dt * (x * x + x * d + (d * d + 2.0 * x * a2) / 3.0 + (x * a3 + d * a2) / 2.0
-                   + (a2 * a2 + 2.0 * d * a3) / 5.0 + a2 * a3 / 3.0 + a3 * a3 / 7.0)
-    record[0, 2] = record[0, 3] = 0.0
-    record[1:, 2] = np.cumsum(first[:-1])
-    record[1:, 3] = np.cumsum(square[:-1])
 
 
 def record_length(duration: float, sample_rate: float) -> int:
@@ -270,6 +256,7 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
     scale = 0.5 * n * np.sqrt(variance)
     derivative = 2j * np.pi * fk
     values = np.empty((realisations, n, RECORD_ROWS))
+    from ..kernels.excitation import fill_record_integrals
 
     def make(r: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(r,)))
@@ -277,7 +264,7 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
         X = scale * (a - 1j * b)
         values[r, :, 0] = np.fft.irfft(X, n=n)
         values[r, :, 1] = np.fft.irfft(derivative * X, n=n)
-        _fill_integrals(values[r], 1.0 / sample_rate)
+        fill_record_integrals(values[r], 1.0 / sample_rate)
 
     workers = min(int(threads), realisations)
     if workers > 1:

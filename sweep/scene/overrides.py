@@ -64,7 +64,13 @@ def parse_override(item: str) -> tuple[str, Any]:
         _fail(f"override '{item}'", "must have the form KEY=VALUE",
               "write a dotted scene key, '=' and a value, e.g. solver.rtol=1e-9 or "
               "axes.length=[0.5, 1.0]")
-    return key, _parse_value_text(value)
+    parsed = _parse_value_text(value)
+    if isinstance(parsed, str) and parsed[:1] in ("[", "{") and not _expects_string(key):
+        kind = "list" if parsed[0] == "[" else "table"
+        _fail(f"override '{key}'", f"{parsed} is not a valid TOML {kind}",
+              "write it with its brackets closed and each value with a unit quoted, e.g. "
+              "axes.length='[\"200 mm\", \"300 mm\"]' or axes.length=[0.2, 0.3]")
+    return key, parsed
 
 
 def _parse_value_text(text: str) -> Any:

@@ -81,6 +81,10 @@ def _read_scene(scene: str | os.PathLike) -> tuple[str, str, str]:
     if stat.S_ISDIR(info.st_mode):
         _fail(where, "is a directory, not a TOML file", "give the path of a .toml scene file")
     data = _read_regular(source, where)
+    if data[:3] == b"CDF" or data[:8] == b"\x89HDF\r\n\x1a\n":
+        _fail(where, "is a netCDF file (a result), not a TOML scene",
+              "give the scene's .toml file or a built-in name; a result keeps the scene it was "
+              "run from in its 'scene' attribute")
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -250,8 +250,16 @@ def to_si(where: str, key: schema.Key, text: str) -> float:
     except Exception as exc:                     # offset units (degC) and the like
         _fail(where, f"{_show(text)} cannot be converted to {key.units} ({exc})",
               f"give e.g. {example}")
-    # 15 significant digits: '33.3 g/m' is 0.0333, not 33.3 x 0.001 = 0.033299999999999996
-    return float(f"{value:.15g}")
+    # 15 significant digits: '33.3 g/m' is 0.0333, not 33.3 x 0.001 = 0.033299999999999996;
+    # a number typed with more digits keeps them all (no rounding: its SI number's bits)
+    digits = _significant_digits(_LEADING_NUMBER.match(text).group(0))
+    return float(f"{value:.15g}") if digits <= 15 else value
+
+
+def _significant_digits(number: str) -> int:
+    """How many significant digits a number as typed has ('0.0333': 3, '2.86e-12': 3)."""
+    mantissa = re.split(r"[eE]", number.strip().lstrip("+-"))[0].replace(".", "")
+    return max(1, len(mantissa.lstrip("0")))
 
 
 def _milligram(where: str, key: schema.Key, text: str) -> None:
