@@ -18,10 +18,13 @@ over its first RAMP seconds, as a shaker's does, by the factor (1 - cos(pi t / R
 
 A random base acceleration is the excitation kind `record` (docs/model.md sec. 11): a_b(t)
 sampled at fs on a grid, records[r, k, 0] = a_b(k / fs) and records[r, k, 1] its time
-derivative (m/s^3, exact from the spectrum; a sample's values side by side, so that a read
-touches one or two cache lines, kernels.layout.RECORD_ROWS), interpolated between samples by
-the cubic Hermite polynomial through both (so the forcing is continuous with its rate, as the
-adaptive step wants), periodic with the record's period N / fs. The records are shared by every grid
+derivative (m/s^3, exact from the spectrum), interpolated between samples by the cubic
+Hermite polynomial through both (so the forcing is continuous with its rate, as the adaptive
+step wants), periodic with the record's period N / fs. Each sample also carries the piece
+from it to the next as a cubic in the fraction u of the interval (its coefficients of u^2 and
+u^3, CUBIC_C and CUBIC_D, `fill_record_pieces`), so that a read is four numbers side by side
+and three multiply-adds, and the running integrals of a_b and a_b^2 (`record_integrals`;
+kernels.layout.RECORD_ROWS). The records are shared by every grid
 point (common random numbers): the kernels take them as the `base` switch itself, an array
 where the sine kinds take True (`signal`), and a row's block names its record: RECORD (its
 realisation r), RECORD_RATE (fs, Hz) and RECORD_SCALE (the level factor, 1: the spectrum as
@@ -58,6 +61,10 @@ SIZE = RAMP + 1
 RECORD_SCALE = ACCEL   # the level factor on the record (1), 10^(dB / 20) of a level in dB
 RECORD_RATE = OMEGA    # fs, the records' sample rate (Hz)
 RECORD = PHASE         # r, which record (realisation) the row follows (an index, as a float)
+# The records' columns (kernels.layout.RECORD_ROWS) beyond a sample's a_b (0), its derivative (1)
+# and the running integrals (2, 3): the coefficients of u^2 and u^3 of the piece from it.
+CUBIC_C = 4
+CUBIC_D = 5
 RECORD_START = END     # the row's statistics start no earlier than this (s): its start-up
                        # transient's end (kernels.trajectory.record_window)
                        # (RAMP, as the sweeps': the record's level rises from 0 over RAMP s)
@@ -171,25 +178,32 @@ def _sample_index(t, fs, n):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _record_interval(t, p, o, s, records):
-    """The sample interval of the record kind's row at time t (s): its two samples and their
-    derivatives (y0, d0, y1, d1), the fraction u of the interval, its length dt = 1 / fs (s)
-    and the level factor (`record_acceleration`)."""
+def _record_piece(t, p, o, s, records):
+    """The record kind's row at time t (s): its piece there as the cubic
+    y + b u + c u^2 + d u^3 in the fraction u of the sample interval (y, b, c, d in m/s^2:
+    the sample, dt times its derivative and the two coefficients the record carries,
+    `cubic`), u, the interval dt = 1 / fs (s) and the level factor."""
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
-    k, k1, u, _ = _sample_index(t, fs, records.shape[1])
-    return (records[r, k, 0], records[r, k, 1], records[r, k1, 0], records[r, k1, 1], u,
-            1.0 / fs, p[o + RECORD_SCALE * s])
+    dt = 1.0 / fs
+    k, _, u, _ = _sample_index(t, fs, records.shape[1])
+    return (records[r, k, 0], dt * records[r, k, 1], records[r, k, CUBIC_C],
+            records[r, k, CUBIC_D], u, dt, p[o + RECORD_SCALE * s])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _piece_integrals(y0, d0, y1, d1, u, dt):
-    """The integrals of the cubic Hermite interpolant through (y0, d0) and (y1, d1) over the
-    first fraction u of its interval dt (s), and of its square: the closed forms of
-    sweep.models.random.with_integrals' whole pieces, at u."""
+def cubic(y0, d0, y1, d1, dt):
+    """The coefficients c, d (m/s^2) of u^2 and u^3 of the cubic Hermite interpolant
+    y0 + dt d0 u + c u^2 + d u^3 through the samples (y0, d0) at u = 0 and (y1, d1) at u = 1
+    (m/s^2, m/s^3) of an interval dt (s) long."""
     b = dt * d0
-    c = 3.0 * (y1 - y0) - 2.0 * b - dt * d1
-    d = 2.0 * (y0 - y1) + b + dt * d1
+    return 3.0 * (y1 - y0) - 2.0 * b - dt * d1, 2.0 * (y0 - y1) + b + dt * d1
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _piece_integrals(y0, b, c, d, u, dt):
+    """The integrals of the piece y0 + b u + c u^2 + d u^3 (m/s^2) over the first fraction u of
+    its interval dt (s), and of its square (m/s, m^2/s^3)."""
     first = u * (y0 + u * (b / 2.0 + u * (c / 3.0 + u * d / 4.0)))
     square = u * (y0 * y0 + u * (y0 * b + u * ((b * b + 2.0 * y0 * c) / 3.0 + u * (
         (y0 * d + b * c) / 2.0 + u * ((c * c + 2.0 * b * d) / 5.0 + u * (
@@ -198,24 +212,27 @@ def _piece_integrals(y0, d0, y1, d1, u, dt):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def fill_record_integrals(record, dt):
-    """Columns 2 and 3 of one record (N, RECORD_ROWS), in place: the running integrals of its
-    cubic Hermite interpolant and of its square from t = 0 to each sample (m/s, m^2/s^3), summed
-    piece by piece in order from `_piece_integrals`' closed forms over whole pieces; columns 0
-    and 1 hold the samples and their derivatives (m/s^2, m/s^3), dt is the sample interval (s).
-    The last piece, from sample N - 1 round to sample 0, is not summed: `record_integrals`
-    adds it for a time past a whole period."""
+def fill_record_pieces(record, dt):
+    """Columns 2 to 5 of one record (N, RECORD_ROWS), in place, from its samples and their
+    derivatives in columns 0 and 1 (m/s^2, m/s^3; dt the sample interval, s): in CUBIC_C and
+    CUBIC_D the coefficients of the piece that starts at each sample (`cubic`; the last piece
+    runs from sample N - 1 round to sample 0, the record being periodic), and in columns 2 and
+    3 the running integrals of the interpolant and of its square from t = 0 to each sample (m/s,
+    m^2/s^3), summed piece by piece in order (`_piece_integrals` over whole pieces; the last
+    piece is left out: `record_integrals` adds it for a time past a whole period)."""
     n = record.shape[0]
     first = 0.0
     square = 0.0
     for k in range(n):
+        k1 = k + 1 if k + 1 < n else 0
+        c, d = cubic(record[k, 0], record[k, 1], record[k1, 0], record[k1, 1], dt)
+        record[k, CUBIC_C] = c
+        record[k, CUBIC_D] = d
         record[k, 2] = first
         record[k, 3] = square
-        if k + 1 < n:
-            a, b = _piece_integrals(record[k, 0], record[k, 1], record[k + 1, 0],
-                                    record[k + 1, 1], 1.0, dt)
-            first += a
-            square += b
+        a, b = _piece_integrals(record[k, 0], dt * record[k, 1], c, d, 1.0, dt)
+        first += a
+        square += b
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, forceinline=True)
@@ -223,46 +240,45 @@ def record_integrals(t, p, o, s, records):
     """(integral of a_b, integral of a_b^2) from 0 to t (s) (m/s, m^2/s^3) of the record kind's
     row, on its cubic Hermite interpolant times the level factor, the ramp left out (exact
     once t is past it: a record's statistics start after it): the running integrals the
-    records carry to each sample (columns 2 and 3, sweep.models.random.with_integrals) and the
-    partial interval in closed form. The difference of two such calls is the integral over
-    the stretch between them."""
+    records carry to each sample (columns 2 and 3, `fill_record_pieces`) and the partial
+    interval in closed form. The difference of two such calls is the integral over the
+    stretch between them."""
     n = records.shape[1]
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
     scale = p[o + RECORD_SCALE * s]
-    k, k1, u, lap = _sample_index(t, fs, n)
-    first, square = _piece_integrals(records[r, k, 0], records[r, k, 1], records[r, k1, 0],
-                                     records[r, k1, 1], u, 1.0 / fs)
+    dt = 1.0 / fs
+    k, _, u, lap = _sample_index(t, fs, n)
+    first, square = _piece_integrals(records[r, k, 0], dt * records[r, k, 1],
+                                     records[r, k, CUBIC_C], records[r, k, CUBIC_D], u, dt)
     first += records[r, k, 2]
     square += records[r, k, 3]
     if lap:                         # a whole period before it
-        whole, whole_sq = _piece_integrals(records[r, n - 1, 0], records[r, n - 1, 1],
-                                           records[r, 0, 0], records[r, 0, 1], 1.0, 1.0 / fs)
+        whole, whole_sq = _piece_integrals(records[r, n - 1, 0], dt * records[r, n - 1, 1],
+                                           records[r, n - 1, CUBIC_C],
+                                           records[r, n - 1, CUBIC_D], 1.0, dt)
         first += whole + records[r, n - 1, 2]
         square += whole_sq + records[r, n - 1, 3]
     return scale * first, scale * scale * square
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _hermite(y0, d0, y1, d1, u, dt):
-    """The cubic Hermite interpolant through (y0, d0) and (y1, d1) at the fraction u of an
-    interval dt (s) long."""
-    u2 = u * u
-    u3 = u2 * u
-    return ((2.0 * u3 - 3.0 * u2 + 1.0) * y0 + (u3 - 2.0 * u2 + u) * dt * d0
-            + (3.0 * u2 - 2.0 * u3) * y1 + (u3 - u2) * dt * d1)
+def _horner(y, b, c, d, u):
+    """The piece y + b u + c u^2 + d u^3 at the fraction u of its interval."""
+    return y + u * (b + u * (c + u * d))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def record_value(t, p, o, s, records):
-    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records` (R, N, 4)
-    at time t (s), the cubic Hermite interpolant of the samples and their derivatives at
-    fs = p[o + RECORD_RATE * s], periodic with period N / fs, times the level factor
-    p[o + RECORD_SCALE * s], and over the first RAMP seconds (base.ramp; 0: none) by the
-    ramp's (1 - cos(pi t / RAMP)) / 2, as a shaker brings its level up. Inlined where it is
-    called (`inlined_signal`); `record_acceleration` is the same as a call."""
-    y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
-    return scale * _hermite(y0, d0, y1, d1, u, dt) * _rise(t, p[o + RAMP * s])
+    """a_b(t) (m/s^2) of the record kind: record r = p[o + RECORD * s] of `records`
+    (R, N, RECORD_ROWS) at time t (s), the cubic Hermite interpolant of the samples and their
+    derivatives at fs = p[o + RECORD_RATE * s] (each piece as the cubic the record carries,
+    `cubic`), periodic with period N / fs, times the level factor p[o + RECORD_SCALE * s], and
+    over the first RAMP seconds (base.ramp; 0: none) by the ramp's (1 - cos(pi t / RAMP)) / 2,
+    as a shaker brings its level up. Inlined where it is called (`inlined_signal`);
+    `record_acceleration` is the same as a call."""
+    y, b, c, d, u, dt, scale = _record_piece(t, p, o, s, records)
+    return scale * _horner(y, b, c, d, u) * _rise(t, p[o + RAMP * s])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, forceinline=True)
@@ -271,7 +287,7 @@ def record_at_nodes(t, h, nodes, p, o, s, records, out, out_o, out_s):
     out[out_o + (i - 1) * out_s], and at t + h into the slot after them (a copy of the last
     where nodes[-1] is 1): a step's stage reads of one row, the row's columns read once for
     them all (the lanes' `_stage_reads`: 11 reads a DOP853 step, most of a one-mode record's
-    run when each was a call of its own)."""
+    run)."""
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
     scale = p[o + RECORD_SCALE * s]
@@ -284,10 +300,10 @@ def record_at_nodes(t, h, nodes, p, o, s, records, out, out_o, out_s):
             out[out_o + (m - 1) * out_s] = out[out_o + (m - 2) * out_s]
             break
         at = t + nodes[i] * h if i < m else t + h
-        k, k1, u, _ = _sample_index(at, fs, n)
-        out[out_o + (i - 1) * out_s] = scale * _hermite(
-            records[r, k, 0], records[r, k, 1], records[r, k1, 0], records[r, k1, 1], u,
-            dt) * _rise(at, ramp)
+        k, _, u, _ = _sample_index(at, fs, n)
+        out[out_o + (i - 1) * out_s] = scale * _horner(
+            records[r, k, 0], dt * records[r, k, 1], records[r, k, CUBIC_C],
+            records[r, k, CUBIC_D], u) * _rise(at, ramp)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -299,12 +315,10 @@ def record_acceleration(t, p, o, s, records):
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_and_rate(t, p, o, s, records):
     """(a_b(t), a_b'(t)) (m/s^2, m/s^3) of the record kind: `record_acceleration` and the
-    time derivative of its cubic Hermite interpolant (and of the ramp's rise)."""
-    y0, d0, y1, d1, u, dt, scale = _record_interval(t, p, o, s, records)
-    u2 = u * u
-    slope = ((6.0 * u2 - 6.0 * u) * y0 + (3.0 * u2 - 4.0 * u + 1.0) * dt * d0
-             + (6.0 * u - 6.0 * u2) * y1 + (3.0 * u2 - 2.0 * u) * dt * d1) / dt
-    return _ramped(t, p[o + RAMP * s], scale * _hermite(y0, d0, y1, d1, u, dt), scale * slope)
+    time derivative of its piece (and of the ramp's rise)."""
+    y, b, c, d, u, dt, scale = _record_piece(t, p, o, s, records)
+    slope = (b + u * (2.0 * c + 3.0 * u * d)) / dt
+    return _ramped(t, p[o + RAMP * s], scale * _horner(y, b, c, d, u), scale * slope)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -349,7 +363,7 @@ def record_bound(t0, t1, p, o, s, records):
     last = int(math.floor(max(t0, t1) * fs))
     top = 0.0
     for k in range(first, last + 1):
-        k0 = k - n if k >= n else k          # t < 2 N / fs, as `_record_interval`
+        k0 = k - n if k >= n else k          # t < 2 N / fs, as `_sample_index`
         k1 = k0 + 1 if k0 + 1 < n else 0
         top = max(top, max(abs(records[r, k0, 0]), abs(records[r, k1, 0]))
                   + 4.0 / 27.0 * dt * (abs(records[r, k0, 1]) + abs(records[r, k1, 1])))

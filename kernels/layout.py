@@ -90,7 +90,9 @@ N_COUNTS = 3
 
 # A random base acceleration's records (sweep.models.random.Records, the kernels' `base`
 # switch of the record kind), (R, N, RECORD_ROWS): per record and sample its a_b (m/s^2), its
-# derivative (m/s^3), and the running integrals of the record's cubic Hermite interpolant and
-# of the interpolant's square from 0 to that sample (m/s, m^2/s^3;
-# kernels.excitation.record_integrals), side by side: a read touches one or two cache lines.
-RECORD_ROWS = 4
+# derivative (m/s^3), the running integrals of the record's cubic Hermite interpolant and of
+# the interpolant's square from 0 to that sample (m/s, m^2/s^3;
+# kernels.excitation.record_integrals) and the coefficients of u^2 and u^3 of the piece from
+# that sample (m/s^2; kernels.excitation.CUBIC_C, CUBIC_D), side by side: a read of a piece
+# touches one or two cache lines.
+RECORD_ROWS = 6

@@ -267,7 +267,8 @@ def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
     from sweep.kernels.layout import RECORD_ROWS
     if records.ndim != 3 or records.shape[2] != RECORD_ROWS:
         raise ValueError(f"records of shape {records.shape}: expected (R, N, {RECORD_ROWS}), "
-                         "the samples with their integrals (sweep.models.random.with_integrals)")
+                         "the samples with their integrals and pieces "
+                         "(sweep.models.random.synthesise)")
     return np.ascontiguousarray(records, dtype=np.float64)
 
 

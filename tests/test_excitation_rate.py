@@ -14,6 +14,7 @@ import pytest
 
 from sweep.kernels import excitation as ex
 from sweep.models.excitation import EXCITATION_NAMES, block, ramp_time, sweep_duration, sweep_rate
+from sweep.models.random import with_pieces
 
 
 def _row(values: dict) -> np.ndarray:
@@ -57,8 +58,8 @@ def test_a_fixed_sine_rate():
 
 def test_a_records_rate_is_the_derivative_of_its_hermite_interpolant():
     rng = np.random.default_rng(7)
-    records = rng.standard_normal((2, 2, 64)).transpose(0, 2, 1).copy()
     fs = 400.0
+    records = with_pieces(rng.standard_normal((2, 2, 64)).transpose(0, 2, 1), fs)
     p = np.zeros(ex.SIZE)
     p[ex.RECORD_SCALE] = 1.7
     p[ex.RECORD_RATE] = fs

@@ -11,6 +11,7 @@ import pytest
 
 from sweep.kernels import excitation as ex
 from sweep.kernels import modes as md
+from sweep.models.random import with_pieces
 
 
 @nb.njit(cache=True)
@@ -80,6 +81,7 @@ def test_a_records_bound_holds_on_every_interval_and_is_within_a_third_of_its_pe
         a, phase = rng.normal(0.0, 1.0, 24), rng.uniform(0.0, 2.0 * math.pi, 24)
         records[r, :, 0] = (a * np.sin(np.outer(tk, w) + phase)).sum(axis=1)
         records[r, :, 1] = (a * w * np.cos(np.outer(tk, w) + phase)).sum(axis=1)
+    records = with_pieces(records, fs)             # what the kernels read beside the samples
     p = np.zeros(ex.SIZE)
     p[ex.RECORD] = 1
     p[ex.RECORD_RATE] = fs

@@ -220,6 +220,44 @@ def test_records_are_periodic_under_hermite(gevs):
     np.testing.assert_allclose(end, x[0, 0], atol=1e-6 * np.abs(x[:, 0]).max())
 
 
+def test_the_kernels_read_the_records_hermite_interpolant(gevs):
+    """Each piece of a record as the kernels read it (the cubic the record carries from its
+    sample, kernels.excitation.record_value through record_acceleration, and a step's stage
+    reads, record_at_nodes) is the cubic Hermite interpolant of the samples and their
+    derivatives (`rnd.hermite`, written with the Hermite basis), over two periods and across
+    the records' wrap, times the level factor and under the ramp's rise; and its rate
+    (record_and_rate) is the interpolant's derivative (a central difference of `rnd.hermite`)."""
+    from sweep.kernels import excitation as ex
+    f, W = gevs
+    fs = 20000.0
+    rec = rnd.synthesise(f, W, 0.01, fs, 2, 9)
+    rng = np.random.default_rng(4)
+    t = np.concatenate([rng.uniform(0.0, 2.0 * rec.period, 400),
+                        rec.period - np.array([1e-9, 0.3 / fs]), np.arange(0, 3) / fs])
+    nodes = np.array([0.0, 0.2, 0.5, 1.0])
+    for r, ramp in ((0, 0.0), (1, 0.004)):
+        p = np.zeros(ex.SIZE)
+        p[ex.RECORD], p[ex.RECORD_RATE], p[ex.RECORD_SCALE], p[ex.RAMP] = r, fs, -0.7, ramp
+        rise = np.where(t < ramp, 0.5 - 0.5 * np.cos(np.pi * t / max(ramp, 1e-300)), 1.0)
+        exact = -0.7 * rnd.hermite(rec.values[r], fs, t) * rise
+        got = np.array([ex.record_acceleration(x, p, 0, 1, rec.values) for x in t])
+        size = np.abs(rec.values[r, :, 0]).max()
+        np.testing.assert_allclose(got, exact, rtol=0, atol=1e-13 * size)
+        h = 1e-7
+        slope = -0.7 * (rnd.hermite(rec.values[r], fs, t + h)
+                        - rnd.hermite(rec.values[r], fs, t - h)) / (2 * h)
+        away = (np.abs(t * fs - np.round(t * fs)) > 0.01) & (t > ramp + h)
+        rates = np.array([ex.record_and_rate(x, p, 0, 1, rec.values)[1] for x in t])
+        np.testing.assert_allclose(rates[away], slope[away], rtol=0,
+                                   atol=1e-6 * np.abs(slope).max())
+        out = np.zeros(len(nodes))
+        for x in t[:50]:
+            ex.record_at_nodes(x, 0.3 / fs, nodes, p, 0, 1, rec.values, out, 0, 1)
+            want = [ex.record_acceleration(x + c * 0.3 / fs, p, 0, 1, rec.values)
+                    for c in nodes[1:]]
+            assert list(out[:3]) == want and out[3] == out[2]
+
+
 def test_record_integrals_are_the_interpolants_integrals(gevs):
     """The running integrals a record carries (rows 2 and 3: of its cubic Hermite interpolant
     and of its square, from 0 to each sample) and the kernels' integrals between any two

@@ -33,8 +33,9 @@ of damped modes (deflection, velocity or absolute acceleration) by composite Gau
 quadrature graded around each resonance; `miles_rms` and `miles_grms` are Miles' white-noise
 single-mode formulas.
 
-Pure NumPy: no Numba, no SciPy (the records' layout, kernels.layout.RECORD_ROWS, is a
-plain constant).
+NumPy, no SciPy; the loop that completes the records (each piece's cubic and the running
+integrals, kernels.excitation.fill_record_pieces) is compiled, and imported only when records
+are made (the records' layout, kernels.layout.RECORD_ROWS, is a plain constant).
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ records' cubic Hermite interpolant, which the kernels integrate, already carries
 less of the spectrum near its top (an auditor's Welch of the interpolant; 11 % at 2.05 x)."""
 MAX_RECORD_BYTES = 2 ** 32
 """Largest records `synthesise` builds: 4 GiB of float64 (R x RECORD_ROWS x N x 8 bytes, the
-samples, their derivatives and their running integrals)."""
+samples, their derivatives, their running integrals and each piece's cubic)."""
 
 GRADING = 2.0 ** np.arange(-3, 11)
 """`linear_mean_square`: quadrature edges at f_n (1 +/- zeta_n x these) around each mode."""
@@ -156,11 +157,12 @@ def default_sample_rate(f: np.ndarray) -> float:
 class Records:
     """Sampled base accelerations: values (R, N, RECORD_ROWS) float64, C-contiguous,
     values[r, k, 0] the acceleration a_b (m/s^2) of realisation r at t = k / sample_rate,
-    values[r, k, 1] its exact time derivative (m/s^3), and values[r, k, 2], values[r, k, 3]
+    values[r, k, 1] its exact time derivative (m/s^3), values[r, k, 2] and values[r, k, 3]
     the integrals of the record's cubic Hermite interpolant (the kernels' a_b) and of its
-    square from 0 to that sample (m/s, m^2/s^3: `with_integrals`); sample_rate (Hz). Each
-    record is periodic with `period`. eq=False: records compare by identity (compare `values`
-    with np.array_equal)."""
+    square from 0 to that sample (m/s, m^2/s^3), values[r, k, 4:6] the coefficients of u^2
+    and u^3 of the interpolant's piece from that sample (m/s^2;
+    kernels.excitation.fill_record_pieces); sample_rate (Hz). Each record is periodic with
+    `period`. eq=False: records compare by identity (compare `values` with np.array_equal)."""
     values: np.ndarray
     sample_rate: float
 
@@ -180,18 +182,17 @@ class Records:
         return int(self.values.shape[1])
 
 
-def with_integrals(values: np.ndarray, sample_rate: float) -> np.ndarray:
-    """(R, N, RECORD_ROWS): records given as their samples and derivatives (R, N, 2) (m/s^2,
-    m/s^3; sample_rate Hz) with the running integrals of their cubic Hermite interpolant and of its
-    square from t = 0 to each sample beside them as columns 2 and 3 (m/s, m^2/s^3). A record is
-    periodic, so its last piece runs from sample N - 1 to sample 0. The kernels read the
-    integral over any stretch of time from these and the partial pieces at its ends in closed
-    form (kernels.excitation.record_integrals)."""
-    from ..kernels.excitation import fill_record_integrals
+def with_pieces(values: np.ndarray, sample_rate: float) -> np.ndarray:
+    """(R, N, RECORD_ROWS): records given as their samples and derivatives, values (R, N, 2)
+    or more columns (m/s^2, m/s^3; sample_rate Hz), with what the kernels read beside them
+    (`Records`: the running integrals of the interpolant and of its square, and each piece's
+    cubic; kernels.excitation.fill_record_pieces). A record is periodic: its last piece runs
+    from sample N - 1 to sample 0."""
+    from ..kernels.excitation import fill_record_pieces
     out = np.empty((values.shape[0], values.shape[1], RECORD_ROWS))
     out[:, :, :2] = values[:, :, :2]
     for r in range(values.shape[0]):
-        fill_record_integrals(out[r], 1.0 / float(sample_rate))
+        fill_record_pieces(out[r], 1.0 / float(sample_rate))
     return out
 
 
@@ -256,7 +257,7 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
     scale = 0.5 * n * np.sqrt(variance)
     derivative = 2j * np.pi * fk
     values = np.empty((realisations, n, RECORD_ROWS))
-    from ..kernels.excitation import fill_record_integrals
+    from ..kernels.excitation import fill_record_pieces
 
     def make(r: int) -> None:
         rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(r,)))
@@ -264,7 +265,7 @@ def synthesise(f: np.ndarray, W: np.ndarray, duration: float, sample_rate: float
         X = scale * (a - 1j * b)
         values[r, :, 0] = np.fft.irfft(X, n=n)
         values[r, :, 1] = np.fft.irfft(derivative * X, n=n)
-        fill_record_integrals(values[r], 1.0 / sample_rate)
+        fill_record_pieces(values[r], 1.0 / sample_rate)
 
     workers = min(int(threads), realisations)
     if workers > 1:
