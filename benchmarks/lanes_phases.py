@@ -1,16 +1,21 @@
-"""Where a multi-mode lanes run spends its time: each phase of kernels/modal_lanes.py's loop.
+"""Where a lanes run spends its time: each phase of the lanes driver's loop
+(kernels/modal_lanes.py's for several modes, kernels/lanes.py's for one).
 
 What it measures
 ----------------
-A copy of kernels/modal_lanes.py compiled with a time-stamp-counter read (rdtsc, from a
+A copy of the driver's module compiled with a time-stamp-counter read (rdtsc, from a
 five-line C helper built here with the system's C compiler) before each phase of
 `solve_block`'s main loop, run on the largest block of a built-in scene as `sweep.run` gives it
-to the kernel (one thread): the share of the cycles in loading and ending lanes with the next
-attempt's set-up, the attempt (the stages' right-hand sides and sums, the error), the
-controller and midspan projection, the modes' event test, `_finish`, the modes' step-end update,
-the steps handed to the scalar path (`_flagged_lane`: extrema, crests, samples) and the lanes'
-advance. The copy is compiled once untimed, then timed once. A diagnostic: the shares say
-where to look, the kernels' own timings are benchmarks/modes_cost.py's and workloads.py's.
+to the kernel (one thread). Several modes (kernels/modal_lanes.py): the share of the cycles in
+loading and ending lanes with the next attempt's set-up, the attempt (the stages' right-hand
+sides and sums, the error), the controller and midspan projection, the modes' event test,
+`_finish`, the modes' step-end update, the steps handed to the scalar path (`_flagged_lane`:
+extrema, crests, samples) and the lanes' advance. One mode (kernels/lanes.py): the next
+attempts, loading and ending lanes, a random record's stage reads, the attempt (the stage
+chain and the error), the PI factors, `_finish`, the ordinary steps' base-excitation metric or
+record statistics, and the steps handed to the scalar path (counted with the loop's top). The
+copy is compiled once untimed, then timed once. A diagnostic: the shares say where to look,
+the kernels' own timings are benchmarks/modes_cost.py's and workloads.py's.
 
 Command
 -------
@@ -18,8 +23,10 @@ Command
 
 e.g. `PYTHONPATH=. python benchmarks/lanes_phases.py harness-base-sine --set
 "axes.base_frequency={start=5.0,stop=100.0,num=16,spacing=\\"log\\"}" --set
-"axes.length=[0.2,0.35,0.5,0.65,0.8]" --set solver.t_end=2.0`. Needs a C compiler (cc); says
-so and stops without one.
+"axes.length=[0.2,0.35,0.5,0.65,0.8]" --set solver.t_end=2.0`, or one mode's random records:
+`PYTHONPATH=. python benchmarks/lanes_phases.py launch-random-gevs --set "axes.length=[0.15]"
+--set "axes.base_asd_scale=[0.0]" --set base.realisations=16 --set
+outputs.response_asd=false`. Needs a C compiler (cc); says so and stops without one.
 """
 
 from __future__ import annotations
@@ -73,28 +80,55 @@ def timer() -> ctypes._CFuncPtr:
     return lib.rdtsc
 
 
-def instrumented(rdtsc: ctypes._CFuncPtr) -> types.ModuleType:
-    """kernels/modal_lanes.py with a cycle count per phase (`solve_block(..., halt, cycles)`)."""
-    src = (ROOT / "kernels" / "modal_lanes.py").read_text()
+# one mode (kernels/lanes.py): the steps handed to the scalar path end the loop, and count
+# with its top (the loop has no marker after them: a step with none `continue`s past it)
+ONE_MODE_PHASES = [
+    ("        tj.next_attempts(W, L, W[W_H * L:(W_H + 1) * L]",
+     "loop top, and the steps handed to the scalar path"),
+    ("        top = 0\n", "next attempts"),
+    ("        n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)\n", "lanes loaded and ended"),
+    ("        if record is not None:\n            _stage_reads(", "lanes to run"),
+    ("        if eighth is None:\n            _attempt(W, rtol", "a record's stage reads"),
+    ("        if pi is not None:\n            _pi_factors", "attempt (stage chain, error)"),
+    ("        _keep_record_start(W, n_run, base)\n", "PI factors"),
+    ("        n_flagged, n_extrema, n_near = _finish(", "a record's start kept"),
+    ("        _ordinary_acceleration(W, settings", "_finish"),
+    ("        if n_flagged == 0:\n            continue\n",
+     "ordinary steps' acceleration peak or record statistics")]
+
+
+def instrumented(rdtsc: ctypes._CFuncPtr, name: str = "modal_lanes",
+                 phases: list | None = None) -> types.ModuleType:
+    """kernels/NAME.py with a cycle count per phase (`solve_block(..., halt, cycles)`), the
+    phases' markers `phases` (PHASES, or ONE_MODE_PHASES for kernels/lanes.py, whose last
+    phase has no marker after it). Written to a file and imported: the one-mode lanes make
+    their stage chains from the source of their functions."""
+    phases = PHASES if phases is None else phases
+    src = (ROOT / "kernels" / f"{name}.py").read_text()
     src = src.replace("from . import", "from sweep.kernels import").replace(
         "from .", "from sweep.kernels.").replace("cache=True", "cache=False")
     if src.count(" steady, halt):\n") != 1:
-        sys.exit("lanes_phases: kernels/modal_lanes.py changed: solve_block's signature")
+        sys.exit(f"lanes_phases: kernels/{name}.py changed: solve_block's signature")
     src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n", 1)
     head, loop = src.split("    while True:\n        if halt[0] != 0:", 1)
     loop = "    while True:\n        if halt[0] != 0:" + loop
-    for k, (text, _) in enumerate(PHASES):
+    for k, (text, _) in enumerate(phases):
         if loop.count(text) != 1:
-            sys.exit(f"lanes_phases: kernels/modal_lanes.py changed: no {text.strip()!r}")
+            sys.exit(f"lanes_phases: kernels/{name}.py changed: no {text.strip()!r}")
         loop = loop.replace(text, f"        _c = rdtsc(); cycles[{k}] += _c - _t0; _t0 = _c\n"
                             + text)
-    last = PHASES[-1][0]
-    loop = loop.replace(last, last + f"        _c = rdtsc(); cycles[{len(PHASES)}] += _c - _t0; "
-                        "_t0 = _c\n")
-    module = types.ModuleType("modal_lanes_phases")
+    if phases is PHASES:
+        last = phases[-1][0]
+        loop = loop.replace(last, last + f"        _c = rdtsc(); cycles[{len(phases)}] += "
+                            "_c - _t0; _t0 = _c\n")
+    import importlib.util
+    path = Path(tempfile.mkdtemp()) / f"{name}_phases.py"
+    path.write_text(head + "    _t0 = rdtsc()\n" + loop)
+    spec = importlib.util.spec_from_file_location(f"{name}_phases", path)
+    module = importlib.util.module_from_spec(spec)
     module.__dict__["rdtsc"] = rdtsc
-    exec(compile(head + "    _t0 = rdtsc()\n" + loop, "modal_lanes_phases", "exec"),
-         module.__dict__)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
     return module
 
 
@@ -113,23 +147,26 @@ def main() -> None:
     original = threads.call
 
     def spy(fn, *call_args):
-        if getattr(fn, "__name__", "") == "solve_block" and "modal_lanes" in fn.__module__:
-            calls.append(call_args)
+        if getattr(fn, "__name__", "") == "solve_block" and fn.__module__.endswith("lanes"):
+            calls.append((fn.__module__.rsplit(".", 1)[-1], call_args))
         return original(fn, *call_args)
 
     threads.call = spy
     sweep.run(sweep.load_scene(args.scene, overrides), progress=False)
     threads.call = original
     if not calls:
-        sys.exit(f"lanes_phases: {args.scene} ran no multi-mode lanes (model.modes >= 2?)")
+        sys.exit(f"lanes_phases: {args.scene} ran on no lanes driver")
+    import importlib
     import inspect
 
-    from sweep.kernels import modal_lanes
-    names = list(inspect.signature(modal_lanes.solve_block.py_func).parameters)
+    name = "modal_lanes" if any(n == "modal_lanes" for n, _ in calls) else "lanes"
+    driver = importlib.import_module(f"sweep.kernels.{name}")
+    names = list(inspect.signature(driver.solve_block.py_func).parameters)
     lo, hi = names.index("lo"), names.index("hi")
-    block = max(calls, key=lambda a: a[hi] - a[lo])
-    module = instrumented(timer())
-    cycles = np.zeros(len(PHASES) + 1, np.uint64)
+    block = max((a for n, a in calls if n == name), key=lambda a: a[hi] - a[lo])
+    phases = PHASES if name == "modal_lanes" else ONE_MODE_PHASES
+    module = instrumented(timer(), name, phases)
+    cycles = np.zeros(len(phases) + 1, np.uint64)
     for timed in (False, True):
         cycles[:] = 0
         fresh = [a.copy() if isinstance(a, np.ndarray) and a.flags.writeable else a
@@ -137,11 +174,12 @@ def main() -> None:
         start = time.perf_counter()
         module.solve_block(*fresh, cycles)
         wall = time.perf_counter() - start
-    names = [name for _, name in PHASES] + ["lanes' advance"]
+    labels = [label for _, label in phases] + (["lanes' advance"] if phases is PHASES else [])
     total = float(cycles.sum())
-    print(f"{args.scene}: block of rows {block[lo]}..{block[hi]}, {wall * 1e3:.0f} ms")
-    for name, value in zip(names, cycles):
-        print(f"  {name:40s} {100.0 * float(value) / total:5.1f} %")
+    print(f"{args.scene} ({name}): block of rows {block[lo]}..{block[hi]}, "
+          f"{wall * 1e3:.0f} ms")
+    for label, value in zip(labels, cycles):
+        print(f"  {label:56s} {100.0 * float(value) / total:5.1f} %")
     print("\n    PYTHONPATH=. python benchmarks/lanes_phases.py " + " ".join(sys.argv[1:]))
 
 
