@@ -164,17 +164,17 @@ def frequency(t, p, o, s):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _sample_index(t, fs, n):
-    """Where time t (s) falls among a record's n samples at fs (Hz): the interval's first and
-    second sample k, k1, the fraction u of the interval, and whether t is past one period."""
+    """Where time t (s) falls among a record's n samples at fs (Hz): the sample k that starts
+    its interval (and its piece), the fraction u of the interval, and whether t is past one
+    period."""
     x = t * fs
     kf = math.floor(x)
     u = x - kf
     k = int(kf)
     lap = k >= n
     k = k - n if lap else k         # t in [0, 2 N / fs): a run never passes the period N / fs
-    k1 = k + 1 if k + 1 < n else 0  # (not `% n`: an integer division per stage and lane, which
+    return k, u, lap                # (not `% n`: an integer division per stage and lane, which
                                     # took half a one-mode record's run on the lanes)
-    return k, k1, u, lap
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -186,7 +186,7 @@ def _record_piece(t, p, o, s, records):
     r = int(p[o + RECORD * s])
     fs = p[o + RECORD_RATE * s]
     dt = 1.0 / fs
-    k, _, u, _ = _sample_index(t, fs, records.shape[1])
+    k, u, _ = _sample_index(t, fs, records.shape[1])
     return (records[r, k, 0], dt * records[r, k, 1], records[r, k, CUBIC_C],
             records[r, k, CUBIC_D], u, dt, p[o + RECORD_SCALE * s])
 
@@ -248,7 +248,7 @@ def record_integrals(t, p, o, s, records):
     fs = p[o + RECORD_RATE * s]
     scale = p[o + RECORD_SCALE * s]
     dt = 1.0 / fs
-    k, _, u, lap = _sample_index(t, fs, n)
+    k, u, lap = _sample_index(t, fs, n)
     first, square = _piece_integrals(records[r, k, 0], dt * records[r, k, 1],
                                      records[r, k, CUBIC_C], records[r, k, CUBIC_D], u, dt)
     first += records[r, k, 2]
@@ -300,7 +300,7 @@ def record_at_nodes(t, h, nodes, p, o, s, records, out, out_o, out_s):
             out[out_o + (m - 1) * out_s] = out[out_o + (m - 2) * out_s]
             break
         at = t + nodes[i] * h if i < m else t + h
-        k, _, u, _ = _sample_index(at, fs, n)
+        k, u, _ = _sample_index(at, fs, n)
         out[out_o + (i - 1) * out_s] = scale * _horner(
             records[r, k, 0], dt * records[r, k, 1], records[r, k, CUBIC_C],
             records[r, k, CUBIC_D], u) * _rise(at, ramp)

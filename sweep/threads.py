@@ -267,8 +267,8 @@ def _random_base(records: np.ndarray | None, base: bool | None) -> Any:
     from sweep.kernels.layout import RECORD_ROWS
     if records.ndim != 3 or records.shape[2] != RECORD_ROWS:
         raise ValueError(f"records of shape {records.shape}: expected (R, N, {RECORD_ROWS}), "
-                         "the samples with their integrals and pieces "
-                         "(sweep.models.random.synthesise)")
+                         "the samples with their integrals and pieces (sweep.models.random: "
+                         "synthesise makes them, with_pieces completes given samples)")
     return np.ascontiguousarray(records, dtype=np.float64)
 
 
