@@ -93,9 +93,10 @@ class RandomInputs:
                    ramp=random_scene.ramp_time(values))
 
     def records(self, threads: int = 1) -> np.ndarray:
-        """The records the kernels take as their `base` switch: (R, N, 4) samples of a_b at
-        0 dB, their derivatives and running integrals (sweep/models/random.py, `Records`),
-        made on `threads` threads (the same bits on any number)."""
+        """The records the kernels take as their `base` switch: (R, N, RECORD_ROWS) samples
+        of a_b at 0 dB, their derivatives, running integrals and pieces
+        (sweep/models/random.py, `Records`), made on `threads` threads (the same bits on any
+        number)."""
         from .random import synthesise
         f, w = self.spectrum
         return synthesise(f, w, self.duration, self.sample_rate, self.realisations,
