@@ -1072,8 +1072,10 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     tj.begin(settings, acc, series, _project(y, weights, 0, n), _project(y, weights, n, n),
              fv, a0, atol_q, atol_v, h_abs, evals, row[md.BOUND])
     if ex.is_record(base):
-        share = -_project(pp, weights, md.P_FORCE * n, n)   # the watched deflection's
-        tj.record_window(acc, row[md.EXCITATION + ex.RECORD_START],   # participation
+        share = 0.0                         # the watched deflection's participation
+        for i in range(n):
+            share -= weights[i] * pp[md.P_FORCE * n + i]
+        tj.record_window(acc, row[md.EXCITATION + ex.RECORD_START],
                          row[md.EXCITATION + ex.RAMP], share)
         t_tail = acc[tj.T_TAIL]
     for i in range(n):
@@ -1104,11 +1106,11 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
         modal[load_slot(n) + k] = abs(loads[2 * k]) if t_loads <= 0.0 else 0.0
     for k in range(6):
         modal[square_slot(n) + k] = 0.0
-    for k in range(4):
         modal[carrier_slot(n) + k] = 0.0
     for k in range(2):                  # the curvature's share G_k of a_b (c'' = r - G_k a_b)
         e = md.BEND_0 if k == 0 else md.BEND_MID
-        modal[carrier_slot(n) + 4 + k] = -_project(pp, curvature[e], md.P_FORCE * n, n)
+        for i in range(n):
+            modal[carrier_slot(n) + 4 + k] -= curvature[e, i] * pp[md.P_FORCE * n + i]
     for i in range(n):
         modal[2 * n + 1 + i] = 0.0
     for i in range(n):
