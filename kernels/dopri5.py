@@ -14,7 +14,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .oscillator import acceleration
+from .oscillator import acceleration, stage_acceleration, step_anchor
 from .vecmath import exp2_fast, log2_fast
 
 # --- the tableau (Dormand & Prince 1980; dense output with Shampine's optimal c6) -------------
@@ -66,6 +66,7 @@ def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base):
     y_new with the solution (weights B). n_stages right-hand-side evaluations.
     """
     n_stages = B.shape[0]
+    anchor = step_anchor(t, h, p, 0, 1, base)
     for s in range(1, n_stages):
         dq = 0.0
         dv = 0.0
@@ -75,7 +76,7 @@ def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base):
         q = y[0] + dq * h
         v = y[1] + dv * h
         K[s, 0] = v
-        K[s, 1] = acceleration(t + C[s] * h, q, v, p, 0, 1, None, parametric, base)
+        K[s, 1] = stage_acceleration(t, C[s] * h, q, v, p, 0, 1, anchor, parametric, base)
     sq = 0.0
     sv = 0.0
     for j in range(n_stages):
@@ -84,7 +85,8 @@ def explicit_rk_step(t, y, h, p, K, y_new, A, B, C, parametric, base):
     y_new[0] = y[0] + h * sq
     y_new[1] = y[1] + h * sv
     K[n_stages, 0] = y_new[1]
-    K[n_stages, 1] = acceleration(t + h, y_new[0], y_new[1], p, 0, 1, None, parametric, base)
+    K[n_stages, 1] = stage_acceleration(t, h, y_new[0], y_new[1], p, 0, 1, anchor, parametric,
+                                        base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

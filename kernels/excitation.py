@@ -42,6 +42,8 @@ import numpy as np
 from numba.core import types
 from numba.extending import overload
 
+from .vecmath import fast_sin_cos
+
 # Columns of the excitation block, relative to its first column.
 ACCEL = 0           # A, the constant level (m/s^2 peak; read when SEGMENTS = 0)
 OMEGA = 1           # w_b, the frequency, a sweep's start frequency (rad/s)
@@ -154,6 +156,63 @@ def acceleration(t, p, o, s):
     libm's sin (the scalar drivers; the lanes drivers take only fixed-frequency, fixed-level
     rows and evaluate A sin(w_b t + phi_b) in their vector loops)."""
     return level(t, p, o, s) * math.sin(phase(t, p, o, s))
+
+
+STAGE_SERIES_BELOW = 2.0 ** -6
+"""|lam h| and |g h| (a step h, s) up to which a sweep's stage reads come from the step's start
+(`sweep_anchor`, `anchored`): the series they take leaves less than 1e-22."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _expm1_over(x):
+    """expm1(x) / x (1 at x = 0) for |x| <= STAGE_SERIES_BELOW: its Taylor series to x^8."""
+    return 1.0 + x * (1.0 / 2.0 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0 + x * (
+        1.0 / 720.0 + x * (1.0 / 5040.0 + x * (1.0 / 40320.0 + x / 362880.0)))))))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def sweep_anchor(t, h, p, o, s):
+    """A logarithmic sweep's state at the start t (s) of a step of h (s), from which `anchored`
+    gives a_b at every stage time t + tau of the step (0 <= tau <= h) with no libm call:
+    (1, sin phi(t), cos phi(t), w(t) (rad/s), A(t) (m/s^2), g = d ln A / dt (1/s)). Where the
+    step is not one stretch of a single level segment after the ramp and before the sweep's
+    END, where |lam h| or |g h| exceed STAGE_SERIES_BELOW, and for a fixed frequency: all
+    zeros, each stage reads `acceleration` (a fixed sine keeps its bits)."""
+    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    lam = p[o + RATE * s]
+    if lam == 0.0 or not abs(lam * h) <= STAGE_SERIES_BELOW:
+        return none
+    n = int(p[o + SEGMENTS * s])
+    a = p[o + ACCEL * s]
+    g = 0.0
+    if n > 0:
+        if t < p[o + RAMP * s] or t + h > p[o + END * s]:
+            return none
+        u = p[o + LOG_OMEGA * s] + lam * t
+        k = _segment(u, p, o, s, n)
+        if _segment(p[o + LOG_OMEGA * s] + lam * (t + h), p, o, s, n) != k:
+            return none
+        g = p[o + (SLOPE + k) * s] * lam
+        if not abs(g * h) <= STAGE_SERIES_BELOW:
+            return none
+        a = math.exp(p[o + (LOG_LEVEL + k) * s]
+                     + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
+    x = phase(t, p, o, s)
+    return 1.0, math.sin(x), math.cos(x), p[o + OMEGA * s] * math.exp(lam * t), a, g
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def anchored(anchor, tau, lam):
+    """a_b (m/s^2) at t + tau (s) of a sweep at rate lam (1/s) from its `sweep_anchor` at t:
+    A(t) exp(g tau) sin(phi(t) + d), d = w(t) tau expm1(lam tau) / (lam tau) the phase the
+    sweep adds in tau, by the angle sum (vecmath's sine and cosine of d); the same value as
+    `acceleration` at t + tau to round-off."""
+    sin0 = anchor[1]
+    cos0 = anchor[2]
+    d = anchor[3] * tau * _expm1_over(lam * tau)
+    sd, cd = fast_sin_cos(d)
+    gt = anchor[5] * tau
+    return anchor[4] * (1.0 + gt * _expm1_over(gt)) * (sin0 * cd + cos0 * sd)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -169,6 +169,50 @@ def shaken(a, p, o, s, a_b):
     return a - p[o + PARTICIPATION * s] * a_b
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _sine_anchor(t, h, p, o, s, base):
+    """A sine row's `excitation.sweep_anchor` for a step of h (s) from t (s); none without base
+    excitation."""
+    if base is None:
+        return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    return ex.sweep_anchor(t, h, p, o + EXCITATION * s, s)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _no_anchor(t, h, p, o, s, base):
+    """A record's steps read their stages each (`acceleration`)."""
+    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+step_anchor = ex.by_kind(_sine_anchor, _no_anchor)
+step_anchor.__doc__ = """step_anchor(t, h, p, o, s, base): what a step of h (s) from t (s) of
+the row at p[o + column * s] reads its stages' a_b from (`stage_acceleration`): a sweep's
+`excitation.sweep_anchor`, else zeros (each stage reads `acceleration`)."""
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _sine_stage(t, tau, q, v, p, o, s, anchor, parametric, base):
+    """`stage_acceleration` of a sine row (or one without base excitation)."""
+    if base is not None and anchor[0] != 0.0:
+        return shaken(acceleration(t + tau, q, v, p, o, s, None, parametric, None), p, o, s,
+                      ex.anchored(anchor, tau, p[o + (EXCITATION + ex.RATE) * s]))
+    return acceleration(t + tau, q, v, p, o, s, None, parametric, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _record_stage(t, tau, q, v, p, o, s, anchor, parametric, base):
+    """`stage_acceleration` of a record's row: `acceleration` at t + tau."""
+    return acceleration(t + tau, q, v, p, o, s, None, parametric, base)
+
+
+stage_acceleration = ex.by_kind(_sine_stage, _record_stage)
+stage_acceleration.__doc__ = """stage_acceleration(t, tau, q, v, p, o, s, anchor, parametric,
+base): q'' (m/s^2) at the stage time t + tau (s) of a step from t whose `step_anchor` is
+`anchor`: a sweep's a_b from the anchor where it holds (three multiply-adds and a reduced sine
+and cosine instead of expm1, exp and sin), else `acceleration` at t + tau, the same bits as
+before."""
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def stiffness(t, q, p, o, s):
     """d(restoring force)/dq per unit mass m (1/s^2) at time t (s) and deflection q (m), from a

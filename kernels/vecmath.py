@@ -5,8 +5,8 @@ A libm call inside a loop stops LLVM vectorising it; these are straight-line ari
 round with `np.floor`, which stays a float (`math.floor` returns an integer: two vector
 conversions per call, with no single instruction for them before AVX-512):
 
-- `fast_cos(x)`, `fast_sin(x)`: cos x and sin x for |x| < 1e5 (Cody-Waite reduction, fdlibm's
-  kernels);
+- `fast_cos(x)`, `fast_sin(x)`, `fast_sin_cos(x)`: cos x and sin x for |x| < 1e5 (Cody-Waite
+  reduction, fdlibm's kernels);
 - `inv_fifth_root(x)`: x^(-1/5) for 2^-31 <= x < 2^32 (power-of-two reduction, Newton);
 - `log2_fast(x)`, `exp2_fast(y)`: to about 1e-9, for the step-size controller.
 """
@@ -51,6 +51,17 @@ def fast_sin(x):
     s, c, quadrant = _reduced(x)
     v = c if (quadrant == 1.0) | (quadrant == 3.0) else s
     return -v if (quadrant == 2.0) | (quadrant == 3.0) else v
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def fast_sin_cos(x):
+    """(sin x, cos x) from one reduction, to about an ulp for |x| < 1e5 (vectorisable)."""
+    s, c, quadrant = _reduced(x)
+    odd = (quadrant == 1.0) | (quadrant == 3.0)
+    sv = c if odd else s
+    cv = s if odd else c
+    return (-sv if (quadrant == 2.0) | (quadrant == 3.0) else sv,
+            -cv if (quadrant == 1.0) | (quadrant == 2.0) else cv)
 
 
 # Newton's start for m^(-1/5) on [1, 2) (least squares, |error| < 2e-5).
