@@ -208,7 +208,7 @@ def _record_stage(t, tau, q, v, p, o, s, anchor, parametric, base):
 stage_acceleration = ex.by_kind(_sine_stage, _record_stage)
 stage_acceleration.__doc__ = """stage_acceleration(t, tau, q, v, p, o, s, anchor, parametric,
 base): q'' (m/s^2) at the stage time t + tau (s) of a step from t whose `step_anchor` is
-`anchor`: a sweep's a_b from the anchor where it holds (three multiply-adds and a reduced sine
+`anchor`: a sweep's a_b from the anchor where it holds (two short series and one reduced sine
 and cosine instead of expm1, exp and sin), else `acceleration` at t + tau, the same bits as
 before."""
 
