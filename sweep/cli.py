@@ -170,9 +170,9 @@ def _parser() -> argparse.ArgumentParser:
                         help="refine each bracketed span by bisecting on length with runs of "
                              "the result's scene (the frequency criterion needs none; not for "
                              "a random result)")
-    design.add_argument("--tolerance", type=float, default=None, metavar="M",
+    design.add_argument("--tolerance", type=_metres, default=None, metavar="M",
                         help="--refine: bisect until the bracket is below this (m, default "
-                             "0.001)")
+                             "0.001; or with a unit, '1 mm')")
     design.add_argument("--over", nargs="+", action="extend", default=None, metavar="AXIS",
                         help="one span for every value of these axes together (a stepped "
                              "test's base_frequency_ratio and direction, an uncertain "
@@ -357,6 +357,24 @@ def _take_files_from_over(args: argparse.Namespace) -> None:
         raise UserError("design: give the result to design from: sweep design RESULT.nc "
                         "[--min-frequency HZ] [--max-amplitude M] ... (a netCDF file that "
                         "'sweep run' wrote, with a length axis)")
+    for word in args.result:
+        if not Path(word).exists() and _a_unit(word):
+            raise UserError(f"design: result '{word}': no such file, and '{word}' reads as a "
+                            "limit's unit: quote a limit with its unit, e.g. "
+                            "--max-deflection '2 mm'")
+
+
+def _a_unit(word: str) -> bool:
+    """Whether `word` reads as the unit of a design limit (a length, a frequency or a strain:
+    sweep.design.limit_value), as an unquoted '--max-deflection 2 mm' leaves 'mm' behind."""
+    from .design import limit_value
+    for units in ("m", "Hz", "1"):
+        try:
+            limit_value(f"1 {word}", units)
+            return True
+        except ValueError:
+            pass
+    return False
 
 
 def _design(args: argparse.Namespace) -> int:

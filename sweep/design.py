@@ -127,8 +127,10 @@ NO_CRITERION = ("design: no criterion given (give --min-frequency HZ, --max-ampl
 
 
 STRAIN_UNITS = {"%": 1e-2, "percent": 1e-2, "microstrain": 1e-6, "ustrain": 1e-6,
-                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
-"""What a strain limit may be written in besides a plain number (1, m/m)."""
+                "\u00b5strain": 1e-6, "\u00b5\u03b5": 1e-6, "\u03bcstrain": 1e-6,
+                "\u03bc\u03b5": 1e-6, "ue": 1e-6, "ppm": 1e-6}
+"""What a strain limit may be written in besides a plain number (1, m/m); micro as the micro
+sign (U+00B5) or the Greek letter mu (U+03BC), as a length limit takes both."""
 UNIT_EXAMPLES = {"m": "'2 mm'", "Hz": "'100 Hz'"}
 """How a limit in these units may be written with its unit (limit_value)."""
 
@@ -475,6 +477,18 @@ def frequency_of(ds: xr.Dataset) -> str:
     return "loaded_frequency" if "loaded_frequency" in ds else "natural_frequency"
 
 
+def _binding_order(failing: list[str], value: Callable[[str], Any]) -> list[str]:
+    """The criteria that fail at one length (in CRITERIA's order), in the order `limited_by`
+    names them: where the solve failed there ('state'), 'state' first and the others only
+    where their value there (`value(name)`) is finite, since a failed solve's NaN values fail
+    every limit without telling anything about it (the grid answer, --refine's bracket end and
+    each of its runs alike)."""
+    if "state" not in failing:
+        return failing
+    return ["state"] + [k for k in failing
+                        if k != "state" and np.all(np.isfinite(value(k)))]
+
+
 def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
              max_amplitude: Limit = None, quantity: str | None = None,
              max_deflection: Limit = None, max_strain: Limit = None,
@@ -577,10 +591,9 @@ def max_span(ds: xr.Dataset, *, min_frequency: Limit = None,
             continue
         b = int(np.argmin(passes))               # the first failing length
         passed[i, :b] = True
-        failing = [k for k in CRITERIA if k in flat and not flat[k][0][i, b] >= 0.0]
-        if "state" in failing:      # the solve failed there: its NaN values fail no limit
-            failing = ["state"] + [k for k in failing
-                                   if k != "state" and np.isfinite(flat[k][1][i, b])]
+        failing = _binding_order([k for k in CRITERIA if k in flat
+                                  and not flat[k][0][i, b] >= 0.0],
+                                 lambda k: flat[k][1][i, b])
         if b == 0:
             spans[i], limited[i] = np.nan, failing[0]
             continue
@@ -1213,8 +1226,9 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         like = _like(one[name])
         like = like.transpose(*[a for a in others if a in like.dims], LENGTH)
         margins = _margins(one, None, limits, like)
-        return [k for k in nonfrequency if k in margins
-                and not np.all(margins[k][0] >= 0.0)]
+        return _binding_order([k for k in nonfrequency if k in margins
+                               and not np.all(margins[k][0] >= 0.0)],
+                              lambda k: margins[k][1])
 
     def frequency_at(point: dict[str, Any], length: float) -> float:
         """The closed-form f1 (Hz) of the stored scene at `length` and `point`: no run."""
@@ -1247,7 +1261,9 @@ def refine_span(ds: xr.Dataset, *, min_frequency: Limit = None,
         b = int(np.argmin(passes))
         a = b - 1
         lo, hi = float(lengths[a]), float(lengths[b])
-        failing = [k for k in CRITERIA if k in margins and not margins[k][0][b] >= 0.0]
+        failing = _binding_order([k for k in CRITERIA if k in margins
+                                  and not margins[k][0][b] >= 0.0],
+                                 lambda k: margins[k][1][b])
         l_f = math.inf
         if "min_frequency" in failing:
             f = margins["min_frequency"][1]

@@ -317,6 +317,29 @@ def test_cli_design_takes_result_files_after_its_options(results, capsys):
     assert "unrecognized arguments: --no-such-option" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("limit, unit", [("--max-deflection", "mm"), ("--min-frequency", "Hz"),
+                                         ("--max-strain", "microstrain")])
+def test_cli_design_an_unquoted_unit_is_named_as_one(results, capsys, limit, unit):
+    """`--max-deflection 2 mm` unquoted leaves 'mm' as a result file: one line that says
+    so and how to quote it (an auditor got "result 'mm': no such file" alone)."""
+    _, path = results["coarse"]
+    assert main(["design", str(path), limit, "2", unit]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"'{unit}'" in err and "quote" in err
+
+
+def test_design_units_micro_as_the_greek_letter_and_a_tolerance_with_a_unit():
+    """A strain limit takes micro as U+03BC as well as the micro sign (a length limit took
+    both, a strain only the sign); --tolerance takes a unit as the limits do."""
+    from sweep.cli import _parser
+    from sweep.design import limit_value
+    for text in ("180 \u03bc\u03b5", "180 \u03bcstrain", "180 \u00b5\u03b5", "180 microstrain"):
+        assert limit_value(text, "1") == pytest.approx(180e-6, rel=1e-15), text
+    args = _parser().parse_args(["design", "r.nc", "--refine", "--tolerance", "1 mm"])
+    assert args.tolerance == pytest.approx(1e-3, rel=1e-15)
+    assert _parser().parse_args(["design", "r.nc", "--tolerance", "0.002"]).tolerance == 0.002
+
+
 def test_cli_design_says_when_its_span_is_interpolated(results, capsys):
     """A response criterion's span is interpolated between grid lengths (a resonance between
     them can make it unsafe): the command says so and points at --refine; a frequency
@@ -555,6 +578,39 @@ def test_refine_both_criteria_the_smaller_binds(results):
     out = refine_span(ds, min_frequency=100.0, max_amplitude=5e-7, tolerance=1e-4)
     assert float(out["max_span"]) == pytest.approx(l_max_frequency(100.0), rel=1e-6)
     assert str(out["limited_by"].values) == "min_frequency"
+
+
+def test_refine_names_a_failed_solve_not_the_limit_its_nan_fails(results, monkeypatch):
+    """A solve that fails beyond some length (its state max_steps_reached, its amplitude NaN)
+    binds the refined span, and `limited_by` says `state` at the bracket's end and at every
+    bisection run, as the grid answer does (an auditor's --refine named max_deflection where
+    a sweep's solve had failed). The failure is made here, past 0.2 m, by marking the stored
+    result and the engine's one-length runs the way a failed solve leaves them."""
+    import importlib
+    ds = _coarse_linear(results).copy(deep=True)
+    limit = 5e-7
+    failed_from = 0.2
+    assert failed_from < _amplitude_reference(limit)   # the failure binds before the limit
+    meanings = ds["state"].attrs["flag_meanings"].split()
+    flag = list(np.atleast_1d(ds["state"].attrs["flag_values"]))[
+        meanings.index("max_steps_reached")]
+
+    def failed_beyond(result: xr.Dataset) -> xr.Dataset:
+        result = result.copy(deep=True)
+        beyond = result["length"] >= failed_from
+        result["state"] = result["state"].where(~beyond, flag)
+        result["amplitude"] = result["amplitude"].where(~beyond)
+        return result
+
+    ds = failed_beyond(ds)
+    assert str(max_span(ds, max_amplitude=limit)["limited_by"].values) == "state"
+    engine = importlib.import_module("sweep.run")
+    real_run = engine.run
+    monkeypatch.setattr(engine, "run", lambda *a, **k: failed_beyond(real_run(*a, **k)))
+    tol = 1e-3
+    out = refine_span(ds, max_amplitude=limit, tolerance=tol)
+    assert str(out["limited_by"].values) == "state"
+    assert failed_from - tol <= float(out["max_span"]) < failed_from
 
 
 def test_refine_bad_tolerance_is_one_line(results):
