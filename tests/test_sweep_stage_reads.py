@@ -1,10 +1,11 @@
 """A logarithmic sweep's stage reads from the step's start (kernels.excitation.sweep_anchor and
 `anchored`, which the one-mode scalar driver's steps use instead of evaluating a_b at every
 stage): against the closed form a_b(t) = A(t) sin(phi(t)) evaluated in extended precision
-(numpy's longdouble), written here from docs/model.md sec. 6, at every stage time of DOP853 and RK45 steps
-along sweeps up and down, with a constant level and with a level table whose slopes differ
-(before, between and after its edges), and the anchor refused where a step crosses a segment
-edge, the ramp's end or the sweep's end, or where the series it takes would not hold."""
+(numpy's longdouble), written here from docs/model.md sec. 6, at every stage time of DOP853
+and RK45 steps along sweeps up and down, with a constant level and with a level table whose
+slopes differ (before, between and after its edges), and the anchor refused where a step
+crosses a segment edge, the ramp's end or the sweep's end, or where the series it takes would
+not hold."""
 
 from __future__ import annotations
 
