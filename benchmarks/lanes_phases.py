@@ -107,9 +107,15 @@ def instrumented(rdtsc: ctypes._CFuncPtr, name: str = "modal_lanes",
     src = (ROOT / "kernels" / f"{name}.py").read_text()
     src = src.replace("from . import", "from sweep.kernels import").replace(
         "from .", "from sweep.kernels.").replace("cache=True", "cache=False")
-    if src.count(" steady, halt):\n") != 1:
+    if src.count(" steady, swept, halt):\n") == 1:     # kernels/lanes.py: the entries call _drive
+        src = src.replace(" steady, swept, halt):\n", " steady, swept, halt, cycles):\n")
+        src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n")
+        src = src.replace(" steady, None, halt)\n", " steady, None, halt, cycles)\n")
+        src = src.replace(" steady, True, halt)\n", " steady, True, halt, cycles)\n")
+    elif src.count(" steady, halt):\n") == 1:
+        src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n", 1)
+    else:
         sys.exit(f"lanes_phases: kernels/{name}.py changed: solve_block's signature")
-    src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n", 1)
     head, loop = src.split("    while True:\n        if halt[0] != 0:", 1)
     loop = "    while True:\n        if halt[0] != 0:" + loop
     for k, (text, _) in enumerate(phases):
@@ -147,8 +153,9 @@ def main() -> None:
     original = threads.call
 
     def spy(fn, *call_args):
-        if getattr(fn, "__name__", "") == "solve_block" and fn.__module__.endswith("lanes"):
-            calls.append((fn.__module__.rsplit(".", 1)[-1], call_args))
+        if (getattr(fn, "__name__", "") in ("solve_block", "solve_swept_block")
+                and fn.__module__.endswith("lanes")):
+            calls.append((fn.__module__.rsplit(".", 1)[-1], fn.__name__, call_args))
         return original(fn, *call_args)
 
     threads.call = spy
@@ -159,11 +166,12 @@ def main() -> None:
     import importlib
     import inspect
 
-    name = "modal_lanes" if any(n == "modal_lanes" for n, _ in calls) else "lanes"
+    name = "modal_lanes" if any(n == "modal_lanes" for n, _, _ in calls) else "lanes"
+    entry = next(f for n, f, _ in calls if n == name)    # solve_block or solve_swept_block
     driver = importlib.import_module(f"sweep.kernels.{name}")
-    names = list(inspect.signature(driver.solve_block.py_func).parameters)
+    names = list(inspect.signature(getattr(driver, entry).py_func).parameters)
     lo, hi = names.index("lo"), names.index("hi")
-    block = max((a for n, a in calls if n == name), key=lambda a: a[hi] - a[lo])
+    block = max((a for n, _, a in calls if n == name), key=lambda a: a[hi] - a[lo])
     phases = PHASES if name == "modal_lanes" else ONE_MODE_PHASES
     module = instrumented(timer(), name, phases)
     cycles = np.zeros(len(phases) + 1, np.uint64)
@@ -172,7 +180,7 @@ def main() -> None:
         fresh = [a.copy() if isinstance(a, np.ndarray) and a.flags.writeable else a
                  for a in block]
         start = time.perf_counter()
-        module.solve_block(*fresh, cycles)
+        getattr(module, entry)(*fresh, cycles)
         wall = time.perf_counter() - start
     labels = [label for _, label in phases] + (["lanes' advance"] if phases is PHASES else [])
     total = float(cycles.sum())

@@ -216,6 +216,24 @@ def anchored(anchor, tau, lam):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def sine_at_nodes(t, h, nodes, p, o, s, out, out_o, out_s):
+    """A sine block's a_b (m/s^2) at a step's stage times t + nodes[i] h (s), i = 1 ..
+    len(nodes) - 1, into out[out_o + (i - 1) * out_s], and at t + h into the slot after them:
+    from the step's `sweep_anchor` where it holds (`anchored`), else `acceleration` at each,
+    the values the one-mode scalar step reads (kernels.oscillator.stage_acceleration). The
+    lanes' stage reads of a sweep (kernels.lanes), as `record_at_nodes` is a record's."""
+    anchor = sweep_anchor(t, h, p, o, s)
+    lam = p[o + RATE * s]
+    m = len(nodes)
+    for i in range(1, m + 1):
+        tau = nodes[i] * h if i < m else h
+        if anchor[0] != 0.0:
+            out[out_o + (i - 1) * out_s] = anchored(anchor, tau, lam)
+        else:
+            out[out_o + (i - 1) * out_s] = acceleration(t + tau, p, o, s)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def frequency(t, p, o, s):
     """The excitation frequency f(t) (Hz) of the block at p[o + column * s] at time t (s)."""
     return p[o + OMEGA * s] / (2.0 * math.pi) * math.exp(p[o + RATE * s] * t)

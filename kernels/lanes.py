@@ -63,10 +63,10 @@ from . import trajectory as tj
 from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, MAX_FACTOR,
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
-from .layout import N_LEVELS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING
-from .oscillator import (BOUND, N_PARAMS, acceleration, base_acceleration, prepare,
+from .layout import N_LEVELS, RTOL, SAMPLE_DT, T_END, TOL, WANT_SETTLING
+from .oscillator import (BOUND, EXCITATION, N_PARAMS, acceleration, base_acceleration, prepare,
                          record_stages, shaken)
-from .transverse import classify, reject_point, valid
+from .transverse import classify, reject_point, swept_outputs, valid
 from .vecmath import inv_fifth_root
 
 # The vector loops may fuse a * b + c into one fused multiply-add (one rounding instead of two;
@@ -104,7 +104,9 @@ W_AB_STAGES = W_START + 6   # a record's a_b (m/s^2) at the attempt's stage s = 
                             # attempt (`_stage_reads`)
 W_B1 = W_AB_STAGES + dop853.N_STAGES   # a record's integrals of a_b and a_b^2 over an ordinary
 W_B2 = W_B1 + 1                         # step (m/s, m^2/s^3; `_record_reads`)
-W_ROWS = W_B2 + 1
+W_ANCHOR = W_B2 + 1     # a sweep's anchor for the attempt, excitation.sweep_anchor's six values
+                        # in rows W_ANCHOR + 0..5 (`_read_sweeps`)
+W_ROWS = W_ANCHOR + 6
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -157,7 +159,7 @@ def _accel_read(W, j, t, q, v, parametric, base, stage):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _read_stages(W, n_run, eighth, base):
+def _read_stages(W, n_run, eighth, swept, base):
     """Each lane's a_b (m/s^2) at its attempt's stage times t + C[s] h, s = 1 .. n - 1, and at
     t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads, before the attempt,
     so that its chain's loop has none and vectorises. The reads stay a scalar loop, lane by
@@ -170,8 +172,78 @@ def _read_stages(W, n_run, eighth, base):
                       W_AB_STAGES * L + j, L)
 
 
-# compiled for the record kind only (the sine kinds have no reads to make)
-_stage_reads = ex.by_kind(None, _read_stages)
+def _anchored_stages(nodes, name):
+    """An inline-always function (W, j, anchor, h, lam) that writes lane j's a_b (m/s^2) at
+    t + nodes[i] h, i = 1 .. len(nodes) - 1, and at t + h into rows W_AB_STAGES .. from its
+    step's anchor (excitation.anchored): one statement a stage, written out from the nodes, so
+    that each store has a constant row and the loop across the lanes that calls it
+    vectorises (a loop over the stages inside it stops LLVM vectorising)."""
+    times = [repr(float(c)) for c in nodes[1:]] + ["1.0"]
+    source = f"def {name}(W, j, anchor, h, lam):\n" + "".join(
+        f"    W[{W_AB_STAGES + i} * {LANES} + j] = anchored(anchor, {c} * h, lam)\n"
+        for i, c in enumerate(times))
+    namespace = {"anchored": ex.anchored}
+    exec(compile(source, f"<anchored stages {name}>", "exec"), namespace)
+    return nb.njit(inline="always", error_model="numpy")(namespace[name])
+
+
+_anchored5 = _anchored_stages(C, "anchored_rk45")
+_anchored8 = _anchored_stages(dop853.C, "anchored_dop853")
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+def _read_sweeps(W, n_run, eighth, swept, base):
+    """With a swept sine (`swept` True), each running lane's a_b (m/s^2) at its attempt's stage
+    times and at t + h into rows W_AB_STAGES .., so that the record kind's chains
+    (`_accel_read`) take them; a fixed frequency reads nothing (its chains evaluate the vector
+    sine). The scalar step's reads (excitation.sine_at_nodes): each lane's anchor at its step's
+    start (excitation.sweep_anchor: libm and the level table's search, a scalar loop), then
+    every stage from it (excitation.anchored) in a vector loop across the lanes, one a stage,
+    then, in the lanes whose anchor does not hold, each stage's own read."""
+    if swept is None:
+        return
+    L = LANES
+    nodes = dop853.C if eighth is not None else C
+    block = (W_P + EXCITATION) * L
+    for j in range(n_run):
+        anchor = ex.sweep_anchor(W[tj.T * L + j], W[W_H * L + j], W, block + j, L)
+        W[W_ANCHOR * L + j] = anchor[0]
+        W[(W_ANCHOR + 1) * L + j] = anchor[1]
+        W[(W_ANCHOR + 2) * L + j] = anchor[2]
+        W[(W_ANCHOR + 3) * L + j] = anchor[3]
+        W[(W_ANCHOR + 4) * L + j] = anchor[4]
+        W[(W_ANCHOR + 5) * L + j] = anchor[5]
+    for j in range(n_run):
+        anchor = (W[W_ANCHOR * L + j], W[(W_ANCHOR + 1) * L + j], W[(W_ANCHOR + 2) * L + j],
+                  W[(W_ANCHOR + 3) * L + j], W[(W_ANCHOR + 4) * L + j],
+                  W[(W_ANCHOR + 5) * L + j])
+        h = W[W_H * L + j]
+        lam = W[block + ex.RATE * L + j]
+        if eighth is None:
+            _anchored5(W, j, anchor, h, lam)
+        else:
+            _anchored8(W, j, anchor, h, lam)
+    for j in range(n_run):
+        if W[W_ANCHOR * L + j] == 0.0 and W[W_H * L + j] > 0.0:
+            ex.sine_at_nodes(W[tj.T * L + j], W[W_H * L + j], nodes, W, block + j, L, W,
+                             W_AB_STAGES * L + j, L)
+
+
+# a sweep's reads for the sine kinds, a record's for the record kind
+_stage_reads = ex.by_kind(_read_sweeps, _read_stages)
+
+
+def reads_switch(swept, base):
+    """None, or True where the attempts take each stage's a_b from rows W_AB_STAGES ..
+    (`_stage_reads`): a random record (`base` an array) or a swept sine (`swept` True)."""
+    raise TypeError("kernels.lanes.reads_switch runs only in compiled code")
+
+
+@overload(reads_switch, inline="always")
+def _reads_switch(swept, base):
+    if isinstance(base, types.Array) or not isinstance(swept, types.NoneType):
+        return lambda swept, base: True
+    return lambda swept, base: None
 
 
 # Each method's stages, written out from its tableau (kernels.stages): straight-line code in
@@ -638,19 +710,49 @@ def _locate_extrema(W, n_run):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def _load_lane(params, settings, point, lane, W, states, reals, counts, series, parametric,
-               base):
+def _point_settings(settings, ends, point, swept):
+    """The settings row `point` runs with: with a swept sine (`swept` True) a copy whose T_END
+    is the point's own end time ends[point] (s; its sweep's), else settings themselves."""
+    if swept is None:
+        return settings
+    own = settings.copy()
+    own[T_END] = ends[point]
+    return own
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _load_lane(params, settings, point, lane, W, states, reals, counts, series, envelope,
+               ends, parametric, base, swept):
     """Give `lane` the trajectory of row `point`; an invalid row is answered at once.
     Returns False when the row needs no integration."""
     p = params[point]
     if not valid(p):
         reject_point(reals[point], counts[point], series[point])
+        if swept is not None:
+            for b in range(envelope.shape[1]):
+                envelope[point, b] = math.nan
         states[point] = mt.INVALID_INPUT
         return False
     prepare(p, W, W_P * LANES + lane, LANES)
-    tj.start(W, W_P * LANES + lane, LANES, settings, W[lane::LANES], series[point], parametric,
-             base)
+    tj.start(W, W_P * LANES + lane, LANES, _point_settings(settings, ends, point, swept),
+             W[lane::LANES], series[point], parametric, base)
     return True
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _end_point(W, j, settings, ends, i, buf, states, reals, counts, series, envelope,
+               parametric, base, swept):
+    """Classify lane j's finished trajectory (point i) into the outputs, with a swept sine's
+    peak frequency and envelope too (transverse.swept_outputs); the state written last."""
+    L = LANES
+    acc = W[j::L]
+    tj.end_series(acc, series[i])
+    own = _point_settings(settings, ends, i, swept)
+    state = classify(W, W_P * L + j, L, own, acc, buf, reals[i], counts[i], parametric, base)
+    if swept is not None:
+        state = swept_outputs(W, (W_P + EXCITATION) * L + j, L, own, acc, buf, state,
+                              reals[i], envelope[i])
+    states[i] = state
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -672,6 +774,26 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                 parametric, base, steady, halt):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
+    (`_drive` with no sweep.)"""
+    _drive(params, settings, lo, hi, states, reals, counts, series, np.empty((0, 0)),
+           np.empty(0), pi, eighth, parametric, base, steady, None, halt)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def solve_swept_block(params, settings, lo, hi, states, reals, counts, series, envelope, ends,
+                      pi, eighth, parametric, base, steady, halt):
+    """`solve_block` for a swept base frequency (settings[SWEPT] = 1; transverse's
+    solve_swept_block on the lanes): envelope (n, n_bands), the response envelope (m;
+    n_bands may be 0), and ends (n,), each point's end time (s; its sweep's). Each lane reads
+    its sweep at its attempt's stage times before the attempt (`_read_sweeps`)."""
+    _drive(params, settings, lo, hi, states, reals, counts, series, envelope, ends, pi, eighth,
+           parametric, base, steady, True, halt)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy")
+def _drive(params, settings, lo, hi, states, reals, counts, series, envelope, ends, pi, eighth,
+           parametric, base, steady, swept, halt):
+    """The lanes over rows lo..hi-1 (`solve_block`, `solve_swept_block`; swept None or True).
 
     `pi` picks the step-size controller and must match settings[CONTROLLER]: None for SciPy's,
     True for the PI controller; `eighth` the method, matching settings[METHOD]: None for RK45,
@@ -694,7 +816,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
     rtol = max(settings[RTOL], MIN_RTOL)
     track = settings[WANT_SETTLING] != 0.0
     thr_rel = settings[TOL]
-    record = ex.record_switch(base)     # None, or True for records: the attempts' chain
+    record = reads_switch(swept, base)  # None, or True: the attempts' stage reads (records, sweeps)
     n_samples = series.shape[1]
     W = np.zeros(W_ROWS * L)
     for j in range(L):
@@ -723,15 +845,13 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
                         step = tj.next_attempt(settings, acc)
                         if step > 0.0:
                             break
-                        i = point[j]
-                        tj.end_series(acc, series[i])
-                        states[i] = classify(W, W_P * L + j, L, settings, acc, bufs[j],
-                                             reals[i], counts[i], parametric, base)
+                        _end_point(W, j, settings, ends, point[j], bufs[j], states, reals,
+                                   counts, series, envelope, parametric, base, swept)
                         point[j] = -1
                     if next_point >= hi:
                         break
                     if _load_lane(params, settings, next_point, j, W, states, reals, counts,
-                                  series, parametric, base):
+                                  series, envelope, ends, parametric, base, swept):
                         point[j] = next_point
                         bufs[j] = tj.new_buffer()
                         capacity[j] = bufs[j].shape[0]
@@ -743,7 +863,7 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eig
             return
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
         if record is not None:
-            _stage_reads(W, n_run, eighth, base)
+            _stage_reads(W, n_run, eighth, swept, base)
         if eighth is None:
             _attempt(W, rtol, n_run, parametric, base, record)
         else:

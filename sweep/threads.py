@@ -111,8 +111,9 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
                      records: np.ndarray | None = None) -> None:
     """Solve every row of `params` (n, N_PARAMS) into the preallocated outputs (first axis n):
     states int8, reals (n, N_REALS), counts (n, N_COUNTS) int64, series (n, n_samples).
-    A swept base frequency (settings[SWEPT] = 1) takes the scalar driver, envelope (n, n_bands)
-    for its response envelope and durations (n,), each point's end time (s; `swept_settings`).
+    A swept base frequency (settings[SWEPT] = 1) takes envelope (n, n_bands) for its response
+    envelope and durations (n,), each point's end time (s; `swept_settings`), on either
+    driver (the lanes: kernels.lanes.solve_swept_block).
     records: a random base acceleration's (R, N, 4) records (sweep.models.random.Records'
     values), which the kernels take as their `base` switch (kernels.excitation's record kind),
     on either driver.
@@ -139,10 +140,16 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
     base = _random_base(records, base)
     eighth, steady = method_switch(settings), early_stop(settings)
     swept = settings[tk.SWEPT] != 0.0
-    if swept:
-        if driver != "scalar":
-            raise ValueError("a swept base frequency takes driver 'scalar'")
+    pi = True if settings[tk.CONTROLLER] != 0.0 else None
+    if swept and driver == "lanes":
+        ends = np.full(params.shape[0], settings[tk.T_END]) if durations is None else durations
+        if envelope is None:
+            envelope = np.empty((params.shape[0], 0))
 
+        def kernel(lo: int, hi: int) -> None:
+            call(lanes.solve_swept_block, params, settings, lo, hi, states, reals, counts,
+                 series, envelope, ends, pi, eighth, parametric, base, steady, watch.halt)
+    elif swept:
         def kernel(lo: int, hi: int) -> None:
             for i in range(lo, hi):
                 call(tk.solve_swept_block, params, swept_settings(settings, durations, i), i,
@@ -153,8 +160,6 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
             call(tk.solve_block, params, settings, lo, hi, states, reals, counts, series,
                  parametric, base, eighth, steady, watch.halt)
     else:
-        pi = True if settings[tk.CONTROLLER] != 0.0 else None
-
         def kernel(lo: int, hi: int) -> None:
             call(lanes.solve_block, params, settings, lo, hi, states, reals, counts, series,
                  pi, eighth, parametric, base, steady, watch.halt)
@@ -172,8 +177,9 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
-    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
-               tick=watch.ticker(), lanes=driver == "lanes")
+    run_blocks(solve_block, params.shape[0], threads, watch.stop,
+               one_at_a_time=swept and driver == "scalar", tick=watch.ticker(),
+               lanes=driver == "lanes")
 
 
 def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settings: np.ndarray,

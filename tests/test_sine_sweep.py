@@ -214,6 +214,7 @@ QUASI_STATIC = {"quasi-static up": (0.5, 20.0, 60.0), "quasi-static down": (0.5,
 SHORT = 0.15                   # m
 CASES.update(QUASI_STATIC)
 METHODS = ["rk45", "dop853"]
+DRIVERS = ["lanes", "scalar"]  # one mode: the lanes by default, the scalar driver on request
 
 
 def case_length(name: str) -> float:
@@ -235,29 +236,31 @@ def references():
 
 @pytest.fixture(scope="module")
 def runs():
-    """The package's run of each case with each method, with the envelope (computed once, on
-    first use)."""
-    cache: dict[tuple[str, str], object] = {}
+    """The package's run of each case with each method and driver, with the envelope
+    (computed once, on first use)."""
+    cache: dict[tuple[str, str, str], object] = {}
 
-    def get(name: str, method: str = "rk45"):
-        if (name, method) not in cache:
+    def get(name: str, method: str = "rk45", driver: str = "lanes"):
+        if (name, method, driver) not in cache:
             g, start, stop = CASES[name]
-            cache[name, method] = sweep.run(scene(
+            cache[name, method, driver] = sweep.run(scene(
                 f"acceleration_g = {g!r}\n{swept(start, stop)}",
-                f'method = "{method}"\n[outputs]\nenvelope = true\n'
+                f'method = "{method}"\ndriver = "{driver}"\n[outputs]\nenvelope = true\n'
                 f"bands_per_octave = {BANDS}\n", length=case_length(name)))
-        return cache[name, method]
+        return cache[name, method, driver]
     return get
 
 
+@pytest.mark.parametrize("driver", DRIVERS)
 @pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("name", fast_first(CASES, "0.1 g up"))
-def test_sweep_peak_matches_scipy(name, method, references, runs):
+def test_sweep_peak_matches_scipy(name, method, driver, references, runs):
     """peak_amplitude to 1e-4 relative, peak_frequency to 0.05 Hz (half a period's frequency
     change is ~0.02 Hz, so a neighbouring extremum would already be close); amplitude is the
     same max (metrics.tail = 1 for a sweep); completed at the sweep's end T. Both methods (at
-    rtol 1e-10 DOP853 reads its peaks off its own seventh-order dense output)."""
-    ref, ds = references(name), runs(name, method)
+    rtol 1e-10 DOP853 reads its peaks off its own seventh-order dense output) and both drivers
+    (the lanes read each stage's a_b before the attempt, kernels.lanes._read_sweeps)."""
+    ref, ds = references(name), runs(name, method, driver)
     length = case_length(name)
     assert int(ds["state"]) == state_code(ds, "completed") == 8
     assert float(ds["sweep_duration"]) == pytest.approx(ref.duration, rel=1e-12)
@@ -314,6 +317,68 @@ def test_up_sweep_peaks_above_down_sweep(g, references, runs):
         assert up.peak > down.peak
 
 
+# ------------------------------------ several sweeps of their own durations in one lanes call
+
+GRID_RATES = [4.0, 8.0]             # octaves per minute: sweeps of 23.8 and 11.9 s
+GRID_LENGTHS = [SHORT, LENGTH]      # below resonance the whole sweep, and through it
+
+
+def test_sweeps_of_their_own_durations_share_the_lanes(references):
+    """Four sweeps in one lanes call (two spans x two rates, 0.1 g up, 20 -> 60 Hz): each lane
+    ends with its own sweep (23.8 or 11.9 s), and each point's peak, its frequency and its
+    envelope equal SciPy's run of that sweep alone (1e-4, 0.05 Hz, 1e-4 in every band) and
+    the scalar driver's (1e-6; it runs each point with its own end time)."""
+    runs = {driver: sweep.run(scene(
+        f"acceleration_g = 0.1\n{swept(20.0, 60.0)}",
+        f'driver = "{driver}"\n[outputs]\nenvelope = true\nbands_per_octave = {BANDS}\n'
+        f"[axes]\nlength = {GRID_LENGTHS!r}\nbase_sweep_rate = {GRID_RATES!r}\n"))
+        for driver in DRIVERS}
+    ds = runs["lanes"]
+    assert np.all(ds["state"].values == state_code(ds, "completed"))
+    for length in GRID_LENGTHS:
+        for rate in GRID_RATES:
+            point = ds.sel(length=length, base_sweep_rate=rate)
+            ref = (references("0.1 g up") if (length, rate) == (LENGTH, RATE)
+                   else Reference(20.0, 60.0, constant_level(0.1), rate=rate, length=length))
+            assert float(point["sweep_duration"]) == pytest.approx(ref.duration, rel=1e-12)
+            assert float(point["peak_amplitude"]) == pytest.approx(ref.peak, rel=1e-4)
+            assert abs(float(point["peak_frequency"]) - ref.peak_frequency) <= 0.05
+            expected = ref.envelope()
+            centres = point["band_frequency"].values
+            for k, v in zip(np.round(BANDS * np.log2(centres / 1000.0)).astype(int),
+                            point["envelope"].values):
+                if k in expected:
+                    assert v == pytest.approx(expected[k], rel=1e-4), (length, rate, k)
+                else:
+                    assert np.isnan(v), (length, rate, k)
+    for name in ("peak_amplitude", "peak_frequency", "envelope", "absolute_acceleration"):
+        np.testing.assert_allclose(ds[name].values, runs["scalar"][name].values, rtol=1e-6)
+
+
+def test_a_bad_row_in_a_lanes_sweep_is_answered_and_the_others_run():
+    """A row the kernel cannot integrate (a NaN mass) among good ones in one lanes call of a
+    sweep: its state is invalid_input and its envelope NaN, and the other rows equal those of
+    a call without it (the lanes keep nothing of one row for the next)."""
+    from sweep.kernels import metrics as mt
+    from sweep.kernels import oscillator as osc
+    from sweep.models import transverse as tm
+    sc = scene(f"acceleration_g = 0.1\n{swept(20.0, 60.0)}",
+               f"[outputs]\nenvelope = true\n[axes]\nlength = [0.2, {LENGTH!r}, 0.4]\n",
+               rtol=1e-8)
+    system = tm._system(tm.resolve(sc), tm.settings_vector(sc))
+    rows = system.rows_at(np.arange(3))
+    good = system.chunk_fn(rows, *system.args, threads=1)
+    bad_rows = rows.copy()
+    bad_rows[1, osc.MASS] = math.nan
+    bad = system.chunk_fn(bad_rows, *system.args, threads=1)
+    assert bad["states"][1] == mt.INVALID_INPUT
+    assert np.all(np.isnan(bad["envelope"][1])) and bad["envelope"].shape[1] > 0
+    for k in (0, 2):
+        assert bad["states"][k] == good["states"][k] == mt.COMPLETED
+        np.testing.assert_array_equal(bad["envelope"][k], good["envelope"][k])
+        np.testing.assert_array_equal(bad["reals"][k], good["reals"][k])
+
+
 # ------------------------------------------------------ 2. slow sweep -> steady resonance
 
 SLOW_LEVEL = 0.005             # g
@@ -355,17 +420,18 @@ def test_slow_sweep_approaches_steady_resonance():
 
 # -------------------------------------------------------------------- 3. the envelope
 
+@pytest.mark.parametrize("driver", DRIVERS)
 @pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("name", fast_first(["0.5 g up", "0.5 g down", "0.1 g up",
                                              "0.1 g down", "quasi-static up",
                                              "quasi-static down"], "0.1 g up"))
-def test_envelope_matches_scipy_extrema_binned(name, method, references, runs):
+def test_envelope_matches_scipy_extrema_binned(name, method, driver, references, runs):
     """The envelope against the SciPy extrema binned into the same bands: equal to 1e-4 in
     every band (20-35 Hz below resonance, the resonant bands, those above; the quasi-static
     span below resonance throughout), NaN exactly where no extremum falls; the coordinates are
     1000 2^(k/N) Hz with edges 2^(+-1/2N) about them, and selecting by nearest frequency
     works."""
-    ref, ds = references(name), runs(name, method)
+    ref, ds = references(name), runs(name, method, driver)
     env = ds["envelope"]
     assert env.dims == ("band_frequency",)
     centres = env["band_frequency"].values
@@ -462,8 +528,8 @@ BAD = {
                             ["base.frequency", "base.sweep"]),
     "table short of the sweep": (f"levels_g = [[30.0, 0.2], [100.0, 0.2]]\n{SWEEP}", "",
                                  ["base.levels_g"]),
-    "lanes driver": (f"acceleration_g = 0.5\n{SWEEP}", 'driver = "lanes"\n',
-                     ["solver.driver", "lanes"]),
+    "lanes driver, three modes": (f"acceleration_g = 0.5\n{SWEEP}", 'driver = "lanes"\n',
+                                  ["solver.driver", "lanes", "several modes"]),
     "envelope without sweep": ("acceleration_g = 0.5\nfrequency = 30.0",
                                "[outputs]\nenvelope = true\n", ["outputs.envelope"]),
     "unknown sweep key": ("acceleration_g = 0.5\n"
@@ -476,7 +542,7 @@ BAD = {
 def test_bad_sweep_input_is_one_clear_line(name):
     base, extra, words = BAD[name]
     with pytest.raises(UserError) as info:
-        sweep.run(scene(base, extra))
+        sweep.run(scene(base, extra, modes=3 if "three modes" in name else 1))
     assert isinstance(info.value, SceneError)
     message = str(info.value)
     assert "\n" not in message and message

@@ -311,8 +311,8 @@ def _present(dotted: str, given: dict[str, Any], axes: dict[str, np.ndarray]) ->
 def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of a sine sweep and a level table (docs/model.md sec. 6): a sweep has a start, a
     stop and a rate (keys or axes) that differ, replaces base.frequency and
-    base.frequency_ratio, is solved by the scalar driver, has no settling time and is not a
-    stepped sweep; a level table replaces the constant level and covers every frequency the
+    base.frequency_ratio, of several modes is solved by the scalar driver, has no settling
+    time and is not a stepped sweep; a level table replaces the constant level and covers every frequency the
     scene's sweeps reach; the envelope outputs need a sweep."""
     swept = [d for d in SWEEP_KEYS if _present(d, given, axes)]
     table = given.get(BASE_TABLE_KEY)
@@ -360,10 +360,10 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
               "state and phase itself; [continuation] steps a fixed frequency",
               "remove [continuation], or use base.frequency with a frequency axis for a "
               "stepped sweep")
-    if given.get("solver.driver") == "lanes":
-        _fail("scene key 'solver.driver'", "a swept base frequency is solved by the 'scalar' "
-              "driver only (the lanes' vector sine takes a fixed frequency)",
-              "remove solver.driver (a sweep takes 'scalar')")
+    if given.get("solver.driver") == "lanes" and given.get("model.modes", 1) > 1:
+        _fail("scene key 'solver.driver'", "a swept base frequency of several modes is solved "
+              "by the 'scalar' driver only (the lanes take a sweep of one mode)",
+              "remove solver.driver (a sweep of several modes takes 'scalar')")
     if given.get("outputs.settling_time"):
         _fail("scene key 'outputs.settling_time'", "a sweep has no settling time (its "
               "excitation never stops changing)", "remove it: a swept scene stores "
@@ -1122,7 +1122,9 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
         # never stops changing), no tail amplitude where the tail is the whole sweep (it
         # would be peak_amplitude again)
         whole = "metrics.tail" not in mentioned
-        for dotted, value in (("outputs.settling_time", False), ("solver.driver", "scalar"),
+        several = values["model.modes"] > 1     # the lanes take a sweep of one mode
+        for dotted, value in (("outputs.settling_time", False),
+                              ("solver.driver", "scalar" if several else "lanes"),
                               ("metrics.tail", 1.0), ("solver.max_steps", SWEEP_MAX_STEPS),
                               ("outputs.response_period", False)) + (
                                   (("outputs.amplitude", False),) if whole else ()):
