@@ -4,9 +4,10 @@ What it measures
 ----------------
 The built-in scene launch-sine-qualification swept up only (base.sweep.direction = "up"): 17
 clamp spacings 0.15-0.55 m of the Table 1 cable, 2 % damping, tabled levels (1.875-2.5 g),
-130 s of simulated time per span, one mode, rtol 1e-8. For RK45 and DOP853 (the scalar
-driver, SciPy's arithmetic), on 1 and 2 threads: the wall time of `sweep.run` over the 17 spans
-(warm Numba cache: one run first), best of --repeats, and the seconds per span.
+130 s of simulated time per span, one mode, rtol 1e-8. For RK45 and DOP853, each on the lanes
+(the default: 16 sweeps side by side in SIMD lanes) and on the scalar driver (SciPy's
+arithmetic, one sweep after another), on 1 and 2 threads: the wall time of `sweep.run` over the
+17 spans (warm Numba cache: one run first), best of --repeats, and the seconds per span.
 
 The peer, in the same run: SciPy's `solve_ivp` (same method, same rtol, the per-point atol the
 engine uses) on the same chirp, its right-hand side a plain Python closure written here from
@@ -102,23 +103,25 @@ def main() -> None:
     cost = []
     runs = {}
     for method in ("rk45", "dop853"):
-        scene = sweep.load_scene(SCENE, overrides={"base.sweep.direction": "up",
-                                                   "solver.method": method})
-        sweep.run(scene, threads=1)                               # compile, warm the cache
-        n = scene.axes["length"].size
-        for threads in (1, 2):
-            best = math.inf
-            for _ in range(args.repeats):
-                began = time.perf_counter()
-                ds = sweep.run(scene, threads=threads)
-                best = min(best, time.perf_counter() - began)
-            runs[method, threads] = ds
-            simulated = float(ds["sweep_duration"]) * n
-            cost.append((method.upper(), threads, n, f"{best:.2f}", f"{best / n:.3f}",
-                         f"{simulated / best:,.0f}",
-                         f"{int(ds['n_steps'].sum()):,}"))
+        for driver in ("lanes", "scalar"):
+            scene = sweep.load_scene(SCENE, overrides={"base.sweep.direction": "up",
+                                                       "solver.method": method,
+                                                       "solver.driver": driver})
+            sweep.run(scene, threads=1)                           # compile, warm the cache
+            n = scene.axes["length"].size
+            for threads in (1, 2):
+                best = math.inf
+                for _ in range(args.repeats):
+                    began = time.perf_counter()
+                    ds = sweep.run(scene, threads=threads)
+                    best = min(best, time.perf_counter() - began)
+                runs[method, driver, threads] = ds
+                simulated = float(ds["sweep_duration"]) * n
+                cost.append((method.upper(), driver, threads, n, f"{best:.2f}",
+                             f"{best / n:.3f}", f"{simulated / best:,.0f}",
+                             f"{int(ds['n_steps'].sum()):,}"))
     print(f"## {SCENE}, up sweep, 17 spans ({time.strftime('%Y-%m-%d')})\n")
-    print(markdown_table(("method", "threads", "spans", "wall s", "s per span",
+    print(markdown_table(("method", "driver", "threads", "spans", "wall s", "s per span",
                           "simulated s per wall s", "steps"), cost))
 
     scene = sweep.load_scene(SCENE, overrides={"base.sweep.direction": "up"})
@@ -131,7 +134,7 @@ def main() -> None:
         if args.peer_spans > 1 else np.array([lengths.size // 2])
     peer = []
     for method in ("rk45", "dop853"):
-        ds = runs[method, 1]
+        ds = runs[method, "lanes", 1]
         per_span = float(ds.attrs["run_seconds"]) / lengths.size
         for i in pick:
             peak, took = scipy_peak(rows[i], method.upper(), float(scene.get("solver.rtol")))
@@ -140,7 +143,7 @@ def main() -> None:
                          f"{took / per_span:,.0f}x", f"{abs(ours / peak - 1):.1e}"))
     print("\n## Peer: scipy.integrate.solve_ivp on the same chirp, same tolerances\n")
     print(markdown_table(("method", "length (m)", "SciPy s per span",
-                          "cable-sweep s per span (1 thread, mean)", "ratio",
+                          "cable-sweep s per span (lanes, 1 thread, mean)", "ratio",
                           "peak |q| relative difference"), peer))
     print("\nCommand: PYTHONPATH=. python " + " ".join(sys.argv))
 

@@ -171,14 +171,11 @@ def _expm1_over(x):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def sweep_anchor(t, h, p, o, s):
-    """A logarithmic sweep's state at the start t (s) of a step of h (s), from which `anchored`
-    gives a_b at every stage time t + tau of the step (0 <= tau <= h) with no libm call:
-    (1, sin phi(t), cos phi(t), w(t) (rad/s), A(t) (m/s^2), g = d ln A / dt (1/s)). Where the
-    step is not one stretch of a single level segment after the ramp and before the sweep's
-    END, where |lam h| or |g h| exceed STAGE_SERIES_BELOW, and for a fixed frequency: all
-    zeros, each stage reads `acceleration` (a fixed sine keeps its bits)."""
-    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+def sweep_state(t, h, p, o, s):
+    """`sweep_anchor` before its sine and cosine: (1, phi(t) (rad), w(t) (rad/s), A(t)
+    (m/s^2), g (1/s)) at the start t (s) of a step of h (s), or all zeros where the anchor does
+    not hold. One expm1 gives the phase (as `phase`) and w(t) = w_b (1 + expm1(lam t))."""
+    none = (0.0, 0.0, 0.0, 0.0, 0.0)
     lam = p[o + RATE * s]
     if lam == 0.0 or not abs(lam * h) <= STAGE_SERIES_BELOW:
         return none
@@ -197,8 +194,24 @@ def sweep_anchor(t, h, p, o, s):
             return none
         a = math.exp(p[o + (LOG_LEVEL + k) * s]
                      + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
-    x = phase(t, p, o, s)
-    return 1.0, math.sin(x), math.cos(x), p[o + OMEGA * s] * math.exp(lam * t), a, g
+    grown = math.expm1(lam * t)
+    return (1.0, p[o + OMEGA * s] * (grown / lam) + p[o + PHASE * s],
+            p[o + OMEGA * s] * (1.0 + grown), a, g)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def sweep_anchor(t, h, p, o, s):
+    """A logarithmic sweep's state at the start t (s) of a step of h (s), from which `anchored`
+    gives a_b at every stage time t + tau of the step (0 <= tau <= h) with no libm call:
+    (1, sin phi(t), cos phi(t), w(t) (rad/s), A(t) (m/s^2), g = d ln A / dt (1/s)). Where the
+    step is not one stretch of a single level segment after the ramp and before the sweep's
+    END, where |lam h| or |g h| exceed STAGE_SERIES_BELOW, and for a fixed frequency: all
+    zeros, each stage reads `acceleration` (a fixed sine keeps its bits). (`sweep_state`, then
+    libm's sine and cosine of the phase.)"""
+    held, x, w, a, g = sweep_state(t, h, p, o, s)
+    if held == 0.0:
+        return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    return 1.0, math.sin(x), math.cos(x), w, a, g
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")

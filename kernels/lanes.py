@@ -67,7 +67,7 @@ from .layout import N_LEVELS, RTOL, SAMPLE_DT, T_END, TOL, WANT_SETTLING
 from .oscillator import (BOUND, EXCITATION, N_PARAMS, acceleration, base_acceleration, prepare,
                          record_stages, shaken)
 from .transverse import classify, reject_point, swept_outputs, valid
-from .vecmath import inv_fifth_root
+from .vecmath import FAST_TRIG_BELOW, fast_sin_cos, inv_fifth_root
 
 # The vector loops may fuse a * b + c into one fused multiply-add (one rounding instead of two;
 # no reordering): about half the floating-point instructions of the stage sums, the cosine's
@@ -104,9 +104,9 @@ W_AB_STAGES = W_START + 6   # a record's a_b (m/s^2) at the attempt's stage s = 
                             # attempt (`_stage_reads`)
 W_B1 = W_AB_STAGES + dop853.N_STAGES   # a record's integrals of a_b and a_b^2 over an ordinary
 W_B2 = W_B1 + 1                         # step (m/s, m^2/s^3; `_record_reads`)
-W_ANCHOR = W_B2 + 1     # a sweep's anchor for the attempt, excitation.sweep_anchor's six values
-                        # in rows W_ANCHOR + 0..5 (`_read_sweeps`)
-W_ROWS = W_ANCHOR + 6
+W_ANCHOR = W_B2 + 1     # a sweep's state at the attempt's start, excitation.sweep_state's five
+                        # values in rows W_ANCHOR + 0..4 (`_read_sweeps`)
+W_ROWS = W_ANCHOR + 5
 
 # W_FLAG values.
 ORDINARY = 0.0        # nothing for the scalar state machine to do
@@ -196,27 +196,28 @@ def _read_sweeps(W, n_run, eighth, swept, base):
     """With a swept sine (`swept` True), each running lane's a_b (m/s^2) at its attempt's stage
     times and at t + h into rows W_AB_STAGES .., so that the record kind's chains
     (`_accel_read`) take them; a fixed frequency reads nothing (its chains evaluate the vector
-    sine). The scalar step's reads (excitation.sine_at_nodes): each lane's anchor at its step's
-    start (excitation.sweep_anchor: libm and the level table's search, a scalar loop), then
-    every stage from it (excitation.anchored) in a vector loop across the lanes, one a stage,
-    then, in the lanes whose anchor does not hold, each stage's own read."""
+    sine). The scalar step's reads (excitation.sine_at_nodes) to round-off: each lane's sweep
+    state at its step's start (excitation.sweep_state: libm's expm1 and exp and the level
+    table's search, a scalar loop), then, in a loop across the lanes that LLVM vectorises, the
+    anchor's sine and cosine of the phase (vecmath.fast_sin_cos) and every stage from it
+    (excitation.anchored), then, in the lanes whose anchor does not hold or whose phase is past
+    vecmath.FAST_TRIG_BELOW, the scalar step's own reads."""
     if swept is None:
         return
     L = LANES
     nodes = dop853.C if eighth is not None else C
     block = (W_P + EXCITATION) * L
     for j in range(n_run):
-        anchor = ex.sweep_anchor(W[tj.T * L + j], W[W_H * L + j], W, block + j, L)
-        W[W_ANCHOR * L + j] = anchor[0]
-        W[(W_ANCHOR + 1) * L + j] = anchor[1]
-        W[(W_ANCHOR + 2) * L + j] = anchor[2]
-        W[(W_ANCHOR + 3) * L + j] = anchor[3]
-        W[(W_ANCHOR + 4) * L + j] = anchor[4]
-        W[(W_ANCHOR + 5) * L + j] = anchor[5]
+        state = ex.sweep_state(W[tj.T * L + j], W[W_H * L + j], W, block + j, L)
+        W[W_ANCHOR * L + j] = state[0]
+        W[(W_ANCHOR + 1) * L + j] = state[1]
+        W[(W_ANCHOR + 2) * L + j] = state[2]
+        W[(W_ANCHOR + 3) * L + j] = state[3]
+        W[(W_ANCHOR + 4) * L + j] = state[4]
     for j in range(n_run):
-        anchor = (W[W_ANCHOR * L + j], W[(W_ANCHOR + 1) * L + j], W[(W_ANCHOR + 2) * L + j],
-                  W[(W_ANCHOR + 3) * L + j], W[(W_ANCHOR + 4) * L + j],
-                  W[(W_ANCHOR + 5) * L + j])
+        sin0, cos0 = fast_sin_cos(W[(W_ANCHOR + 1) * L + j])
+        anchor = (W[W_ANCHOR * L + j], sin0, cos0, W[(W_ANCHOR + 2) * L + j],
+                  W[(W_ANCHOR + 3) * L + j], W[(W_ANCHOR + 4) * L + j])
         h = W[W_H * L + j]
         lam = W[block + ex.RATE * L + j]
         if eighth is None:
@@ -224,7 +225,8 @@ def _read_sweeps(W, n_run, eighth, swept, base):
         else:
             _anchored8(W, j, anchor, h, lam)
     for j in range(n_run):
-        if W[W_ANCHOR * L + j] == 0.0 and W[W_H * L + j] > 0.0:
+        held = (W[W_ANCHOR * L + j] != 0.0) & (abs(W[(W_ANCHOR + 1) * L + j]) < FAST_TRIG_BELOW)
+        if not held and W[W_H * L + j] > 0.0:
             ex.sine_at_nodes(W[tj.T * L + j], W[W_H * L + j], nodes, W, block + j, L, W,
                              W_AB_STAGES * L + j, L)
 

@@ -14,6 +14,9 @@ conversions per call, with no single instruction for them before AVX-512):
 import numba as nb
 import numpy as np
 
+FAST_TRIG_BELOW = 1e5
+"""|x| below which `fast_cos`, `fast_sin` and `fast_sin_cos` hold to about an ulp."""
+
 # Cody-Waite split of pi/2 and fdlibm's minimax kernels on [-pi/4, pi/4].
 _TWO_OVER_PI = 0.63661977236758134308
 _PIO2_1 = 1.57079632673412561417e+00

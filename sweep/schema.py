@@ -262,7 +262,7 @@ KEYS: tuple[Key, ...] = (
     Key("solver", "driver", "str", "lanes", choices=("lanes", "scalar"),
         long_name="transverse kernel driver: lock-step SIMD lanes (fast) or one trajectory per "
                   "thread (SciPy's arithmetic exactly, the reference); default lanes, but scalar "
-                  "for a sine sweep, for several modes where fewer than 4 points share one lanes "
+                  "for a sine sweep of several modes, for several modes where fewer than 4 points share one lanes "
                   "call (a single span; elastic clamps of 5 or more modes whose K differs at "
                   "every point: up to 4 modes every span's own modes share one call), and for a "
                   "random scene where fewer than 4 points x records share one (2 with one mode)"),
