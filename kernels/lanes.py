@@ -172,6 +172,9 @@ def _read_stages(W, n_run, eighth, swept, base):
                       W_AB_STAGES * L + j, L)
 
 
+_IDLE = (0.0, 0.0, 0.0, 0.0, 0.0)     # an idle lane's sweep state (`_read_sweeps`)
+
+
 def _anchored_stages(nodes, name):
     """An inline-always function (W, j, anchor, h, lam) that writes lane j's a_b (m/s^2) at
     t + nodes[i] h, i = 1 .. len(nodes) - 1, and at t + h into rows W_AB_STAGES .. from its
@@ -208,7 +211,8 @@ def _read_sweeps(W, n_run, eighth, swept, base):
     nodes = dop853.C if eighth is not None else C
     block = (W_P + EXCITATION) * L
     for j in range(n_run):
-        state = ex.sweep_state(W[tj.T * L + j], W[W_H * L + j], W, block + j, L)
+        h = W[W_H * L + j]
+        state = ex.sweep_state(W[tj.T * L + j], h, W, block + j, L) if h > 0.0 else _IDLE
         W[W_ANCHOR * L + j] = state[0]
         W[(W_ANCHOR + 1) * L + j] = state[1]
         W[(W_ANCHOR + 2) * L + j] = state[2]

@@ -177,9 +177,8 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
-    run_blocks(solve_block, params.shape[0], threads, watch.stop,
-               one_at_a_time=swept and driver == "scalar", tick=watch.ticker(),
-               lanes=driver == "lanes")
+    run_blocks(solve_block, params.shape[0], threads, watch.stop, one_at_a_time=swept,
+               tick=watch.ticker(), lanes=driver == "lanes")
 
 
 def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settings: np.ndarray,
@@ -308,11 +307,11 @@ def run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
                tick: Callable[[], None] | None = None, lanes: bool = True) -> None:
     """Run solve_block(lo, hi) over blocks covering rows 0..n-1 on `threads` threads (0: all),
     guided scheduling and timed blocks (module docstring); with `stop` set no new block starts.
-    one_at_a_time: every block one row, a thread for every row (points that each take long:
-    a sine sweep's). tick(): called every WATCH_SECONDS from a thread of its own while the
-    blocks run (`Watch.tick`). lanes: whether solve_block runs lanes, which drain at a block's
-    end (blocks of at least MIN_BLOCK points, a thread per LANES_PER_THREAD); False: a scalar
-    driver (SCALAR_BLOCK)."""
+    one_at_a_time: points that each take long (a sine sweep's): a thread for every row, and on a
+    scalar driver every block one row (the lanes take equal shares). tick(): called every
+    WATCH_SECONDS from a thread of its own while the blocks run (`Watch.tick`). lanes: whether
+    solve_block runs lanes, which drain at a block's end (blocks of at least MIN_BLOCK points, a
+    thread per LANES_PER_THREAD); False: a scalar driver (SCALAR_BLOCK)."""
     if tick is None:
         _run_blocks(solve_block, n, threads, stop, one_at_a_time, lanes)
         return
@@ -353,8 +352,8 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
         while not stop.is_set():
             with lock:
                 lo = start
-                hi = start = lo + 1 if one_at_a_time else next_block(lo, n, n_threads, cap,
-                                                                     least)
+                hi = start = lo + 1 if one_at_a_time and not lanes else next_block(
+                    lo, n, n_threads, cap, least)
             if lo >= n:
                 return
             began = time.perf_counter()
