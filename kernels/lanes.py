@@ -175,8 +175,14 @@ def _read_stages(W, n_run, eighth, swept, base):
 _IDLE = (0.0, 0.0, 0.0, 0.0, 0.0)     # an idle lane's sweep state (`_read_sweeps`)
 
 
+# excitation.anchored as a function of its own that LLVM inlines where it is called (Numba's
+# own inlining copied its IR into each of DOP853's twelve stage writes: 8 s of compile)
+_anchored = nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False,
+                    forceinline=True)(ex.anchored.py_func)
+
+
 def _anchored_stages(nodes, name):
-    """An inline-always function (W, j, anchor, h, lam) that writes lane j's a_b (m/s^2) at
+    """A function (W, j, anchor, h, lam), inlined by LLVM, that writes lane j's a_b (m/s^2) at
     t + nodes[i] h, i = 1 .. len(nodes) - 1, and at t + h into rows W_AB_STAGES .. from its
     step's anchor (excitation.anchored): one statement a stage, written out from the nodes, so
     that each store has a constant row and the loop across the lanes that calls it
@@ -185,9 +191,10 @@ def _anchored_stages(nodes, name):
     source = f"def {name}(W, j, anchor, h, lam):\n" + "".join(
         f"    W[{W_AB_STAGES + i} * {LANES} + j] = anchored(anchor, {c} * h, lam)\n"
         for i, c in enumerate(times))
-    namespace = {"anchored": ex.anchored}
+    namespace = {"anchored": _anchored}
     exec(compile(source, f"<anchored stages {name}>", "exec"), namespace)
-    return nb.njit(inline="always", error_model="numpy")(namespace[name])
+    return nb.njit(nogil=True, error_model="numpy", _nrt=False,
+                   forceinline=True)(namespace[name])
 
 
 _anchored5 = _anchored_stages(C, "anchored_rk45")
