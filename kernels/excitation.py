@@ -543,18 +543,7 @@ def _is_record(base):
     return lambda base: False
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _true(base):
-    return True
-
-
 peak_bound = by_kind(level_bound, record_bound)
 peak_bound.__doc__ = """peak_bound(t0, t1, p, o, s, base): an upper bound (m/s^2) of |a_b(t)|
 over [t0, t1] (s) for the scene's kind (`level_bound`, `record_bound`): what lets an observer
 skip a search for a peak that cannot exceed the largest so far."""
-
-record_switch = by_kind(None, _true)
-record_switch.__doc__ = """None for the sine kinds, True for the record kind (an array of
-records as the `base` switch): a switch whose `is None` branches Numba prunes before it
-inlines (a branch on `is_record(base)` is pruned only after, so both sides' inlined code is
-copied and typed)."""

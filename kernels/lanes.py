@@ -46,6 +46,12 @@ reads in a scalar loop, then the observers record_step calls (trajectory.observe
 observe_random, observe_level_crossings: straight-line selects) in vector loops, and, with
 DOP853, the spectra's samples (`_record_samples`: trajectory.take_hermite_samples, as
 record_step takes them), so the same bits as the scalar path.
+
+A sine sweep (`solve_swept_block`) runs on the record kind's chains too (`reads_switch`): each
+lane's a_b at its attempt's stage times is written before the attempt from its step's anchor
+(`_read_sweeps`: excitation.sweep_state lane by lane, then the anchor's sine and every stage in
+a loop across the lanes), each lane ends with its own sweep (`_point_settings`), and its
+point's peak frequency and envelope are transverse.swept_outputs' where it ends (`_end_point`).
 """
 
 import math
@@ -161,7 +167,8 @@ def _accel_read(W, j, t, q, v, parametric, base, stage):
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _read_stages(W, n_run, eighth, swept, base):
     """Each lane's a_b (m/s^2) at its attempt's stage times t + C[s] h, s = 1 .. n - 1, and at
-    t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads, before the attempt,
+    t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads (swept: unused, the
+    sine kinds' `_read_sweeps` takes it), before the attempt,
     so that its chain's loop has none and vectorises. The reads stay a scalar loop, lane by
     lane (oscillator.record_stages reads a lane's columns once for its stages): LLVM will not
     vectorise a gather from the records beside a store into W, which it cannot prove apart."""
@@ -177,8 +184,9 @@ _IDLE = (0.0, 0.0, 0.0, 0.0, 0.0)     # an idle lane's sweep state (`_read_sweep
 
 # excitation.anchored as a function of its own that LLVM inlines where it is called (Numba's
 # own inlining copied its IR into each of DOP853's twelve stage writes: 8 s of compile)
-_anchored = nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False,
-                    forceinline=True)(ex.anchored.py_func)
+_anchored = nb.njit(nogil=True, error_model="numpy", _nrt=False,
+                    forceinline=True)(ex.anchored.py_func)   # not cached: excitation.anchored's
+                                                             # own entries share its cache key
 
 
 def _anchored_stages(nodes, name):
@@ -248,7 +256,10 @@ _stage_reads = ex.by_kind(_read_sweeps, _read_stages)
 
 def reads_switch(swept, base):
     """None, or True where the attempts take each stage's a_b from rows W_AB_STAGES ..
-    (`_stage_reads`): a random record (`base` an array) or a swept sine (`swept` True)."""
+    (`_stage_reads`): a random record (`base` an array) or a swept sine (`swept` True). A
+    switch whose `is None` branches Numba prunes before it inlines (a branch on
+    `excitation.is_record(base)` is pruned only after, so both sides' inlined code would be
+    copied and typed)."""
     raise TypeError("kernels.lanes.reads_switch runs only in compiled code")
 
 
@@ -314,8 +325,8 @@ _chain8 = _chains(dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "d
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, rtol, n_run, parametric, base, record):
-    """One Dormand-Prince attempt in every lane of W (record: `excitation.record_switch`,
-    True for a random record's chains): the stages (`_chain5`, from dopri5.A,
+    """One Dormand-Prince attempt in every lane of W (record: `reads_switch`, True for the
+    chains that read each stage's a_b from W: a random record's, a sweep's): the stages (`_chain5`, from dopri5.A,
     B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
     y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
     count runs across the lanes with straight-line arithmetic, so LLVM vectorises it rather

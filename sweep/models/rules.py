@@ -312,8 +312,8 @@ def _check_sweep(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
     """Rules of a sine sweep and a level table (docs/model.md sec. 6): a sweep has a start, a
     stop and a rate (keys or axes) that differ, replaces base.frequency and
     base.frequency_ratio, of several modes is solved by the scalar driver, has no settling
-    time and is not a stepped sweep; a level table replaces the constant level and covers every frequency the
-    scene's sweeps reach; the envelope outputs need a sweep."""
+    time and is not a stepped sweep; a level table replaces the constant level and covers
+    every frequency the scene's sweeps reach; the envelope outputs need a sweep."""
     swept = [d for d in SWEEP_KEYS if _present(d, given, axes)]
     table = given.get(BASE_TABLE_KEY)
     if table is not None:
