@@ -1117,7 +1117,7 @@ def _transverse_defaults(values: dict[str, Any], given: dict[str, Any],
     swept = any(d in mentioned for d in SWEEP_KEYS)
     if "solver.t_end" not in mentioned and not swept and not random_scene.is_random(values):
         values["solver.t_end"] = DEFAULT_T_END     # a sweep's points end with their sweeps
-    if swept:            # no settling; the scalar driver; the peaks over the whole sweep
+    if swept:            # no settling; the peaks over the whole sweep; the lanes for one mode
         # and no variable that means nothing for a sweep: no response period (the frequency
         # never stops changing), no tail amplitude where the tail is the whole sweep (it
         # would be peak_amplitude again)
