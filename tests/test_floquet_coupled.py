@@ -248,7 +248,7 @@ def test_coupling_moves_the_growth_rate(tmp_path):
                                   ratios=ratios, loads=loads))
     out = tmp_path / "chart.nc"
     done = subprocess.run([sys.executable, "-m", "sweep.cli", "run", str(scene), "-o", str(out)],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     import xarray as xr
     with xr.open_dataset(out) as ds:

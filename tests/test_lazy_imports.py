@@ -6,6 +6,7 @@ runs in a fresh interpreter, the only way to see what an import costs."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import subprocess
 import sys
@@ -13,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+# the sweep this process imports (and its Numba cache), found without importing it
+ROOT = Path(importlib.util.find_spec("sweep").origin).resolve().parents[1]
 HEAVY = ("numpy", "xarray", "numba", "pandas", "dask", "distributed", "scipy", "matplotlib",
          "pint")
 

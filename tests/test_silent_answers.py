@@ -240,7 +240,7 @@ def test_a_scene_with_a_start_does_not_warn(text):
 def test_cli_says_in_one_line_what_an_empty_scene_ran(tmp_path):
     empty = tmp_path / "empty.toml"
     empty.write_text("")
-    root = Path(__file__).resolve().parents[1]
+    root = Path(sweep.__file__).resolve().parents[1]     # the sweep imported here (its cache)
     done = subprocess.run([sys.executable, "-m", "sweep.cli", "run", str(empty), "-q", "-o",
                            str(tmp_path / "empty.nc")],
                           capture_output=True, text=True, cwd=tmp_path, timeout=600,
