@@ -107,13 +107,13 @@ def instrumented(rdtsc: ctypes._CFuncPtr, name: str = "modal_lanes",
     src = (ROOT / "kernels" / f"{name}.py").read_text()
     src = src.replace("from . import", "from sweep.kernels import").replace(
         "from .", "from sweep.kernels.").replace("cache=True", "cache=False")
-    if src.count(" steady, swept, halt):\n") == 1:     # kernels/lanes.py: the entries call _drive
-        src = src.replace(" steady, swept, halt):\n", " steady, swept, halt, cycles):\n")
-        src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n")
-        src = src.replace(" steady, None, halt)\n", " steady, None, halt, cycles)\n")
-        src = src.replace(" steady, True, halt)\n", " steady, True, halt, cycles)\n")
-    elif src.count(" steady, halt):\n") == 1:
-        src = src.replace(" steady, halt):\n", " steady, halt, cycles):\n", 1)
+    if src.count(" base, swept, halt):\n") == 1:     # kernels/lanes.py: the entries call _drive
+        src = src.replace(" base, swept, halt):\n", " base, swept, halt, cycles):\n")
+        src = src.replace(" base, halt):\n", " base, halt, cycles):\n")
+        src = src.replace(" base, None, halt)\n", " base, None, halt, cycles)\n")
+        src = src.replace(" base, True, halt)\n", " base, True, halt, cycles)\n")
+    elif src.count(" eighth, halt):\n") == 1:
+        src = src.replace(" eighth, halt):\n", " eighth, halt, cycles):\n", 1)
     else:
         sys.exit(f"lanes_phases: kernels/{name}.py changed: solve_block's signature")
     head, loop = src.split("    while True:\n        if halt[0] != 0:", 1)

@@ -781,7 +781,7 @@ def _end_point(W, j, settings, ends, i, buf, states, reals, counts, series, enve
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, parametric,
-                 base, eighth, steady):
+                 base, eighth):
     """trajectory.record_step for lane j (point i) after an accepted attempt. The lane's views of
     W and of the point's time-series row are taken here, where Numba keeps no reference counts
     (`_nrt=False`; nothing here allocates): taken in solve_block, each view cost two atomic
@@ -789,34 +789,33 @@ def _record_lane(W, j, settings, K, Qc, buf, series, i, track, thr_rel, xe, para
     L = LANES
     tj.record_step(W, W_P * L + j, L, settings, W[j::L], K, W[W_QN * L + j],
                    W[W_VN * L + j], W[W_H * L + j], Qc, buf, series[i], track,
-                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base, eighth,
-                   steady)
+                   0.0, 0.0, thr_rel, xe, W[W_QE * L + j], parametric, base, eighth)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, pi, eighth,
-                parametric, base, steady, halt):
+                parametric, base, halt):
     """Solve rows lo..hi-1 of `params` through LANES lock-step lanes: the interface and
     results (to round-off) of transverse.solve_block, several times faster per core.
     (`_drive` with no sweep.)"""
     _drive(params, settings, lo, hi, states, reals, counts, series, np.empty((0, 0)),
-           np.empty(0), pi, eighth, parametric, base, steady, None, halt)
+           np.empty(0), pi, eighth, parametric, base, None, halt)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, settings, lo, hi, states, reals, counts, series, envelope, ends,
-                      pi, eighth, parametric, base, steady, halt):
+                      pi, eighth, parametric, base, halt):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1; transverse's
     solve_swept_block on the lanes): envelope (n, n_bands), the response envelope (m;
     n_bands may be 0), and ends (n,), each point's end time (s; its sweep's). Each lane reads
     its sweep at its attempt's stage times before the attempt (`_read_sweeps`)."""
     _drive(params, settings, lo, hi, states, reals, counts, series, envelope, ends, pi, eighth,
-           parametric, base, steady, True, halt)
+           parametric, base, True, halt)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _drive(params, settings, lo, hi, states, reals, counts, series, envelope, ends, pi, eighth,
-           parametric, base, steady, swept, halt):
+           parametric, base, swept, halt):
     """The lanes over rows lo..hi-1 (`solve_block`, `solve_swept_block`; swept None or True).
 
     `pi` picks the step-size controller and must match settings[CONTROLLER]: None for SciPy's,
@@ -827,8 +826,7 @@ def _drive(params, settings, lo, hi, states, reals, counts, series, envelope, en
     settings[BASE] is 1 (oscillator's base-excitation switch), or the records of a random base
     acceleration (kernels.excitation's record kind: each lane reads its row's record in its
     stage chain; its ordinary steps' statistics are `_record_statistics`', the rest
-    record_step's);
-    `steady` True when settings[STOP_STEADY] is 1 (the early stop, trajectory.record_step).
+    record_step's).
 
     halt (1,): once another thread sets halt[0] != 0 (an interrupt), the call returns after
     the attempt in hand, the rows in flight left unsolved (their `states` untouched; a lane's
@@ -924,4 +922,4 @@ def _drive(params, settings, lo, hi, states, reals, counts, series, envelope, en
                 bufs[j] = tj.with_room(bufs[j], W[j::L])
                 capacity[j] = bufs[j].shape[0]
             _record_lane(W, j, settings, K, Qc, bufs[j], series, i, track, thr_rel, xe,
-                         parametric, base, eighth, steady)
+                         parametric, base, eighth)

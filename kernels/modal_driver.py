@@ -1121,13 +1121,13 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series, modal, base,
-              eighth, steady, weights, basis):
+              eighth, weights, basis):
     """Integrate one point (raw row `row`, kernels.modes columns) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing the watched deflection's metrics
     (kernels.trajectory's accumulator; weights: its mode weights, the basis' midspan values
     for the midspan) and the modes' accumulator (modal, `modal_size`, m; basis: the span's,
     kernels.modes) on the fly; `track`, centre, thr_fixed, thr_rel and the switches base,
-    eighth (the method, as settings[METHOD]) and steady: as transverse.integrate.
+    eighth (the method, as settings[METHOD]): as transverse.integrate.
     Returns (accumulator, extrema buffer, final state y)."""
     n = n_modes
     dim = 2 * n
@@ -1183,7 +1183,7 @@ def integrate(row, n_modes, settings, track, centre, thr_fixed, thr_rel, series,
         q_mid = _project(y_new, weights, 0, n)
         v_mid = _project(y_new, weights, n, n)
         tj.record_step(p1, 0, 1, settings, acc, K_mid, q_mid, v_mid, h, Qc, buf, series, track,
-                       centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth, steady)
+                       centre, thr_fixed, thr_rel, -1.0, 0.0, True, base, eighth)
         observe_random_modes(t, t_tail, y, y_new, K, h, n, basis[md.CLAMPS], modal, acc, base)
         restart_modes(acc, t_tail, t, t_new, y, y_new, K, h, n, eighth, modal, Km, QA, qx,
                       basis, Qc, p1, base)
@@ -1230,7 +1230,7 @@ def at_rest(row, basis, t, y, band, base):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_point(row, basis, settings, reals, counts, series, modal, final, envelope, base,
-                eighth, steady):
+                eighth):
     """Integrate and classify one point (kernels.transverse.solve_point's outputs, plus each
     mode's tail amplitude in modal, m, and the final state y in final, m and m/s). Bad
     parameters give INVALID_INPUT, NaN metrics. basis: the span's (kernels.modes)."""
@@ -1251,7 +1251,7 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
         return mt.INVALID_INPUT
     ext = np.empty(modal_size(n_modes))
     acc, buf, y = integrate(row, n_modes, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                            settings[TOL], series, ext, base, eighth, steady,
+                            settings[TOL], series, ext, base, eighth,
                             basis[md.MIDSPAN], basis)
     resting = at_rest(row, basis, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
     state = classify_metrics(settings, acc, buf, reals, counts, base, resting)
@@ -1272,8 +1272,7 @@ def solve_point(row, basis, settings, reals, counts, series, modal, final, envel
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, basis, settings, states, reals, counts, base, eighth,
-                       steady):
+def settle_second_pass(params, basis, settings, states, reals, counts, base, eighth):
     """Finish the points left SECOND_PASS (at rest away from zero), as
     kernels.transverse.settle_second_pass does for one mode: integrate again to find the
     final midspan value, then track |q_mid - final| against the band."""
@@ -1286,10 +1285,10 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
             continue
         track = bool(True)    # a run-time bool, as solve_point's: integrate compiles once
         first, _, _ = integrate(params[i], n_modes, settings, track, 0.0, 0.0, settings[TOL],
-                                np.empty(0), modal, base, eighth, steady, weights, basis)
+                                np.empty(0), modal, base, eighth, weights, basis)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, track, first[tj.Q], band, 0.0,
-                                 np.empty(0), modal, base, eighth, steady, weights,
+                                 np.empty(0), modal, base, eighth, weights,
                                  basis)
         states[i] = tj.settle(second, reals[i], counts[i])
         done += 1
@@ -1297,8 +1296,7 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def judge_off_midspan(params, basis, settings, states, reals, counts, modal, base, eighth,
-                      steady):
+def judge_off_midspan(params, basis, settings, states, reals, counts, modal, base, eighth):
     """Finish the points a driver left OFF_MIDSPAN (`span_state`: the midspan deflection
     decayed while a mode with a node at midspan kept moving): integrate again watching the
     mode with the largest tail amplitude (modal, (n, N), m) instead of the midspan, and take
@@ -1327,7 +1325,7 @@ def judge_off_midspan(params, basis, settings, states, reals, counts, modal, bas
         weights = np.zeros(n)
         weights[k] = 1.0
         acc, buf, y = integrate(params[i], n, settings, settings[WANT_SETTLING] != 0.0, 0.0,
-                                0.0, settings[TOL], np.empty(0), ext, base, eighth, steady,
+                                0.0, settings[TOL], np.empty(0), ext, base, eighth,
                                 weights, basis)
         resting = at_rest(params[i], basis, acc[tj.T], y, settings[TOL] * acc[tj.TAIL_AMP], base)
         state = classify_metrics(settings, acc, buf, own_reals, own_counts, base, resting)
@@ -1354,7 +1352,7 @@ def judge_off_midspan(params, basis, settings, states, reals, counts, modal, bas
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, modal,
-                final, base, eighth, steady, halt):
+                final, base, eighth, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)), one trajectory after another:
     kernels.transverse.solve_block's outputs plus modal (n, N), each mode's tail amplitude
     max |q_n| (m), and final (n, 2N), the state y at the end (m, m/s; NaN where the point
@@ -1367,14 +1365,14 @@ def solve_block(params, basis, settings, lo, hi, states, reals, counts, series, 
         if halt[0] != 0:
             return
         states[i] = solve_point(params[i], basis, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], none, base, eighth, steady)
+                                modal[i], final[i], none, base, eighth)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, basis, settings, lo, hi, states, reals, counts, series, modal,
-                      final, envelope, base, eighth, steady):
+                      final, envelope, base, eighth):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope of the midspan deflection: envelope (n, n_bands) (m; n_bands may be 0)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], basis, settings, reals[i], counts[i], series[i],
-                                modal[i], final[i], envelope[i], base, eighth, steady)
+                                modal[i], final[i], envelope[i], base, eighth)

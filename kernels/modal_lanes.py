@@ -639,7 +639,7 @@ def _end_lane(params, n, settings, point, j, W, Y, MOD, states, reals, counts, s
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, buf, series,
                   i, track, thr_rel, eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, basis,
-                  Kmid, Qc, base, steady):
+                  Kmid, Qc, base):
     """An accepted step of lane j (point i) that `_finish` left to the scalar path: reduced as
     modal_driver.integrate does (the divergence test on every mode, each mode's tail amplitude
     by modal_driver._observe_modes, the midspan Observer trajectory.record_step) on copies of
@@ -673,7 +673,7 @@ def _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, bound, weights, 
     q_new = drv._project(ynl, weights, 0, n)
     v_new = drv._project(ynl, weights, n, n)
     tj.record_step(P1L[j], 0, 1, settings, acc, Kmid, q_new, v_new, h, Qc, buf, series[i],
-                   track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth, steady)
+                   track, 0.0, 0.0, thr_rel, -1.0, 0.0, True, base, eighth)
     drv.observe_random_modes(t, t_tail, yl, ynl, Kl, h, n, basis[md.CLAMPS], ml, acc, base)
     drv.restart_modes(acc, t_tail, t, t_new, yl, ynl, Kl, h, n, eighth, ml, Km, QA, qx,
                       basis, Qc, P1L[j], base)
@@ -765,7 +765,7 @@ _record_statistics = ex.by_kind(None, _record_steps)
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, family, which, settings, lo, hi, states, reals, counts, series, modal,
-                final, base, eighth, steady, halt):
+                final, base, eighth, halt):
     """Solve rows lo..hi-1 of `params` (n, modes.n_columns(N)) through LANES lock-step lanes:
     the interface and results (to round-off) of modal_driver.solve_block (its outputs plus
     modal (n, N), each mode's tail amplitude max |q_n|, m, and final (n, 2N), the final
@@ -774,10 +774,9 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
     one call may each run their own (elastic clamps whose K differs from point to point), as
     far as the right-hand side and the observers read them lane by lane (their polynomials'
     structure and the zeros of their coupling and midspan weights are the same). base:
-    None, or True when settings[BASE] is 1; eighth: None, or True when
-    settings[METHOD] is 1 (DOP853); steady: None, or True when settings[STOP_STEADY] is 1 (the
-    early stop). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows
-    in flight unsolved). Releases the GIL (sweep.threads runs blocks on threads)."""
+    None, or True when settings[BASE] is 1; eighth: None, or True when settings[METHOD] is 1
+    (DOP853). halt: as kernels.lanes.solve_block's (an interrupt returns at once, the rows in
+    flight unsolved). Releases the GIL (sweep.threads runs blocks on threads)."""
     L = LANES
     basis = md.member(family, 0)     # the family's structure: every basis' the same
     n = md.basis_modes(basis)
@@ -932,6 +931,6 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
                 if _flagged_lane(W, j, n, settings, Y, YN, K, KM, H, P1L, MOD, BOUNDS[j],
                                  mine[md.MIDSPAN], bufs[j], series, point[j], track, thr_rel,
                                  eighth, n_stages, Kl, yl, ynl, ml, Km, QA, qx, mine, Kmid,
-                                 Qc, base, steady):
+                                 Qc, base):
                     MOVE[j] = 1.0
         _advance(Y, YN, K, MOVE, dim, n_stages, n_run)

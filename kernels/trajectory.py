@@ -31,7 +31,7 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
                      step_factor)
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
-                     STEADY_PERIODS, STEADY_TOL, TAIL, T_END)
+                     STEADY_PERIODS, STEADY_TOL, STOP_STEADY, TAIL, T_END)
 from .layout import RHS_EVALS as EVALS_COLUMN, SETTLING
 from .oscillator import (BOUND, DAMPING, EXCITATION, PARTICIPATION, Q0, Q_SCALE, V0, V_SCALE,
                          acceleration, base_acceleration)
@@ -757,15 +757,16 @@ def _observe_base(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_tail
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, track, centre,
-                thr_fixed, thr_rel, xe_known, qe_known, parametric, base, eighth, steady):
+                thr_fixed, thr_rel, xe_known, qe_known, parametric, base, eighth):
     """Reduce the metrics of an accepted step [acc[T], acc[T_NEW]] on its dense output and
     advance the trajectory to its end. p[o + column * s]: the point's prepared row (its
     divergence bound on |q|, m, and base excitation); `buf` must have room for one more
     extremum (`with_room`).
 
-    eighth: the method's switch (None: RK45, True: DOP853), for `interpolant`; steady: the
-    early stop's (None, or True with settings[STOP_STEADY]: solver.stop_when_steady), a
-    switch so that a scene without it does not compile it.
+    eighth: the method's switch (None: RK45, True: DOP853), for `interpolant`. The early stop
+    (settings[STOP_STEADY]: solver.stop_when_steady) is read here, at a maximum, not passed
+    as a switch: a switch's every value is a compile of the whole driver, and this test costs
+    nothing measurable on the extrema it runs on.
 
     If the driver has already located the step's extremum of q, xe_known in [0, 1] is its
     x = (t - t_old)/h and qe_known q there; xe_known < 0 means: locate it here. The interpolant
@@ -820,7 +821,7 @@ def record_step(p, o, s, settings, acc, K, q_new, v_new, h, Qc, buf, series, tra
             acc[TAIL_AMP] = max(acc[TAIL_AMP], abs(qe))
             acc[TAIL_QMIN] = min(acc[TAIL_QMIN], qe)
             acc[TAIL_QMAX] = max(acc[TAIL_QMAX], qe)
-        if (steady is not None and kind == mt.MAXIMUM
+        if (settings[STOP_STEADY] != 0.0 and kind == mt.MAXIMUM
                 and acc[T_FINAL] == settings[T_END]):
             t_tail = _stop_when_steady(settings, acc, buf, te, qe, t_tail,
                                        p[o + DAMPING * s])

@@ -39,11 +39,11 @@ from .oscillator import (BOUND, EXCITATION, MASS, N_PARAMS, acceleration, prepar
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric, base,
-              eighth, steady):
+              eighth):
     """Integrate one point (p: its prepared row, oscillator.prepare) from t = 0 to t_end with
     SciPy's RK45 or DOP853 (settings[METHOD]), reducing metrics on the fly. base: oscillator's
     base-excitation switch (None or True); eighth: the method's (None: RK45, True: DOP853, as
-    settings[METHOD]); steady: the early stop's (trajectory.record_step).
+    settings[METHOD]).
 
     When `track`, the accumulator's LAST_ABOVE is the last time |q - centre| exceeded
     thr_fixed + thr_rel * (running peak |q|). Returns (accumulator row, extrema buffer).
@@ -75,8 +75,7 @@ def integrate(p, settings, track, centre, thr_fixed, thr_rel, series, parametric
         if acc[tj.N_EXT] >= buf.shape[0]:
             buf = tj.with_room(buf, acc)
         tj.record_step(p, 0, 1, settings, acc, K, y_new[0], y_new[1], h, Qc, buf, series,
-                       track, centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth,
-                       steady)
+                       track, centre, thr_fixed, thr_rel, -1.0, 0.0, parametric, base, eighth)
     tj.end_series(acc, series)
     return acc, buf
 
@@ -234,8 +233,7 @@ def at_rest(p, o, s, acc, band, parametric, base):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def settle_second_pass(params, settings, states, reals, counts, parametric, base, eighth,
-                       steady):
+def settle_second_pass(params, settings, states, reals, counts, parametric, base, eighth):
     """Finish the points a driver left as SECOND_PASS (at rest away from zero): integrate
     again to find the final value, then a second time tracking |q - q_final| against the band
     tol * amplitude; the settling time is the last time q was outside it. The state becomes
@@ -249,18 +247,17 @@ def settle_second_pass(params, settings, states, reals, counts, parametric, base
         prepare(params[i], p, 0, 1)
         track = bool(True)    # a run-time bool, as solve_point's: integrate compiles once
         first, _ = integrate(p, settings, track, 0.0, 0.0, settings[TOL], np.empty(0),
-                             parametric, base, eighth, steady)
+                             parametric, base, eighth)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _ = integrate(p, settings, track, first[tj.Q], band, 0.0, np.empty(0), parametric,
-                              base, eighth, steady)
+                              base, eighth)
         states[i] = tj.settle(second, reals[i], counts[i])
         done += 1
     return done
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
-def solve_point(row, settings, reals, counts, series, envelope, parametric, base, eighth,
-                steady):
+def solve_point(row, settings, reals, counts, series, envelope, parametric, base, eighth):
     """Integrate the point of parameter row `row` and classify it. Never raises for bad
     parameters: they give INVALID_INPUT. With settings[SWEPT] (a swept base frequency) the
     sweep's outputs too (`swept_outputs`: peak frequency, envelope; the state COMPLETED)."""
@@ -272,7 +269,7 @@ def solve_point(row, settings, reals, counts, series, envelope, parametric, base
     p = np.empty(N_PARAMS)
     prepare(row, p, 0, 1)
     acc, buf = integrate(p, settings, settings[WANT_SETTLING] != 0.0, 0.0, 0.0,
-                         settings[TOL], series, parametric, base, eighth, steady)
+                         settings[TOL], series, parametric, base, eighth)
     state = classify(p, 0, 1, settings, acc, buf, reals, counts, parametric, base)
     if settings[SWEPT] != 0.0:
         state = swept_outputs(p, EXCITATION, 1, settings, acc, buf, state, reals, envelope)
@@ -320,7 +317,7 @@ def swept_outputs(p, o, s, settings, acc, buf, state, reals, envelope):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_block(params, settings, lo, hi, states, reals, counts, series, parametric, base,
-                eighth, steady, halt):
+                eighth, halt):
     """Solve rows lo..hi-1 of `params` (n, N_PARAMS), one trajectory after another.
 
     Outputs (preallocated, first axis n): states int8 (metrics flags), reals (n, N_REALS),
@@ -329,23 +326,22 @@ def solve_block(params, settings, lo, hi, states, reals, counts, series, paramet
     runs blocks on several threads (sweep.threads). Points left SECOND_PASS are finished by
     settle_second_pass. base: oscillator's base-excitation switch, None or True (True when
     settings[BASE] is 1: the sweep layer passes it, so that Numba compiles only one); eighth
-    likewise, True when settings[METHOD] is 1 (DOP853); steady, True when settings[STOP_STEADY]
-    is 1 (solver.stop_when_steady). halt: as kernels.lanes.solve_block's (an interrupt starts
-    no further row).
+    likewise, True when settings[METHOD] is 1 (DOP853). halt: as kernels.lanes.solve_block's (an
+    interrupt starts no further row).
     """
     none = np.empty(0)
     for i in range(lo, hi):
         if halt[0] != 0:
             return
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i], none,
-                                parametric, base, eighth, steady)
+                                parametric, base, eighth)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def solve_swept_block(params, settings, lo, hi, states, reals, counts, series, envelope,
-                      parametric, base, eighth, steady):
+                      parametric, base, eighth):
     """`solve_block` for a swept base frequency (settings[SWEPT] = 1), with the response
     envelope: envelope (n, n_bands) (m; n_bands may be 0, `swept_outputs`)."""
     for i in range(lo, hi):
         states[i] = solve_point(params[i], settings, reals[i], counts[i], series[i],
-                                envelope[i], parametric, base, eighth, steady)
+                                envelope[i], parametric, base, eighth)

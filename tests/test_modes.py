@@ -141,6 +141,13 @@ def test_reference_linear_part_participations_and_quadrature():
     for part, few, gl in zip(proj.parts(q, p), fewest.parts(q, p), gauss.parts(q, p)):
         np.testing.assert_allclose(part, gl, rtol=0, atol=1e-13 * np.abs(gl).max())
         np.testing.assert_allclose(few, gl, rtol=0, atol=1e-13 * np.abs(gl).max())
+    # force (the references' right-hand side) is the sum of the parts, one state or many
+    total = sum(gauss.parts(q, p))
+    np.testing.assert_allclose(proj.force(q, p), total, rtol=0, atol=1e-13 * np.abs(total).max())
+    states = np.stack((q, -0.5 * q, q[::-1]))
+    totals = sum(gauss.parts(states, p))
+    np.testing.assert_allclose(proj.force(states, p), totals, rtol=0,
+                               atol=1e-13 * np.abs(totals).max())
 
 
 # ------------------------------------------------- 2. modal amplitudes against the reference
