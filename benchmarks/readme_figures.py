@@ -21,7 +21,8 @@ from pathlib import Path
 from typing import Any, Callable
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))                    # the checkout's sweep/kernels
+if __name__ == "__main__":      # run as a script: the checkout's sweep/kernels (imported by the
+    sys.path.insert(0, str(ROOT))   # tests: theirs, the path left alone for what they spawn)
 
 import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402

@@ -190,3 +190,16 @@ def test_the_lanes_right_hand_side_is_inlined_by_llvm_from_one_call_site():
     attempt = next(node for node in tree.body
                    if isinstance(node, ast.FunctionDef) and node.name == "_attempt")
     assert _calls_of(attempt, "lanes_derivative") == 1
+
+
+def test_the_tests_leave_the_sweep_under_test_first_on_the_path():
+    """What this process spawns imports the sweep it imported: a dask worker starts with this
+    process's sys.path, and a checkout put before an installed sweep there (a test module
+    inserting the repository's root at import) made CI's dask workers compile every kernel
+    again into the checkout's own Numba cache (95 cache indexes, minutes of CI). Every test
+    module is imported before any test runs, so this sees what they all left."""
+    import sweep
+    imported = Path(sweep.__file__).resolve().parents[1]
+    first = next((Path(entry or ".").resolve() for entry in sys.path
+                  if (Path(entry or ".") / "sweep" / "__init__.py").is_file()), imported)
+    assert first == imported, (first, imported)
