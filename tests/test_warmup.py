@@ -19,7 +19,7 @@ import sweep
 from conftest import COMPILE_LINES
 from sweep.warmup import POINTS_PER_AXIS, reduced
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(sweep.__file__).resolve().parents[1]    # the sweep imported here (its Numba cache)
 
 
 def sweep_cli(argv: list[str], cwd: Path, cache: Path | None = None
