@@ -96,36 +96,32 @@ class Projection:
         self._m = m
         self._derivatives = np.concatenate((self.d1, self.d2, self.d3, self.d4), axis=1)
 
-    def parts(self, q: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(linear, cubic, quintic) parts of F (m s-2) at modal coordinates q (m) and end load
-        p (N, compression > 0); q may be (N,) or (..., N)."""
+    def _at_nodes(self, q: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(linear, cubic, quintic) parts of R (N m-1) at the nodes, for modal coordinates q
+        (m; (N,) or (..., N)) and end load p (N): the four derivatives w_x .. w_xxxx from one
+        product with the stacked matrices."""
         c = self.cable
         ei = c.youngs_modulus * c.inertia
         ea = c.youngs_modulus * c.area
-        q = np.asarray(q, dtype=float)
-        w1, w2, w3, w4 = q @ self.d1, q @ self.d2, q @ self.d3, q @ self.d4
+        m = self._m
+        w = np.asarray(q, dtype=float) @ self._derivatives
+        w1, w2, w3, w4 = w[..., :m], w[..., m:2 * m], w[..., 2 * m:3 * m], w[..., 3 * m:]
         linear = p * w2 + ei * w4
         cubic = (-3.0 * ei * w2 ** 3 - 11.0 * ei * w2 * w3 * w1
                  - (2.0 * p + 4.0 * c.membrane * ea) * w2 * w1 ** 2 - 3.0 * ei * w4 * w1 ** 2)
         quintic = 10.5 * ei * w2 ** 3 * w1 ** 2
-        return linear @ self.project, cubic @ self.project, quintic @ self.project
+        return linear, cubic, quintic
+
+    def parts(self, q: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(linear, cubic, quintic) parts of F (m s-2) at modal coordinates q (m) and end load
+        p (N, compression > 0); q may be (N,) or (..., N)."""
+        return tuple(part @ self.project for part in self._at_nodes(q, p))
 
     def force(self, q: np.ndarray, p: float) -> np.ndarray:
         """F(q, P) (m s-2) at modal coordinates q (m; (N,) or (..., N)): the sum of `parts`,
-        with R summed at the nodes before the one projection (a reference's right-hand side:
-        a third of the array operations of `parts`, 10 % off a 2-mode reference's time;
-        equal to round-off, tests/test_modes.py)."""
-        c = self.cable
-        ei = c.youngs_modulus * c.inertia
-        m = self._m
-        w = np.asarray(q, dtype=float) @ self._derivatives
-        w1, w2, w3, w4 = w[..., :m], w[..., m:2 * m], w[..., 2 * m:3 * m], w[..., 3 * m:]
-        slope2 = w1 * w1
-        bend2 = w2 * w2
-        r = (p * w2 + ei * w4 - 3.0 * ei * w4 * slope2
-             + w2 * (ei * bend2 * (10.5 * slope2 - 3.0) - 11.0 * ei * w3 * w1
-                     - (2.0 * p + 4.0 * c.membrane * c.youngs_modulus * c.area) * slope2))
-        return r @ self.project
+        summed at the nodes before one projection (a reference's right-hand side)."""
+        linear, cubic, quintic = self._at_nodes(q, p)
+        return (linear + cubic + quintic) @ self.project
 
 
 def load_function(amplitude: float, omega: float, kind: str = "harmonic") -> Callable:
