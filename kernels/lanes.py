@@ -168,8 +168,8 @@ def _accel_read(W, j, t, q, v, parametric, base, stage):
 def _read_stages(W, n_run, eighth, swept, base):
     """Each lane's a_b (m/s^2) at its attempt's stage times t + C[s] h, s = 1 .. n - 1, and at
     t + h (rows W_AB_STAGES ..; `_accel_read`): a random record's reads (swept: unused, the
-    sine kinds' `_read_sweeps` takes it), before the attempt,
-    so that its chain's loop has none and vectorises. The reads stay a scalar loop, lane by
+    sine kinds' `_read_sweeps` takes it), before the attempt, so that its chain's loop has
+    none and vectorises. The reads stay a scalar loop, lane by
     lane (oscillator.record_stages reads a lane's columns once for its stages): LLVM will not
     vectorise a gather from the records beside a store into W, which it cannot prove apart."""
     L = LANES
@@ -326,8 +326,8 @@ _chain8 = _chains(dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "d
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
 def _attempt(W, rtol, n_run, parametric, base, record):
     """One Dormand-Prince attempt in every lane of W (record: `reads_switch`, True for the
-    chains that read each stage's a_b from W: a random record's, a sweep's): the stages (`_chain5`, from dopri5.A,
-    B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
+    chains that read each stage's a_b from W: a random record's, a sweep's): the stages
+    (`_chain5`, from dopri5.A, B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
     y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
     count runs across the lanes with straight-line arithmetic, so LLVM vectorises it rather
     than unrolling it. Each lane's absolute tolerances are its accumulator's

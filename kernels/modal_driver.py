@@ -1288,8 +1288,7 @@ def settle_second_pass(params, basis, settings, states, reals, counts, base, eig
                                 np.empty(0), modal, base, eighth, weights, basis)
         band = settings[TOL] * first[tj.TAIL_AMP]
         second, _, _ = integrate(params[i], n_modes, settings, track, first[tj.Q], band, 0.0,
-                                 np.empty(0), modal, base, eighth, weights,
-                                 basis)
+                                 np.empty(0), modal, base, eighth, weights, basis)
         states[i] = tj.settle(second, reals[i], counts[i])
         done += 1
     return done

@@ -76,7 +76,8 @@ def test_a_record_s_result_does_not_depend_on_what_was_compiled_before(tmp_path)
     import sys
     from pathlib import Path
 
-    root = str(Path(__file__).resolve().parents[1])
+    import sweep
+    root = str(Path(sweep.__file__).resolve().parents[1])     # the sweep under test
 
     def start(cache, *overrides):
         env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": root}
