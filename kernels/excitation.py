@@ -228,22 +228,28 @@ def anchored(anchor, tau, lam):
     return anchor[4] * (1.0 + gt * _expm1_over(gt)) * (sin0 * cd + cos0 * sd)
 
 
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def stage_signal(t, tau, anchor, p, o, s):
+    """A sine block's a_b (m/s^2) at the stage time t + tau (s) of a step from t whose
+    `sweep_anchor` is `anchor`: `anchored` where the anchor holds, else `acceleration` at
+    t + tau. The one rule of a stage's read, for the one-mode scalar step
+    (kernels.oscillator.stage_acceleration) and the lanes' (`sine_at_nodes`)."""
+    if anchor[0] != 0.0:
+        return anchored(anchor, tau, p[o + RATE * s])
+    return acceleration(t + tau, p, o, s)
+
+
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def sine_at_nodes(t, h, nodes, p, o, s, out, out_o, out_s):
     """A sine block's a_b (m/s^2) at a step's stage times t + nodes[i] h (s), i = 1 ..
     len(nodes) - 1, into out[out_o + (i - 1) * out_s], and at t + h into the slot after them:
-    from the step's `sweep_anchor` where it holds (`anchored`), else `acceleration` at each,
-    the values the one-mode scalar step reads (kernels.oscillator.stage_acceleration). The
-    lanes' stage reads of a sweep (kernels.lanes), as `record_at_nodes` is a record's."""
+    `stage_signal` from the step's `sweep_anchor`, the values the one-mode scalar step reads.
+    The lanes' stage reads of a sweep (kernels.lanes), as `record_at_nodes` is a record's."""
     anchor = sweep_anchor(t, h, p, o, s)
-    lam = p[o + RATE * s]
     m = len(nodes)
     for i in range(1, m + 1):
         tau = nodes[i] * h if i < m else h
-        if anchor[0] != 0.0:
-            out[out_o + (i - 1) * out_s] = anchored(anchor, tau, lam)
-        else:
-            out[out_o + (i - 1) * out_s] = acceleration(t + tau, p, o, s)
+        out[out_o + (i - 1) * out_s] = stage_signal(t, tau, anchor, p, o, s)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)

@@ -193,10 +193,10 @@ the row at p[o + column * s] reads its stages' a_b from (`stage_acceleration`): 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _sine_stage(t, tau, q, v, p, o, s, anchor, parametric, base):
     """`stage_acceleration` of a sine row (or one without base excitation)."""
-    if base is not None and anchor[0] != 0.0:
-        return shaken(acceleration(t + tau, q, v, p, o, s, None, parametric, None), p, o, s,
-                      ex.anchored(anchor, tau, p[o + (EXCITATION + ex.RATE) * s]))
-    return acceleration(t + tau, q, v, p, o, s, None, parametric, base)
+    a = acceleration(t + tau, q, v, p, o, s, None, parametric, None)
+    if base is None:
+        return a
+    return shaken(a, p, o, s, ex.stage_signal(t, tau, anchor, p, o + EXCITATION * s, s))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
