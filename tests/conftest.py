@@ -3,13 +3,27 @@
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import sweep
+
 from sweep.kernels import oscillator as osc
 from sweep.kernels import transverse as tk
 from sweep.threads import solve_transverse
+
+SWEEP_ROOT = Path(sweep.__file__).resolve().parents[1]
+"""The folder holding the sweep under test, installed or a checkout, as this process imported
+it: a subprocess must import the same copy, or it compiles into a Numba cache of its own."""
+
+
+def sweep_env(env: dict[str, str] | None = None) -> dict[str, str]:
+    """`env` (default: this process's environment) for a subprocess that imports the sweep
+    under test (SWEEP_ROOT first on its path)."""
+    return {**(os.environ if env is None else env), "PYTHONPATH": str(SWEEP_ROOT)}
 
 
 def param_row(m=1.0, c=0.0, k0=1.0, k1=0.0, g0=0.0, g1=0.0, h=0.0, omega=0.0,

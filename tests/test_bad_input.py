@@ -24,7 +24,8 @@ import pytest
 import sweep
 from sweep.cli import main
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]   # installed or checkout, as imported
+from conftest import sweep_env
+
 CORPUS = Path(__file__).resolve().parent / "data" / "bad"
 BAD_SCENES = sorted(CORPUS.glob("*.toml"))
 PREFIX = "sweep: error: "
@@ -127,7 +128,7 @@ def run_in_process(argv: list[str], fragments: list[str], work: Path, capsys) ->
 
 
 def run_process(argv: list[str], cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     return subprocess.run([sys.executable, "-m", "sweep.cli", *argv], capture_output=True,
                           text=True, cwd=cwd, env=env, timeout=300)
 
@@ -456,7 +457,7 @@ def test_fifo_scene_does_not_block_the_process(workdir):
 
 def run_process_bytes(argv: list[bytes], cwd: Path) -> subprocess.CompletedProcess:
     """run_process with raw bytes arguments (not valid UTF-8), output decoded leniently."""
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     r = subprocess.run([sys.executable.encode(), b"-m", b"sweep.cli", *argv],
                        capture_output=True, cwd=cwd, env=env, timeout=300)
     return subprocess.CompletedProcess(r.args, r.returncode, r.stdout.decode("utf-8", "replace"),

@@ -20,9 +20,8 @@ import sweep.execute as ex
 from sweep.cli import main as sweep_main
 from sweep.errors import UserError
 
-from conftest import stderr_lines
+from conftest import stderr_lines, sweep_env
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 TINY = """
 name = "dask-test"
@@ -36,7 +35,7 @@ length = [0.5, 0.6, 0.7, 0.8]
 
 
 def _env() -> dict:
-    return {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    return sweep_env()
 
 
 def _one_error_line(stderr: str) -> str:

@@ -18,10 +18,9 @@ import xarray as xr
 import sweep
 from sweep.cli import main as sweep_main
 
-from conftest import TABLE1_CABLE, fast_first, stderr_lines
+from conftest import TABLE1_CABLE, fast_first, stderr_lines, sweep_env
 from sweep.kernels.states import NOT_SOLVED
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 SCENE = """
 name = "execute-test"
@@ -91,7 +90,7 @@ def test_random_spectra_on_dask_equal_threads():
 
 
 def _cli(args, cwd, **kwargs):
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     return subprocess.Popen([sys.executable, "-m", "sweep.cli", *args], cwd=cwd, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
 
@@ -144,7 +143,7 @@ def _start_and_wait_for_a_chunk(tmp_path, args):
     (tmp_path / "s.toml").write_text(LONG_SCENE)
     store = tmp_path / "out.nc.chunks"
     # SIGINT as a terminal's Ctrl-C gives it (a test runner may have it ignored for children)
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     proc = subprocess.Popen([sys.executable, "-c", SHORT_BLOCKS, "run", "s.toml", "-o", "out.nc",
                              *args], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True,

@@ -16,9 +16,8 @@ from matplotlib.figure import Figure
 import sweep
 from sweep import plot as splot
 
-from conftest import fast_first
+from conftest import fast_first, sweep_env
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 LINE = """
@@ -96,7 +95,7 @@ def results(tmp_path_factory):
 
 
 def cli(*args, cwd=None, env=None):
-    env = {**(env if env is not None else os.environ), "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env(env)
     return subprocess.run([sys.executable, "-m", "sweep.cli", *args], capture_output=True,
                           text=True, cwd=cwd, env=env, timeout=600)
 
@@ -244,7 +243,7 @@ def test_importing_the_plot_module_picks_no_backend():
     code = ("import sys, sweep.plot; import matplotlib; "
             "print('matplotlib.pyplot' in sys.modules)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          env={**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}, timeout=300)
+                          env=sweep_env(), timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "False"
 
@@ -299,7 +298,7 @@ def test_cli_plot_bad_options_are_one_line(results, tmp_path, args, message):
 ])
 @pytest.mark.slow
 def test_examples_run_on_a_reduced_grid(tmp_path, script, stem, keys):
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     done = subprocess.run([sys.executable, str(EXAMPLES / script), "--small", "--out",
                            str(tmp_path)], capture_output=True, text=True, env=env, timeout=600)
     assert done.returncode == 0, done.stderr

@@ -19,7 +19,8 @@ import sweep.files
 from sweep import cli
 from sweep import plot as splot
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
+from conftest import sweep_env
+
 
 LINE = """
 name = "hostile-line"
@@ -65,7 +66,7 @@ def _refused(args, out_dir: Path, capsys, message: str) -> str:
 
 
 def _subprocess(*args, timeout=120):
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     return subprocess.run([sys.executable, "-m", "sweep.cli", "plot", *map(str, args)],
                           capture_output=True, text=True, env=env, timeout=timeout)
 

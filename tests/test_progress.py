@@ -10,7 +10,6 @@ import struct
 import subprocess
 import sys
 import termios
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,9 +17,8 @@ import pytest
 import sweep
 from sweep.execute import Progress, announce_compilation, execute
 
-from conftest import stderr_lines
+from conftest import stderr_lines, sweep_env
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 SMALL = """
 name = "progress-test"
@@ -100,7 +98,7 @@ def test_a_terminal_gets_one_line_that_fits_a_narrow_window(tmp_path):
     (tmp_path / "s.toml").write_text(SMALL)
     master, slave = os.openpty()
     fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 40, 0, 0))
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     env.pop("COLUMNS", None)
     proc = subprocess.Popen([sys.executable, "-m", "sweep.cli", "run", "s.toml", "-o", "o.nc"],
                             cwd=tmp_path, env=env, stdin=subprocess.DEVNULL,

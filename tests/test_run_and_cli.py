@@ -6,7 +6,6 @@ import os
 import signal
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +14,8 @@ import xarray as xr
 import sweep
 from sweep.kernels import metrics as km
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]   # installed or checkout, as imported
+from conftest import sweep_env
+
 
 SMALL = """
 name = "small"
@@ -36,7 +36,7 @@ t_end = 2.0
 
 
 def cli(*args, cwd=None):
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     return subprocess.run([sys.executable, "-m", "sweep.cli", *args], capture_output=True,
                           text=True, cwd=cwd, env=env, timeout=600)
 
@@ -44,7 +44,7 @@ def cli(*args, cwd=None):
 def test_python_dash_m_sweep_is_the_console_script(tmp_path):
     """`python -m sweep` for an environment whose scripts are not on PATH: the same commands
     and exit codes as `sweep` (a bad scene key: one line, exit 2)."""
-    env = {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    env = sweep_env()
     ok = subprocess.run([sys.executable, "-m", "sweep", "--version"], capture_output=True,
                         text=True, env=env, timeout=600)
     assert ok.returncode == 0 and ok.stdout.startswith("sweep (cable-sweep) ")

@@ -18,9 +18,8 @@ import xarray as xr
 import sweep
 from sweep.store import ChunkStore
 
-from conftest import stderr_lines
+from conftest import stderr_lines, sweep_env
 
-PACKAGE_ROOT = Path(sweep.__file__).resolve().parents[1]
 
 # 63 points, 8 chunks of up to 8: a fraction of a second once the kernels are cached.
 SCENE = """
@@ -45,7 +44,7 @@ VOLATILE = {"history", "run_seconds"}
 
 
 def _env() -> dict:
-    return {**os.environ, "PYTHONPATH": str(PACKAGE_ROOT)}
+    return sweep_env()
 
 
 def _sweep(cwd: Path, *args: str, code: str | None = None,

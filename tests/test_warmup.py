@@ -7,7 +7,6 @@ cold start's lines, which sweep.execute prints whenever Numba compiles.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -16,15 +15,14 @@ import numpy as np
 import pytest
 
 import sweep
-from conftest import COMPILE_LINES
+from conftest import COMPILE_LINES, sweep_env
 from sweep.warmup import POINTS_PER_AXIS, reduced
 
-ROOT = Path(sweep.__file__).resolve().parents[1]    # the sweep imported here (its Numba cache)
 
 
 def sweep_cli(argv: list[str], cwd: Path, cache: Path | None = None
               ) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = sweep_env()
     if cache is not None:
         env["NUMBA_CACHE_DIR"] = str(cache)
     return subprocess.run([sys.executable, "-m", "sweep.cli", *argv], capture_output=True,
