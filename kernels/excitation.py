@@ -85,7 +85,14 @@ def phase(t, p, o, s):
     lam = p[o + RATE * s]
     if lam == 0.0:
         return p[o + OMEGA * s] * t + p[o + PHASE * s]
-    return p[o + OMEGA * s] * (math.expm1(lam * t) / lam) + p[o + PHASE * s]
+    return _swept_phase(math.expm1(lam * t), lam, p, o, s)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _swept_phase(grown, lam, p, o, s):
+    """phi (rad) of a sweep at rate lam != 0 (1/s) at the time t whose expm1(lam t) is
+    `grown`: w_b expm1(lam t) / lam + phi_b."""
+    return p[o + OMEGA * s] * (grown / lam) + p[o + PHASE * s]
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -174,7 +181,7 @@ def _expm1_over(x):
 def sweep_state(t, h, p, o, s):
     """`sweep_anchor` before its sine and cosine: (1, phi(t) (rad), w(t) (rad/s), A(t)
     (m/s^2), g (1/s)) at the start t (s) of a step of h (s), or all zeros where the anchor does
-    not hold. One expm1 gives the phase (as `phase`) and w(t) = w_b (1 + expm1(lam t))."""
+    not hold. One expm1 gives the phase and w(t) = w_b (1 + expm1(lam t))."""
     none = (0.0, 0.0, 0.0, 0.0, 0.0)
     lam = p[o + RATE * s]
     if lam == 0.0 or not abs(lam * h) <= STAGE_SERIES_BELOW:
@@ -195,8 +202,7 @@ def sweep_state(t, h, p, o, s):
         a = math.exp(p[o + (LOG_LEVEL + k) * s]
                      + p[o + (SLOPE + k) * s] * (u - p[o + (EDGE + k) * s]))
     grown = math.expm1(lam * t)
-    return (1.0, p[o + OMEGA * s] * (grown / lam) + p[o + PHASE * s],
-            p[o + OMEGA * s] * (1.0 + grown), a, g)
+    return (1.0, _swept_phase(grown, lam, p, o, s), p[o + OMEGA * s] * (1.0 + grown), a, g)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
