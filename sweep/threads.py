@@ -352,9 +352,9 @@ def _run_blocks(solve_block: Callable[[int, int], None], n: int, threads: int,
             solve_block(lo, hi)
             cap = timed_cap(hi - lo, time.perf_counter() - began, most, least_timed)
 
-    if n_threads == 1:
-        work()
-        return
+    # Even one thread works off the calling thread: a signal's Python handler (an interrupt
+    # setting `stop`) runs only once the main thread is back in Python, never inside a kernel
+    # call, which may last a whole block (a one-thread sine sweep ignored Ctrl-C for 24 s).
     with ThreadPoolExecutor(n_threads, thread_name_prefix="cable-sweep") as pool:
         try:
             for future in [pool.submit(work) for _ in range(n_threads)]:

@@ -204,6 +204,47 @@ def test_ctrl_c_keeps_finished_blocks_says_how_to_resume_and_exits_130(tmp_path,
         assert_same_result(a, b)
 
 
+ONE_BLOCK_SCENE = """
+name = "one-long-block"
+[cable]
+damping_ratio = 0.02
+[load]
+amplitude = 4.0
+[initial]
+displacement = 1e-3
+[axes]
+length = {start = 0.2, stop = 1.0, num = 8}
+frequency_ratio = {start = 0.5, stop = 3.0, num = 8}
+[solver]
+t_end = 800.0
+rtol = 1e-10
+"""
+
+
+def test_ctrl_c_on_one_thread_stops_the_kernel_inside_its_block(tmp_path):
+    """A tester: on one thread Ctrl-C waited for the whole block (a one-mode sine sweep, 24 s),
+    as the thread that solved was the main one, where Python runs a signal's handler only
+    between kernel calls. One 64-point block of the lanes (about 3 s here), its finished rows
+    saved every 0.2 s: SIGINT once the first are saved stops the kernel inside the block, so
+    some of its rows are left to --resume."""
+    (tmp_path / "s.toml").write_text(ONE_BLOCK_SCENE)
+    store = tmp_path / "out.nc.chunks"
+    script = ("import sys, sweep.execute as e; e.FLUSH_SECONDS = 0.2; "
+              "from sweep.cli import main; sys.exit(main(sys.argv[1:]))")
+    proc = subprocess.Popen([sys.executable, "-c", script, "run", "s.toml", "-o", "out.nc",
+                             "--threads", "1"], cwd=tmp_path, env=sweep_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 300
+    while not list(store.glob("chunk-*.npz")):
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert 0 < _stored_points(store) < 64, err          # before: the whole block, 64
+
+
 def test_ctrl_c_without_an_output_file_says_nothing_was_kept(capsys):
     """Without -o nothing is kept: the line says so, and how to make a run resumable."""
     from sweep.cli import _interrupted, _parser

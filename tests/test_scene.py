@@ -272,6 +272,19 @@ def test_a_fixed_frequency_on_a_stepped_scene_drops_the_continuation_it_orphans(
     assert scene.get("continuation.axis") == "base_frequency_ratio"
 
 
+@pytest.mark.parametrize("override", [
+    {"continuation.axis": "base_frequncy_ratio"}, {"continuation.axis": "frequency_ratio"},
+    {"continuation.axis": ""}, {"continuation": {"axis": "damping_ratio"}},
+    {"continuation.axis": "base_frequency", "base.frequency": 30.0}])
+def test_a_continuation_override_naming_no_axis_is_refused(override):
+    """A tester: --set continuation.axis with a typo ran 26 independent dwells from rest with
+    status 0, the stepped sweep dropped without a word (the orphaned continuation's removal
+    took the override for a lost axis); the scene file's own refusal applies."""
+    with pytest.raises(SceneError) as info:
+        load_scene("harness-stepped-sine", overrides=override)
+    assert "scene key 'continuation.axis'" in str(info.value), str(info.value)
+
+
 @pytest.mark.parametrize("overrides, words", [
     ({"base.frequency": 20.0, "base.sweep.rate": 3.0},
      "overrides 'base.frequency' and 'base.sweep': give one, not both"),

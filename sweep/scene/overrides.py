@@ -17,7 +17,8 @@ ended with its sweep (no solver.t_end) then needs a solver.t_end override, refus
 without one. A sweep's start, stop or rate (key or axis) replaces the scene's base.frequency
 or frequency_ratio (key or axis), that dwell's solver.t_end (unless an override gives one)
 and a stepped sweep's [continuation], and keeps the sweep's other keys. A [continuation] whose
-axis an override removes goes with it.
+axis an override removes goes with it, unless an override gives the continuation (then the
+rules judge its axis, as a scene file's).
 Overrides of two ways to give one quantity are refused.
 """
 
@@ -199,7 +200,8 @@ def _apply_overrides(doc: dict[str, Any], overrides: Mapping[str, Any]) -> None:
             _override_axis(doc, name, value, section)
         else:
             _override_scalar(doc, section, name, value)
-    if stepped and not _continuation_axis_present(doc):
+    stepping = any(d == "continuation" or d.startswith("continuation.") for d in overrides)
+    if stepped and not stepping and not _continuation_axis_present(doc):
         del doc["continuation"]     # an override removed the stepped axis: nothing to step along
 
 
