@@ -276,6 +276,7 @@ def test_the_dataset_has_a_realisation_dimension_and_means():
     ({"base.sample_rate": 900.0}, "cannot carry the spectrum"),
     ({"base.sample_rate": 1200.0}, "give at least 1250 Hz"),
     ({"outputs.clearance": [1e-3] * 5}, "1 to 4 levels"),
+    ({"outputs.clearance": [1e-3, 2e-3, 1e-3]}, "a level is given twice"),
     ({"base.asd": [[10.0, 1.0], [500.0, 1.0]], "base.asd_g2": [[10.0, 0.1], [500.0, 0.1]]},
      "give one, not both"),
     ({"solver.stop_when_steady": True}, "never steady"),

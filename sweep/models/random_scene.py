@@ -124,6 +124,10 @@ def check(given: dict[str, Any], axes: Mapping[str, Any]) -> None:
             _fail("scene key 'outputs.clearance'", f"{_show(list(levels))}: give 1 to "
                   f"{MAX_LEVELS} levels of |deflection|, each > 0 (m)",
                   "e.g. clearance = [0.001, 0.002]")
+        if len(set(levels)) < len(levels):
+            _fail("scene key 'outputs.clearance'", f"{_show(list(levels))}: a level is given "
+                  "twice (the clearance coordinate's values must differ, for .sel)",
+                  "remove the repeated level")
     _check_sampling(given, key)
     _check_spectra(given)
 

@@ -635,8 +635,9 @@ def _check_modes(given: dict[str, Any], axes: dict[str, np.ndarray]) -> None:
         if values is None:
             continue
         if len(values) != n_modes:
+            each = "q_1" if n_modes == 1 else f"q_1 .. q_{n_modes}"
             _fail(f"scene key '{listed}'", f"has {len(values)} entries for model.modes = "
-                  f"{n_modes}", f"give one value per mode, q_1 .. q_{n_modes} "
+                  f"{n_modes}", f"give one value per mode, {each} "
                   f"({schema.BY_DOTTED[listed].units})")
         if single in given or schema.BY_DOTTED[single].axis in axes:
             _fail(f"scene keys '{single}' and '{listed}'", "give one, not both",
