@@ -555,6 +555,33 @@ def test_an_axis_over_decades_is_drawn_log(values, log):
     assert _is_log_spaced(np.array(values)) is log
 
 
+def test_an_axis_from_zero_over_decades_is_drawn_symlog_with_cells_around_each_value():
+    """A tester: clamp_axial_stiffness = [0, 1e4, 1e6] N/m (0: the cable slides) was drawn on
+    a linear axis, two of its three cells slivers. With one 0 and positive values drawn log,
+    the axis is symlog, linear up to the smallest positive value; each cell holds its value,
+    the cells meet, and matplotlib's symlog transform spaces 0, 1e4 and 1e6 as the edges
+    assume (0 -> 1e4 as long as one decade)."""
+    from matplotlib.figure import Figure as Fig
+
+    from sweep.plot.style import symlog_threshold
+    values = np.array([0.0, 1e4, 1e6])
+    assert symlog_threshold(values) == 1e4
+    assert symlog_threshold(np.array([1e6, 1e4, 0.0])) == 1e4
+    for linear in ([0.0, 1.0, 2.0], [0.0, 5.0, 9.0], [1.0, 1e2, 1e4], [0.0, 1e4]):
+        assert symlog_threshold(np.array(linear)) is None, linear
+    edges = splot._edges(values)
+    assert np.all(edges[:-1] < values) and np.all(values < edges[1:])
+    np.testing.assert_allclose(edges, [-5e3, 5e3, 1e5, 1e7], rtol=1e-12)
+    ds = xr.Dataset({"amplitude": (("clamp_axial_stiffness", "length"), np.ones((3, 2)))},
+                    coords={"clamp_axial_stiffness": values, "length": [0.2, 0.3]})
+    ax = Fig().add_subplot()
+    splot.maps._mesh(ax, ds, "length", "clamp_axial_stiffness", ds.amplitude.values)
+    assert ax.get_yscale() == "symlog"
+    shown = ax.transData.transform(np.column_stack([[0.25] * 3, values]))[:, 1]
+    assert 2.0 * (shown[1] - shown[0]) == pytest.approx(shown[2] - shown[1], rel=1e-9)
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["0", "10000", "1e+06"]
+
+
 def test_the_span_loads_get_a_strain_figure_and_two_stiffnesses_decades_apart_a_log_axis():
     """A span that reports its loads gets 'max_strain' (the quantity `sweep design
     --max-strain` limits; harness-clamps had no strain figure), and an axis of two clamp

@@ -19,7 +19,8 @@ from .labels import POINT_DIM, _title, label, point_ticks
 from .overlays import overlays_for
 from .result import DIRECTION_DIM, select_points, swept_axes
 from .style import (_coord, _edges, _is_displacement, _is_log_spaced, _legend, _new_axes,
-                    _padded_range, _plain_ticks, _unit, _wide_range, state_styles)
+                    _padded_range, _plain_ticks, _unit, _wide_range, state_styles,
+                    symlog_scale, symlog_threshold)
 
 _NAN_COLOUR = "0.82"
 _DECADES = 6          # a log colour scale spans at most this many decades below the maximum
@@ -82,6 +83,10 @@ def _scale(ax: Axes, which: str, values: np.ndarray, scale: str | None) -> None:
     """The x or y scale: `scale` when given ("linear", "log"), else log for a log-spaced
     coordinate. A log scale needs positive values (UserError otherwise)."""
     if scale is None:
+        threshold = symlog_threshold(values)
+        if threshold is not None:
+            symlog_scale(ax, which, values, threshold)
+            return
         scale = "log" if _is_log_spaced(values) else "linear"
     if scale not in ("linear", "log"):
         raise UserError(f"{which}scale '{scale}': use 'linear' or 'log'")

@@ -190,11 +190,40 @@ def _is_log_spaced(values: np.ndarray) -> bool:
     return bool(np.allclose(r, r[0], rtol=1e-6))
 
 
+def symlog_threshold(values: np.ndarray) -> float | None:
+    """The smallest positive value of a coordinate that is one 0 and positive values drawn on
+    a log axis (`_is_log_spaced`: clamp_axial_stiffness = 0 (sliding), 1e4, 1e6 N/m, whose two
+    first cells were slivers on a linear axis), else None. Such an axis is drawn symlog, linear
+    below that value (`symlog_scale`)."""
+    v = np.sort(np.asarray(values, dtype=float))
+    if v.size < 3 or v[0] != 0.0 or not _is_log_spaced(v[1:]):
+        return None
+    return float(v[1])
+
+
+SYMLOG_LINSCALE = 0.9
+"""matplotlib's symlog `linscale` (base 10) that makes its linear part x / linthresh, so the
+linear stretch 0..linthresh is as long as one decade above it, as `_edges` assumes."""
+
+
+def symlog_scale(ax: Axes, which: str, values: np.ndarray, threshold: float) -> None:
+    """Draw axis `which` ("x", "y") symlog, linear below `threshold`, ticked at the values."""
+    (ax.set_xscale if which == "x" else ax.set_yscale)(
+        "symlog", linthresh=threshold, linscale=SYMLOG_LINSCALE)
+    (ax.set_xticks if which == "x" else ax.set_yticks)(
+        values, [f"{v:g}" for v in np.asarray(values, float)])
+
+
 def _edges(values: np.ndarray) -> np.ndarray:
-    """Cell edges around sorted centres (geometric for a log-spaced axis)."""
+    """Cell edges around sorted centres (geometric for a log-spaced axis; for a symlog one,
+    `symlog_threshold`, midway in x / t below the threshold t and 1 + log10(x / t) above)."""
     v = np.asarray(values, dtype=float)
     if v.size == 1:
         return v[0] + (np.array([-0.05, 0.05]) * abs(v[0]) if v[0] else np.array([-0.5, 0.5]))
+    t = symlog_threshold(v)
+    if t is not None:
+        e = _edges(np.where(v <= t, v / t, 1.0 + np.log10(np.maximum(v, t) / t)))
+        return np.where(e <= 1.0, e * t, t * 10.0 ** (e - 1.0))
     log = _is_log_spaced(v)
     w = np.log(v) if log else v
     mid = 0.5 * (w[1:] + w[:-1])
