@@ -112,6 +112,7 @@ def test_the_linear_clamped_span_is_the_textbook_response(modes, ratio):
         assert float(ds["modal_amplitude"].sel(mode=1).squeeze()) == pytest.approx(mode1, rel=1e-4)
         np.testing.assert_allclose(ds["modal_frequency"].values.ravel(),
                                    omega_n / (2 * math.pi), rtol=1e-9)
+        assert _one(ds, "linear_amplitude") == pytest.approx(midspan, rel=1e-9)   # N modes
     else:
         assert _one(ds, "linear_amplitude") == pytest.approx(mode1, rel=1e-9)
 
@@ -227,6 +228,7 @@ def test_the_linear_elastic_span_is_the_closed_form_response(modes, ratio):
     omega = ratio * omega_n[0]
     q = gamma * 1e-5 * 9.80665 / (omega_n ** 2 - omega ** 2 + 2j * ZETA * omega_n * omega)
     assert _one(ds, "amplitude") == pytest.approx(abs(np.sum(q * mid)), rel=1e-4)
+    assert _one(ds, "linear_amplitude") == pytest.approx(abs(np.sum(q * mid)), rel=1e-9)
     # the loads of the steady complex shape W(s) = sum q_n phi_n(s) (derivatives in s): the
     # curvatures |W''| / l^2, the reaction EI |W'''(0)| / l^3 (N W' is of order q^3: nil) and
     # the tension's peak k_s (int |W'|^2 + |int W'^2|) / (4 l) over a cycle, k_s = EA / l

@@ -31,6 +31,7 @@ from sweep.kernels import states as km
 from ..dataset import derived
 from ..schema import G2_UNITS, G_UNITS, STANDARD_GRAVITY
 from . import random_scene
+from .linear import linear_modes
 from .random_scene import REALISATION_DIM
 
 CLEARANCE_DIM = "clearance"
@@ -197,55 +198,15 @@ def mean_and_interval(values: xr.DataArray) -> tuple[xr.DataArray, xr.DataArray]
     return mean, (factor * spread / np.sqrt(n.where(n > 0))).where(n >= 2)
 
 
-def _linear_modes(coeffs: dict[str, Any], params: dict[str, Any], basis: Any, n_modes: int,
-                  coords: dict[str, xr.DataArray]
-                  ) -> tuple[xr.DataArray, np.ndarray, np.ndarray, np.ndarray, xr.DataArray]:
-    """The span made linear, mode by mode, on the axes it depends on: (a template on those
-    axes, omega (rad/s), 2 zeta omega (1/s) and weights (midspan value times participation),
-    each (..., mode), and the base level factor on the template's axes). Mode n at f1 times
-    its basis frequency ratio with damping ratio zeta; elastic ends swept over the grid: each
-    point's own basis."""
-    from .basis import BasisFamily, end_stiffness
-    mode = "mode_"                        # the modes' axis of the sums (dropped by them)
-    if n_modes == 1:
-        ratio = xr.DataArray(np.ones(1), dims=mode)
-        weight = xr.DataArray(np.ones(1), dims=mode)
-        gamma = derived(coeffs["participation"], coords)
-    elif isinstance(basis, BasisFamily):  # elastic ends varying: each point's own basis
-        stiffness = derived(end_stiffness("elastic", params["clamp_rotational_stiffness"],
-                                          params["length"],
-                                          params["youngs_modulus"] * params["inertia"]), coords)
-        at = basis.index(np.asarray(stiffness.values, float))
-        ratios = np.array([b.frequency_ratio / b.frequency_ratio[0] for b in basis.bases])
-        weights = np.array([b.midspan * b.participation_ratio for b in basis.bases])
-        ratio = xr.DataArray(ratios[at], dims=stiffness.dims + (mode,))
-        weight = xr.DataArray(weights[at], dims=stiffness.dims + (mode,))
-        gamma = derived(4.0 / np.pi, coords)
-    else:
-        ratio = xr.DataArray(basis.frequency_ratio / basis.frequency_ratio[0], dims=mode)
-        weight = xr.DataArray(basis.midspan * basis.participation_ratio, dims=mode)
-        gamma = derived(4.0 / np.pi, coords)
-    f1 = derived(coeffs["natural_frequency"], coords)
-    zeta = derived(params["damping_ratio"], coords)
-    level = derived(coeffs["base_accel"], coords)
-    f1, zeta, gamma, level, ratio, weight = xr.broadcast(f1, zeta, gamma, level, ratio, weight)
-    order = [d for d in f1.dims if d != mode] + [mode]
-    omega = 2.0 * np.pi * (f1 * ratio).transpose(*order).values
-    template = f1.isel({mode: 0}, drop=True).transpose(*order[:-1])
-    level = level.isel({mode: 0}, drop=True).transpose(*order[:-1])
-    return (template, omega, 2.0 * zeta.transpose(*order).values * omega,
-            (gamma * weight).transpose(*order).values, level)
-
-
 def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, Any],
                basis: Any, n_modes: int, coords: dict[str, xr.DataArray]) -> xr.DataArray:
     """The exact RMS midspan deflection (m) of the same span made linear (no stretching, no
     end load) under the same spectrum at each level: the root of the integral of
     |H(f)|^2 W(f) over the spectrum, H the midspan's receptance summed over the modes
-    (`_linear_modes`; sweep/models/random.py `linear_mean_square`); on the axes it depends on."""
+    (`sweep.models.linear.linear_modes`; sweep/models/random.py `linear_mean_square`); on the axes it depends on."""
     from .random import linear_mean_square
     f, w = random.spectrum
-    template, omega, damping, weights, level = _linear_modes(coeffs, params, basis, n_modes,
+    template, omega, damping, weights, level = linear_modes(coeffs, params, basis, n_modes,
                                                              coords)
     ms = linear_mean_square(f, w, omega, damping, weights)
     out = template.copy(data=np.sqrt(ms) * level.values)
@@ -262,10 +223,10 @@ def linear_spectra(random: RandomInputs, coeffs: dict[str, Any], params: dict[st
     """The exact spectral densities of the same span made linear, at `frequency` (Hz): the
     midspan deflection's |G|^2 W (m^2/Hz) and the absolute acceleration's |1 - w^2 G|^2 W
     (g^2/Hz), G(f) = -sum_n weights_n / (omega_n^2 - w^2 + i 2 zeta_n omega_n w) the
-    midspan's receptance (`_linear_modes`), W the spectrum at the point's level."""
+    midspan's receptance (`sweep.models.linear.linear_modes`), W the spectrum at the point's level."""
     from .random import asd_at
     f, w = random.spectrum
-    template, omega, damping, weights, level = _linear_modes(coeffs, params, basis, n_modes,
+    template, omega, damping, weights, level = linear_modes(coeffs, params, basis, n_modes,
                                                              coords)
     nu = np.asarray(frequency.values, float)
     w_nu = 2.0 * np.pi * nu

@@ -26,7 +26,7 @@ from ..dataset import (TIME_DIM, Provenance, counter, derived, elapsed_time, fla
 from ..runner import RunOptions, check_memory, placer, point_order, solve_chunked
 from ..scene import Scene
 from ..schema import BY_AXIS, G2_UNITS, G_UNITS, STANDARD_GRAVITY
-from . import excitation, loads, modal, random_outputs, response_asd
+from . import excitation, linear, loads, modal, random_outputs, response_asd
 from .basis import Basis, BasisFamily, end_stiffness, span_basis
 from .random_outputs import RandomInputs
 from .continuation import DIRECTION_DIM
@@ -89,10 +89,7 @@ _BASE_DERIVED = {
     **{axis: (BY_AXIS[axis].units, BY_AXIS[axis].long_name)
        for axis in ("base_acceleration", "base_acceleration_g", "base_frequency",
                     "base_frequency_ratio")},
-    "linear_amplitude": ("m", "steady midspan amplitude of the linearised span's first mode "
-                              "(no load, K3 = K5 = 0), Gamma A / sqrt((w1^2 - w^2)^2 + (2 zeta "
-                              "w1 w)^2), Gamma the mode's participation times its midspan value "
-                              "(4/pi for pinned ends); NaN: unbounded (undamped at resonance)"),
+    "linear_amplitude": ("m", linear.LINEAR_AMPLITUDE_LONG_NAME.format(modes="its first mode")),
     "resonance_amplification": ("1", "linear resonance amplification Q = 1/(2 zeta): peak "
                                      "amplitude over the quasi-static Gamma A / w1^2; NaN: "
                                      "undamped"),
@@ -921,6 +918,9 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                                       attrs={"units": "1",
                                              "long_name": long_name.format(method=short)})
     data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
+    if "linear_amplitude" in data and inputs.n_modes > 1:      # the first mode's: over N
+        data["linear_amplitude"] = linear.linear_amplitude(coeffs, inputs.params, inputs.basis,
+                                                           inputs.n_modes, coords)
     if result.modal is not None:
         modes = modal_outputs(result.modal, dims, shape, coeffs, coords, inputs.basis,
                               inputs.params)
