@@ -203,7 +203,8 @@ def linear_rms(random: RandomInputs, coeffs: dict[str, Any], params: dict[str, A
     """The exact RMS midspan deflection (m) of the same span made linear (no stretching, no
     end load) under the same spectrum at each level: the root of the integral of
     |H(f)|^2 W(f) over the spectrum, H the midspan's receptance summed over the modes
-    (`sweep.models.linear.linear_modes`; sweep/models/random.py `linear_mean_square`); on the axes it depends on."""
+    (`sweep.models.linear.linear_modes`; sweep/models/random.py `linear_mean_square`); on the
+    axes it depends on."""
     from .random import linear_mean_square
     f, w = random.spectrum
     template, omega, damping, weights, level = linear_modes(coeffs, params, basis, n_modes,
@@ -223,7 +224,8 @@ def linear_spectra(random: RandomInputs, coeffs: dict[str, Any], params: dict[st
     """The exact spectral densities of the same span made linear, at `frequency` (Hz): the
     midspan deflection's |G|^2 W (m^2/Hz) and the absolute acceleration's |1 - w^2 G|^2 W
     (g^2/Hz), G(f) = -sum_n weights_n / (omega_n^2 - w^2 + i 2 zeta_n omega_n w) the
-    midspan's receptance (`sweep.models.linear.linear_modes`), W the spectrum at the point's level."""
+    midspan's receptance (`sweep.models.linear.linear_modes`), W the spectrum at the point's
+    level."""
     from .random import asd_at
     f, w = random.spectrum
     template, omega, damping, weights, level = linear_modes(coeffs, params, basis, n_modes,
