@@ -138,13 +138,14 @@ def _stored_points(store: Path) -> int:
     return sum(hi - lo for lo, hi in ranges)
 
 
-def _start_and_wait_for_a_chunk(tmp_path, args):
-    """Start `sweep run` on the long scene; return it once the store holds a finished chunk."""
-    (tmp_path / "s.toml").write_text(LONG_SCENE)
+def _start_and_wait_for_a_chunk(tmp_path, args, scene=LONG_SCENE, script=SHORT_BLOCKS):
+    """Start `sweep run` on `scene` (the long one) in a process that runs `script`; return it
+    once the store holds a finished chunk."""
+    (tmp_path / "s.toml").write_text(scene)
     store = tmp_path / "out.nc.chunks"
     # SIGINT as a terminal's Ctrl-C gives it (a test runner may have it ignored for children)
     env = sweep_env()
-    proc = subprocess.Popen([sys.executable, "-c", SHORT_BLOCKS, "run", "s.toml", "-o", "out.nc",
+    proc = subprocess.Popen([sys.executable, "-c", script, "run", "s.toml", "-o", "out.nc",
                              *args], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
@@ -204,21 +205,11 @@ def test_ctrl_c_keeps_finished_blocks_says_how_to_resume_and_exits_130(tmp_path,
         assert_same_result(a, b)
 
 
-ONE_BLOCK_SCENE = """
-name = "one-long-block"
-[cable]
-damping_ratio = 0.02
-[load]
-amplitude = 4.0
-[initial]
-displacement = 1e-3
-[axes]
-length = {start = 0.2, stop = 1.0, num = 8}
-frequency_ratio = {start = 0.5, stop = 3.0, num = 8}
-[solver]
-t_end = 800.0
-rtol = 1e-10
-"""
+# Its points 8 x 8, ten times as long: one block of the lanes on one thread (about 3 s here).
+ONE_BLOCK_SCENE = LONG_SCENE.replace("num = 20", "num = 8").replace("t_end = 80.0",
+                                                                    "t_end = 800.0")
+FLUSH_OFTEN = ("import sys, sweep.execute as e; e.FLUSH_SECONDS = 0.2; "
+               "from sweep.cli import main; sys.exit(main(sys.argv[1:]))")
 
 
 def test_ctrl_c_on_one_thread_stops_the_kernel_inside_its_block(tmp_path):
@@ -227,18 +218,8 @@ def test_ctrl_c_on_one_thread_stops_the_kernel_inside_its_block(tmp_path):
     between kernel calls. One 64-point block of the lanes (about 3 s here), its finished rows
     saved every 0.2 s: SIGINT once the first are saved stops the kernel inside the block, so
     some of its rows are left to --resume."""
-    (tmp_path / "s.toml").write_text(ONE_BLOCK_SCENE)
-    store = tmp_path / "out.nc.chunks"
-    script = ("import sys, sweep.execute as e; e.FLUSH_SECONDS = 0.2; "
-              "from sweep.cli import main; sys.exit(main(sys.argv[1:]))")
-    proc = subprocess.Popen([sys.executable, "-c", script, "run", "s.toml", "-o", "out.nc",
-                             "--threads", "1"], cwd=tmp_path, env=sweep_env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    deadline = time.monotonic() + 300
-    while not list(store.glob("chunk-*.npz")):
-        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
-        time.sleep(0.02)
+    proc, store = _start_and_wait_for_a_chunk(tmp_path, ["--threads", "1"], ONE_BLOCK_SCENE,
+                                              FLUSH_OFTEN)
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
