@@ -255,14 +255,22 @@ def test_no_base_gives_zero_columns_and_no_base_quantities():
 
 
 def test_linear_closed_form_and_resonance_amplification():
-    out, _ = _columns(BASE, {"axes.base_frequency": [5.0, 20.0, 100.0]})
+    """One mode's linear_amplitude (sweep/models/linear.py, which gives every mode count's) is
+    Gamma A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2)."""
+    from sweep.models import linear
+    from sweep.models import transverse as tm
+    scene = load_scene_text(BASE, overrides={"axes.base_frequency": [5.0, 20.0, 100.0]})
+    inputs = tm.resolve(scene)
+    out = models.oscillator(inputs.params)
+    amplitude = linear.linear_amplitude(out, inputs.params, inputs.basis, 1, inputs.coords)
+    assert list(amplitude.dims) == ["length", "base_frequency"]
     a = 0.5 * G
     for i, length in enumerate((0.3, 0.5)):
         w1 = _omega_1(length)
         for j, f in enumerate((5.0, 20.0, 100.0)):
             w = 2 * math.pi * f
             expected = GAMMA * a / math.sqrt((w1 ** 2 - w ** 2) ** 2 + (0.04 * w1 * w) ** 2)
-            assert float(out["linear_amplitude"][i, j]) == pytest.approx(expected, rel=1e-12)
+            assert float(amplitude[i, j]) == pytest.approx(expected, rel=1e-12)
     assert float(out["resonance_amplification"]) == pytest.approx(25.0)
     undamped, _ = _columns(BASE.replace("damping_ratio = 0.02", "damping_ratio = 0.0"))
     assert np.isnan(float(undamped["resonance_amplification"]))

@@ -16,16 +16,30 @@ import xarray as xr
 from ..dataset import derived
 
 
+MODE = "mode_"
+"""The modes' axis of `linear_modes`' arrays (summed away by `receptance`)."""
+
+
+def receptance(omega: np.ndarray, damping: np.ndarray, weights: np.ndarray,
+               w: np.ndarray) -> np.ndarray:
+    """The midspan's receptance G(w) = -sum_n weights_n / (omega_n^2 - w^2 + i damping_n w)
+    (m per m/s^2 of base acceleration) at angular frequencies w (rad/s), from `linear_modes`'
+    omega (rad/s), damping (2 zeta omega, 1/s) and weights, each (..., N): w's shape
+    broadcasts against their leading axes."""
+    w = np.asarray(w)[..., None]
+    return -np.sum(weights / (omega ** 2 - w ** 2 + 1j * damping * w), axis=-1)
+
+
 def linear_modes(coeffs: dict[str, Any], params: dict[str, Any], basis: Any, n_modes: int,
                  coords: dict[str, xr.DataArray]
-                  ) -> tuple[xr.DataArray, np.ndarray, np.ndarray, np.ndarray, xr.DataArray]:
+                 ) -> tuple[xr.DataArray, np.ndarray, np.ndarray, np.ndarray, xr.DataArray]:
     """The span made linear, mode by mode, on the axes it depends on: (a template on those
     axes, omega (rad/s), 2 zeta omega (1/s) and weights (midspan value times participation),
     each (..., mode), and the base level factor on the template's axes). Mode n at f1 times
     its basis frequency ratio with damping ratio zeta; elastic ends swept over the grid: each
     point's own basis."""
     from .basis import BasisFamily, end_stiffness
-    mode = "mode_"                        # the modes' axis of the sums (dropped by them)
+    mode = MODE
     if n_modes == 1:
         ratio = xr.DataArray(np.ones(1), dims=mode)
         weight = xr.DataArray(np.ones(1), dims=mode)
@@ -63,16 +77,11 @@ def linear_amplitude(coeffs: dict[str, Any], params: dict[str, Any], basis: Any,
     w_n w)|, NaN where unbounded (undamped at resonance); on the axes it depends on."""
     template, omega, damping, weights, level = linear_modes(coeffs, params, basis, n_modes,
                                                             coords)
-    mode = "mode_"
-
-    def by_mode(values: np.ndarray) -> xr.DataArray:
-        return xr.DataArray(values, dims=template.dims + (mode,))
-
-    w = derived(coeffs["base_omega"], coords)
+    modes = [xr.DataArray(a, dims=template.dims + (MODE,)) for a in (omega, damping, weights)]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        receptance = abs((by_mode(weights) / (by_mode(omega) ** 2 - w ** 2
-                                              + 1j * by_mode(damping) * w)).sum(mode))
-        amplitude = receptance * level.drop_vars(list(level.coords))
+        g = xr.apply_ufunc(receptance, *modes, derived(coeffs["base_omega"], coords),
+                           input_core_dims=[[MODE]] * 3 + [[]])
+        amplitude = abs(g) * level.drop_vars(list(level.coords))
     amplitude = amplitude.where(np.isfinite(amplitude))
     amplitude = amplitude.transpose(*[d for d in coords if d in amplitude.dims])
     return amplitude.assign_attrs(

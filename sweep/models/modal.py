@@ -323,8 +323,7 @@ def oscillator(p: Mapping[str, Any]) -> dict[str, Any]:
         from .random import mean_square
         level, omega_b = 3.0 * base["base_accel"] * np.sqrt(mean_square(f, w)), c["omega_1"]
     elif np.any(base["participation"] != 0.0) and not swept:
-        out.update(base_response(level, omega_b, c["omega_1"], p["damping_ratio"],
-                                 base["participation"]))
+        out.update(base_response(level, omega_b, c["omega_1"], p["damping_ratio"]))
     if swept:                     # the scales of the sweep's largest level, lowest frequency
         start, stop, rate = p["base_sweep_start"], p["base_sweep_stop"], p["base_sweep_rate"]
         out["sweep_duration"] = excitation.sweep_duration(start, stop, rate)
@@ -400,22 +399,16 @@ def _level(p: Mapping[str, Any]) -> Any:
     return p["base_acceleration_g"] * STANDARD_GRAVITY
 
 
-def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any,
-                  participation: Any = PARTICIPATION) -> dict[str, Any]:
+def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any) -> dict[str, Any]:
     """Derived quantities of base excitation A sin(w t) (docs/model.md sec. 5), element-wise.
 
     accel: A (m/s^2); omega: w (rad/s); omega_1: the unloaded w1 (rad/s); damping_ratio: zeta.
     Returns base_acceleration (m/s^2), base_acceleration_g (g), base_frequency (Hz),
-    base_frequency_ratio (f/f1), linear_amplitude (m): the steady midspan amplitude of the
-    linearised span (K3 = K5 = 0, P = 0), Gamma A / sqrt((w1^2 - w^2)^2 + (2 zeta w1 w)^2)
-    (NaN where that is unbounded: undamped at resonance), and resonance_amplification (1):
-    Q = 1/(2 zeta), its peak over the quasi-static Gamma A / w1^2 (NaN undamped).
+    base_frequency_ratio (f/f1) and resonance_amplification (1): Q = 1/(2 zeta), the linear
+    span's peak over its quasi-static Gamma A / w1^2 (NaN undamped). The linear span's own
+    steady amplitude, over the scene's modes, is sweep/models/linear.py's `linear_amplitude`.
     """
-    omega = np.float64(omega) if isinstance(omega, float) else omega   # inf, not OverflowError
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        denominator = np.sqrt((omega_1 ** 2 - omega ** 2) ** 2
-                              + (2.0 * damping_ratio * omega_1 * omega) ** 2)
-        linear = participation * accel / denominator
+    with np.errstate(divide="ignore"):
         q_factor = 0.5 / (np.float64(damping_ratio) if isinstance(damping_ratio, (int, float))
                           else damping_ratio)
     return {
@@ -423,7 +416,6 @@ def base_response(accel: Any, omega: Any, omega_1: Any, damping_ratio: Any,
         "base_acceleration_g": accel / STANDARD_GRAVITY,
         "base_frequency": omega / (2.0 * np.pi),
         "base_frequency_ratio": omega / omega_1,
-        "linear_amplitude": _finite_or_nan(linear),
         "resonance_amplification": _finite_or_nan(q_factor),
     }
 

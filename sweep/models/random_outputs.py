@@ -31,7 +31,7 @@ from sweep.kernels import states as km
 from ..dataset import derived
 from ..schema import G2_UNITS, G_UNITS, STANDARD_GRAVITY
 from . import random_scene
-from .linear import linear_modes
+from .linear import linear_modes, receptance
 from .random_scene import REALISATION_DIM
 
 CLEARANCE_DIM = "clearance"
@@ -232,8 +232,7 @@ def linear_spectra(random: RandomInputs, coeffs: dict[str, Any], params: dict[st
                                                              coords)
     nu = np.asarray(frequency.values, float)
     w_nu = 2.0 * np.pi * nu
-    g = -np.sum(weights[..., None, :] / (omega[..., None, :] ** 2 - w_nu[:, None] ** 2
-                                         + 1j * damping[..., None, :] * w_nu[:, None]), axis=-1)
+    g = receptance(omega[..., None, :], damping[..., None, :], weights[..., None, :], w_nu)
     given = asd_at(nu, f, w) * (level.values[..., None] ** 2)
     dims = template.dims + tuple(frequency.dims)
     coords_ = {**{d: template[d] for d in template.dims if d in template.coords},

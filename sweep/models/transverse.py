@@ -89,7 +89,6 @@ _BASE_DERIVED = {
     **{axis: (BY_AXIS[axis].units, BY_AXIS[axis].long_name)
        for axis in ("base_acceleration", "base_acceleration_g", "base_frequency",
                     "base_frequency_ratio")},
-    "linear_amplitude": ("m", linear.LINEAR_AMPLITUDE_LONG_NAME.format(modes="its first mode")),
     "resonance_amplification": ("1", "linear resonance amplification Q = 1/(2 zeta): peak "
                                      "amplitude over the quasi-static Gamma A / w1^2; NaN: "
                                      "undamped"),
@@ -918,7 +917,7 @@ def assemble(inputs: Inputs, coeffs: dict[str, Any], result: KernelResult,
                                       attrs={"units": "1",
                                              "long_name": long_name.format(method=short)})
     data.update(derived_variables(coeffs, coords, _derived_table(coeffs, inputs.has_base)))
-    if "linear_amplitude" in data and inputs.n_modes > 1:      # the first mode's: over N
+    if "resonance_amplification" in coeffs:          # a fixed-frequency sine base
         data["linear_amplitude"] = linear.linear_amplitude(coeffs, inputs.params, inputs.basis,
                                                            inputs.n_modes, coords)
     if result.modal is not None:
