@@ -327,8 +327,9 @@ _chain8 = _chains(dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "d
 def _attempt(W, rtol, n_run, parametric, base, record):
     """One Dormand-Prince attempt in every lane of W (record: `reads_switch`, True for the
     chains that read each stage's a_b from W: a random record's, a sweep's): the stages
-    (`_chain5`, from dopri5.A, B, C), the fifth-order solution (W_QN, W_VN), the stage derivatives k1 .. k6 (k6 = f(t + h,
-    y_new)) in W_K and SciPy's error norm from dopri5.E (W_ERR). One loop with a run-time trip
+    (`_chain5`, from dopri5.A, B, C), the fifth-order solution (W_QN, W_VN), the stage
+    derivatives k1 .. k6 (k6 = f(t + h, y_new)) in W_K and SciPy's error norm from dopri5.E
+    (W_ERR). One loop with a run-time trip
     count runs across the lanes with straight-line arithmetic, so LLVM vectorises it rather
     than unrolling it. Each lane's absolute tolerances are its accumulator's
     (trajectory.point_atol, set by trajectory.start). Lanes n_run and above are idle and skipped.

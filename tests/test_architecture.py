@@ -198,8 +198,7 @@ def test_the_tests_leave_the_sweep_under_test_first_on_the_path():
     inserting the repository's root at import) made CI's dask workers compile every kernel
     again into the checkout's own Numba cache (95 cache indexes, minutes of CI). Every test
     module is imported before any test runs, so this sees what they all left."""
-    import sweep
-    imported = Path(sweep.__file__).resolve().parents[1]
+    from conftest import SWEEP_ROOT
     first = next((Path(entry or ".").resolve() for entry in sys.path
-                  if (Path(entry or ".") / "sweep" / "__init__.py").is_file()), imported)
-    assert first == imported, (first, imported)
+                  if (Path(entry or ".") / "sweep" / "__init__.py").is_file()), SWEEP_ROOT)
+    assert first == SWEEP_ROOT, (first, SWEEP_ROOT)

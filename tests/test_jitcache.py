@@ -74,13 +74,11 @@ def test_a_record_s_result_does_not_depend_on_what_was_compiled_before(tmp_path)
     import os
     import subprocess
     import sys
-    from pathlib import Path
 
-    import sweep
-    root = str(Path(sweep.__file__).resolve().parents[1])     # the sweep under test
+    from conftest import sweep_env
 
     def start(cache, *overrides):
-        env = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "PYTHONPATH": root}
+        env = sweep_env({**os.environ, "NUMBA_CACHE_DIR": str(cache)})
         return subprocess.Popen([sys.executable, "-c", _RECORD_RUNS, *overrides], env=env,
                                 cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 text=True)

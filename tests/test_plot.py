@@ -561,8 +561,6 @@ def test_an_axis_from_zero_over_decades_is_drawn_symlog_with_cells_around_each_v
     the axis is symlog, linear up to the smallest positive value; each cell holds its value,
     the cells meet, and matplotlib's symlog transform spaces 0, 1e4 and 1e6 as the edges
     assume (0 -> 1e4 as long as one decade)."""
-    from matplotlib.figure import Figure as Fig
-
     from sweep.plot.style import symlog_threshold
     values = np.array([0.0, 1e4, 1e6])
     assert symlog_threshold(values) == 1e4
@@ -574,7 +572,7 @@ def test_an_axis_from_zero_over_decades_is_drawn_symlog_with_cells_around_each_v
     np.testing.assert_allclose(edges, [-5e3, 5e3, 1e5, 1e7], rtol=1e-12)
     ds = xr.Dataset({"amplitude": (("clamp_axial_stiffness", "length"), np.ones((3, 2)))},
                     coords={"clamp_axial_stiffness": values, "length": [0.2, 0.3]})
-    ax = Fig().add_subplot()
+    ax = Figure().add_subplot()
     splot.maps._mesh(ax, ds, "length", "clamp_axial_stiffness", ds.amplitude.values)
     assert ax.get_yscale() == "symlog"
     shown = ax.transData.transform(np.column_stack([[0.25] * 3, values]))[:, 1]

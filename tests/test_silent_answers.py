@@ -11,11 +11,9 @@
 from __future__ import annotations
 
 import math
-import os
 import subprocess
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,7 +25,7 @@ from sweep.kernels import metrics as km
 from sweep.kernels import transverse as tk
 from sweep.scene import load_scene, load_scene_text
 
-from conftest import param_row, settings, solve
+from conftest import param_row, settings, solve, sweep_env
 
 LONG = '[model]\nkind = "longitudinal"\n'
 E, RHO, A = 1.1e11, 8900.0, 6e-6
@@ -240,11 +238,10 @@ def test_a_scene_with_a_start_does_not_warn(text):
 def test_cli_says_in_one_line_what_an_empty_scene_ran(tmp_path):
     empty = tmp_path / "empty.toml"
     empty.write_text("")
-    root = Path(sweep.__file__).resolve().parents[1]     # the sweep imported here (its cache)
     done = subprocess.run([sys.executable, "-m", "sweep.cli", "run", str(empty), "-q", "-o",
                            str(tmp_path / "empty.nc")],
                           capture_output=True, text=True, cwd=tmp_path, timeout=600,
-                          env={**os.environ, "PYTHONPATH": str(root)})
+                          env=sweep_env())
     assert done.returncode == 0, done.stderr
     lines = [line for line in done.stderr.splitlines() if "warning" in line]
     assert len(lines) == 1 and lines[0].startswith("sweep: warning: the scene sets no keys")
