@@ -107,28 +107,19 @@ def _modal_rhs(n: int, size: int, bases: list[tuple], base: bool) -> Any:
     shaken = True if base else None
     width = 2 * n
     last = size - 1
-    if bases[0][md.POLYNOMIAL] is None:
-        @nb.cfunc(lsoda_sig)
-        def rhs(t, u, du, p):
-            d = nb.carray(p, (size,))
-            b = int(d[last])
-            S = (d[:P], d[P:P + n], CP_all[b], None, d[P + n:last])
-            derivative(t, nb.carray(u, (width,)), nb.carray(du, (width,)), S, n, T_all[b],
-                       shaken)
-        return rhs
     PY = [np.ascontiguousarray(np.stack([b[md.POLYNOMIAL][k] for b in bases]))
           for k in range(5)]
     prog, starts, mono, coef, ends = PY
     last_group = int(bases[0][md.POLYNOMIAL][5])
 
     @nb.cfunc(lsoda_sig)
-    def rhs_py(t, u, du, p):
+    def rhs(t, u, du, p):
         d = nb.carray(p, (size,))
         b = int(d[last])
         S = (d[:P], d[P:P + n], CP_all[b],
              (prog[b], starts[b], mono[b], coef[b], ends[b], last_group), d[P + n:last])
         derivative(t, nb.carray(u, (width,)), nb.carray(du, (width,)), S, n, T_all[b], shaken)
-    return rhs_py
+    return rhs
 
 
 def _shape_key(basis: tuple) -> tuple:
@@ -137,8 +128,6 @@ def _shape_key(basis: tuple) -> tuple:
     from sweep.kernels import modes as md
     py = basis[md.POLYNOMIAL]
     key = (basis[md.TABLES].shape, basis[md.COUPLING].shape)
-    if py is None:
-        return key + (None,)
     return key + tuple(a.shape for a in py[:5]) + (py[5],)
 
 
@@ -182,7 +171,7 @@ def problem(name: str, overrides: dict[str, Any]) -> Problem:
         groups = []
         for members in keys.values():
             py = family[members[0]][md.POLYNOMIAL]
-            M = 0 if py is None else py[0].shape[0]
+            M = py[0].shape[0]
             size = P + n + M + 1
             mine = np.flatnonzero(np.isin(index, members))
             data = np.zeros((mine.size, _padded(size)))

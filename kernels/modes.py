@@ -58,7 +58,9 @@ terms (`_energy_forces`). A chunk with no such row runs Eq.17's loop alone, as b
 ratios, (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes, (N, 6): each mode's beam-function
 form, for `shape_at`, and a bound of max |phi_n|; coupling, (N, N): A_ij / pi^2, the
 uniform stretching's; clamps, (10, N): the rows the load observers read, CLAMPS below;
-polynomial: the force's polynomial, or None where the quadrature is used).
+polynomial: the force's polynomial, or an empty one (`no_polynomial`: no monomials) where
+the quadrature is used; one type for both, so that a basis of either form runs on the same
+compiled driver, which picks the form at run time, once an evaluation).
 Nothing here knows the shapes' kind.
 
 A point's raw row (columns below) holds the span's linear coefficients (w_p, its damping), the
@@ -71,8 +73,6 @@ import math
 
 import numba as nb
 import numpy as np
-from numba import types
-from numba.extending import overload
 
 from . import excitation as ex
 from .vecmath import fast_cos, fast_sin
@@ -112,7 +112,7 @@ SHAPES = 4          # (N, 6): each mode's beam-function form (beta, A, B, C, D),
                     # `shape_at`, and an upper bound of max |phi_n| over the span (column 5)
 COUPLING = 5        # (N, N): A_ij / pi^2 = int dphi_i/dxi dphi_j/dxi ds, the span's stretch
 CLAMPS = 6          # (10, N): what the load observers watch per mode (rows below; s = x / l)
-POLYNOMIAL = 7      # the same force as a polynomial in q, or None (FORCE_TERMS, below)
+POLYNOMIAL = 7      # the same force as a polynomial in q, or empty (`no_polynomial`, below)
 
 # Rows of basis[CLAMPS]: what the load observers of the modal drivers read (per unit q_n).
 BEND_0 = 0          # phi_n''(0): the curvature at the clamp x = 0 (times 1 / l^2)
@@ -303,9 +303,7 @@ def lane_basis_size(basis):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _coefficients_size(PY):
-    """The coefficients of polynomial PY (none for None: a switch, pruned on the argument)."""
-    if PY is None:
-        return 0
+    """The coefficients of polynomial PY (none for an empty one)."""
     return PY[3].shape[0]
 
 
@@ -326,9 +324,7 @@ def write_lane_basis(basis, LB, j):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _write_coefficients(PY, LB, row, j):
-    """LB[row.., j] = polynomial PY's coefficients (none for None)."""
-    if PY is None:
-        return
+    """LB[row.., j] = polynomial PY's coefficients (none for an empty one)."""
     coef = PY[3]
     for t in range(coef.shape[0]):
         LB[row + t, j] = coef[t]
@@ -358,7 +354,7 @@ def stacked(bases):
     for other in bases[1:]:
         if any(a.shape != b.shape for a, b in zip(first[:POLYNOMIAL], other[:POLYNOMIAL])):
             return None
-        if first[POLYNOMIAL] is None or other[POLYNOMIAL] is None or not all(
+        if not uses_polynomial(first) or not uses_polynomial(other) or not all(
                 np.array_equal(first[POLYNOMIAL][k], other[POLYNOMIAL][k])
                 for k in (0, 1, 2, 4, 5)):
             return None
@@ -366,25 +362,10 @@ def stacked(bases):
             return None
     arrays = tuple(np.ascontiguousarray(np.stack([b[k] for b in bases]))
                    for k in range(POLYNOMIAL))
-    if first[POLYNOMIAL] is None:
-        return arrays + (None,)
     polynomial = tuple(np.ascontiguousarray(np.stack([b[POLYNOMIAL][k] for b in bases]))
                        for k in range(5)) + (
         np.array([b[POLYNOMIAL][5] for b in bases], np.int64),)
     return arrays + (polynomial,)
-
-
-def _member_polynomial(PY, b):
-    """Polynomial b of a family's stacked polynomials, or None for None (compiled code only:
-    chosen from PY's type, as a branch on `PY is None` would leave an optional type)."""
-    raise TypeError("kernels.modes._member_polynomial runs only in compiled code")
-
-
-@overload(_member_polynomial)
-def _choose_member_polynomial(PY, b):
-    if isinstance(PY, types.NoneType):
-        return lambda PY, b: None
-    return lambda PY, b: (PY[0][b], PY[1][b], PY[2][b], PY[3][b], PY[4][b], PY[5][b])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -392,9 +373,10 @@ def member(family, b):
     """Basis b of a family stacked item by item along a first axis (`stacked`: every item of
     every basis the same shape, the polynomials' structure the same):
     the basis tuple the kernels take, its arrays views of the family's."""
+    PY = family[POLYNOMIAL]
     return (family[TABLES][b], family[STATIONS][b], family[MIDSPAN][b], family[RATIOS][b],
             family[SHAPES][b], family[COUPLING][b], family[CLAMPS][b],
-            _member_polynomial(family[POLYNOMIAL], b))
+            (PY[0][b], PY[1][b], PY[2][b], PY[3][b], PY[4][b], PY[5][b]))
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -618,17 +600,33 @@ FORCE_TERMS = (
 )
 
 
+def no_polynomial(n_modes):
+    """The POLYNOMIAL item of a basis whose force is evaluated by quadrature: the layout of
+    sweep.models.basis.force_polynomial's (program, starts, monomials, coefficients,
+    symmetric, pure) with no monomial and no term, so that both forms are one Numba type
+    (plain NumPy, called from Python)."""
+    return (np.zeros((0, 2), np.int64), np.zeros((n_modes, N_GROUPS + 1), np.int64),
+            np.zeros(0, np.int64), np.zeros(0), np.zeros((n_modes, N_GROUPS), np.int64), 0)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def has_polynomial(PY):
+    """Whether polynomial PY has monomials (a basis that uses it: every real one holds the
+    N modes' own), not `no_polynomial`'s empty one."""
+    return PY[0].shape[0] > 0
+
+
 def uses_polynomial(basis):
     """Whether the right-hand side evaluates the basis' force as its polynomial (POLYNOMIAL)
-    rather than by quadrature (POLYNOMIAL None: a switch, so that each compiles only its own)."""
-    return basis[POLYNOMIAL] is not None
+    rather than by quadrature (an empty POLYNOMIAL, `no_polynomial`)."""
+    return basis[POLYNOMIAL][0].shape[0] > 0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _field_rows(T, PY):
     """`field_rows` of tables T and polynomial PY."""
     nodes = T.shape[2] + folded_pairs(T)
-    if PY is None:
+    if not has_polynomial(PY):
         return nodes
     return max(nodes, (PY[0].shape[0] + N_GROUPS + 1 + 3) // 4)
 
@@ -907,7 +905,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     lane has one it is not computed). A lane whose S_ENERGY is
     1 takes its bending terms from the span's energy (module docstring), projected on the
     shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL; where it
-    is not None, the same force is evaluated as each mode's polynomial in q
+    has monomials (`has_polynomial`), the same force is evaluated as each mode's polynomial in q
     (`_polynomial_lanes`, FLD its scratch: `field_rows`) instead of at the nodes.
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode
@@ -961,8 +959,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     active = 0
     energy = False                      # some lane's bending terms from the span's energy
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
-    if PY is not None:                  # (a switch: None where the basis has no polynomial,
-        R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))   # each compiles its own)
+    polynomial = has_polynomial(PY)     # (chosen here, once an evaluation)
+    R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))
+    if polynomial:
         active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric)
     else:
         for l in range(n_run):
@@ -984,10 +983,10 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                     FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
                                                   PP[sc + S_BETA_Q, l])
                                     + _axial(a, b, SC[0, l], SC[1, l]))
-    if PY is None:
+    if not polynomial:
         _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
-        if PY is not None:
+        if polynomial:
             _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB, own)
         elif symmetric and i % 2 == 1:
             for l in range(n_run):
@@ -1036,9 +1035,7 @@ def scratch(pp, n_modes, basis):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
 def _monomials_scratch(PY):
-    """Room for polynomial PY's monomials (none for None)."""
-    if PY is None:
-        return np.empty(0)
+    """Room for polynomial PY's monomials (none for an empty one)."""
     return np.empty(PY[0].shape[0])
 
 
@@ -1061,9 +1058,9 @@ def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy,
     monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's);
     symmetric: the antisymmetric modes at rest, their monomials 0 and unread
     (`_polynomial_mode`). Returns
-    the quadrature nodes still to sum: none; or, PY None (no polynomial: a switch, so that the
-    polynomial's code is not compiled), F zeroed and every column of the tables T."""
-    if PY is None:
+    the quadrature nodes still to sum: none; or, PY empty (`no_polynomial`), F zeroed and
+    every column of the tables T."""
+    if not has_polynomial(PY):
         for i in range(n):
             F[i] = 0.0
         return T.shape[2]

@@ -726,6 +726,26 @@ def test_the_polynomial_is_chosen_where_it_costs_less():
     assert POLYNOMIAL_MAX_MODES < 8
 
 
+def test_either_force_form_is_one_type_to_the_kernels():
+    """A basis whose force is its polynomial and one read by quadrature are the same Numba
+    type (the quadrature's an empty polynomial, kernels.modes.no_polynomial), alone and as a
+    lanes call's family: pinned, clamped and elastic spans of N modes run on one compiled
+    driver, which picks the form at run time (before, a clamped scene after a pinned one
+    compiled every modal driver again)."""
+    import numba as nb
+
+    from sweep.kernels import modes as md
+    from sweep.models.basis import clamped, elastic_ends, pinned_sines
+    for n in (2, 3, 5):
+        bases = [pinned_sines(n).kernel_arrays(), clamped(n).kernel_arrays(),
+                 elastic_ends(n, 3.0).kernel_arrays()]
+        assert [md.uses_polynomial(b) for b in bases] == [False, n <= 4, n <= 4]
+        assert len({nb.typeof(b) for b in bases}) == 1
+        assert len({nb.typeof(md.stacked([b])) for b in bases}) == 1     # a lanes call's
+        assert md.stacked(bases[:1] * 2) is None      # (bases by quadrature do not stack)
+        assert not md.has_polynomial.py_func(md.no_polynomial(n))
+
+
 def test_one_modes_modal_lists_are_its_initial_state():
     """model.modes = 1 with initial.modal_displacement / modal_velocity (one entry each): the
     same run as initial.displacement / velocity (a reviewer found the lists accepted and then

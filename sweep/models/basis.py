@@ -85,8 +85,8 @@ class Basis:
         (`mirrored_quadrature`); ratios is (2, N): w_n / w_p and Gamma_n / (4 / pi); shapes
         with each mode's bound of max |phi_n| (`shape_sizes`) as a sixth column;
         polynomial: the force as each mode's polynomial in q where that costs the right-hand
-        side less than the quadrature (`force_polynomial`), else None (a switch: the kernels
-        compile only the form a basis uses)."""
+        side less than the quadrature (`force_polynomial`), else an empty one
+        (kernels.modes.no_polynomial: both forms one type to Numba, one compile)."""
         if not self._arrays:
             ratios = np.ascontiguousarray(np.stack([self.frequency_ratio,
                                                     self.participation_ratio]), np.float64)
@@ -212,10 +212,11 @@ def with_force_form(arrays: tuple[Any, ...], polynomial: bool,
     """A basis' kernel arrays with its force evaluated as the polynomial (True) or by
     quadrature (False), whatever the basis would choose, and its quadrature folded about
     midspan (`mirrored_quadrature`) or read node by node: for comparing the forms."""
+    from ..kernels.modes import no_polynomial
     tables = unfolded_tables(arrays[0])
     quadrature = mirrored_quadrature(tables) if mirrored else _unfolded(tables)
     return ((quadrature,) + arrays[1:7]
-            + (force_polynomial(tables) if polynomial else None,))
+            + (force_polynomial(tables) if polynomial else no_polynomial(tables.shape[1]),))
 
 
 TABLE_ORDERS = (1, 2, 3, 4, 0, 1, 2)
@@ -349,13 +350,16 @@ polynomial costs 0.66 and 1.09 times the quadrature at 4.0 (clamped, 4 modes), 1
 at 6.6 (5), 1.6 and 2.7 at 10 (6): clamped and elastic ends of up to 4 modes take it."""
 
 
-def cheaper_polynomial(tables: np.ndarray) -> tuple[np.ndarray, ...] | None:
+def cheaper_polynomial(tables: np.ndarray) -> tuple[Any, ...]:
     """The force's polynomial (`force_polynomial`) where it costs the right-hand side less
-    than the quadrature on `tables` (7, N, nodes), else None (`polynomial_pays`)."""
-    if tables.shape[1] > POLYNOMIAL_MAX_MODES:
-        return None
-    polynomial = force_polynomial(tables)
-    return polynomial if polynomial_pays(tables, polynomial) else None
+    than the quadrature on `tables` (7, N, nodes) (`polynomial_pays`), else an empty one
+    (kernels.modes.no_polynomial)."""
+    from ..kernels.modes import no_polynomial
+    if tables.shape[1] <= POLYNOMIAL_MAX_MODES:
+        polynomial = force_polynomial(tables)
+        if polynomial_pays(tables, polynomial):
+            return polynomial
+    return no_polynomial(tables.shape[1])
 
 
 def polynomial_pays(tables: np.ndarray, polynomial: tuple[np.ndarray, ...]) -> bool:
