@@ -105,19 +105,19 @@ def rk_step(t, y, h, S, n_modes, T, K, y_new, stage, A, B, C, base):
     scratch of length 2N."""
     n_stages = B.shape[0]
     dim = 2 * n_modes
-    for s in range(1, n_stages):
+    for s in range(1, n_stages + 1):   # the stages, then f(t + h, y_new): one call site, as
+        last = s == n_stages            # md.derivative is inlined (forceinline) where called
+        X = y_new if last else stage
         for i in range(dim):
             d = 0.0
-            for j in range(s):
-                d += K[j, i] * A[s, j]
-            stage[i] = y[i] + d * h
-        md.derivative(t + C[s] * h, stage, K[s], S, n_modes, T, base)
-    for i in range(dim):
-        d = 0.0
-        for j in range(n_stages):
-            d += K[j, i] * B[j]
-        y_new[i] = y[i] + h * d
-    md.derivative(t + h, y_new, K[n_stages], S, n_modes, T, base)
+            if last:
+                for j in range(n_stages):
+                    d += K[j, i] * B[j]
+            else:
+                for j in range(s):
+                    d += K[j, i] * A[s, j]
+            X[i] = y[i] + d * h
+        md.derivative(t + h if last else t + C[s] * h, X, K[s], S, n_modes, T, base)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -172,7 +172,7 @@ def initial_step(y, f, t_end, max_step, rtol, atol_q, atol_v, order, S, n_modes,
     f1 = np.empty(dim)
     for i in range(dim):
         y1[i] = y[i] + h0 * f[i]
-    md.derivative(h0, y1, f1, S, n_modes, T, base)
+    md.derivative_call(h0, y1, f1, S, n_modes, T, base)
     d2 = 0.0
     for i in range(dim):
         scale = (atol_q if i < n_modes else atol_v) + abs(y[i]) * rtol
@@ -739,7 +739,7 @@ def _observe_modes(t, t_new, t_tail, y, y_new, K, h, n_modes, eighth, modal, Km,
     if not located:
         for c in range(n):
             _mode_interpolant(y, y_new, K, h, c, n, eighth, Km, QA[c])
-    located = True
+    located = bool(True)                # (run-time, as above: one compile of each observer)
     s_lo = 0.0
     if t < t_tail:                                   # the tail starts inside the step
         s_lo = (t_tail - t) / h
@@ -1056,7 +1056,7 @@ def start(row, n_modes, settings, y, f, pp, S, T, p1, acc, series, modal, weight
     t_tail = t_end * (1.0 - settings[TAIL])
     for i in range(2 * n):
         y[i] = row[md.N_FIXED + i]
-    md.derivative(0.0, y, f, S, n, T, base)
+    md.derivative_call(0.0, y, f, S, n, T, base)
     atol_q, atol_v = tj.point_atol(p1, 0, 1, settings, rtol)
     evals = 1.0
     if settings[FIRST_STEP] > 0.0:
@@ -1208,16 +1208,16 @@ def at_rest(row, basis, t, y, band, base):
     for i in range(n):
         z[i] = y[i]
         z[n + i] = 0.0
-    md.derivative(t, z, f, S, n, T, base)
+    md.derivative_call(t, z, f, S, n, T, base)
     up = np.empty(2 * n)
     down = np.empty(2 * n)
     total = 0.0
     for i in range(n):
         step = 1e-6 * max(abs(y[i]), 1e-9 * row[md.BOUND])
         z[i] = y[i] + step
-        md.derivative(t, z, up, S, n, T, base)
+        md.derivative_call(t, z, up, S, n, T, base)
         z[i] = y[i] - step
-        md.derivative(t, z, down, S, n, T, base)
+        md.derivative_call(t, z, down, S, n, T, base)
         z[i] = y[i]
         k = -(up[n + i] - down[n + i]) / (2.0 * step)
         if not k > 0.0:

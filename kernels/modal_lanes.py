@@ -795,6 +795,7 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
     weights = basis[md.MIDSPAN]      # (the basis' arrays taken once: a tuple's item taken in
     CP = basis[md.COUPLING]          # the loop costs a reference count update a call)
     PY = basis[md.POLYNOMIAL]
+    polynomial = md.has_polynomial(PY)
     own = family[md.RATIOS].shape[0] > 1          # the lanes carry bases of their own
     record = ex.is_record(base)      # a random record: the accumulator has its
     slots = tj.SCALAR_SLOTS if record else tj.N_SLOTS   # statistics' slots
@@ -898,8 +899,12 @@ def solve_block(params, family, which, settings, lo, hi, states, reals, counts, 
                            H, LB, BI)
                 tj.move_books(MOVES[m, 0], MOVES[m, 1], bufs, capacity, point)
         n_run = min(L, (top + SIMD - 1) // SIMD * SIMD)
-        _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
-                 n_run, base, CP, PY, LB, own)
+        if polynomial:                    # (two specialisations of the attempt, each
+            _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
+                     n_run, base, CP, PY, LB, own)
+        else:                             # compiled with its own form alone)
+            _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth,
+                     n_run, base, CP, None, LB, own)
         _control(W, H, ERR, SC, settings, n_run)
         _midspan(K, YN, KM, QV, weights, LB, own, n, n_stages, eighth, n_run)
         _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth)

@@ -904,8 +904,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     sum CP_ij q_i q_j, adds -N k^2 b / rho A to F (a lane whose TENSION is 0 has none; when no
     lane has one it is not computed). A lane whose S_ENERGY is
     1 takes its bending terms from the span's energy (module docstring), projected on the
-    shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL; where it
-    has monomials (`has_polynomial`), the same force is evaluated as each mode's polynomial in q
+    shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL, or None
+    (a switch: the quadrature's code alone, as kernels.modal_lanes passes it for a basis
+    without one); where it has monomials (`has_polynomial`), the same force is evaluated as each mode's polynomial in q
     (`_polynomial_lanes`, FLD its scratch: `field_rows`) instead of at the nodes.
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode
@@ -956,39 +957,37 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
             _lanes_signal(tt, PP, sc, SC, n_run, base)
         else:
             _lanes_fast_signal(tt, PP, sc, SC, n_run, base)
-    active = 0
+    if PY is not None and has_polynomial(PY):    # (None: the quadrature alone is compiled)
+        R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))
+        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric)
+        for i in range(n):
+            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB, own)
+            _mode_acceleration(K, s, i, X, PP, SC, n, n_run, base)
+        return
     energy = False                      # some lane's bending terms from the span's energy
     eq17 = False                        # some lane's Eq.17's (which alone read c and d)
-    polynomial = has_polynomial(PY)     # (chosen here, once an evaluation)
-    R = FLD.reshape((FLD.shape[0] * FLD.shape[1], FLD.shape[2]))
-    if polynomial:
-        active = _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric)
+    for l in range(n_run):
+        energy = energy or PP[sc + S_ENERGY, l] != 0.0
+        eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
+    for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
+        _lanes_fields(T, f, X, FLD, n, n_run, symmetric)
+    if energy and not eq17:
+        _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
+    elif energy:
+        _energy_forces(PP, sc, FLD, SC, nodes, n_run)
     else:
-        for l in range(n_run):
-            energy = energy or PP[sc + S_ENERGY, l] != 0.0
-            eq17 = eq17 or PP[sc + S_ENERGY, l] == 0.0
-        for f in range(0, 4 if eq17 else 2, 2):     # (a, b), then (c, d) for Eq.17's lanes
-            _lanes_fields(T, f, X, FLD, n, n_run, symmetric)
-        if energy and not eq17:
-            _energy_only_forces(PP, sc, FLD, SC, nodes, n_run)
-        elif energy:
-            _energy_forces(PP, sc, FLD, SC, nodes, n_run)
-        else:
-            for j in range(nodes):
-                for l in range(n_run):
-                    a = FLD[0, j, l]
-                    b = FLD[1, j, l]
-                    c = FLD[2, j, l]
-                    d = FLD[3, j, l]
-                    FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
-                                                  PP[sc + S_BETA_Q, l])
-                                    + _axial(a, b, SC[0, l], SC[1, l]))
-    if not polynomial:
-        _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
+        for j in range(nodes):
+            for l in range(n_run):
+                a = FLD[0, j, l]
+                b = FLD[1, j, l]
+                c = FLD[2, j, l]
+                d = FLD[3, j, l]
+                FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
+                                              PP[sc + S_BETA_Q, l])
+                                + _axial(a, b, SC[0, l], SC[1, l]))
+    _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
-        if polynomial:
-            _polynomial_mode(i, PY, R, active, SC[3], n_run, symmetric, LB, own)
-        elif symmetric and i % 2 == 1:
+        if symmetric and i % 2 == 1:
             for l in range(n_run):
                 SC[3, l] = 0.0
         else:
@@ -1014,13 +1013,21 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
                     p2 = r0 + j if j < mirrors else j
                     for l in range(n_run):
                         SC[3, l] += w1 * FLD[1, p1, l] + w2 * FLD[2, p2, l]
-        for l in range(n_run):
-            acc = (PP[P_STIFF * n + i, l] * X[i, l] + PP[P_DAMPING * n + i, l] * X[n + i, l]
-                   - SC[3, l])
-            if base is not None:
-                acc += PP[P_FORCE * n + i, l] * SC[2, l]
-            K[s, i, l] = X[n + i, l]
-            K[s, n + i, l] = acc
+        _mode_acceleration(K, s, i, X, PP, SC, n, n_run, base)
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
+def _mode_acceleration(K, s, i, X, PP, SC, n, n_run, base):
+    """K[s, i] = q_i' and K[s, n + i] = q_i'' of every lane from mode i's projected force
+    SC[3] (per unit rho A) and, with a base, the base acceleration SC[2]."""
+    for l in range(n_run):
+        acc = (PP[P_STIFF * n + i, l] * X[i, l] + PP[P_DAMPING * n + i, l] * X[n + i, l]
+               - SC[3, l])
+        if base is not None:
+            acc += PP[P_FORCE * n + i, l] * SC[2, l]
+        K[s, i, l] = X[n + i, l]
+        K[s, n + i, l] = acc
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -1051,19 +1058,12 @@ def row_scratch(row, basis):
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
-def _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q, energy, symmetric,
-                      F):
+def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, symmetric, F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
     monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's);
     symmetric: the antisymmetric modes at rest, their monomials 0 and unread
-    (`_polynomial_mode`). Returns
-    the quadrature nodes still to sum: none; or, PY empty (`no_polynomial`), F zeroed and
-    every column of the tables T."""
-    if not has_polynomial(PY):
-        for i in range(n):
-            F[i] = 0.0
-        return T.shape[2]
+    (`_polynomial_mode`). Returns the quadrature nodes still to sum: none."""
     program = PY[0]
     starts = PY[1]
     mono = PY[2]
@@ -1129,7 +1129,8 @@ def _state_fields(T, f, j, y, n, split, symmetric):
     return e0, o0, e1, o1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+         forceinline=True)
 def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s), dy = (q', q'') (m/s,
     m/s^2): `lanes_derivative`'s right-hand side for the scalar driver, libm's cos and sin,
@@ -1166,8 +1167,14 @@ def derivative(t, y, dy, S, n_modes, T, base):
     for i in range(1, n, 2):
         symmetric = symmetric and y[i] == 0.0
     # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
-    nodes = _polynomial_state(y, T, PY, MB, n, linear, membrane, beta_b, beta_q,
-                              pp[sc + S_ENERGY], symmetric, F)
+    # (no call where there is no polynomial: a call per evaluation cost a pinned span 30 %)
+    if has_polynomial(PY):
+        nodes = _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q,
+                                  pp[sc + S_ENERGY], symmetric, F)
+    else:
+        for i in range(n):
+            F[i] = 0.0
+        nodes = T.shape[2]
     # A paired node sums its symmetric modes (e) and antisymmetric ones (o) apart: the mirror
     # node's fields are (-1)^order (e - o), and each mode projects both nodes' forces at once,
     # their sum or difference. Where every antisymmetric mode is at rest the mirror nodes'
@@ -1213,3 +1220,13 @@ def derivative(t, y, dy, S, n_modes, T, base):
             acc += pp[P_FORCE * n + i] * ab
         dy[i] = y[n + i]
         dy[n + i] = acc
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def derivative_call(t, y, dy, S, n_modes, T, base):
+    """`derivative` as a function call of its own, for the callers that evaluate it a few times
+    a point (the first step's guess, the start, the rest test): `derivative` is inlined where
+    it is called (forceinline: a call passes about 100 words of arrays an evaluation; inlined
+    into the scalar driver's step, a pinned 3-mode span runs 1.1x faster), and one copy here
+    serves all of these, so that a driver compiles two copies, not six."""
+    derivative(t, y, dy, S, n_modes, T, base)
