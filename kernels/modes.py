@@ -619,7 +619,7 @@ def has_polynomial(PY):
 def uses_polynomial(basis):
     """Whether the right-hand side evaluates the basis' force as its polynomial (POLYNOMIAL)
     rather than by quadrature (an empty POLYNOMIAL, `no_polynomial`)."""
-    return basis[POLYNOMIAL][0].shape[0] > 0
+    return has_polynomial.py_func(basis[POLYNOMIAL])
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
@@ -906,8 +906,9 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     1 takes its bending terms from the span's energy (module docstring), projected on the
     shapes' slopes and curvatures too (`_energy_forces`). PY: the basis' POLYNOMIAL, or None
     (a switch: the quadrature's code alone, as kernels.modal_lanes passes it for a basis
-    without one); where it has monomials (`has_polynomial`), the same force is evaluated as each mode's polynomial in q
-    (`_polynomial_lanes`, FLD its scratch: `field_rows`) instead of at the nodes.
+    without one); where it has monomials (`has_polynomial`), the same force is evaluated as
+    each mode's polynomial in q (`_polynomial_lanes`, FLD its scratch: `field_rows`) instead
+    of at the nodes.
 
     Everything that couples the modes is evaluated at the nodes and projected on each mode
     there: the nonlinear terms and the axial load's linear term P(t) w_xx (for pinned sines a
@@ -1063,7 +1064,7 @@ def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, sy
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
     monomials' scratch; energy 1 (the span's energy's bending terms) or 0 (Eq.17's);
     symmetric: the antisymmetric modes at rest, their monomials 0 and unread
-    (`_polynomial_mode`). Returns the quadrature nodes still to sum: none."""
+    (`_polynomial_mode`)."""
     program = PY[0]
     starts = PY[1]
     mono = PY[2]
@@ -1090,7 +1091,6 @@ def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, sy
                 acc += coef[t] * MB[mono[t]]
             f += scale * acc
         F[i] = f
-    return 0
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
@@ -1167,10 +1167,11 @@ def derivative(t, y, dy, S, n_modes, T, base):
     for i in range(1, n, 2):
         symmetric = symmetric and y[i] == 0.0
     # the polynomial's force (the nodes' loop then runs over none), or F zeroed for the nodes
-    # (no call where there is no polynomial: a call per evaluation cost a pinned span 30 %)
+    # (no call where there is no polynomial: a call per evaluation cost a pinned span 1.28x)
     if has_polynomial(PY):
-        nodes = _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q,
-                                  pp[sc + S_ENERGY], symmetric, F)
+        _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, pp[sc + S_ENERGY],
+                          symmetric, F)
+        nodes = 0
     else:
         for i in range(n):
             F[i] = 0.0
