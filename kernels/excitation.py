@@ -42,6 +42,7 @@ import numpy as np
 from numba.core import types
 from numba.extending import overload
 
+from .flags import CONTRACT
 from .vecmath import fast_sin_cos
 
 # Columns of the excitation block, relative to its first column.
@@ -177,7 +178,7 @@ def _expm1_over(x):
         1.0 / 720.0 + x * (1.0 / 5040.0 + x * (1.0 / 40320.0 + x / 362880.0)))))))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, _nrt=False)
 def sweep_state(t, h, p, o, s):
     """`sweep_anchor` before its sine and cosine: (1, phi(t) (rad), w(t) (rad/s), A(t)
     (m/s^2), g (1/s)) at the start t (s) of a step of h (s), or all zeros where the anchor does
@@ -205,7 +206,7 @@ def sweep_state(t, h, p, o, s):
     return (1.0, _swept_phase(grown, lam, p, o, s), p[o + OMEGA * s] * (1.0 + grown), a, g)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, _nrt=False)
 def sweep_anchor(t, h, p, o, s):
     """A logarithmic sweep's state at the start t (s) of a step of h (s), from which `anchored`
     gives a_b at every stage time t + tau of the step (0 <= tau <= h) with no libm call:
@@ -245,7 +246,7 @@ def stage_signal(t, tau, anchor, p, o, s):
     return acceleration(t + tau, p, o, s)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def sine_at_nodes(t, h, nodes, p, o, s, out, out_o, out_s):
     """A sine block's a_b (m/s^2) at a step's stage times t + nodes[i] h (s), i = 1 ..
     len(nodes) - 1, into out[out_o + (i - 1) * out_s], and at t + h into the slot after them:
@@ -408,7 +409,7 @@ def record_at_nodes(t, h, nodes, p, o, s, records, out, out_o, out_s):
             records[r, k, CUBIC_D], u) * _rise(at, ramp)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def record_acceleration(t, p, o, s, records):
     """`record_value` as a call of its own (`signal`: the several-mode System's reads)."""
     return record_value(t, p, o, s, records)
@@ -423,7 +424,7 @@ def record_and_rate(t, p, o, s, records):
     return _ramped(t, p[o + RAMP * s], scale * _horner(y, b, c, d, u), scale * slope)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def level_bound(t0, t1, p, o, s, base):
     """An upper bound (m/s^2) of |a_b(t)| over [t0, t1] (s) for the sine kinds: the constant
     level |ACCEL|, or the level table's largest A over the stretch of ln w that [t0, t1]
@@ -450,7 +451,7 @@ def level_bound(t0, t1, p, o, s, base):
     return top
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def record_bound(t0, t1, p, o, s, records):
     """An upper bound (m/s^2) of |a_b(t)| over [t0, t1] (s) for the record kind: on each
     sample interval the span touches, the cubic Hermite through (y0, d0) and (y1, d1) is at

@@ -28,7 +28,7 @@ block at once.
 No libm call may sit in those loops: cos(W t) is `vecmath.fast_cos` (Cody-Waite reduction and
 fdlibm's kernels) and the controller's err^(-1/5) is `vecmath.inv_fifth_root` (range reduction
 by powers of two and Newton's method), both to an ulp or two; the loops fuse multiply-adds
-(`_CONTRACT`), and the right-hand side uses each point's coefficients divided by -m (`_accel`)
+(`CONTRACT`), and the right-hand side uses each point's coefficients divided by -m (`_accel`)
 rather than dividing by m. Results therefore equal the scalar driver's to round-off, not bit
 for bit: to what a trajectory makes of round-off, which on strongly nonlinear points reaches
 ~1e-9 relative (tests/test_lanes.py measures it with a one-ulp change of q(0) in the scalar
@@ -69,16 +69,12 @@ from . import trajectory as tj
 from .dopri5 import (DENSE_TERMS, EXTREMUM_RESIDUAL, QUARTIC_TERMS, A, B, C, E, MAX_FACTOR,
                      MIN_FACTOR, MIN_RTOL, N_STAGES, P, RHS_PER_ATTEMPT, SAFETY, pi_log2_err,
                      pi_step_factor)
+from .flags import CONTRACT
 from .layout import N_LEVELS, RTOL, SAMPLE_DT, T_END, TOL, WANT_SETTLING
 from .oscillator import (BOUND, EXCITATION, N_PARAMS, acceleration, base_acceleration, prepare,
                          record_stages, shaken)
 from .transverse import classify, reject_point, swept_outputs, valid
 from .vecmath import FAST_TRIG_BELOW, fast_sin_cos, inv_fifth_root
-
-# The vector loops may fuse a * b + c into one fused multiply-add (one rounding instead of two;
-# no reordering): about half the floating-point instructions of the stage sums, the cosine's
-# polynomials and the controller. Results stay equal to the scalar driver's to round-off.
-_CONTRACT = {"contract"}
 
 LANES = 16             # trajectories per lock-step group (a multiple of the SIMD width)
 SIMD = 4                # doubles per vector register the loops are rounded to (AVX2)
@@ -209,7 +205,7 @@ _anchored5 = _anchored_stages(C, "anchored_rk45")
 _anchored8 = _anchored_stages(dop853.C, "anchored_dop853")
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _read_sweeps(W, n_run, eighth, swept, base):
     """With a swept sine (`swept` True), each running lane's a_b (m/s^2) at its attempt's stage
     times and at t + h into rows W_AB_STAGES .., so that the record kind's chains
@@ -323,7 +319,7 @@ _chain5 = _chains(A, B, C, (E,), False, "rk45_chain")
 _chain8 = _chains(dop853.A, dop853.B, dop853.C, (dop853.E5, dop853.E3), True, "dop853_chain")
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _attempt(W, rtol, n_run, parametric, base, record):
     """One Dormand-Prince attempt in every lane of W (record: `reads_switch`, True for the
     chains that read each stage's a_b from W: a random record's, a sweep's): the stages
@@ -361,7 +357,7 @@ def _attempt(W, rtol, n_run, parametric, base, record):
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _attempt8(W, rtol, n_run, parametric, base, record):
     """One DOP853 attempt in every lane of W (as `_attempt`, stages by `_chain8`): the
     eighth-order solution (W_QN, W_VN), f(t + h, y_new) in the rows of RK45's last stage
@@ -408,7 +404,7 @@ def _attempt8(W, rtol, n_run, parametric, base, record):
             W[W_AB * L + j] = base_acceleration(t + h, W, W_P * L + j, L, True, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _pi_factors(W, n_run):
     """The PI controller's step-size factor for every lane's attempt (W_FACTOR), and the
     memory of an accepted attempt's error (LOG2_ERR_PREV). Its own loop: `_finish` stays as
@@ -422,7 +418,7 @@ def _pi_factors(W, n_run):
         W[tj.LOG2_ERR_PREV * L + j] = pi_log2_err(err) if remember else memory
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     """trajectory.control across lanes (accept/reject, step-size update, counts), then for an
     ordinary accepted step the first metrics pass (threshold tol * peak around 0; the
@@ -504,7 +500,7 @@ def _finish(W, settings, n_samples, n_run, pi, eighth, parametric, base):
     return n_flagged, n_extrema, n_near
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _observe_acceleration(W, settings, n_run):
     """trajectory.observe_acceleration for every lane whose attempt `_finish` accepted as an
     ordinary step (the flagged ones get it from record_step): the base-excitation metric, in
@@ -692,7 +688,7 @@ def _newton_extremum(v0, v1, h, c0, c1, c2, c3):
     return x, abs(g) <= NEWTON_RESIDUAL * (abs(v0) + abs(v1))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _locate_extrema(W, n_run):
     """For lanes flagged HAS_EXTREMUM after an RK45 attempt: the x in [0, 1] where the step's
     interpolated q' vanishes (W_XE, by `_newton_extremum`) and q there (W_QE). Where the

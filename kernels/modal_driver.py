@@ -30,6 +30,7 @@ from . import metrics as mt
 from . import modes as md
 from . import oscillator as osc
 from . import trajectory as tj
+from .flags import CONTRACT
 from .layout import (AMPLITUDE, CLAMP_BEND, CLAMP_SHEAR, CURVATURE_M0, FAILURE_TIME,
                      FIRST_STEP, MAX_STEP, LOADS, METHOD, MID_BEND, N_COUNTS, N_REALS, PEAK, PERIOD, RHS_EVALS, RTOL, SETTLING,
                      SPAN_MAX, SPAN_PLACE, STRETCH, SWEPT, TAIL, TOL, T_END, WANT_SETTLING)
@@ -284,7 +285,7 @@ def carrier_slot(n_modes):
     return 3 * n_modes + 21
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, _nrt=False)
 def inertia_at(factor, t, p1, base):
     """(inertia, its rate) (m, m/s) for kernels.modes.span_loads at t (s): `factor` (the
     accumulator's, kernels.modes.inertia_factor, s^2) times a_b(t) and a_b'(t) of the
@@ -305,7 +306,7 @@ def end_load_at(modal, n_modes, t):
     return md.end_load(modal[s], modal[s + 1], modal[s + 2], modal[s + 3], t)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def state_loads(rows, coupling, q, v, n_modes, modal, t, p1, base, out):
     """kernels.modes.span_loads of the modes' state (q, v) at t (s), its shear factor, end load
     and base inertia read from the modes' accumulator `modal` (`modal_size`; a lane's column
@@ -894,7 +895,7 @@ def _load_bound(t, t_new, y, h, QA, n, basis, modal, q_max, p1, base, k):
                              p1, base, k)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def load_bound_within(t, t_new, q_max, n, rows, coupling, modal, p1, base, k):
     """`_load_bound` over the step [t, t_new] (s) from bounds q_max (N, m) of each mode's
     |q_n| over it (the multi-mode lanes' own, modal_lanes._mode_events); rows, coupling: the

@@ -65,21 +65,19 @@ from . import metrics as mt
 from . import modal_driver as drv
 from . import modes as md
 from . import trajectory as tj
+from .flags import CONTRACT
 from .lanes import _step_factor
 from .layout import (CONTROLLER, LOADS, METHOD, N_COUNTS,
                      N_REALS, RTOL, SAMPLE_DT, TOL, WANT_SETTLING)
 from .oscillator import BOUND, N_PARAMS
 from .transverse import classify_metrics
 
-# The vector loops may fuse a * b + c into one fused multiply-add (no reordering).
-_CONTRACT = {"contract"}
-
 LANES = 32      # trajectories per lock-step group: the lane loops' trip count; 32 lets LLVM's
                 # interleaved vector loops (4 x 8 doubles) run whole (16: 2.3x slower a lane)
 SIMD = 4        # the vector loops cover the active lanes rounded up to this
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
     """OUT[c, l] = Y[c, l] + (K[0, c, l] w[0] + ... + K[s - 1, c, l] w[s - 1]) H[l] (SciPy's
     stage sums, in order; with skip_zeros the zero weights are left out)."""
@@ -104,7 +102,7 @@ def _combine(K, s, w, Y, H, OUT, dim, n_run, skip_zeros):
                 OUT[c, l] = Y[c, l] + OUT[c, l] * H[l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eighth, n_run,
              base, CP, PY, LB, own):
     """One attempt of the tableau (A, B, C) from every lane's (t, Y) with step H (SciPy's
@@ -172,7 +170,7 @@ def _attempt(W, Y, YN, K, ST, TT, H, ERR, PP, n, T, FLD, SC, A, B, C, rtol, eigh
             ERR[l] = math.sqrt(ST[0, l] / dim)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _control(W, H, ERR, SC, settings, n_run):
     """trajectory.control across the lanes with an attempt (H > 0): the counts, the step-size
     update (SciPy's controller for the method, or the PI controller) and accept/reject. SC[0]:
@@ -207,7 +205,7 @@ def _control(W, H, ERR, SC, settings, n_run):
         W[tj.STEPS * L + l] += 1.0 if active & accepted else 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _midspan(K, YN, KM, QV, weights, LB, own, n, n_stages, eighth, n_run):
     """KM[s, 0, l], KM[s, 1, l]: the stages of lane l projected on the midspan deflection and
     its rate (modal_driver._project's sums, in order), for the stages record_step reads: all
@@ -243,7 +241,7 @@ def _midspan(K, YN, KM, QV, weights, LB, own, n, n_stages, eighth, n_run):
                         QV[part, l] += w * YN[part * n + i, l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _reaches(Y, YN, K, H, REACH, QB, n, n_run, eighth):
     """REACH[c, l]: an upper bound (m) of |q_c(t) - q_c(t_0)| over lane l's attempt, on mode
     c's interpolant as the scalar path builds it (modal_driver._mode_interpolant: DOP853's
@@ -306,7 +304,7 @@ BOUND_MARGIN = 1.0 + 1e-12
 may round the sum an ulp or two below the scalar path's."""
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _span_events(W, QB, MOD, SPAN, MOVE, FLAG, n, n_run, LB):
     """SPAN[l] = 1 where lane l's ordinary accepted step (MOVE 1, FLAG 0: `_finish`) ends in
     the tail window and modal_driver._span_bound over the step (from QB, `_reaches`)
@@ -351,7 +349,7 @@ def _span_lane(j, n, Y, YN, K, H, MOD, eighth, Kl, yl, ynl, ml, Km, QA, qx, basi
     MOD[place, j] = ml[place]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, basis, own,
                  BI, LD, P1L, REACH, QB, QMAX, base):
     """EV[l] = 1 where lane l's accepted attempt has, in some mode, a divergence (|q_n| > bound, or
@@ -432,7 +430,7 @@ def _mode_events(W, Y, YN, H, ERR, BOUNDS, MOD, EV, BIG, n, n_run, LB, family, b
                 break
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_run,
             sampled_here, base):
     """For every lane's accepted attempt: an ordinary step (nothing to locate on the dense
@@ -482,7 +480,7 @@ def _finish(W, H, ERR, QV, KM, EV, FLAG, MOVE, P1, settings, n_samples, last, n_
     return n_flagged
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD, P1L,
                 base):
     """The modes' accumulator (modal_driver.modal_size rows) at the end of an ordinary
@@ -527,7 +525,7 @@ def _tail_modes(W, YN, MOD, MOVE, FLAG, n, n_run, LB, family, basis, own, BI, LD
             MOD[loads + k, l] = max(MOD[loads + k, l], abs(b[2 * k]))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _advance(Y, YN, K, MOVE, dim, n_stages, n_run):
     """The lanes with MOVE[l] != 0 (an accepted step that goes on) move to the step's end:
     Y = y_new and K[0] = f(t + h, y_new)."""

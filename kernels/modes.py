@@ -75,6 +75,7 @@ import numba as nb
 import numpy as np
 
 from . import excitation as ex
+from .flags import CONTRACT
 from .vecmath import fast_cos, fast_sin
 
 # Columns of a raw multi-mode row.
@@ -144,7 +145,7 @@ def folded_pairs(T):
     return T.shape[2] if T[PARITY, 0, 0] != 0.0 else 0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, inertia_rate,
                out):
     """The stretching and the clamps' shear as the load observers watch them, for the modes'
@@ -192,7 +193,7 @@ def span_loads(rows, coupling, q, v, n_modes, kappa, load, load_rate, inertia, i
         out[3 + 2 * end] = d3 - (axial_rate * s1 + axial * d1) + sign * inertia_rate
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def span_load_bound(rows, coupling, q_max, n_modes, kappa, load_max, inertia_max, k):
     """An upper bound of |L_k| (`span_loads`' load k: 0 the stretch E, 1 and 2 the shears F_0
     and F_1, m^2 and m) over states whose modes are within |q_n| <= q_max[n] (m), with the end
@@ -532,19 +533,15 @@ def prepare(row, n_modes, pp, ratios):
         pp[s + S_EXCITATION + c] = row[EXCITATION + c]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def base_acceleration(t, pp, n_modes, base):
     """a_b(t) (m/s^2) of a prepared row (kernels.excitation.signal: `base` True for the sine
     kinds, the records for the record kind)."""
     return ex.signal(t, pp, 3 * n_modes + S_EXCITATION, 1, base)
 
 
-# The right-hand side may fuse a * b + c into one fused multiply-add (no reordering): the lanes
-# driver's vector loops gain most of it; both drivers run this one function.
-_CONTRACT = {"contract"}
 
-
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, inline="always")
 def _eq17_bending(a, b, c, d, beta_b, beta_q):
     """Eq.17's nonlinear bending terms at a node, from the fields (a, b, c, d) there (module
     docstring): beta_b (-3 b^3 - 11 a b c - 3 a^2 d) + 10.5 beta_q a^2 b^3 (per unit rho A);
@@ -554,7 +551,7 @@ def _eq17_bending(a, b, c, d, beta_b, beta_q):
     return beta_b * (-3.0 * b2 * b - 11.0 * a * b * c - 3.0 * a2 * d) + 10.5 * beta_q * a2 * b2 * b
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, inline="always")
 def _energy_bending(a, b, beta_b, beta_q):
     """The nonlinear bending force from the span's energy at a node, from the fields (a, b)
     there (module docstring), as its two parts: (the part projected on dphi_m/dxi, the part
@@ -565,7 +562,7 @@ def _energy_bending(a, b, beta_b, beta_q):
             a2 * b * (6.0 * beta_q * a2 - 3.0 * beta_b))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, inline="always")
 def _axial(a, b, linear, membrane):
     """The axial terms at a node, projected on phi_m: (linear - membrane a^2) b, linear = P(t)
     k^2 / rho A less the uniform tension's N k^2 / rho A, membrane = beta_m(t) (the paper's local
@@ -656,7 +653,7 @@ def _group_scale(g, linear, membrane, beta_b, beta_q, energy):
     return (1.0 - energy) * beta_q
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     """The polynomial form of the force (POLYNOMIAL: program (K, 2), starts (N, N_GROUPS + 1),
@@ -688,7 +685,7 @@ def _polynomial_lanes(X, PP, sc, SC, PY, R, n, n_run, symmetric):
     return active
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
     """out[l] = the force on mode i in lane l (per unit rho A, as the quadrature's projection):
@@ -730,7 +727,7 @@ def _polynomial_mode(i, PY, R, active, out, n_run, symmetric, LB, own):
             out[l] += R[n_mono + g, l] * R[n_mono + N_GROUPS, l]
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
     """The nonlinear forces at the nodes (per unit rho A, in the fields' units) of lanes
@@ -756,7 +753,7 @@ def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
             FLD[2, j, l] = e * g2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
     """`_energy_forces` where every lane's bending terms come from the span's energy: from
@@ -772,7 +769,7 @@ def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
             FLD[2, j, l] = g2
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _lanes_signal(tt, PP, sc, SC, n_run, base):
     """SC[2, l] = a_b(tt[l]) (m/s^2) of each lane's excitation block (rows sc + S_EXCITATION..
@@ -783,7 +780,7 @@ def _lanes_signal(tt, PP, sc, SC, n_run, base):
         SC[2, l] = ex.signal(tt[l], flat, (sc + S_EXCITATION) * lanes + l, lanes, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _lanes_sine(tt, PP, sc, SC, n_run, base):
     """`_lanes_signal` for the lanes' fixed-frequency, fixed-level sine, vectorised
@@ -797,7 +794,7 @@ def _lanes_sine(tt, PP, sc, SC, n_run, base):
 _lanes_fast_signal = ex.by_kind(_lanes_sine, _lanes_signal)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
     """Fields f and f + 1 (0: a and b, 2: c and d) of every lane at every node of the basis'
@@ -845,7 +842,7 @@ def _lanes_fields(T, f, X, FLD, n, n_run, symmetric):
             FLD[f + 1, half + j, l] = e - o
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _pair_forces(FLD, half, paired, parts, n_run, symmetric):
     """The forces FLD[0..parts-1] at each paired node j (row j) and its mirror (row half + j)
@@ -883,7 +880,7 @@ def _symmetric_lanes(T, X, n, n_run):
     return True
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP, PY, LB,
                      own):
@@ -1017,7 +1014,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
         _mode_acceleration(K, s, i, X, PP, SC, n, n_run, base)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def _mode_acceleration(K, s, i, X, PP, SC, n, n_run, base):
     """K[s, i] = q_i' and K[s, n + i] = q_i'' of every lane from mode i's projected force
@@ -1058,7 +1055,7 @@ def row_scratch(row, basis):
     return scratch(pp, n, basis)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, symmetric, F):
     """F[i] = the force on mode i of one state y (per unit rho A) from the basis' polynomial
     (POLYNOMIAL; `_polynomial_lanes` with one lane, the same sums in the same order): MB its
@@ -1093,7 +1090,7 @@ def _polynomial_state(y, PY, MB, n, linear, membrane, beta_b, beta_q, energy, sy
         F[i] = f
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, inline="always")
 def _node_forces(a, b, c, d, linear, membrane, beta_b, beta_q, energy):
     """One node's forces from its fields (a, b, c, d): (on phi_m, on phi_m', on phi_m''), the
     bending terms from the span's energy (energy True: c and d unread) or Eq.17's."""
@@ -1104,7 +1101,7 @@ def _node_forces(a, b, c, d, linear, membrane, beta_b, beta_q, energy):
     return g0 + _eq17_bending(a, b, c, d, beta_b, beta_q), 0.0, 0.0
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, inline="always")
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, inline="always")
 def _state_fields(T, f, j, y, n, split, symmetric):
     """Fields f and f + 1 (0: a and b, 2: c and d) of one state at column j of the folded
     tables T, as (e_f, o_f, e_f+1, o_f+1): split (folded), the antisymmetric modes' share
@@ -1129,7 +1126,7 @@ def _state_fields(T, f, j, y, n, split, symmetric):
     return e0, o0, e1, o1
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=_CONTRACT, _nrt=False,
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
 def derivative(t, y, dy, S, n_modes, T, base):
     """dy = f(t, y) for one state y = (q_1..q_N, q_1'..q_N') (m, m/s), dy = (q', q'') (m/s,

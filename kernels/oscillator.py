@@ -53,6 +53,7 @@ import math
 import numba as nb
 
 from . import excitation as ex
+from .flags import CONTRACT
 from .stages import InlineWhereTrue
 from .vecmath import fast_cos, fast_sin
 
@@ -105,7 +106,7 @@ def prepare(row, p, o, s):
         p[o + c * s] = row[c] * minus_inv_m
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False)
 def _excitation_signal(t, p, o, s, base):
     """kernels.excitation's a_b(t) of the row's block (a sine kind, fixed or swept, or, where
     `base` is an array of records, the record kind: `excitation.signal`): a call of its own, so
@@ -122,7 +123,7 @@ def record_stages(t, h, nodes, p, o, s, records, out, out_o, out_s):
     ex.record_at_nodes(t, h, nodes, p, o + EXCITATION * s, s, records, out, out_o, out_s)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", inline=InlineWhereTrue(4), _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, inline=InlineWhereTrue(4), _nrt=False)
 def base_acceleration(t, p, o, s, fast, base):
     """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation
     block's own (kernels.excitation: fixed or swept frequency, constant or tabled level, or a

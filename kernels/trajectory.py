@@ -29,6 +29,7 @@ from .dopri5 import (ERROR_ESTIMATOR_ORDER, ERROR_EXPONENT, MIN_RTOL,
                      PI_MIN_ERR_PREV, RHS_PER_ATTEMPT, dense_coefficients, dense_extremum,
                      dense_root, dense_value, initial_step, pi_log2_err, pi_step_factor,
                      step_factor)
+from .flags import CONTRACT
 from .layout import (ATOL, ATOL_SCALE, CONTROLLER, FIRST_STEP, MAX_STEP, MAX_STEPS, METHOD,
                      LEVEL_0, MAX_LEVELS, MIN_STEP, N_LEVELS, RTOL, SAMPLE_DT,
                      STEADY_PERIODS, STEADY_TOL, STOP_STEADY, TAIL, T_END)
@@ -701,7 +702,7 @@ def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv, base):
     acc[ACC_AMP] = max(acc[ACC_AMP], abs(at_start))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline=InlineWhereTrue(18))
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, _nrt=False, inline=InlineWhereTrue(18))
 def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_tail, track,
                      centre, thr_fixed, thr_rel, take, fast, base):
     """The Observer: what every accepted step's end adds to the metrics, for both drivers
@@ -743,7 +744,7 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_t
     return thr, above
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline=InlineWhereTrue(15))
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False, inline=InlineWhereTrue(15))
 def _observe_base(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_tail, take, fast,
                   base):
     """`observe_step_end`'s base-excitation part: `observe_acceleration` with a_b(t + h) (fast:

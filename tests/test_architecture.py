@@ -202,3 +202,92 @@ def test_the_tests_leave_the_sweep_under_test_first_on_the_path():
     first = next((Path(entry or ".").resolve() for entry in sys.path
                   if (Path(entry or ".") / "sweep" / "__init__.py").is_file()), SWEEP_ROOT)
     assert first == SWEEP_ROOT, (first, SWEEP_ROOT)
+
+
+class _KernelCalls:
+    """Which compiled kernel functions each kernel function calls, read from the source: by
+    name in its module, through `from . import x as y` and `from .x import f`, and through the
+    functions that choose a callee as they compile (an `@overload`'s body, `by_kind`)."""
+
+    def __init__(self) -> None:
+        self.trees = {p.stem: ast.parse(p.read_text()) for p in (ROOT / "kernels").glob("*.py")}
+        self.keywords, self.chooses, self.bodies = {}, {}, {}
+        self.aliases = {m: {} for m in self.trees}
+        for module, tree in self.trees.items():
+            for node in tree.body:
+                if isinstance(node, ast.ImportFrom) and node.level == 1:
+                    for a in node.names:
+                        self.aliases[module][a.asname or a.name] = (
+                            (a.name, None) if node.module is None else (node.module, a.name))
+                elif isinstance(node, ast.FunctionDef):
+                    for deco in node.decorator_list:
+                        if not isinstance(deco, ast.Call):
+                            continue
+                        if "jit" in ast.unparse(deco.func):
+                            self.keywords[module, node.name] = {k.arg: k.value
+                                                                for k in deco.keywords}
+                            self.bodies[module, node.name] = node
+                        elif ast.unparse(deco.func) == "overload":
+                            self.chooses[module, ast.unparse(deco.args[0])] = (module, [node])
+                elif (isinstance(node, ast.Assign) and isinstance(node.value, ast.Call)
+                      and ast.unparse(node.value.func).endswith("by_kind")):
+                    self.chooses[module, node.targets[0].id] = (module, node.value.args)
+
+    def _named(self, module: str, expr: ast.expr) -> tuple[str, str] | None:
+        if isinstance(expr, ast.Attribute) and isinstance(expr.value, ast.Name):
+            target = self.aliases[module].get(expr.value.id)
+            return (target[0], expr.attr) if target and target[1] is None else None
+        if isinstance(expr, ast.Name):
+            target = self.aliases[module].get(expr.id)
+            return target if target and target[1] is not None else (module, expr.id)
+        return None
+
+    def callees(self, module: str, node: ast.AST, seen: frozenset = frozenset()) -> set:
+        found = set()
+        for call in (n for n in ast.walk(node) if isinstance(n, ast.Call)):
+            key = self._named(module, call.func)
+            if key in self.keywords:
+                found.add(key)
+            elif key in self.chooses and key not in seen:
+                where, choices = self.chooses[key]
+                for choice in choices:
+                    named = self._named(where, choice) if isinstance(choice, ast.Name) else None
+                    if named in self.keywords:
+                        found.add(named)
+                    elif not isinstance(choice, ast.Name):
+                        found |= self.callees(where, choice, seen | {key})
+        return found
+
+
+def test_a_contracting_kernel_calls_only_kernels_that_state_their_fastmath():
+    """Numba compiles a function that sets no `fastmath` with the flags of the first caller
+    that compiles it, and every later caller of the same types reuses that compile (from the
+    cache too). Called both from a kernel that lets a * b + c fuse (fastmath={"contract"}) and
+    from one that does not (or from Python), such a function's last bits depended on what had
+    been compiled before: a 3-mode random scene's results differed in 85 of 356 values after
+    the test suite had filled the cache (docs/architecture.md). So a kernel compiled with
+    contraction calls only kernels that state their own fastmath (or are inlined into it as
+    Numba IR, inline="always"), and every kernel that sets none is compiled without it."""
+    calls = _KernelCalls()
+    wrong = []
+    for key, keywords in calls.keywords.items():
+        flag = keywords.get("fastmath")
+        if flag is None or (isinstance(flag, ast.Constant) and not flag.value):
+            continue
+        todo, seen = [key], {key}
+        while todo:         # what it calls, and what the callees it inlines as IR call
+            for callee in calls.callees(todo[0][0], calls.bodies[todo.pop(0)]) - seen:
+                seen.add(callee)
+                inline = calls.keywords[callee].get("inline")
+                if inline is not None and not (isinstance(inline, ast.Constant)
+                                               and inline.value == "never"):
+                    todo.append(callee)    # "always", or InlineWhereTrue: inlined somewhere
+                if "fastmath" not in calls.keywords[callee] and not (
+                        isinstance(inline, ast.Constant) and inline.value == "always"):
+                    wrong.append(f"kernels/{key[0]}.py: {key[1]} calls "
+                                 f"{callee[0]}.{callee[1]}")
+    # the check sees through the choosers: modes._lanes_signal reads a record through
+    # excitation.signal's overload, and modal_lanes reaches its record hooks through by_kind
+    assert ("excitation", "record_acceleration") in calls.callees(
+        "modes", calls.bodies["modes", "_lanes_signal"])
+    assert not wrong, "\n".join(["set fastmath on the callee:"] + sorted(wrong))

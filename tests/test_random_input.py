@@ -253,8 +253,8 @@ def test_the_kernels_read_the_records_hermite_interpolant(gevs):
         out = np.zeros(len(nodes))
         for x in t[:50]:
             ex.record_at_nodes(x, 0.3 / fs, nodes, p, 0, 1, rec.values, out, 0, 1)
-            # record_value compiled for this call: record_acceleration's cached compile may
-            # be a kernel's, with that caller's fastmath flags (Numba's callees inherit them)
+            # record_value compiled for this call, without contraction as record_at_nodes
+            # is; record_acceleration lets a * b + c fuse (kernels/flags.py)
             want = [ex.record_value(x + c * 0.3 / fs, p, 0, 1, rec.values)
                     for c in nodes[1:]]
             assert list(out[:3]) == want and out[3] == out[2]
