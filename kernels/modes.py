@@ -755,6 +755,23 @@ def _energy_forces(PP, sc, FLD, SC, nodes, n_run):
 
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
          forceinline=True)
+def _eq17_forces(PP, sc, FLD, SC, nodes, n_run):
+    """`_energy_forces` where every lane's bending terms come from Eq.17: FLD[0, j] = Eq.17's
+    bending terms and the stretching and axial load at each node, from the fields FLD[0..3] =
+    (a, b, c, d) there."""
+    for j in range(nodes):
+        for l in range(n_run):
+            a = FLD[0, j, l]
+            b = FLD[1, j, l]
+            c = FLD[2, j, l]
+            d = FLD[3, j, l]
+            FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
+                                          PP[sc + S_BETA_Q, l])
+                            + _axial(a, b, SC[0, l], SC[1, l]))
+
+
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
+         forceinline=True)
 def _energy_only_forces(PP, sc, FLD, SC, nodes, n_run):
     """`_energy_forces` where every lane's bending terms come from the span's energy: from
     the fields FLD[0..1] = (a, b) alone (c and d are not computed then), the same three
@@ -974,15 +991,7 @@ def lanes_derivative(tt, X, K, s, PP, n_modes, T, FLD, SC, n_run, fast, base, CP
     elif energy:
         _energy_forces(PP, sc, FLD, SC, nodes, n_run)
     else:
-        for j in range(nodes):
-            for l in range(n_run):
-                a = FLD[0, j, l]
-                b = FLD[1, j, l]
-                c = FLD[2, j, l]
-                d = FLD[3, j, l]
-                FLD[0, j, l] = (_eq17_bending(a, b, c, d, PP[sc + S_BETA_B, l],
-                                              PP[sc + S_BETA_Q, l])
-                                + _axial(a, b, SC[0, l], SC[1, l]))
+        _eq17_forces(PP, sc, FLD, SC, nodes, n_run)
     _pair_forces(FLD, half, paired, 3 if energy else 1, n_run, symmetric)
     for i in range(n):
         if symmetric and i % 2 == 1:

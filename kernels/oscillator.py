@@ -123,7 +123,8 @@ def record_stages(t, h, nodes, p, o, s, records, out, out_o, out_s):
     ex.record_at_nodes(t, h, nodes, p, o + EXCITATION * s, s, records, out, out_o, out_s)
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, inline=InlineWhereTrue(4), _nrt=False)
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, inline=InlineWhereTrue(4),
+         _nrt=False)
 def base_acceleration(t, p, o, s, fast, base):
     """a_b(t) (m/s^2): the clamps' acceleration at time t (s). fast None: the excitation
     block's own (kernels.excitation: fixed or swept frequency, constant or tabled level, or a

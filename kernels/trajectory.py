@@ -702,7 +702,8 @@ def observe_tail_start(acc, p, o, s, t_tail, t, q, v, fv, base):
     acc[ACC_AMP] = max(acc[ACC_AMP], abs(at_start))
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, _nrt=False, inline=InlineWhereTrue(18))
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=False, _nrt=False,
+         inline=InlineWhereTrue(18))
 def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_tail, track,
                      centre, thr_fixed, thr_rel, take, fast, base):
     """The Observer: what every accepted step's end adds to the metrics, for both drivers
@@ -744,7 +745,8 @@ def observe_step_end(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_t
     return thr, above
 
 
-@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False, inline=InlineWhereTrue(15))
+@nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, _nrt=False,
+         inline=InlineWhereTrue(15))
 def _observe_base(acc, a, sa, p, o, s, t, h, t_new, q_new, v_new, fv_new, t_tail, take, fast,
                   base):
     """`observe_step_end`'s base-excitation part: `observe_acceleration` with a_b(t + h) (fast:

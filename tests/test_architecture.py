@@ -166,8 +166,8 @@ def test_the_per_step_kernels_keep_no_reference_counts():
 
 
 LLVM_INLINED = ["lanes_derivative", "_polynomial_lanes", "_polynomial_mode", "_lanes_fields",
-                "_energy_forces", "_energy_only_forces", "_pair_forces", "_lanes_signal",
-                "_lanes_sine"]
+                "_energy_forces", "_energy_only_forces", "_eq17_forces", "_pair_forces",
+                "_lanes_signal", "_lanes_sine"]
 
 
 def _calls_of(function: ast.FunctionDef, name: str) -> int:
