@@ -12,8 +12,9 @@ as it is; a shared callee that is called rather than inlined can then round diff
 the order in which a process met its callers (the twenty-fourth session found one, a record
 read, and inlined it). And Numba compiles a callee that states no `fastmath` with the flags
 of its first caller: called from Python first (as the tests do), a read that the multi-mode
-kernels compile with contraction lost it, and a 3-mode random scene changed in 121 of its
-values (the thirty-eighth session; kernels/flags.py has the rule that prevents it).
+kernels compile with contraction lost it, and 38 of the 54 outputs of launch-random-gevs with
+3 modes moved (the thirty-eighth session, benchmarks/RESULTS.md; kernels/flags.py has the
+rule that prevents it).
 
 Command
 -------

@@ -264,10 +264,11 @@ def test_a_contracting_kernel_calls_only_kernels_that_state_their_fastmath():
     that compiles it, and every later caller of the same types reuses that compile (from the
     cache too). Called both from a kernel that lets a * b + c fuse (fastmath={"contract"}) and
     from one that does not (or from Python), such a function's last bits depended on what had
-    been compiled before: a 3-mode random scene's results differed in 85 of 356 values after
-    the test suite had filled the cache (docs/architecture.md). So a kernel compiled with
-    contraction calls only kernels that state their own fastmath (or are inlined into it as
-    Numba IR, inline="always"), and every kernel that sets none is compiled without it."""
+    been compiled before: after the test suite had filled the cache, two 3-mode random runs
+    differed in 85 values (of 356 in ten multi-mode runs; docs/architecture.md,
+    benchmarks/RESULTS.md). So a kernel compiled with contraction calls only kernels that
+    state their own fastmath (or are inlined into it as Numba IR, inline="always"), and every
+    kernel that sets none is compiled without it."""
     calls = _KernelCalls()
     wrong = []
     for key, keywords in calls.keywords.items():
