@@ -540,7 +540,6 @@ def base_acceleration(t, pp, n_modes, base):
     return ex.signal(t, pp, 3 * n_modes + S_EXCITATION, 1, base)
 
 
-
 @nb.njit(cache=True, nogil=True, error_model="numpy", fastmath=CONTRACT, inline="always")
 def _eq17_bending(a, b, c, d, beta_b, beta_q):
     """Eq.17's nonlinear bending terms at a node, from the fields (a, b, c, d) there (module
