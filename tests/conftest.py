@@ -124,28 +124,3 @@ def ctrl_c_raises():
     finally:
         signal.signal(signal.SIGINT, before)
 
-
-# ------------------------------------------------ the order two workers take the files in
-
-COLD_COMPILE_FILES = ("test_jitcache.py", "test_warmup.py", "test_lanes.py")
-"""Files whose tests compile in subprocesses on empty Numba caches of their own (two to four
-minutes of one core each): started first, so that no worker is left with one of them at the
-end while the other has nothing to do."""
-
-
-def pytest_configure(config: pytest.Config) -> None:
-    """Keep the order below under `-n 2 --dist loadfile` (pytest-xdist would otherwise hand out
-    files by their number of tests, which put these files last)."""
-    if hasattr(config.option, "loadscopereorder"):
-        config.option.loadscopereorder = False
-
-
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The cold-compile files first, in the order named, then the others by their number of
-    tests, the most first (pytest-xdist's own order); each file's tests keep their order."""
-    count: dict[str, int] = {}
-    for item in items:
-        count[item.path.name] = count.get(item.path.name, 0) + 1
-    first = {name: rank for rank, name in enumerate(COLD_COMPILE_FILES)}
-    items.sort(key=lambda item: (first.get(item.path.name, len(first)),
-                                 -count[item.path.name], item.path.name))

@@ -289,6 +289,7 @@ def test_sweep_modes_compares_the_bending_at_the_clamp(tmp_path, capsys):
         assert float(line.split()[1]) == pytest.approx(change, rel=1e-2), name
 
 
+@pytest.mark.slow
 def test_a_sine_sweep_reports_the_loads_peak_over_the_whole_sweep():
     """A logarithmic sweep 40 -> 80 Hz at 60 octaves/min (1 s; the level rising over 10 cycles
     of its start frequency, as kernels/excitation.py defines it) on the clamped span at 2 g,
@@ -452,6 +453,7 @@ def test_the_clamp_reaction_is_the_continuous_beams(rotation, modes):
         assert force == pytest.approx(exact, rel=3e-2 if modes == 1 else 2e-3), ratio
 
 
+@pytest.mark.slow
 def test_the_clamp_reaction_under_a_random_record_matches_scipy():
     """Three pinned modes between immovable clamps (damping 0.05) under one record of a flat
     random base acceleration (1 s, 0.04 g^2/Hz, 10-500 Hz): the reaction's peak over the statistics

@@ -323,6 +323,7 @@ GRID_RATES = [4.0, 8.0]             # octaves per minute: sweeps of 23.8 and 11.
 GRID_LENGTHS = [SHORT, LENGTH]      # below resonance the whole sweep, and through it
 
 
+@pytest.mark.slow
 def test_sweeps_of_their_own_durations_share_the_lanes(references):
     """Four sweeps in one lanes call (two spans x two rates, 0.5 g up, 20 -> 60 Hz: below
     resonance the whole sweep, and up the resonant branch to its end): each lane ends with its
