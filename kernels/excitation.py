@@ -508,8 +508,7 @@ def inlined_signal(t, p, o, s, base):
     """`signal` with the record kind's read inlined into the caller (`record_value`): the
     one-mode System's reads (kernels.oscillator). Shared as a call with the several-mode
     System, whose process could compile it first (or another process, into the Numba cache),
-    it made the one-mode results depend on which scenes had been compiled before
-    (tests/test_jitcache.py)."""
+    it made the one-mode results depend on which scenes had been compiled before."""
     return signal(t, p, o, s, base)
 
 

@@ -123,4 +123,3 @@ def ctrl_c_raises():
         yield
     finally:
         signal.signal(signal.SIGINT, before)
-
